@@ -1,0 +1,41 @@
+#pragma once
+// The pinhole model of an RGB-D camera whose depth is registered to its colour image.
+//
+// Invariant: pixel coordinates are of undistorted images; (0, 0) is the centre of the
+// top-left pixel. `distortion` is carried for completeness (a source may report it) but
+// project()/backproject() do not apply it: sources either undistort or report zeros.
+
+#include <Eigen/Core>
+#include <array>
+
+namespace kestrel {
+
+struct PinholeCamera {
+  int width = 640;
+  int height = 480;
+  double fx = 525.0;
+  double fy = 525.0;
+  double cx = 319.5;
+  double cy = 239.5;
+  std::array<double, 5> distortion{};  ///< k1, k2, p1, p2, k3 (OpenCV order)
+
+  /// Point in the camera optical frame seen at pixel (u, v) with depth z (metres, along +z).
+  Eigen::Vector3d backproject(double u, double v, double z) const {
+    return {(u - cx) * z / fx, (v - cy) * z / fy, z};
+  }
+  /// Pixel of a point in the optical frame; the point must have z > 0.
+  Eigen::Vector2d project(const Eigen::Vector3d& p) const {
+    return {fx * p.x() / p.z() + cx, fy * p.y() / p.z() + cy};
+  }
+  /// True if (u, v) lies inside the image, `border` pixels away from its edges.
+  bool contains(double u, double v, double border = 0.0) const {
+    return u >= border - 0.5 && v >= border - 0.5 && u <= width - 0.5 - border &&
+           v <= height - 0.5 - border;
+  }
+  /// This camera for an image scaled by `s` (e.g. 0.5 for the next pyramid level).
+  PinholeCamera scaled(double s) const;
+  /// Throws InputError naming `what` unless the values are usable.
+  void validate(const char* what) const;
+};
+
+}  // namespace kestrel

@@ -1,0 +1,23 @@
+#pragma once
+// Small, strict helpers for the text formats kestrel reads (TUM lists and trajectories,
+// world files, g2o): whitespace-separated fields, numbers that must be whole tokens.
+
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace kestrel {
+
+/// Fields of `line` split on spaces and tabs (a trailing '\r' is ignored).
+std::vector<std::string_view> split_fields(std::string_view line);
+
+/// True for a blank line or one whose first non-blank character is '#'.
+bool is_comment_or_blank(std::string_view line);
+
+/// The whole token as a double ("nan" and "inf" parse; check finiteness yourself), or empty.
+std::optional<double> parse_double(std::string_view token);
+/// The whole token as a base-10 integer, or empty.
+std::optional<long long> parse_int(std::string_view token);
+
+}  // namespace kestrel

@@ -1,0 +1,222 @@
+#include "common/transport/node.h"
+
+#include <spdlog/spdlog.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <csignal>
+#include <stdexcept>
+
+#include "common/error.h"
+#include "common/transport/channels.h"
+#include "common/transport/lcm_url.h"
+#include "kestrel/replay_ack_t.hpp"
+
+namespace kestrel::transport {
+namespace {
+
+std::atomic<bool> g_signalled{false};
+
+void on_signal(int) { g_signalled = true; }
+
+void install_signal_handlers() {
+  static const bool installed = [] {
+    struct sigaction sa {};
+    sa.sa_handler = on_signal;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, &sa, nullptr);
+    sigaction(SIGTERM, &sa, nullptr);
+    return true;
+  }();
+  (void)installed;
+}
+
+int64_t wall_utime() {
+  return std::chrono::duration_cast<std::chrono::microseconds>(
+             std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+// Log the first few rejections on a channel, then one in a hundred, so that a stream of bad
+// messages cannot flood the terminal while the count stays exact.
+bool should_log(int64_t nth) { return nth <= 5 || nth % 100 == 0; }
+
+}  // namespace
+
+Node::Node(std::string name, const std::string& lcm_url, double heartbeat_period_s)
+    : name_(std::move(name)),
+      url_(resolve_lcm_url(lcm_url)),
+      lcm_(url_),
+      heartbeat_period_(std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+          std::chrono::duration<double>(heartbeat_period_s))) {
+  if (!lcm_.good()) throw std::runtime_error("cannot start LCM on '" + url_ + "'");
+  install_signal_handlers();
+  add_subscription(
+      channel::kReplayControl,
+      [this](const void* data, size_t size) -> int64_t {
+        on_control(decode_message<kestrel::replay_control_t>(data, size, channel::kReplayControl));
+        return 0;
+      },
+      0, /*is_control=*/true);
+  advertise(channel::kProcessStatus);
+}
+
+Node::~Node() {
+  health_ = kestrel::process_status_t::STATE_STOPPING;
+  publish_heartbeat();
+}
+
+void Node::add_subscription(const std::string& channel, Dispatch dispatch, int queue_capacity,
+                            bool is_control) {
+  subscriptions_.push_back({this, channel, std::move(dispatch), is_control});
+  lcm::Subscription* sub = lcm_.subscribeFunction(channel, &Node::on_message, &subscriptions_.back());
+  if (!sub) throw std::runtime_error("cannot subscribe to " + channel);
+  sub->setQueueCapacity(queue_capacity);
+}
+
+void Node::advertise(const std::string& channel) {
+  for (const auto& c : advertised_)
+    if (c == channel) return;
+  advertised_.push_back(channel);
+}
+
+void Node::on_message(const lcm::ReceiveBuffer* rbuf, const std::string&, Subscription* s) {
+  s->node->handle(*s, *rbuf);
+}
+
+void Node::handle(Subscription& s, const lcm::ReceiveBuffer& rbuf) {
+  if (s.is_control) {
+    try {
+      s.dispatch(rbuf.data, rbuf.data_size);
+    } catch (const std::exception& e) {
+      reject(s.channel, e.what());
+    }
+    return;
+  }
+  ++counters_.messages_in;
+  in_handler_ = true;
+  outputs_.clear();
+  int64_t utime = 0;
+  try {
+    utime = s.dispatch(rbuf.data, rbuf.data_size);
+    if (utime > counters_.last_input_utime) counters_.last_input_utime = utime;
+  } catch (const InputError& e) {
+    reject(s.channel, e.what());
+  } catch (const std::exception& e) {
+    // A library failing on an input it accepted is a bug, but the process must keep serving
+    // the other inputs: report it loudly, count it, carry on.
+    reject(s.channel, std::string("handler failed: ") + e.what());
+  }
+  in_handler_ = false;
+  if (lockstep_session_ != 0) {
+    kestrel::replay_ack_t ack;
+    ack.session = lockstep_session_;
+    ack.process = name_;
+    ack.channel = s.channel;
+    ack.input_utime = utime;
+    ack.output_channels = outputs_;
+    ack.num_outputs = static_cast<int32_t>(outputs_.size());
+    lcm_.publish(channel::kReplayAck, &ack);
+  }
+}
+
+void Node::reject(const std::string& channel, const std::string& why) {
+  ++counters_.messages_rejected;
+  const int64_t nth = ++rejections_per_channel_[channel];
+  if (should_log(nth)) {
+    // `why` usually starts with the channel already (decode errors); avoid saying it twice.
+    const bool named = why.compare(0, channel.size(), channel) == 0;
+    spdlog::warn("rejected message #{} on {}: {}", nth, channel,
+                 named ? why.substr(std::min(why.size(), channel.size() + 2)) : why);
+  }
+}
+
+void Node::on_control(const kestrel::replay_control_t& control) {
+  switch (control.command) {
+    case kestrel::replay_control_t::COMMAND_BEGIN:
+      if (lockstep_session_ != control.session) spdlog::info("lock-step replay session {} begins", control.session);
+      lockstep_session_ = control.session;
+      publish_heartbeat();  // the replay learns our subscriptions from this
+      break;
+    case kestrel::replay_control_t::COMMAND_RESET:
+      spdlog::info("reset requested by replay session {}", control.session);
+      if (reset_) reset_();
+      publish_heartbeat();
+      break;
+    case kestrel::replay_control_t::COMMAND_END:
+      if (lockstep_session_ == control.session) {
+        spdlog::info("lock-step replay session {} ends", control.session);
+        lockstep_session_ = 0;
+      }
+      break;
+    default:
+      throw InputError(std::string(channel::kReplayControl) + ": unknown command " +
+                       std::to_string(control.command));
+  }
+}
+
+void Node::publish_bytes(const std::string& channel, const std::vector<uint8_t>& bytes) {
+  if (lcm_.publish(channel, bytes.data(), static_cast<unsigned int>(bytes.size())) != 0) {
+    spdlog::warn("publishing {} bytes on {} failed", bytes.size(), channel);
+  }
+  ++counters_.messages_out;
+  if (in_handler_) outputs_.push_back(channel);
+  advertise(channel);
+}
+
+void Node::set_health(int8_t state, const std::string& message) {
+  const bool changed = state != health_ || message != health_message_;
+  health_ = state;
+  health_message_ = message;
+  if (changed) publish_heartbeat();
+}
+
+bool Node::stopping() const { return stopping_ || g_signalled; }
+
+bool Node::spin_once(int timeout_ms) {
+  if (stopping()) return false;
+  maybe_heartbeat();
+  const int rc = lcm_.handleTimeout(timeout_ms);
+  if (rc < 0 && !stopping()) {
+    // select() interrupted by a signal other than ours, or LCM failed: retry on the next call.
+    spdlog::debug("LCM handle returned {}", rc);
+  }
+  maybe_heartbeat();
+  return !stopping();
+}
+
+int Node::spin() {
+  if (health_ == kestrel::process_status_t::STATE_STARTING)
+    set_health(kestrel::process_status_t::STATE_RUNNING, "");
+  while (spin_once(100)) {
+  }
+  return kExitOk;
+}
+
+void Node::maybe_heartbeat() {
+  const auto now = std::chrono::steady_clock::now();
+  if (now < next_heartbeat_) return;
+  next_heartbeat_ = now + heartbeat_period_;
+  publish_heartbeat();
+}
+
+void Node::publish_heartbeat() {
+  kestrel::process_status_t s;
+  s.utime = wall_utime();
+  s.name = name_;
+  s.pid = static_cast<int32_t>(::getpid());
+  s.state = health_;
+  s.message = health_message_;
+  for (const Subscription& sub : subscriptions_)
+    if (!sub.is_control) s.subscriptions.push_back(sub.channel);
+  s.num_subscriptions = static_cast<int32_t>(s.subscriptions.size());
+  s.publications = advertised_;
+  s.num_publications = static_cast<int32_t>(s.publications.size());
+  s.messages_in = counters_.messages_in;
+  s.messages_out = counters_.messages_out;
+  s.messages_rejected = counters_.messages_rejected;
+  s.last_input_utime = counters_.last_input_utime;
+  lcm_.publish(channel::kProcessStatus, &s);
+}
+
+}  // namespace kestrel::transport

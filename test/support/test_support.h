@@ -1,0 +1,52 @@
+#pragma once
+// Helpers shared by the tests: where the data and the built tools are, temporary folders,
+// and running a tool as a child process.
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace kestrel::test {
+
+/// ../shared/data, or empty if it is absent.
+std::filesystem::path shared_data();
+/// shared_data()/tum/<name>; calls GTEST_SKIP-able check: returns empty if absent.
+std::filesystem::path tum_sequence(const std::string& name);
+
+/// <build>/bin/kestrel-<tool>.
+std::filesystem::path tool(const std::string& name);
+
+/// A fresh folder removed at destruction.
+class TempDir {
+ public:
+  TempDir();
+  ~TempDir();
+  const std::filesystem::path& path() const { return path_; }
+  std::filesystem::path operator/(const std::string& name) const { return path_ / name; }
+
+ private:
+  std::filesystem::path path_;
+};
+
+struct RunResult {
+  int exit_code = -1;  ///< exit status, or 128 + signal
+  std::string out;
+  std::string err;
+};
+/// Runs argv[0] with the rest as arguments, waits at most `timeout_s`, captures stdout/stderr.
+RunResult run(const std::vector<std::string>& argv, double timeout_s = 120.0);
+
+/// True if this process may create a network namespace (root or unprivileged user
+/// namespaces); integration tests that need one skip otherwise.
+bool can_isolate_network();
+
+}  // namespace kestrel::test
+
+/// Skips the current test with a clear message when ../shared/data/tum/<name> is absent.
+#define KESTREL_REQUIRE_TUM(var, name)                                                    \
+  const std::filesystem::path var = ::kestrel::test::tum_sequence(name);                  \
+  if (var.empty())                                                                         \
+  GTEST_SKIP() << "../shared/data/tum/" << (name)                                          \
+               << " is absent: this test needs the real TUM RGB-D sequence"
