@@ -13,6 +13,7 @@ inline constexpr const char* kSlamGraph = "SLAM_GRAPH";         // slam_graph_t
 inline constexpr const char* kMapOctomap = "MAP_OCTOMAP";       // octomap_t
 inline constexpr const char* kPlanRequest = "PLAN_REQUEST";     // plan_request_t
 inline constexpr const char* kPlan = "PLAN";                    // plan_t
+inline constexpr const char* kVehicleCommand = "VEHICLE_COMMAND"; // vehicle_command_t
 inline constexpr const char* kProcessStatus = "PROCESS_STATUS"; // process_status_t
 inline constexpr const char* kReplayControl = "REPLAY_CONTROL"; // replay_control_t
 inline constexpr const char* kReplayAck = "REPLAY_ACK";         // replay_ack_t
