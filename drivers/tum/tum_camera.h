@@ -1,0 +1,31 @@
+#pragma once
+// The colour camera of a TUM RGB-D sequence, chosen from the folder name.
+//
+// TUM recorded with three Kinects, "freiburg1", "freiburg2" and "freiburg3"; the sequence
+// folders carry that name (rgbd_dataset_freiburg1_xyz). For each, TUM publishes calibrated
+// colour-camera intrinsics (https://vision.in.tum.de/data/datasets/rgbd-dataset/file_formats,
+// "Intrinsic Camera Calibration of the Kinect"); for any other folder the ROS default
+// 525/525/319.5/239.5 is used, as TUM advises for uncalibrated use. Images are 640x480.
+//
+// Distortion is reported as zero: the images are not undistorted here (TUM's registered depth
+// cannot be undistorted exactly), and PinholeCamera's invariant is that the source either
+// undistorts or reports zeros. For fr1 the residual distortion is a few pixels at the corners.
+
+#include <string>
+
+#include "common/camera.h"
+
+namespace kestrel::tum {
+
+enum class TumCamera { kFreiburg1, kFreiburg2, kFreiburg3, kUnknown };
+
+/// The camera named in the last component of `folder` ("freiburg1" .. "freiburg3").
+TumCamera detect_camera(const std::string& folder);
+
+/// TUM's calibrated intrinsics for `camera` (ROS default for kUnknown), 640x480, no distortion.
+PinholeCamera camera_intrinsics(TumCamera camera);
+
+/// "freiburg1", ..., "unknown (ROS default intrinsics)".
+const char* camera_name(TumCamera camera);
+
+}  // namespace kestrel::tum
