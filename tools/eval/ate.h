@@ -1,0 +1,25 @@
+#pragma once
+// Absolute trajectory error: the distance between each scored frame's ground-truth position
+// and its estimated position after the rigid alignment of tools/eval/alignment.h (or none).
+
+#include <cstdint>
+#include <vector>
+
+#include "tools/eval/alignment.h"
+#include "tools/eval/association.h"
+#include "tools/eval/statistics.h"
+
+namespace kestrel::eval {
+
+struct AteResult {
+  Alignment alignment;           ///< maps the estimate's world into the ground truth's
+  Summary error_m;               ///< over the scored frames, metres
+  std::vector<int64_t> utimes;   ///< the scored frames, in order
+  std::vector<double> errors_m;  ///< |p_gt - T_gt_est * p_est| per scored frame
+};
+
+/// ATE over the scored frames of `association`; with `align` false the estimate is compared
+/// as it is. No scored frame gives an empty summary.
+AteResult compute_ate(const Association& association, bool align);
+
+}  // namespace kestrel::eval

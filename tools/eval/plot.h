@@ -1,0 +1,21 @@
+#pragma once
+// A one-page picture of an evaluation, drawn with OpenCV (no Python): the top view (x-y, in
+// the ground truth's world) of the ground truth and the aligned estimate, with a grid in
+// metres, a scale bar and a legend; below it the ATE position error and the velocity error
+// over time, with the gross failures marked.
+
+#include <opencv2/core.hpp>
+#include <string>
+
+#include "tools/eval/evaluate.h"
+#include "tools/eval/options.h"
+
+namespace kestrel::eval {
+
+/// The picture (8-bit BGR, 1000 px wide); `title` is printed above the figures.
+cv::Mat render_plot(const Evaluation& e, const EvalOptions& options, const std::string& title);
+
+/// Writes `image` as PNG; throws InputError naming `path` if it cannot be written.
+void write_png(const std::string& path, const cv::Mat& image);
+
+}  // namespace kestrel::eval
