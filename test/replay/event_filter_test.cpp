@@ -1,0 +1,68 @@
+// EventFilter: which log events a replay publishes, and the reasons it gives for the rest.
+
+#include <gtest/gtest.h>
+
+#include "common/error.h"
+#include "tools/replay/event_filter.h"
+
+namespace kestrel::replay {
+namespace {
+
+transport::LogEvent event(const std::string& channel, int64_t timestamp) {
+  transport::LogEvent e;
+  e.channel = channel;
+  e.timestamp = timestamp;
+  return e;
+}
+
+TEST(EventFilter, NeverReplaysTheProtocolChannels) {
+  EventFilter filter({}, nullptr);
+  EXPECT_TRUE(filter.accept(event("IMU", 0)));
+  EXPECT_FALSE(filter.accept(event("PROCESS_STATUS", 1)));
+  EXPECT_FALSE(filter.accept(event("REPLAY_ACK", 2)));
+  EXPECT_FALSE(filter.accept(event("REPLAY_CONTROL", 3)));
+  EXPECT_EQ(filter.skipped_channels().size(), 3u);
+  EXPECT_EQ(filter.skipped_channels().at("REPLAY_ACK").events, 1);
+}
+
+TEST(EventFilter, SkipsWhatLiveProcessesPublishNamingThem) {
+  auto publishers = [](const std::string& c) {
+    return c == "VO_UPDATE" ? std::vector<std::string>{"vo", "vo2"} : std::vector<std::string>{};
+  };
+  EventFilter filter({}, publishers);
+  EXPECT_TRUE(filter.accept(event("CAMERA_RGBD", 0)));
+  EXPECT_FALSE(filter.accept(event("VO_UPDATE", 1)));
+  EXPECT_FALSE(filter.accept(event("VO_UPDATE", 2)));
+  const SkippedChannel& s = filter.skipped_channels().at("VO_UPDATE");
+  EXPECT_EQ(s.events, 2);
+  EXPECT_EQ(s.reason, "published by live process vo, vo2");
+}
+
+TEST(EventFilter, AnExplicitRegexSelectsWholeNamesAndOverridesTheLiveRule) {
+  auto publishers = [](const std::string&) { return std::vector<std::string>{"someone"}; };
+  EventFilter filter({"CAMERA_.*|IMU", 0.0, 0.0}, publishers);
+  EXPECT_TRUE(filter.accept(event("CAMERA_RGBD", 0)));
+  EXPECT_TRUE(filter.accept(event("IMU", 0)));
+  EXPECT_FALSE(filter.accept(event("IMU_RAW", 0)));  // the whole name must match
+  EXPECT_FALSE(filter.accept(event("GROUND_TRUTH", 0)));
+  EXPECT_EQ(filter.skipped_channels().at("GROUND_TRUTH").reason, "not selected by --channels");
+}
+
+TEST(EventFilter, KeepsTheTimeWindowRelativeToTheFirstEvent) {
+  EventFilter filter({"", 1.0, 2.0}, nullptr);
+  const int64_t t0 = 5'000'000;
+  EXPECT_FALSE(filter.accept(event("IMU", t0)));               // 0 s
+  EXPECT_FALSE(filter.accept(event("IMU", t0 + 999'999)));     // just before 1 s
+  EXPECT_TRUE(filter.accept(event("IMU", t0 + 1'000'000)));    // 1 s
+  EXPECT_TRUE(filter.accept(event("IMU", t0 + 3'000'000)));    // 3 s: the end is included
+  EXPECT_FALSE(filter.accept(event("IMU", t0 + 3'000'001)));
+  EXPECT_EQ(filter.outside_window(), 3);
+}
+
+TEST(EventFilter, ChecksRegexes) {
+  EXPECT_EQ(check_channel_regex("CAMERA_.*"), "");
+  EXPECT_NE(check_channel_regex("CAMERA_(").find("not a valid regular expression"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace kestrel::replay

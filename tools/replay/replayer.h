@@ -1,0 +1,62 @@
+#pragma once
+// Replaying an LCM log into running kestrel processes, in one of two modes (README.md):
+//
+//  * lock-step (replay_lockstep): deterministic. Finds the processes from their heartbeats,
+//    optionally resets them, then publishes one event at a time and waits until every
+//    process that consumes it, and everything they publish in turn, has been acknowledged
+//    (AckLedger). Optionally records every output in a canonical order (OutputRecorder).
+//  * timed (replay_timed): like lcm-logplayer, paced on the events' timestamps.
+//
+// Both read the log with LogReader, so a damaged log is replayed up to (and beyond) the
+// damage, which the report states.
+
+#include <atomic>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "common/transport/log_file.h"
+#include "tools/replay/event_filter.h"
+#include "tools/replay/report.h"
+
+namespace kestrel::replay {
+
+/// A process did not answer, stopped, or broke the protocol; what() names it.
+class PeerError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+/// LCM could not be started on the URL.
+class NetworkUnavailable : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct LockstepOptions {
+  std::string lcm_url;                 ///< "" = $LCM_DEFAULT_URL or kestrel's default
+  std::vector<std::string> expect;     ///< process names that must take part
+  double discovery_timeout_s = 10.0;   ///< give up finding `expect` after this
+  double settle_s = 1.0;               ///< the process set must not change for this long
+  double begin_period_s = 0.2;         ///< BEGIN is repeated this often while discovering
+  bool reset = true;                   ///< RESET every process before the first event
+  double ack_timeout_s = 10.0;         ///< longest wait without progress on one event
+  SelectionOptions selection;
+  std::string record_path;             ///< "" = do not record
+};
+
+struct TimedOptions {
+  std::string lcm_url;
+  double speed = 1.0;  ///< log seconds per wall second
+  SelectionOptions selection;
+};
+
+/// Throws PeerError, NetworkUnavailable, InputError (recording file). Returns early with
+/// report.interrupted set once `interrupted` becomes true; END is always sent.
+ReplayReport replay_lockstep(transport::LogReader& log, const LockstepOptions& options,
+                             const std::atomic<bool>& interrupted);
+
+/// Throws NetworkUnavailable.
+ReplayReport replay_timed(transport::LogReader& log, const TimedOptions& options,
+                          const std::atomic<bool>& interrupted);
+
+}  // namespace kestrel::replay
