@@ -1,0 +1,68 @@
+// The health board: heartbeats matched by pid, silence noticed, endings kept.
+
+#include "tools/launch/health.h"
+
+#include <gtest/gtest.h>
+
+namespace kestrel::launch {
+namespace {
+
+using Clock = HealthBoard::Clock;
+using std::chrono::milliseconds;
+
+process_status_t beat(const std::string& name, int32_t pid, int8_t state, int64_t in = 0) {
+  process_status_t s{};
+  s.name = name;
+  s.pid = pid;
+  s.state = state;
+  s.messages_in = in;
+  return s;
+}
+
+TEST(HealthBoard, FollowsEachProcessThroughItsLife) {
+  HealthBoard board(3.0);
+  const auto t0 = Clock::now();
+  board.started("vo", 100, t0);
+  board.started("estimator", 101, t0);
+  EXPECT_EQ(board.rows(t0)[0].state, "starting");
+  EXPECT_FALSE(board.all_running(t0));
+
+  // Matched by pid, whatever name the process gives itself.
+  board.heartbeat(beat("odometry", 100, process_status_t::STATE_RUNNING, 42), t0 + milliseconds(500));
+  board.heartbeat(beat("estimator", 101, process_status_t::STATE_DEGRADED), t0 + milliseconds(500));
+  auto rows = board.rows(t0 + milliseconds(600));
+  ASSERT_EQ(rows.size(), 2u);
+  EXPECT_EQ(rows[0].state, "RUNNING");
+  EXPECT_EQ(rows[0].last->messages_in, 42);
+  EXPECT_EQ(rows[1].state, "DEGRADED");
+  EXPECT_FALSE(board.all_running(t0 + milliseconds(600)));
+  board.heartbeat(beat("estimator", 101, process_status_t::STATE_RUNNING), t0 + milliseconds(900));
+  EXPECT_TRUE(board.all_running(t0 + milliseconds(1000)));
+
+  // Silence: older than 3 s.
+  rows = board.rows(t0 + milliseconds(4000));
+  EXPECT_EQ(rows[0].state, "silent 3.5 s");
+  EXPECT_FALSE(rows[0].healthy);
+
+  board.ended("vo", "killed by SIGSEGV");
+  EXPECT_EQ(board.rows(t0 + milliseconds(4000))[0].state, "ended: killed by SIGSEGV");
+  // A restart forgets the old pid's heartbeats.
+  board.started("vo", 200, t0 + milliseconds(5000));
+  board.heartbeat(beat("vo", 100, process_status_t::STATE_RUNNING), t0 + milliseconds(5100));
+  rows = board.rows(t0 + milliseconds(5200));
+  EXPECT_EQ(rows[0].state, "starting");
+  EXPECT_EQ(rows.back().name, "vo (not launched here)");  // the stale pid, shown apart
+}
+
+TEST(HealthBoard, AProcessThatNeverBeatsIsNamed) {
+  HealthBoard board(3.0);
+  const auto t0 = Clock::now();
+  board.started("mapper", 7, t0);
+  EXPECT_EQ(board.rows(t0 + milliseconds(3500))[0].state, "no heartbeat");
+  const std::string table = board.table(t0 + milliseconds(3500));
+  EXPECT_NE(table.find("mapper"), std::string::npos);
+  EXPECT_NE(table.find("no heartbeat"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace kestrel::launch

@@ -1,0 +1,130 @@
+// kestrel-launch end to end, with two rgbd-codec processes as the set (they heartbeat like
+// every kestrel process): health from heartbeats, a killed process reported and restarted,
+// clean stops, a source that ends the launch, and bad process-set files.
+
+#include <gtest/gtest.h>
+#include <signal.h>
+
+#include <fstream>
+#include <regex>
+
+#include "test/replay/fixtures.h"
+#include "test/support/test_support.h"
+
+namespace kestrel::test {
+namespace {
+
+class LaunchTool : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (!can_isolate_network()) GTEST_SKIP() << "cannot create a private network namespace here";
+    std::ofstream(sets) << "processes:\n"
+                           "  - {name: codec-a, command: rgbd-codec --name codec-a --out A, side: onboard}\n"
+                           "  - {name: codec-b, command: rgbd-codec --name codec-b --in A --out B, side: offboard}\n";
+  }
+  std::unique_ptr<Background> launch(std::vector<std::string> extra) {
+    std::vector<std::string> argv{tool("launch"), "all", "--sets", sets.string(), "--isolated",
+                                  "--status-period", "0.5", "--log-dir", (dir / "logs").string()};
+    argv.insert(argv.end(), extra.begin(), extra.end());
+    return std::make_unique<Background>(argv, dir.path(), "launch");
+  }
+  // The pid the launcher reported for the latest start of `name`.
+  static pid_t started_pid(const Background& b, const std::string& name) {
+    const std::string err = b.err();
+    const std::regex re("started " + name + " \\(pid ([0-9]+)\\)");
+    pid_t pid = -1;
+    for (auto it = std::sregex_iterator(err.begin(), err.end(), re); it != std::sregex_iterator(); ++it)
+      pid = std::stoi((*it)[1]);
+    return pid;
+  }
+
+  TempDir dir;
+  std::filesystem::path sets = dir / "sets.yaml";
+};
+
+TEST_F(LaunchTool, ShowsHealthReportsAKilledProcessAndRestartsIt) {
+  auto l = launch({"--restart"});
+  ASSERT_TRUE(l->wait_for_output("all processes running", 20, true)) << l->err();
+  ASSERT_TRUE(l->wait_for_output("RUNNING", 10)) << l->out();
+  const pid_t first = started_pid(*l, "codec-a");
+  ASSERT_GT(first, 0);
+  ASSERT_EQ(::kill(first, SIGKILL), 0);
+  ASSERT_TRUE(l->wait_for_output("codec-a (pid " + std::to_string(first) + ") killed by SIGKILL", 10, true))
+      << l->err();
+  ASSERT_TRUE(l->wait_for_output("restarting codec-a", 10, true)) << l->err();
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  pid_t second = first;
+  while (second == first && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    second = started_pid(*l, "codec-a");
+  }
+  ASSERT_NE(second, first) << l->err();
+
+  l->signal(SIGTERM);
+  const auto code = l->wait_exit(15);
+  ASSERT_TRUE(code.has_value()) << "the launcher did not stop";
+  // The restart was asked for, so the kill is not a failure; the stop is clean.
+  EXPECT_EQ(*code, 0) << l->err();
+  EXPECT_NE(l->out().find("ended: exited with status 0"), std::string::npos) << l->out();
+  EXPECT_NE(::kill(second, 0), 0) << "codec-a outlived the launcher";
+}
+
+TEST_F(LaunchTool, WithoutRestartADeadProcessIsAFailureAndCtrlCStopsTheRest) {
+  auto l = launch({});
+  ASSERT_TRUE(l->wait_for_output("all processes running", 20, true)) << l->err();
+  const pid_t b = started_pid(*l, "codec-b");
+  ASSERT_EQ(::kill(b, SIGKILL), 0);
+  ASSERT_TRUE(l->wait_for_output("codec-b (pid " + std::to_string(b) + ") killed by SIGKILL", 10, true));
+  const pid_t a = started_pid(*l, "codec-a");
+  EXPECT_EQ(::kill(a, 0), 0) << "the peer of a dead process must keep running";
+  l->signal(SIGINT);
+  const auto code = l->wait_exit(15);
+  ASSERT_TRUE(code.has_value());
+  EXPECT_EQ(*code, 130);
+  EXPECT_NE(::kill(a, 0), 0);
+}
+
+TEST_F(LaunchTool, TheLaunchEndsWithItsSource) {
+  {
+    auto l = launch({"--source", "/bin/sleep 1"});
+    const auto code = l->wait_exit(20);
+    ASSERT_TRUE(code.has_value());
+    EXPECT_EQ(*code, 0) << l->err();
+    EXPECT_NE(l->err().find("the source exited with status 0"), std::string::npos) << l->err();
+  }
+  {
+    auto l = launch({"--source", "/bin/false"});
+    const auto code = l->wait_exit(20);
+    ASSERT_TRUE(code.has_value());
+    EXPECT_EQ(*code, 1) << l->err();
+  }
+}
+
+TEST_F(LaunchTool, ListsTheSetWithoutStartingIt) {
+  const auto r = run({tool("launch"), "onboard", "--sets", sets.string(), "--list"});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("codec-a"), std::string::npos);
+  EXPECT_EQ(r.out.find("codec-b"), std::string::npos);
+  EXPECT_NE(r.out.find("kestrel-rgbd-codec --name codec-a --out A"), std::string::npos) << r.out;
+}
+
+TEST_F(LaunchTool, BadSetsAndUnbuiltToolsAreOneLineErrors) {
+  std::ofstream(dir / "bad.yaml") << "processes:\n  - {name: x, command: x, side: sideways}\n";
+  auto r = run({tool("launch"), "all", "--sets", (dir / "bad.yaml").string()});
+  EXPECT_EQ(r.exit_code, 3);
+  EXPECT_NE(r.err.find("bad.yaml:2: side is onboard or offboard"), std::string::npos) << r.err;
+
+  std::ofstream(dir / "unbuilt.yaml") << "processes:\n  - {name: x, command: no-such-tool, side: onboard}\n";
+  r = run({tool("launch"), "all", "--sets", (dir / "unbuilt.yaml").string()});
+  EXPECT_EQ(r.exit_code, 3);
+  EXPECT_NE(r.err.find("no kestrel-no-such-tool"), std::string::npos) << r.err;
+
+  r = run({tool("launch"), "sideways"});
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  r = run({tool("launch"), "all", "--sets", (dir / "absent.yaml").string()});
+  EXPECT_EQ(r.exit_code, 3);
+  EXPECT_NE(r.err.find("absent.yaml: no such file"), std::string::npos) << r.err;
+}
+
+}  // namespace
+}  // namespace kestrel::test

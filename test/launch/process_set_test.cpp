@@ -1,0 +1,123 @@
+// Process-set files: what a good file selects, and a one-line error naming the file and line
+// for each way a file can be wrong.
+
+#include "tools/launch/process_set.h"
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "common/error.h"
+#include "test/support/test_support.h"
+
+namespace kestrel::launch {
+namespace {
+
+using test::TempDir;
+
+std::filesystem::path write(const TempDir& dir, const std::string& text) {
+  const auto path = dir / "sets.yaml";
+  std::ofstream(path) << text;
+  return path;
+}
+
+std::string error_of(const std::filesystem::path& file) {
+  try {
+    read_process_sets(file);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+const char* kGood = R"(# comment
+processes:
+  - {name: vo, command: vo --fast, side: onboard}
+  - name: estimator
+    command: estimator
+    side: onboard
+  - {name: slam, command: /bin/true, side: offboard}
+)";
+
+TEST(ProcessSets, ReadsEveryProcessInFileOrder) {
+  TempDir dir;
+  const ProcessSet all = read_process_sets(write(dir, kGood));
+  ASSERT_EQ(all.size(), 3u);
+  EXPECT_EQ(all[0].name, "vo");
+  EXPECT_EQ(all[0].argv, (std::vector<std::string>{"vo", "--fast"}));
+  EXPECT_EQ(all[1].side, "onboard");
+  EXPECT_EQ(all[2].argv, (std::vector<std::string>{"/bin/true"}));
+}
+
+TEST(ProcessSets, SelectsBySideOnlyAndWithout) {
+  TempDir dir;
+  const ProcessSet all = read_process_sets(write(dir, kGood));
+  auto names = [](const ProcessSet& s) {
+    std::vector<std::string> n;
+    for (const auto& p : s) n.push_back(p.name);
+    return n;
+  };
+  using V = std::vector<std::string>;
+  EXPECT_EQ(names(select(all, "onboard", {}, {})), (V{"vo", "estimator"}));
+  EXPECT_EQ(names(select(all, "offboard", {}, {})), (V{"slam"}));
+  EXPECT_EQ(names(select(all, "all", {}, {"estimator"})), (V{"vo", "slam"}));
+  EXPECT_EQ(names(select(all, "all", {"slam", "vo"}, {})), (V{"vo", "slam"}));
+  EXPECT_TRUE(select(all, "offboard", {"vo"}, {}).empty());
+  EXPECT_THROW(select(all, "ground", {}, {}), InputError);
+  EXPECT_THROW(select(all, "all", {"mapper"}, {}), InputError);
+  EXPECT_THROW(select(all, "all", {}, {"mapper"}), InputError);
+}
+
+TEST(ProcessSets, MalformedFilesNameTheFileAndLine) {
+  TempDir dir;
+  const auto missing = dir / "absent.yaml";
+  EXPECT_NE(error_of(missing).find("absent.yaml: no such file"), std::string::npos);
+
+  struct Case {
+    const char* text;
+    const char* expected;  // after "sets.yaml"
+  };
+  const Case cases[] = {
+      {"processes: [", "sets.yaml:"},                                           // YAML syntax
+      {"procs: []\n", "sets.yaml: expected a top-level 'processes:' list"},
+      {"processes:\n  - {name: vo, side: onboard}\n", "sets.yaml:2: a process needs name, command and side"},
+      {"processes:\n  - {name: vo, command: vo, side: moon}\n", "sets.yaml:2: side is onboard or offboard"},
+      {"processes:\n  - {name: vo, command: '  ', side: onboard}\n", "sets.yaml:2: empty command"},
+      {"processes:\n  - {name: vo, command: vo, side: onboard, nice: 5}\n", "sets.yaml:2: unknown key 'nice'"},
+      {"processes:\n  - {name: a, command: x, side: onboard}\n  - {name: a, command: y, side: onboard}\n",
+       "sets.yaml:3: process 'a' declared twice"},
+      {"processes:\n  - {name: a/b, command: x, side: onboard}\n", "sets.yaml:2: a name is one word"},
+      {"processes:\n  - {name: a, command: [x, y], side: onboard}\n", "sets.yaml:2"},
+  };
+  for (const auto& c : cases) {
+    const std::string e = error_of(write(dir, c.text));
+    EXPECT_NE(e.find(c.expected), std::string::npos) << "for:\n" << c.text << "got: '" << e << "'";
+    EXPECT_EQ(e.find('\n'), std::string::npos) << "one line: " << e;
+  }
+}
+
+TEST(ProcessSets, TheShippedFileIsValidAndHasBothSides) {
+  const ProcessSet all = read_process_sets(KESTREL_DEFAULT_PROCESS_SETS);
+  EXPECT_FALSE(select(all, "onboard", {}, {}).empty());
+  EXPECT_FALSE(select(all, "offboard", {}, {}).empty());
+}
+
+TEST(ResolveExecutable, PrefersKestrelToolsThenPath) {
+  TempDir dir;
+  const auto tool = dir / "kestrel-thing";
+  std::ofstream(tool) << "#!/bin/sh\n";
+  std::filesystem::permissions(tool, std::filesystem::perms::owner_all);
+  EXPECT_EQ(resolve_executable("thing", dir.path()), tool);
+  EXPECT_EQ(resolve_executable("sh", dir.path()).filename(), "sh");  // from PATH
+  EXPECT_EQ(resolve_executable(tool.string(), "/nonexistent"), tool);
+  try {
+    resolve_executable("nothing-like-this", dir.path());
+    FAIL() << "resolved a tool that does not exist";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("no kestrel-nothing-like-this"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(resolve_executable((dir / "missing").string(), dir.path()), InputError);
+}
+
+}  // namespace
+}  // namespace kestrel::launch

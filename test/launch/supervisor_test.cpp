@@ -1,0 +1,127 @@
+// The supervisor with real child processes (plain shell commands): exit statuses, signals,
+// restarts and a stop that also ends a child that ignores SIGTERM.
+
+#include "tools/launch/supervisor.h"
+
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+
+#include <fstream>
+#include <sstream>
+#include <thread>
+
+#include "test/support/test_support.h"
+
+namespace kestrel::launch {
+namespace {
+
+using test::TempDir;
+using Clock = Supervisor::Clock;
+
+ProcessSpec shell(const std::string& name, const std::string& script) {
+  return {name, {"/bin/sh", "-c", script}, "onboard"};
+}
+
+// Polls until `n` events of `kind` arrived or 10 s passed.
+std::vector<ChildEvent> poll_until(Supervisor& s, ChildEvent::Kind kind, size_t n) {
+  std::vector<ChildEvent> seen;
+  const auto deadline = Clock::now() + std::chrono::seconds(10);
+  size_t count = 0;
+  while (count < n && Clock::now() < deadline) {
+    for (const auto& e : s.poll()) {
+      seen.push_back(e);
+      count += e.kind == kind;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  return seen;
+}
+
+TEST(DescribeWaitStatus, ExitCodesAndSignals) {
+  EXPECT_EQ(describe_wait_status(3 << 8).description, "exited with status 3");
+  EXPECT_EQ(describe_wait_status(3 << 8).code, 3);
+  EXPECT_EQ(describe_wait_status(SIGSEGV).description, "killed by SIGSEGV");
+  EXPECT_EQ(describe_wait_status(SIGSEGV).code, 128 + SIGSEGV);
+}
+
+TEST(Supervisor, ReportsHowEachChildEndedAndKeepsItsOutput) {
+  TempDir dir;
+  SupervisorOptions o;
+  o.log_dir = dir / "logs";
+  o.environment = {"KESTREL_TEST_VALUE=seen"};
+  const ProcessSet set{shell("fails", "echo \"why: $KESTREL_TEST_VALUE\"; exit 3"),
+                       shell("crashes", "kill -SEGV $$")};
+  Supervisor s(set, {"/bin/sh", "/bin/sh"}, o);
+  const auto started = s.start_all();
+  ASSERT_EQ(started.size(), 2u);
+  EXPECT_EQ(started[0].kind, ChildEvent::kStarted);
+  auto events = poll_until(s, ChildEvent::kEnded, 2);
+  std::map<std::string, std::string> how;
+  for (const auto& e : events)
+    if (e.kind == ChildEvent::kEnded) how[e.name] = e.ending.description;
+  EXPECT_EQ(how["fails"], "exited with status 3");
+  EXPECT_EQ(how["crashes"], "killed by SIGSEGV");
+  EXPECT_EQ(s.running(), 0u);
+  std::stringstream log;
+  log << std::ifstream(o.log_dir / "fails.log").rdbuf();
+  EXPECT_EQ(log.str(), "why: seen\n");
+}
+
+TEST(Supervisor, RestartsADeadChildUpToTheLimit) {
+  TempDir dir;
+  SupervisorOptions o;
+  o.log_dir = dir.path();
+  o.restart = true;
+  o.restart_delay_s = 0.01;
+  o.max_restarts = 2;
+  Supervisor s({shell("flaky", "echo run >> " + (dir / "runs").string() + "; exit 1")}, {"/bin/sh"}, o);
+  s.start_all();
+  const auto events = poll_until(s, ChildEvent::kGaveUp, 1);
+  int ended = 0, restarting = 0, gave_up = 0;
+  for (const auto& e : events) {
+    ended += e.kind == ChildEvent::kEnded;
+    restarting += e.kind == ChildEvent::kRestarting;
+    gave_up += e.kind == ChildEvent::kGaveUp;
+  }
+  EXPECT_EQ(ended, 3);  // the first run and two restarts
+  EXPECT_EQ(restarting, 2);
+  EXPECT_EQ(gave_up, 1);
+  EXPECT_EQ(s.children()[0].restarts, 2);
+  std::ifstream runs(dir / "runs");
+  int lines = 0;
+  for (std::string l; std::getline(runs, l);) ++lines;
+  EXPECT_EQ(lines, 3);
+}
+
+TEST(Supervisor, StopEndsEveryChildEvenOneThatIgnoresSigterm) {
+  TempDir dir;
+  SupervisorOptions o;
+  o.log_dir = dir.path();
+  o.stop_timeout_s = 0.5;
+  const ProcessSet set{shell("polite", "exec sleep 30"),
+                       shell("stubborn", "trap '' TERM; echo ready; while :; do sleep 0.05; done")};
+  Supervisor s(set, {"/bin/sh", "/bin/sh"}, o);
+  s.start_all();
+  // Let the stubborn one install its trap before we signal it.
+  const auto deadline = Clock::now() + std::chrono::seconds(5);
+  while (Clock::now() < deadline) {
+    std::ifstream log(dir / "stubborn.log");
+    std::string l;
+    if (std::getline(log, l) && l == "ready") break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  const pid_t stubborn = s.find("stubborn")->pid;
+  const auto t0 = Clock::now();
+  const auto events = s.stop_all();
+  EXPECT_LT(std::chrono::duration<double>(Clock::now() - t0).count(), 5.0);
+  EXPECT_EQ(s.running(), 0u);
+  std::map<std::string, std::string> how;
+  for (const auto& e : events) how[e.name] = e.ending.description;
+  EXPECT_EQ(how["polite"], "killed by SIGTERM");
+  EXPECT_EQ(how["stubborn"], "killed by SIGKILL");
+  EXPECT_NE(::kill(stubborn, 0), 0) << "the stubborn child still exists";
+}
+
+}  // namespace
+}  // namespace kestrel::launch

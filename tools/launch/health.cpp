@@ -1,0 +1,94 @@
+#include "tools/launch/health.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+
+namespace kestrel::launch {
+
+std::string state_name(int8_t state) {
+  switch (state) {
+    case process_status_t::STATE_STARTING: return "STARTING";
+    case process_status_t::STATE_RUNNING: return "RUNNING";
+    case process_status_t::STATE_DEGRADED: return "DEGRADED";
+    case process_status_t::STATE_STOPPING: return "STOPPING";
+    case process_status_t::STATE_FAILED: return "FAILED";
+    default: return "STATE " + std::to_string(state);
+  }
+}
+
+void HealthBoard::started(const std::string& name, pid_t pid, Clock::time_point now) {
+  if (!entries_.count(name)) order_.push_back(name);
+  Entry& e = entries_[name];
+  e = Entry{};
+  e.pid = pid;
+  e.since = now;
+  e.launched = true;
+}
+
+void HealthBoard::ended(const std::string& name, const std::string& how) {
+  auto it = entries_.find(name);
+  if (it != entries_.end()) it->second.ended = how;
+}
+
+void HealthBoard::heartbeat(const process_status_t& status, Clock::time_point now) {
+  // By pid first: a launched process may call itself anything.
+  auto it = std::find_if(entries_.begin(), entries_.end(), [&](const auto& kv) {
+    return kv.second.launched && kv.second.pid == status.pid && !kv.second.ended;
+  });
+  if (it == entries_.end()) {
+    const std::string key = status.name + " (not launched here)";
+    if (!entries_.count(key)) order_.push_back(key);
+    it = entries_.emplace(key, Entry{}).first;
+    it->second.pid = status.pid;
+  }
+  it->second.last = status;
+  it->second.last_at = now;
+}
+
+std::vector<HealthBoard::Row> HealthBoard::rows(Clock::time_point now) const {
+  std::vector<Row> out;
+  for (const auto& name : order_) {
+    const Entry& e = entries_.at(name);
+    Row r{name, e.pid, "", false, e.last};
+    const double since_start = std::chrono::duration<double>(now - e.since).count();
+    if (e.ended) {
+      r.state = "ended: " + *e.ended;
+    } else if (!e.last) {
+      r.state = since_start > silent_after_s_ ? "no heartbeat" : "starting";
+    } else {
+      const double age = std::chrono::duration<double>(now - e.last_at).count();
+      if (age > silent_after_s_) {
+        r.state = fmt::format("silent {:.1f} s", age);
+      } else {
+        r.state = state_name(e.last->state);
+        r.healthy = e.last->state == process_status_t::STATE_RUNNING;
+      }
+    }
+    out.push_back(std::move(r));
+  }
+  return out;
+}
+
+std::string HealthBoard::table(Clock::time_point now) const {
+  // The state goes last but one: "ended: killed by SIGSEGV" is long, the counters are not.
+  std::string s = fmt::format("{:<16} {:>7} {:>9} {:>9} {:>8}  {:<16} {}\n", "process", "pid", "in",
+                              "out", "rejected", "state", "message");
+  for (const Row& r : rows(now)) {
+    const auto& l = r.last;
+    s += fmt::format("{:<16} {:>7} {:>9} {:>9} {:>8}  {:<16} {}\n", r.name, r.pid,
+                     l ? std::to_string(l->messages_in) : "-", l ? std::to_string(l->messages_out) : "-",
+                     l ? std::to_string(l->messages_rejected) : "-", r.state, l ? l->message : "");
+  }
+  return s;
+}
+
+bool HealthBoard::all_running(Clock::time_point now) const {
+  for (const Row& r : rows(now)) {
+    const Entry& e = entries_.at(r.name);
+    if (e.launched && !e.ended && !r.healthy) return false;
+  }
+  return true;
+}
+
+}  // namespace kestrel::launch

@@ -1,0 +1,63 @@
+#pragma once
+// What the launcher knows of each process's health: its latest heartbeat (PROCESS_STATUS),
+// matched to the child by pid, and how long ago it came. Rendered as a small table.
+//
+// Invariants: a process is "silent" when its last heartbeat is older than `silent_after_s`
+// (or it never sent one that long after starting); heartbeats of processes the launcher did
+// not start are kept under their own name, so a stray peer is visible too.
+
+#include <sys/types.h>
+
+#include <chrono>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "kestrel/process_status_t.hpp"
+
+namespace kestrel::launch {
+
+class HealthBoard {
+ public:
+  using Clock = std::chrono::steady_clock;
+
+  explicit HealthBoard(double silent_after_s = 3.0) : silent_after_s_(silent_after_s) {}
+
+  /// A process the launcher (re)started; forgets the heartbeat of its previous pid.
+  void started(const std::string& name, pid_t pid, Clock::time_point now);
+  /// A process that ended, with how ("exited with status 1").
+  void ended(const std::string& name, const std::string& how);
+  void heartbeat(const process_status_t& status, Clock::time_point now);
+
+  struct Row {
+    std::string name;
+    pid_t pid = -1;
+    std::string state;  ///< RUNNING, DEGRADED..., "silent 4.2 s", "no heartbeat", "ended: ..."
+    bool healthy = false;
+    std::optional<process_status_t> last;
+  };
+  std::vector<Row> rows(Clock::time_point now) const;
+  /// One line per process: name, pid, state, messages in/out/rejected, message.
+  std::string table(Clock::time_point now) const;
+  /// True once every started, running process has sent a RUNNING heartbeat.
+  bool all_running(Clock::time_point now) const;
+
+ private:
+  struct Entry {
+    pid_t pid = -1;
+    Clock::time_point since{};
+    std::optional<process_status_t> last;
+    Clock::time_point last_at{};
+    std::optional<std::string> ended;
+    bool launched = false;
+  };
+  double silent_after_s_;
+  std::map<std::string, Entry> entries_;  // by launch name
+  std::vector<std::string> order_;
+};
+
+/// "RUNNING", "DEGRADED", ... for process_status_t::state.
+std::string state_name(int8_t state);
+
+}  // namespace kestrel::launch

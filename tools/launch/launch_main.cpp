@@ -1,0 +1,225 @@
+// kestrel-launch SET: starts the onboard, offboard or all processes of kestrel (process sets in
+// tools/launch/processes.yaml), shows their health from their heartbeats, reports a process
+// that dies (and restarts it with --restart), and stops them all on Ctrl-C or SIGTERM. With
+// --source the set is fed by one more process (a driver or a replay) and the launch ends when
+// that process ends.
+
+#include <signal.h>
+#include <spdlog/spdlog.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <lcm/lcm-cpp.hpp>
+#include <string>
+#include <vector>
+
+#include "common/cli.h"
+#include "common/error.h"
+#include "common/transport/channels.h"
+#include "common/transport/lcm_url.h"
+#include "common/transport/message.h"
+#include "tools/launch/health.h"
+#include "tools/launch/isolation.h"
+#include "tools/launch/process_set.h"
+#include "tools/launch/supervisor.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace kestrel::launch;
+using Clock = std::chrono::steady_clock;
+
+std::atomic<int> g_signal{0};
+void on_signal(int sig) { g_signal = sig; }
+
+struct Options {
+  std::string set;
+  std::string sets_file = KESTREL_DEFAULT_PROCESS_SETS;
+  std::vector<std::string> only, without;
+  std::string source;
+  std::string lcm_url;
+  bool isolated = false;
+  bool restart = false;
+  int max_restarts = 5;
+  std::string log_dir;
+  double status_period_s = 10.0;
+  bool list = false;
+};
+
+// The last lines of a dead process's log: usually the reason it died.
+std::string tail(const fs::path& log, size_t lines) {
+  std::ifstream in(log);
+  std::vector<std::string> all;
+  for (std::string l; std::getline(in, l);) all.push_back(l);
+  std::string out;
+  for (size_t i = all.size() > lines ? all.size() - lines : 0; i < all.size(); ++i)
+    out += (out.empty() ? "    | " : "\n    | ") + all[i];
+  return out;
+}
+
+// LCM 1.3 takes member functions, not lambdas.
+struct HeartbeatListener {
+  HealthBoard* board;
+  void handle(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+    try {
+      board->heartbeat(kestrel::transport::decode_message<kestrel::process_status_t>(
+                           rbuf->data, rbuf->data_size, channel),
+                       Clock::now());
+    } catch (const kestrel::InputError& e) {
+      spdlog::warn("{}", e.what());
+    }
+  }
+};
+
+int launch(const Options& o) {
+  ProcessSet set = select(read_process_sets(o.sets_file), o.set, o.only, o.without);
+  if (!o.source.empty()) set.push_back({"source", split_command(o.source), "source"});
+  if (set.empty()) throw CLI::ValidationError("SET", "selects no process");
+  const fs::path tool_dir = fs::canonical("/proc/self/exe").parent_path();
+  std::vector<fs::path> executables;
+  for (const auto& p : set) executables.push_back(resolve_executable(p.argv[0], tool_dir));
+  if (o.list) {
+    for (size_t i = 0; i < set.size(); ++i) {
+      std::string args;
+      for (size_t k = 1; k < set[i].argv.size(); ++k) args += " " + set[i].argv[k];
+      fmt::print("{:<12} {:<9} {}{}\n", set[i].name, set[i].side, executables[i].string(), args);
+    }
+    return kestrel::kExitOk;
+  }
+
+  // Before any thread exists: a network namespace applies to the calling thread only.
+  if (o.isolated) {
+    try {
+      spdlog::info("private network: {}", to_string(enter_private_network()));
+    } catch (const IsolationError& e) {
+      spdlog::error("{}", e.what());
+      return kestrel::kExitUnavailable;
+    }
+  }
+  const std::string url = kestrel::transport::resolve_lcm_url(o.lcm_url);
+  lcm::LCM lcm(url);
+  if (!lcm.good()) {
+    spdlog::error("cannot open LCM at {}", url);
+    return kestrel::kExitUnavailable;
+  }
+
+  SupervisorOptions so;
+  so.log_dir = o.log_dir.empty() ? fs::temp_directory_path() / ("kestrel-launch-" + std::to_string(::getpid()))
+                                 : fs::path(o.log_dir);
+  so.environment = {"LCM_DEFAULT_URL=" + url};
+  so.restart = o.restart;
+  so.max_restarts = o.max_restarts;
+  Supervisor supervisor(set, executables, so);
+  HealthBoard board;
+  HeartbeatListener listener{&board};
+  lcm.subscribe(kestrel::channel::kProcessStatus, &HeartbeatListener::handle, &listener);
+
+  struct sigaction sa {};
+  sa.sa_handler = on_signal;
+  for (int sig : {SIGINT, SIGTERM, SIGHUP}) ::sigaction(sig, &sa, nullptr);
+
+  spdlog::info("{} process{} on {}; logs in {}", set.size(), set.size() == 1 ? "" : "es", url,
+               so.log_dir.string());
+  bool unexpected_end = false;
+  std::optional<Ending> source_ending;
+  auto report = [&](const std::vector<ChildEvent>& events, bool stopping) {
+    for (const auto& e : events) {
+      const auto* child = supervisor.find(e.name);
+      switch (e.kind) {
+        case ChildEvent::kStarted:
+          spdlog::info("started {} (pid {})", e.name, e.pid);
+          board.started(e.name, e.pid, Clock::now());
+          break;
+        case ChildEvent::kEnded:
+          board.ended(e.name, e.ending.description);
+          if (e.name == "source" && !stopping) {
+            source_ending = e.ending;
+            spdlog::info("the source {}", e.ending.description);
+          } else if (!stopping) {
+            unexpected_end |= !so.restart;  // a restarted process fails the launch only once it is given up
+            spdlog::error("{} (pid {}) {}; last lines of {}:\n{}", e.name, e.pid,
+                          e.ending.description, child->log.string(), tail(child->log, 5));
+          }
+          break;
+        case ChildEvent::kRestarting:
+          spdlog::warn("restarting {} in {:.1f} s", e.name, so.restart_delay_s);
+          break;
+        case ChildEvent::kGaveUp:
+          unexpected_end = true;
+          spdlog::error("{} keeps failing: not restarted again ({} restarts)", e.name, so.max_restarts);
+          break;
+      }
+    }
+  };
+
+  // Consumers first, the source last, so that nothing it sends is lost.
+  report(supervisor.start_all(), false);
+  auto next_status = Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                        std::chrono::duration<double>(o.status_period_s));
+  bool announced_healthy = false;
+  while (g_signal == 0 && !source_ending) {
+    lcm.handleTimeout(100);
+    report(supervisor.poll(), false);
+    const auto now = Clock::now();
+    if (!announced_healthy && board.all_running(now)) {
+      announced_healthy = true;
+      spdlog::info("all processes running");
+    }
+    if (o.status_period_s > 0 && now >= next_status) {
+      next_status = now + std::chrono::duration_cast<Clock::duration>(
+                              std::chrono::duration<double>(o.status_period_s));
+      fmt::print("{}", board.table(now));
+      std::fflush(stdout);
+    }
+    const bool restart_pending = std::any_of(supervisor.children().begin(), supervisor.children().end(),
+                                             [](const auto& c) { return c.restart_at.has_value(); });
+    if (supervisor.running() == 0 && !restart_pending) {
+      spdlog::error("every process has ended");
+      break;
+    }
+  }
+  if (g_signal != 0) spdlog::info("stopping on {}", sigabbrev_np(g_signal) ? sigabbrev_np(g_signal) : "signal");
+  report(supervisor.stop_all(), true);
+  fmt::print("{}", board.table(Clock::now()));
+  if (g_signal == SIGINT) return kestrel::kExitInterrupted;
+  if (source_ending) return source_ending->code == 0 && !unexpected_end ? kestrel::kExitOk : kestrel::kExitFailure;
+  return unexpected_end ? kestrel::kExitFailure : kestrel::kExitOk;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  kestrel::cli::App app(
+      "launch",
+      "Starts a kestrel process set (onboard, offboard or all), shows each process's health "
+      "from its heartbeats, reports a process that dies with its exit status, and stops them "
+      "all on Ctrl-C/SIGTERM. Exit: 0 clean stop or the source finished well; 1 a process "
+      "died or the source failed; 2 usage; 3 bad process-set file; 4 no network; 130 Ctrl-C.");
+  Options o;
+  app.add_option("set", o.set, "onboard, offboard or all")
+      ->required()
+      ->check(CLI::IsMember({"onboard", "offboard", "all"}));
+  app.add_option("--sets", o.sets_file, "Process-set file (YAML)")->capture_default_str();
+  app.add_option("--only", o.only, "Start only these processes of the set (a,b)")->delimiter(',');
+  app.add_option("--without", o.without, "Leave these processes out (a,b)")->delimiter(',');
+  app.add_option("--source", o.source,
+                 "One more process that feeds the set, e.g. \"sim --world room\" or \"replay "
+                 "LOG --record out.lcmlog\"; started last, and the launch ends when it ends");
+  app.add_option("--lcm-url", o.lcm_url, "LCM URL for the launcher and every process "
+                                         "(default: $LCM_DEFAULT_URL or kestrel's)");
+  app.add_flag("--isolated", o.isolated,
+               "Run the set in a private network namespace with multicast on loopback");
+  app.add_flag("--restart", o.restart, "Restart a process that dies");
+  app.add_option("--max-restarts", o.max_restarts, "Give up on a process after this many restarts")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--log-dir", o.log_dir, "Folder for the processes' logs (default: a new one in $TMPDIR)");
+  app.add_option("--status-period", o.status_period_s, "Seconds between health tables (0: none)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+  app.add_flag("--list", o.list, "Print the processes the command would start, and exit");
+  return app.run(argc, argv, [&] { return launch(o); });
+}

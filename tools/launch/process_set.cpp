@@ -1,0 +1,120 @@
+#include "tools/launch/process_set.h"
+
+#include <unistd.h>
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <set>
+#include <sstream>
+
+#include "common/error.h"
+
+namespace kestrel::launch {
+namespace {
+
+std::string where(const std::filesystem::path& file, const YAML::Node& node) {
+  const auto mark = node.Mark();
+  return mark.is_null() ? file.string() : file.string() + ":" + std::to_string(mark.line + 1);
+}
+
+ProcessSpec read_process(const std::filesystem::path& file, const YAML::Node& node) {
+  if (!node.IsMap()) throw InputError(where(file, node) + ": a process is a map (name, command, side)");
+  for (const auto& key : node) {
+    const auto k = key.first.as<std::string>();
+    if (k != "name" && k != "command" && k != "side")
+      throw InputError(where(file, key.first) + ": unknown key '" + k + "' (name, command, side)");
+  }
+  ProcessSpec p;
+  if (!node["name"] || !node["command"] || !node["side"])
+    throw InputError(where(file, node) + ": a process needs name, command and side");
+  p.name = node["name"].as<std::string>();
+  p.argv = split_command(node["command"].as<std::string>());
+  p.side = node["side"].as<std::string>();
+  if (p.name.empty() || p.name.find_first_of(" /\t") != std::string::npos)
+    throw InputError(where(file, node["name"]) + ": a name is one word without '/'");
+  if (p.argv.empty()) throw InputError(where(file, node["command"]) + ": empty command");
+  if (p.side != "onboard" && p.side != "offboard")
+    throw InputError(where(file, node["side"]) + ": side is onboard or offboard, not '" + p.side + "'");
+  return p;
+}
+
+}  // namespace
+
+std::vector<std::string> split_command(const std::string& command) {
+  std::istringstream in(command);
+  std::vector<std::string> words;
+  for (std::string w; in >> w;) words.push_back(w);
+  return words;
+}
+
+ProcessSet read_process_sets(const std::filesystem::path& file) {
+  if (!std::filesystem::is_regular_file(file)) throw InputError(file.string() + ": no such file");
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(file.string());
+  } catch (const YAML::Exception& e) {
+    throw InputError(file.string() + ":" + std::to_string(e.mark.line + 1) + ": " + e.msg);
+  }
+  if (!root.IsMap() || !root["processes"] || !root["processes"].IsSequence())
+    throw InputError(file.string() + ": expected a top-level 'processes:' list");
+  ProcessSet set;
+  std::set<std::string> names;
+  try {
+    for (const auto& node : root["processes"]) {
+      ProcessSpec p = read_process(file, node);
+      if (!names.insert(p.name).second)
+        throw InputError(where(file, node) + ": process '" + p.name + "' declared twice");
+      set.push_back(std::move(p));
+    }
+  } catch (const YAML::Exception& e) {  // e.g. a list where a string belongs
+    throw InputError(file.string() + ":" + std::to_string(e.mark.line + 1) + ": " + e.msg);
+  }
+  return set;
+}
+
+ProcessSet select(const ProcessSet& all, const std::string& set,
+                  const std::vector<std::string>& only, const std::vector<std::string>& without) {
+  if (set != "onboard" && set != "offboard" && set != "all")
+    throw InputError("unknown process set '" + set + "' (onboard, offboard or all)");
+  auto declared = [&](const std::string& name) {
+    return std::any_of(all.begin(), all.end(), [&](const ProcessSpec& p) { return p.name == name; });
+  };
+  for (const auto* names : {&only, &without})
+    for (const auto& n : *names)
+      if (!declared(n)) throw InputError("no process named '" + n + "' in the process sets");
+  auto listed = [](const std::vector<std::string>& v, const std::string& n) {
+    return std::find(v.begin(), v.end(), n) != v.end();
+  };
+  ProcessSet out;
+  for (const auto& p : all) {
+    if (set != "all" && p.side != set) continue;
+    if (!only.empty() && !listed(only, p.name)) continue;
+    if (listed(without, p.name)) continue;
+    out.push_back(p);
+  }
+  return out;
+}
+
+std::filesystem::path resolve_executable(const std::string& command,
+                                         const std::filesystem::path& tool_dir) {
+  auto runnable = [](const std::filesystem::path& p) {
+    return std::filesystem::is_regular_file(p) && ::access(p.c_str(), X_OK) == 0;
+  };
+  if (command.find('/') != std::string::npos) {
+    if (runnable(command)) return command;
+    throw InputError("'" + command + "': not an executable file");
+  }
+  for (const auto& candidate : {tool_dir / ("kestrel-" + command), tool_dir / command})
+    if (runnable(candidate)) return candidate;
+  if (const char* path = std::getenv("PATH")) {
+    std::istringstream dirs(path);
+    for (std::string dir; std::getline(dirs, dir, ':');)
+      if (!dir.empty() && runnable(std::filesystem::path(dir) / command))
+        return std::filesystem::path(dir) / command;
+  }
+  throw InputError("'" + command + "': no kestrel-" + command + " in " + tool_dir.string() +
+                   " (is it built?) and no '" + command + "' on PATH");
+}
+
+}  // namespace kestrel::launch

@@ -1,0 +1,42 @@
+#pragma once
+// Process sets: which kestrel processes `kestrel launch SET` starts, read from a small YAML
+// file (tools/launch/processes.yaml is the default). Each process has a unique name, the
+// command that runs it and a side (onboard or offboard); the set `all` is every process.
+//
+// Invariants: a ProcessSet never holds two processes with one name, nor an empty command; a
+// malformed file is an InputError naming the file (and line where yaml-cpp knows it).
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace kestrel::launch {
+
+struct ProcessSpec {
+  std::string name;               ///< unique within a launch; also its log file's name
+  std::vector<std::string> argv;  ///< argv[0] is a kestrel tool name ("vo") or a path
+  std::string side;               ///< "onboard", "offboard" or "source"
+};
+
+using ProcessSet = std::vector<ProcessSpec>;
+
+/// Every process the file declares, in file order. Throws InputError.
+ProcessSet read_process_sets(const std::filesystem::path& file);
+
+/// The processes of `set` ("onboard", "offboard" or "all"), minus those named in
+/// `without`; with `only` non-empty, just those. Throws InputError for an unknown set or a
+/// name in `only`/`without` that the file does not declare.
+ProcessSet select(const ProcessSet& all, const std::string& set,
+                  const std::vector<std::string>& only, const std::vector<std::string>& without);
+
+/// Splits a command line on whitespace ("sim --world room"); no quoting, on purpose: the
+/// commands here are tool names and plain arguments.
+std::vector<std::string> split_command(const std::string& command);
+
+/// Where argv[0] runs from: a path is used as given; a bare name `x` is `kestrel-x` in
+/// `tool_dir` if present there, else `x` itself looked up in `tool_dir` and then on PATH.
+/// Throws InputError naming the command when nothing runnable is found.
+std::filesystem::path resolve_executable(const std::string& command,
+                                         const std::filesystem::path& tool_dir);
+
+}  // namespace kestrel::launch

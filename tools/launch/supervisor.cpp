@@ -1,0 +1,170 @@
+#include "tools/launch/supervisor.h"
+
+#include <fcntl.h>
+#include <signal.h>
+#include <cstring>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdlib>
+#include <stdexcept>
+#include <thread>
+
+namespace kestrel::launch {
+
+Ending describe_wait_status(int wait_status) {
+  if (WIFEXITED(wait_status)) {
+    const int code = WEXITSTATUS(wait_status);
+    return {code, "exited with status " + std::to_string(code)};
+  }
+  if (WIFSIGNALED(wait_status)) {
+    const int sig = WTERMSIG(wait_status);
+    const char* abbrev = sigabbrev_np(sig);
+    return {128 + sig, std::string("killed by SIG") + (abbrev ? abbrev : std::to_string(sig).c_str())};
+  }
+  return {1, "ended (wait status " + std::to_string(wait_status) + ")"};
+}
+
+Supervisor::Supervisor(const ProcessSet& set, const std::vector<std::filesystem::path>& executables,
+                       SupervisorOptions options)
+    : options_(std::move(options)) {
+  if (set.size() != executables.size()) throw std::invalid_argument("one executable per process");
+  std::filesystem::create_directories(options_.log_dir);
+  for (size_t i = 0; i < set.size(); ++i) {
+    Child child;
+    child.spec = set[i];
+    child.executable = executables[i];
+    child.log = options_.log_dir / (set[i].name + ".log");
+    children_.push_back(std::move(child));
+  }
+}
+
+Supervisor::~Supervisor() { stop_all(); }
+
+ChildEvent Supervisor::start(Child& child) {
+  // Everything the child needs is prepared before fork(): after it, only async-signal-safe
+  // calls are allowed (the launcher has an LCM thread).
+  std::vector<std::string> args = child.spec.argv;
+  args[0] = child.executable.string();
+  std::vector<char*> argv;
+  for (auto& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  std::vector<std::string> env_strings;
+  for (char** e = environ; *e; ++e) env_strings.emplace_back(*e);
+  env_strings.insert(env_strings.end(), options_.environment.begin(), options_.environment.end());
+  std::vector<char*> envp;
+  for (auto& e : env_strings) envp.push_back(e.data());
+  envp.push_back(nullptr);
+  const int log_fd = ::open(child.log.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
+  if (log_fd < 0) throw std::runtime_error(child.log.string() + ": " + std::strerror(errno));
+
+  const pid_t pid = ::fork();
+  if (pid < 0) {
+    ::close(log_fd);
+    throw std::runtime_error(std::string("fork: ") + std::strerror(errno));
+  }
+  if (pid == 0) {
+    ::setpgid(0, 0);
+    ::signal(SIGINT, SIG_DFL);
+    ::signal(SIGTERM, SIG_DFL);
+    sigset_t none;
+    sigemptyset(&none);
+    ::sigprocmask(SIG_SETMASK, &none, nullptr);
+    ::dup2(log_fd, STDOUT_FILENO);
+    ::dup2(log_fd, STDERR_FILENO);
+    const int devnull = ::open("/dev/null", O_RDONLY);
+    if (devnull >= 0) ::dup2(devnull, STDIN_FILENO);
+    ::execve(argv[0], argv.data(), envp.data());
+    const char msg[] = "kestrel launch: exec failed\n";
+    [[maybe_unused]] auto n = ::write(STDERR_FILENO, msg, sizeof msg - 1);
+    ::_exit(127);
+  }
+  ::setpgid(pid, pid);  // also here, so the group exists before we might signal it
+  ::close(log_fd);
+  child.pid = pid;
+  child.restart_at.reset();
+  return {ChildEvent::kStarted, child.spec.name, pid, {}};
+}
+
+std::vector<ChildEvent> Supervisor::start_all() {
+  std::vector<ChildEvent> events;
+  for (auto& c : children_)
+    if (c.pid < 0) events.push_back(start(c));
+  return events;
+}
+
+std::optional<ChildEvent> Supervisor::reap(Child& child, bool block) {
+  if (child.pid < 0) return std::nullopt;
+  int status = 0;
+  const pid_t r = ::waitpid(child.pid, &status, block ? 0 : WNOHANG);
+  if (r == 0) return std::nullopt;
+  if (r < 0 && errno == EINTR) return std::nullopt;
+  const pid_t pid = child.pid;
+  child.pid = -1;
+  child.last_ending = r < 0 ? Ending{1, "vanished"} : describe_wait_status(status);
+  ::kill(-pid, SIGKILL);  // anything it left behind in its group
+  return ChildEvent{ChildEvent::kEnded, child.spec.name, pid, *child.last_ending};
+}
+
+std::vector<ChildEvent> Supervisor::poll(Clock::time_point now) {
+  std::vector<ChildEvent> events;
+  for (auto& c : children_) {
+    if (auto e = reap(c, false)) {
+      events.push_back(*e);
+      if (!options_.restart) continue;
+      if (c.restarts >= options_.max_restarts) {
+        events.push_back({ChildEvent::kGaveUp, c.spec.name, e->pid, e->ending});
+        continue;
+      }
+      c.restart_at = now + std::chrono::duration_cast<Clock::duration>(
+                               std::chrono::duration<double>(options_.restart_delay_s));
+      events.push_back({ChildEvent::kRestarting, c.spec.name, e->pid, e->ending});
+    }
+    if (c.pid < 0 && c.restart_at && now >= *c.restart_at) {
+      ++c.restarts;
+      events.push_back(start(c));
+    }
+  }
+  return events;
+}
+
+std::vector<ChildEvent> Supervisor::stop_all() {
+  std::vector<ChildEvent> events;
+  for (auto it = children_.rbegin(); it != children_.rend(); ++it) {
+    it->restart_at.reset();
+    if (it->pid > 0) ::kill(-it->pid, SIGTERM);
+  }
+  const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                           std::chrono::duration<double>(options_.stop_timeout_s));
+  while (running() > 0 && Clock::now() < deadline) {
+    for (auto& c : children_)
+      if (auto e = reap(c, false)) events.push_back(*e);
+    if (running() > 0) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  for (auto& c : children_) {
+    if (c.pid > 0) ::kill(-c.pid, SIGKILL);
+    if (auto e = reap(c, true)) events.push_back(*e);
+  }
+  return events;
+}
+
+const Supervisor::Child* Supervisor::find(pid_t pid) const {
+  for (const auto& c : children_)
+    if (c.pid == pid) return &c;
+  return nullptr;
+}
+
+const Supervisor::Child* Supervisor::find(const std::string& name) const {
+  for (const auto& c : children_)
+    if (c.spec.name == name) return &c;
+  return nullptr;
+}
+
+size_t Supervisor::running() const {
+  size_t n = 0;
+  for (const auto& c : children_) n += c.pid > 0;
+  return n;
+}
+
+}  // namespace kestrel::launch

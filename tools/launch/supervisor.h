@@ -1,0 +1,88 @@
+#pragma once
+// Starts a set of processes, notices when one ends, restarts it if asked, and stops them all.
+// Each child runs in its own process group (so a terminal's Ctrl-C reaches only the
+// launcher, which then stops the children in order) with stdout and stderr appended to
+// <log_dir>/<name>.log.
+//
+// Invariants: every child started is reaped by poll() or stop_all(); stop_all() returns only
+// when no child is left (SIGTERM, then SIGKILL after `stop_timeout_s`); a child that keeps
+// failing is restarted at most `max_restarts` times, each after `restart_delay_s`.
+
+#include <sys/types.h>
+
+#include <chrono>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "tools/launch/process_set.h"
+
+namespace kestrel::launch {
+
+struct SupervisorOptions {
+  std::filesystem::path log_dir;
+  std::vector<std::string> environment;  ///< "KEY=value" added to every child's environment
+  bool restart = false;
+  double restart_delay_s = 1.0;
+  int max_restarts = 5;
+  double stop_timeout_s = 5.0;
+};
+
+/// How a process ended: "exited with status 3", "killed by SIGSEGV".
+struct Ending {
+  int code = 0;  ///< exit status, or 128 + signal number (the shell's convention)
+  std::string description;
+};
+Ending describe_wait_status(int wait_status);
+
+/// Something that happened to a child, for the launcher to report.
+struct ChildEvent {
+  enum Kind { kStarted, kEnded, kRestarting, kGaveUp } kind;
+  std::string name;
+  pid_t pid = -1;
+  Ending ending;  ///< kEnded only
+};
+
+class Supervisor {
+ public:
+  using Clock = std::chrono::steady_clock;
+
+  struct Child {
+    ProcessSpec spec;
+    std::filesystem::path executable;
+    std::filesystem::path log;
+    pid_t pid = -1;  ///< -1 when not running
+    int restarts = 0;
+    std::optional<Ending> last_ending;
+    std::optional<Clock::time_point> restart_at;
+  };
+
+  /// `executables[i]` runs `set[i]` (see resolve_executable). Starts nothing yet.
+  Supervisor(const ProcessSet& set, const std::vector<std::filesystem::path>& executables,
+             SupervisorOptions options);
+  ~Supervisor();  ///< stops whatever still runs
+  Supervisor(const Supervisor&) = delete;
+  Supervisor& operator=(const Supervisor&) = delete;
+
+  /// Starts every child, in set order.
+  std::vector<ChildEvent> start_all();
+  /// Reaps ended children and performs due restarts; never blocks.
+  std::vector<ChildEvent> poll(Clock::time_point now = Clock::now());
+  /// SIGTERM to every running child in reverse start order, waits, then SIGKILL.
+  std::vector<ChildEvent> stop_all();
+
+  const std::vector<Child>& children() const { return children_; }
+  const Child* find(pid_t pid) const;
+  const Child* find(const std::string& name) const;
+  size_t running() const;
+
+ private:
+  ChildEvent start(Child& child);
+  std::optional<ChildEvent> reap(Child& child, bool block);
+
+  std::vector<Child> children_;
+  SupervisorOptions options_;
+};
+
+}  // namespace kestrel::launch
