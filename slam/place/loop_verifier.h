@@ -1,0 +1,57 @@
+#pragma once
+// Geometric verification of a loop-closure candidate (PAPER.md section 3): ORB matches that
+// pass the ratio test, a 3-D-3-D RANSAC on the points both keyframes measured, then two-frame
+// bundle adjustment (two_view_adjustment.h) to refine the relative pose and give its
+// uncertainty. A candidate is accepted only with enough inliers, spread in space, that
+// reproject well after the adjustment.
+//
+// The accepted constraint is a pose-graph edge from the candidate keyframe to the query:
+// T_candidate_query and its information matrix in the pose graph's error convention
+// (slam/posegraph/spaces.h).
+
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <string>
+
+#include "common/geometry/se3.h"
+#include "slam/place/frame_features.h"
+#include "slam/place/two_view_adjustment.h"
+
+namespace kestrel::slam {
+
+struct VerificationOptions {
+  double ratio = 0.6;               ///< best / second-best Hamming distance at most
+  int max_hamming = 64;             ///< and the best at most this (of 256 bits)
+  int min_inliers = 10;             ///< after RANSAC and after the adjustment
+  double min_inlier_fraction = 0.25;  ///< of the ratio-test matches with depth in both frames
+  int ransac_iterations = 300;
+  double inlier_floor_m = 0.02;     ///< 3-D distance tolerance at short range
+  double inlier_sigmas = 3.0;       ///< tolerance in depth-noise standard deviations
+  double depth_noise = 1.4e-3;      ///< sigma_z = depth_noise * z^2, metres
+  double min_spread_m = 0.15;       ///< inliers must span at least this (2nd principal axis, std dev)
+  double max_pixel_error = 3.0;     ///< an inlier's reprojection error after the adjustment
+  double max_rms_px = 2.0;
+  double translation_sigma_floor_m = 0.01;  ///< added to the adjustment's covariance
+  double rotation_sigma_floor_rad = 0.005;
+  TwoViewOptions adjustment;
+};
+
+struct LoopConstraint {
+  bool accepted = false;
+  std::string reason;               ///< why not, when rejected
+  Eigen::Isometry3d T_candidate_query = Eigen::Isometry3d::Identity();
+  Matrix6d information = Matrix6d::Zero();  ///< of the pose-graph edge candidate -> query
+  int matches = 0;                  ///< ratio-test matches with depth in both frames
+  int inliers = 0;                  ///< after the adjustment
+  double rms_px = 0.0;
+};
+
+/// Verifies `candidate` as an earlier view of the place `query` sees. `seed` drives RANSAC.
+LoopConstraint verify_loop(const FrameFeatures& query, const FrameFeatures& candidate,
+                           const VerificationOptions& options, uint64_t seed);
+
+/// The information of the pose-graph edge (g2o's error convention) whose measurement is
+/// Z = T_a_b^-1, given the covariance of a right perturbation of T_a_b (TwoViewResult).
+Matrix6d edge_information(const Eigen::Isometry3d& T_a_b, const Matrix6d& covariance_right_T_a_b);
+
+}  // namespace kestrel::slam
