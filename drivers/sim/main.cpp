@@ -1,0 +1,197 @@
+// kestrel-sim: flies the synthetic world and outputs what a Kinect and an IMU would see,
+// with exact ground truth: live on LCM (CAMERA_RGBD, IMU, GROUND_TRUTH), paced in real time,
+// at --rate or as fast as possible; or into an LCM log (--log) and/or a TUM RGB-D folder
+// (--tum), without touching the network. See README.md.
+
+#include <spdlog/spdlog.h>
+
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <iostream>
+#include <optional>
+#include <thread>
+
+#include "common/cli.h"
+#include "common/error.h"
+#include "common/transport/channels.h"
+#include "common/transport/log_file.h"
+#include "common/transport/node.h"
+#include "common/transport/rgbd_codec.h"
+#include "drivers/sim/flights.h"
+#include "drivers/sim/messages.h"
+#include "drivers/sim/simulation.h"
+#include "drivers/sim/tum_writer.h"
+#include "drivers/sim/world_catalog.h"
+
+namespace {
+
+using namespace kestrel;
+using Clock = std::chrono::steady_clock;
+
+std::atomic<bool> g_interrupted{false};
+void on_signal(int) { g_interrupted = true; }
+
+struct Options {
+  std::string world = "room";
+  std::string map;
+  std::string flight = "loop";
+  double duration_s = 20.0;
+  uint64_t seed = 1;
+  std::string log;
+  std::string tum;
+  double rate = 1.0;
+  std::string lcm_url;
+  bool exact = false;
+  int motion_blur = 1;
+  std::string rgb_encoding = "jpeg";
+  std::string depth_encoding = "zstd";
+  int jpeg_quality = 95;
+  bool list = false;
+};
+
+void add_options(cli::App& app, Options& o) {
+  app.add_option("--world", o.world, "room, floor, office, stata (needs --map), a .world file or a map .yaml")
+      ->capture_default_str();
+  app.add_option("--map", o.map, "ROS occupancy map (yaml) for --world stata, e.g. ../shared/data/maps/stata_basement.yaml");
+  app.add_option("--flight", o.flight, "hover, figure8, aggressive, loop, survey")->capture_default_str();
+  app.add_option("--duration", o.duration_s, "Seconds of flight to simulate")->check(cli::Positive)->capture_default_str();
+  app.add_option("--seed", o.seed, "Sensor noise seed (same seed, same bytes)")->capture_default_str();
+  app.add_option("--log", o.log, "Write an LCM log here (no network, full speed)");
+  app.add_option("--tum", o.tum, "Write a TUM RGB-D folder here (no network, full speed)");
+  app.add_option("--rate", o.rate, "Live: sensor seconds per wall second (0 = as fast as possible)")
+      ->check(CLI::Range(0.0, 1e6))
+      ->capture_default_str();
+  app.add_option("--lcm-url", o.lcm_url, "LCM URL (default: $LCM_DEFAULT_URL or kestrel's)");
+  app.add_flag("--exact", o.exact, "Noiseless sensors: exact IMU, depth only quantised, no colour noise");
+  app.add_option("--motion-blur", o.motion_blur, "Renders averaged per colour frame (1 = no motion blur)")
+      ->check(CLI::Range(1, 16))
+      ->capture_default_str();
+  app.add_option("--rgb-encoding", o.rgb_encoding, "Colour on the wire: raw or jpeg")
+      ->check(CLI::IsMember({"raw", "jpeg"}))
+      ->capture_default_str();
+  app.add_option("--depth-encoding", o.depth_encoding, "Depth on the wire: raw or zstd (lossless)")
+      ->check(CLI::IsMember({"raw", "zstd"}))
+      ->capture_default_str();
+  app.add_option("--jpeg-quality", o.jpeg_quality, "JPEG quality")->check(CLI::Range(1, 100))->capture_default_str();
+  app.add_flag("--list", o.list, "List the built-in worlds and the flights, then exit");
+}
+
+// Where the events go: files, or LCM with pacing.
+struct Sinks {
+  std::optional<transport::LogWriter> log;
+  std::optional<sim::TumFolderWriter> tum;
+  std::optional<transport::Node> node;
+  void publish(const std::string& channel, int64_t utime, const std::vector<uint8_t>& bytes) {
+    if (log) log->write(channel, utime, bytes);
+    if (node) node->publish_bytes(channel, bytes);
+  }
+};
+
+int run(const Options& o) {
+  if (o.list) {
+    for (const auto& w : sim::builtin_world_names()) std::cout << "world " << w << "\n";
+    std::cout << "world stata (--map FILE.yaml)\n";
+    for (const auto& f : sim::flight_names()) std::cout << "flight " << f << "\n";
+    return kExitOk;
+  }
+  const auto t0 = Clock::now();
+  const sim::World world = sim::load_world(o.world, o.map);
+  std::unique_ptr<sim::Flight> flight;
+  try {
+    flight = sim::make_flight(o.flight, world);
+  } catch (const std::invalid_argument& e) {
+    throw CLI::ValidationError("--flight", e.what());
+  }
+  sim::SimulationOptions so;
+  so.seed = o.seed;
+  so.camera.rgb.motion_blur_samples = o.motion_blur;
+  if (o.exact) {
+    so.camera.rgb.noise = false;
+    so.camera.depth.noise = false;
+    so.imu.noise = false;
+  }
+  sim::Simulation simulation(world, *flight, so);
+  transport::RgbdEncoding encoding;
+  encoding.rgb = o.rgb_encoding == "raw" ? kestrel::rgbd_frame_t::RGB_RGB8 : kestrel::rgbd_frame_t::RGB_JPEG;
+  encoding.depth = o.depth_encoding == "raw" ? kestrel::rgbd_frame_t::DEPTH_U16_MM : kestrel::rgbd_frame_t::DEPTH_U16_MM_ZSTD;
+  encoding.jpeg_quality = o.jpeg_quality;
+  spdlog::info("world '{}' ({} surfaces), flight '{}', {:.1f} s, seed {}; set up in {:.2f} s", world.name(),
+               world.surfaces().size(), flight->name(), o.duration_s, o.seed,
+               std::chrono::duration<double>(Clock::now() - t0).count());
+
+  Sinks sinks;
+  const bool offline = !o.log.empty() || !o.tum.empty();
+  if (!o.log.empty()) sinks.log.emplace(o.log);
+  if (!o.tum.empty()) sinks.tum.emplace(o.tum, so.camera.camera, so.camera.T_body_camera);
+  bool restart = false;
+  if (offline) {
+    std::signal(SIGINT, on_signal);
+    std::signal(SIGTERM, on_signal);
+  } else {
+    try {
+      sinks.node.emplace("sim", o.lcm_url);
+    } catch (const std::runtime_error& e) {
+      std::cerr << "kestrel-sim: error: " << e.what() << "\n";
+      return kExitUnavailable;
+    }
+    for (const char* c : {channel::kCameraRgbd, channel::kImu, channel::kGroundTruth}) sinks.node->advertise(c);
+    sinks.node->on_reset([&] { restart = true; });
+    sinks.node->set_health(kestrel::process_status_t::STATE_RUNNING, "");
+  }
+  auto stopping = [&] { return g_interrupted.load() || (sinks.node && sinks.node->stopping()); };
+
+  const int64_t end_utime = so.start_utime + static_cast<int64_t>(o.duration_s * 1e6);
+  int64_t frames = 0, imu_samples = 0;
+  const auto start = Clock::now();
+  auto wall_start = start;
+  while (!stopping()) {
+    if (restart) {
+      simulation.reset();
+      wall_start = Clock::now();
+      restart = false;
+    }
+    sim::SimEvent e = simulation.next();
+    if (e.utime > end_utime) break;
+    if (sinks.node && o.rate > 0) {  // pace: wait for the event's wall time, serving LCM
+      const auto due = wall_start + std::chrono::duration_cast<Clock::duration>(
+                                        std::chrono::duration<double>(simulation.seconds(e.utime) / o.rate));
+      while (!stopping() && Clock::now() < due) {
+        const auto ms = std::chrono::duration_cast<std::chrono::milliseconds>(due - Clock::now()).count();
+        sinks.node->spin_once(static_cast<int>(std::max<int64_t>(0, ms)));
+      }
+    } else if (sinks.node) {
+      sinks.node->spin_once(0);
+    }
+    if (e.kind == sim::SimEvent::kImu) {
+      sinks.publish(channel::kImu, e.utime, transport::encode_message(sim::imu_message(e.utime, e.imu)));
+      sinks.publish(channel::kGroundTruth, e.utime,
+                    transport::encode_message(sim::ground_truth_message(e.utime, e.truth, &e.imu)));
+      if (sinks.tum) sinks.tum->add_imu(e.utime, e.imu, e.T_world_camera);
+      ++imu_samples;
+    } else {
+      if (sinks.log || sinks.node)
+        sinks.publish(channel::kCameraRgbd, e.utime, transport::encode_message(transport::encode_rgbd(e.frame, encoding)));
+      if (sinks.tum) sinks.tum->add_frame(e.frame, e.T_world_camera);
+      ++frames;
+    }
+  }
+  if (sinks.log) sinks.log->close();
+  if (sinks.tum) sinks.tum->close();
+  const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  std::cout << "frames: " << frames << "\n"
+            << "imu samples: " << imu_samples << "\n"
+            << "simulated seconds: " << o.duration_s << "\n"
+            << "wall seconds: " << seconds << "\n"
+            << "times real time: " << (seconds > 0 ? o.duration_s / seconds : 0.0) << "\n";
+  return stopping() ? kExitInterrupted : kExitOk;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  kestrel::cli::App app("sim", "Fly the synthetic world: RGB-D frames, IMU and exact ground truth, live on LCM or to a log / TUM folder");
+  Options options;
+  add_options(app, options);
+  return app.run(argc, argv, [&] { return run(options); });
+}

@@ -1,0 +1,116 @@
+#include "drivers/sim/occupancy_map.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <filesystem>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "common/error.h"
+
+namespace kestrel::sim {
+namespace {
+
+// Line (1-based) of a node, for messages.
+int line_of(const YAML::Node& node) { return node.Mark().line + 1; }
+
+double number(const YAML::Node& root, const std::string& path, const char* key) {
+  const YAML::Node n = root[key];
+  try {
+    const double v = n.as<double>();
+    if (!std::isfinite(v)) throw YAML::Exception(n.Mark(), "not finite");
+    return v;
+  } catch (const YAML::Exception&) {
+    throw InputError(at_line(path, line_of(n), std::string("'") + key + "' must be a number"));
+  }
+}
+
+}  // namespace
+
+cv::Mat OccupancyMap::free_mask() const {
+  cv::Mat mask(image.size(), CV_8UC1);
+  for (int r = 0; r < image.rows; ++r) {
+    const uchar* in = image.ptr<uchar>(r);
+    uchar* out = mask.ptr<uchar>(r);
+    for (int c = 0; c < image.cols; ++c) {
+      const double p = negate ? in[c] / 255.0 : (255 - in[c]) / 255.0;
+      out[c] = p < free_thresh ? 255 : 0;
+    }
+  }
+  return mask;
+}
+
+Eigen::Affine2d OccupancyMap::T_world_pixel() const {
+  // Pixel (col, row) -> map metres with y up from the bottom edge, then the origin pose.
+  Eigen::Affine2d T_map_pixel = Eigen::Affine2d::Identity();
+  T_map_pixel.linear() << resolution, 0, 0, -resolution;
+  T_map_pixel.translation() << 0.5 * resolution, (image.rows - 0.5) * resolution;
+  Eigen::Affine2d T_world_map = Eigen::Affine2d::Identity();
+  T_world_map.linear() = Eigen::Rotation2Dd(origin.z()).toRotationMatrix();
+  T_world_map.translation() = origin.head<2>();
+  return T_world_map * T_map_pixel;
+}
+
+OccupancyMap read_occupancy_map(const std::string& yaml_path) {
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(yaml_path);
+  } catch (const YAML::BadFile&) {
+    throw InputError(yaml_path + ": cannot open map file");
+  } catch (const YAML::Exception& e) {
+    throw InputError(at_line(yaml_path, e.mark.line + 1, "not valid YAML: " + e.msg));
+  }
+  if (!root.IsMap()) throw InputError(at_line(yaml_path, 1, "expected a YAML mapping of map keys"));
+  for (const char* key : {"image", "resolution", "origin"}) {
+    if (!root[key]) throw InputError(yaml_path + ": missing key '" + std::string(key) + "'");
+  }
+  OccupancyMap map;
+  map.yaml_path = yaml_path;
+  map.resolution = number(root, yaml_path, "resolution");
+  if (map.resolution <= 0) throw InputError(at_line(yaml_path, line_of(root["resolution"]), "'resolution' must be > 0"));
+  const YAML::Node origin = root["origin"];
+  if (!origin.IsSequence() || origin.size() != 3)
+    throw InputError(at_line(yaml_path, line_of(origin), "'origin' must be a list [x, y, yaw]"));
+  for (size_t i = 0; i < 3; ++i) {
+    try {
+      map.origin[static_cast<int>(i)] = origin[i].as<double>();
+    } catch (const YAML::Exception&) {
+      throw InputError(at_line(yaml_path, line_of(origin), "'origin' values must be numbers"));
+    }
+    if (!std::isfinite(map.origin[static_cast<int>(i)]))
+      throw InputError(at_line(yaml_path, line_of(origin), "'origin' values must be finite"));
+  }
+  if (root["negate"]) map.negate = number(root, yaml_path, "negate") != 0;
+  if (root["occupied_thresh"]) map.occupied_thresh = number(root, yaml_path, "occupied_thresh");
+  if (root["free_thresh"]) map.free_thresh = number(root, yaml_path, "free_thresh");
+  if (!(map.free_thresh >= 0 && map.free_thresh < map.occupied_thresh && map.occupied_thresh <= 1))
+    throw InputError(at_line(yaml_path, line_of(root["free_thresh"] ? root["free_thresh"] : root["occupied_thresh"]),
+                             "need 0 <= free_thresh < occupied_thresh <= 1"));
+  if (root["mode"]) {
+    const std::string mode = root["mode"].as<std::string>("");
+    if (mode != "trinary" && mode != "scale")
+      throw InputError(at_line(yaml_path, line_of(root["mode"]), "unsupported mode '" + mode + "' (trinary or scale)"));
+  }
+  std::string image;
+  try {
+    image = root["image"].as<std::string>();
+  } catch (const YAML::Exception&) {
+    throw InputError(at_line(yaml_path, line_of(root["image"]), "'image' must be a file name"));
+  }
+  std::filesystem::path image_path(image);
+  if (image_path.is_relative()) image_path = std::filesystem::path(yaml_path).parent_path() / image_path;
+  map.image_path = image_path.string();
+  const cv::Mat raw = cv::imread(map.image_path, cv::IMREAD_UNCHANGED);
+  if (raw.empty())
+    throw InputError(at_line(yaml_path, line_of(root["image"]), "cannot read map image '" + map.image_path + "'"));
+  if (raw.depth() != CV_8U)
+    throw InputError(at_line(yaml_path, line_of(root["image"]), "map image '" + map.image_path + "' is not 8-bit"));
+  if (raw.channels() == 1) map.image = raw;
+  else if (raw.channels() == 3) cv::cvtColor(raw, map.image, cv::COLOR_BGR2GRAY);
+  else if (raw.channels() == 4) cv::cvtColor(raw, map.image, cv::COLOR_BGRA2GRAY);
+  else throw InputError(at_line(yaml_path, line_of(root["image"]), "map image has an unsupported channel count"));
+  return map;
+}
+
+}  // namespace kestrel::sim

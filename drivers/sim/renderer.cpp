@@ -1,0 +1,190 @@
+#include "drivers/sim/renderer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <stdexcept>
+
+#include "drivers/sim/kinect_depth.h"
+#include "drivers/sim/random.h"
+#include "drivers/sim/rgb_sensor.h"
+
+namespace kestrel::sim {
+namespace {
+
+// log2 to about 0.01: exponent bits plus a quadratic in the mantissa. Only chooses mip levels.
+inline float fast_log2(float x) {
+  uint32_t bits;
+  std::memcpy(&bits, &x, sizeof bits);
+  const float exponent = static_cast<float>(static_cast<int>(bits >> 23) - 127);
+  bits = (bits & 0x007fffffu) | 0x3f800000u;
+  float m;
+  std::memcpy(&m, &bits, sizeof m);
+  const float f = m - 1.0f;
+  return exponent + f * (1.3465557f - 0.34655573f * f);
+}
+
+// What a pixel of one visible surface needs, hoisted out of the pixel loop.
+struct Shader {
+  const MipTexture* texture;
+  const ShadeMap* shade;
+  float tex_s, tex_t, off_s, off_t;  // texels per metre and offsets
+  float lod_c, wear_lod_c;           // lod = 1.5 log2 z + lod_c
+  float detail;
+  float mean[3];
+  float wear_k;                      // wear_gain * detail / 38.25 (a unit normal per 38.25 grey)
+  float wear_m[4], wear_o[2];
+  float abs_d;                       // |plane_d|, for the incidence angle
+};
+
+}  // namespace
+
+Renderer::Renderer(const World& world, const CameraOptions& options, uint64_t seed)
+    : world_(world), options_(options), seed_(seed), raster_(options.camera, options.near_m, options.far_m) {
+  options_.camera.validate("sim camera");
+  if (options_.rgb.motion_blur_samples < 1) throw std::invalid_argument("motion_blur_samples must be >= 1");
+  const PinholeCamera& c = options_.camera;
+  const size_t n = static_cast<size_t>(c.width) * c.height;
+  for (auto& p : planes_) p.assign(n, 0.0f);
+  ir_return_.assign(n, 0.0f);
+  ray_inverse_norm_.resize(n);
+  for (int v = 0; v < c.height; ++v)
+    for (int u = 0; u < c.width; ++u) {
+      const double x = (u - c.cx) / c.fx, y = (v - c.cy) / c.fy;
+      ray_inverse_norm_[static_cast<size_t>(v) * c.width + u] = static_cast<float>(1.0 / std::sqrt(x * x + y * y + 1.0));
+    }
+}
+
+RgbdFrame Renderer::render(const Eigen::Isometry3d& T_world_camera, int64_t utime, int64_t seq) {
+  return render(std::vector<Eigen::Isometry3d>{T_world_camera}, utime, seq);
+}
+
+RgbdFrame Renderer::render(const std::vector<Eigen::Isometry3d>& exposure, int64_t utime, int64_t seq) {
+  if (exposure.empty()) throw std::invalid_argument("Renderer::render: no pose");
+  for (auto& p : planes_) std::fill(p.begin(), p.end(), 0.0f);
+  const size_t middle = exposure.size() / 2;
+  // The middle pose last, so the rasteriser's buffers hold it for the depth image.
+  for (size_t i = 0; i < exposure.size(); ++i) {
+    if (i == middle) continue;
+    raster_.draw(world_.surfaces(), exposure[i]);
+    shade(false);
+  }
+  raster_.draw(world_.surfaces(), exposure[middle]);
+  shade(true);
+  if (exposure.size() > 1) {
+    const float scale = 1.0f / static_cast<float>(exposure.size());
+    for (auto& p : planes_)
+      for (float& x : p) x *= scale;
+  }
+  const uint64_t frame_key = derive(derive(seed_, tag("camera")), static_cast<uint64_t>(seq));
+  RgbdFrame frame;
+  frame.utime = utime;
+  frame.depth_utime = utime;
+  frame.seq = seq;
+  frame.camera = options_.camera;
+  frame.T_body_camera = options_.T_body_camera;
+  expose_rgb(planes_, options_.camera, options_.rgb, static_cast<uint32_t>(frame_key), frame.rgb);
+  make_kinect_depth(raster_, ir_return_, options_.depth, static_cast<uint32_t>(frame_key >> 32), frame.depth_mm);
+  return frame;
+}
+
+void Renderer::shade(bool ir) {
+  const PinholeCamera& cam = options_.camera;
+  const auto& visible = raster_.visible();
+  const float f = static_cast<float>(0.5 * (cam.fx + cam.fy));
+  const float exposure = static_cast<float>(options_.rgb.exposure);
+  std::vector<Shader> shaders(visible.size());
+  for (size_t i = 0; i < visible.size(); ++i) {
+    const SurfaceLook& look = world_.look(visible[i].surface);
+    Shader& s = shaders[i];
+    s.texture = look.texture.get();
+    s.shade = &look.shade;
+    s.tex_s = look.texels_per_m_s;
+    s.tex_t = look.texels_per_m_t;
+    s.off_s = look.offset_s;
+    s.off_t = look.offset_t;
+    s.abs_d = std::abs(visible[i].plane_d);
+    // Footprint of a pixel on the plane, geometric mean of its two axes: z^1.5 / (f sqrt|d|).
+    const float base = -std::log2(f) - 0.5f * std::log2(std::max(s.abs_d, 1e-6f));
+    s.lod_c = base + 0.5f * std::log2(look.texels_per_m_s * look.texels_per_m_t);
+    s.wear_lod_c = base - static_cast<float>(std::log2(kWearTexelM));
+    s.detail = look.detail;
+    for (int c = 0; c < 3; ++c) s.mean[c] = look.mean[c];
+    s.wear_k = look.wear_gain * look.detail / 38.25f;
+    std::copy(look.wear_m, look.wear_m + 4, s.wear_m);
+    std::copy(look.wear_offset, look.wear_offset + 2, s.wear_o);
+  }
+  const MipTexture& wear = world_.wear_texture();
+  const int w = cam.width;
+  for (int v = 0; v < cam.height; ++v) {
+    const uint16_t* ids = raster_.ids(v);
+    const float* inv = raster_.inverse_depth(v);
+    const size_t row = static_cast<size_t>(v) * w;
+    float* R = planes_[0].data() + row;
+    float* G = planes_[1].data() + row;
+    float* B = planes_[2].data() + row;
+    float* irow = ir_return_.data() + row;
+    const float* rin = ray_inverse_norm_.data() + row;
+    const float fv = static_cast<float>(v);
+    for (int u = 0; u < w;) {
+      const uint16_t id = ids[u];
+      int end = u + 1;
+      while (end < w && ids[end] == id) ++end;
+      if (id == Rasterizer::kNone) {
+        if (ir) std::fill(irow + u, irow + end, 0.0f);
+        u = end;
+        continue;
+      }
+      const ViewSurface& vs = visible[id];
+      const Shader& s = shaders[id];
+      const float s_row = vs.s_b * fv + vs.s_c, t_row = vs.t_b * fv + vs.t_c;
+      for (; u < end; ++u) {
+        const float fu = static_cast<float>(u);
+        const float z = 1.0f / inv[u];
+        const float sm = z * (vs.s_a * fu + s_row) + vs.s_0;
+        const float tm = z * (vs.t_a * fu + t_row) + vs.t_0;
+        const float lz = 1.5f * fast_log2(z);
+        const uint32_t texel = s.texture->sample(sm * s.tex_s + s.off_s, tm * s.tex_t + s.off_t, lz + s.lod_c);
+        float albedo[3] = {static_cast<float>(texel & 255u), static_cast<float>((texel >> 8) & 255u),
+                           static_cast<float>((texel >> 16) & 255u)};
+        const float grey = wear.sample_grey(s.wear_m[0] * sm + s.wear_m[1] * tm + s.wear_o[0],
+                                            s.wear_m[2] * sm + s.wear_m[3] * tm + s.wear_o[1], lz + s.wear_lod_c);
+        const float wear_factor = 1.0f + s.wear_k * (grey - 127.5f);
+        const float light = s.shade->at(sm, tm) * exposure * wear_factor;
+        for (int c = 0; c < 3; ++c) albedo[c] = s.mean[c] + s.detail * (albedo[c] - s.mean[c]);
+        R[u] += albedo[0] * light;
+        G[u] += albedo[1] * light;
+        B[u] += albedo[2] * light;
+        if (ir) {
+          const float rho = (0.299f * albedo[0] + 0.587f * albedo[1] + 0.114f * albedo[2]) * wear_factor * (1.0f / 255.0f);
+          irow[u] = rho * inv[u] * s.abs_d * rin[u];
+        }
+      }
+    }
+  }
+}
+
+cv::Mat Renderer::ideal_depth() const {
+  const PinholeCamera& cam = options_.camera;
+  cv::Mat depth(cam.height, cam.width, CV_32FC1);
+  for (int v = 0; v < cam.height; ++v) {
+    const float* inv = raster_.inverse_depth(v);
+    float* out = depth.ptr<float>(v);
+    for (int u = 0; u < cam.width; ++u) out[u] = inv[u] > 0.0f ? 1.0f / inv[u] : 0.0f;
+  }
+  return depth;
+}
+
+cv::Mat Renderer::surface_ids() const {
+  const PinholeCamera& cam = options_.camera;
+  cv::Mat ids(cam.height, cam.width, CV_32SC1);
+  for (int v = 0; v < cam.height; ++v) {
+    const uint16_t* in = raster_.ids(v);
+    int* out = ids.ptr<int>(v);
+    for (int u = 0; u < cam.width; ++u)
+      out[u] = in[u] == Rasterizer::kNone ? -1 : raster_.visible()[in[u]].surface;
+  }
+  return ids;
+}
+
+}  // namespace kestrel::sim

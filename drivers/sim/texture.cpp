@@ -1,0 +1,55 @@
+#include "drivers/sim/texture.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace kestrel::sim {
+namespace {
+
+uint32_t pack(const cv::Vec3f& c) {
+  uint32_t v = 0;
+  for (int i = 0; i < 3; ++i) {
+    const float x = std::clamp(c[i], 0.0f, 1.0f) * 255.0f + 0.5f;
+    v |= static_cast<uint32_t>(x) << (8 * i);
+  }
+  return v;
+}
+
+}  // namespace
+
+MipTexture::MipTexture(const cv::Mat& rgb) {
+  if (rgb.type() != CV_32FC3 || rgb.rows != rgb.cols || rgb.rows <= 0 ||
+      (rgb.rows & (rgb.rows - 1)) != 0) {
+    throw std::invalid_argument("MipTexture: need a square CV_32FC3 image with a power-of-two side");
+  }
+  size_ = rgb.rows;
+  while ((1 << log2_size_) < size_) ++log2_size_;
+  cv::Mat level = rgb;
+  for (int l = 0;; ++l) {
+    std::vector<uint32_t> packed(level.total());
+    for (int r = 0; r < level.rows; ++r) {
+      const cv::Vec3f* row = level.ptr<cv::Vec3f>(r);
+      for (int c = 0; c < level.cols; ++c) packed[static_cast<size_t>(r) * level.cols + c] = pack(row[c]);
+    }
+    levels_.push_back(std::move(packed));
+    inverse_scale_.push_back(std::ldexp(1.0f, -l));
+    if (level.rows == 1) {
+      const cv::Vec3f m = level.at<cv::Vec3f>(0, 0);
+      mean_ = Eigen::Vector3f(m[0], m[1], m[2]).cwiseMax(0.0f).cwiseMin(1.0f);
+      break;
+    }
+    // Box filter of 2x2 blocks; blocks never straddle the wrap because the side is even.
+    cv::Mat next(level.rows / 2, level.cols / 2, CV_32FC3);
+    for (int r = 0; r < next.rows; ++r) {
+      const cv::Vec3f* a = level.ptr<cv::Vec3f>(2 * r);
+      const cv::Vec3f* b = level.ptr<cv::Vec3f>(2 * r + 1);
+      cv::Vec3f* o = next.ptr<cv::Vec3f>(r);
+      for (int c = 0; c < next.cols; ++c)
+        o[c] = 0.25f * (a[2 * c] + a[2 * c + 1] + b[2 * c] + b[2 * c + 1]);
+    }
+    level = next;
+  }
+}
+
+}  // namespace kestrel::sim

@@ -1,0 +1,87 @@
+#pragma once
+// A tiling colour texture with its mip-map chain, and the trilinear lookup the renderer uses.
+//
+// Invariants: level 0 is square with a power-of-two side; level l has side (size >> l), down to
+// one texel, each texel the mean of the 2x2 texels below it (box pre-filter), so a lookup at the
+// level matching the pixel footprint does not alias. Texels are packed R | G << 8 | B << 16.
+// Texture coordinates are in level-0 texels and wrap (the texture tiles the plane).
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <cstdint>
+#include <opencv2/core/mat.hpp>
+#include <vector>
+
+namespace kestrel::sim {
+
+class MipTexture {
+ public:
+  /// From a CV_32FC3 image (R, G, B in [0, 1]) that tiles periodically.
+  explicit MipTexture(const cv::Mat& rgb);
+
+  int size() const { return size_; }
+  int levels() const { return static_cast<int>(levels_.size()); }
+  const std::vector<uint32_t>& level(int l) const { return levels_[l]; }
+  /// Mean colour (the last level), R, G, B in [0, 1].
+  const Eigen::Vector3f& mean() const { return mean_; }
+
+  /// Colour at (x, y) level-0 texels and level of detail `lod` (log2 of the pixel footprint
+  /// in level-0 texels, clamped to the chain), packed like the texels. Bilinear within a level;
+  /// between levels it blends only when `lod` is within a quarter level of the midpoint
+  /// ("brilinear"), which halves the cost of trilinear filtering at no visible loss.
+  uint32_t sample(float x, float y, float lod) const {
+    const int top = levels() - 1;
+    if (lod <= 0.0f) return bilinear(0, x, y);
+    if (lod >= static_cast<float>(top)) return bilinear(top, x, y);
+    const int l = static_cast<int>(lod);
+    const float frac = lod - static_cast<float>(l);
+    if (frac < 0.25f) return bilinear(l, x, y);
+    if (frac > 0.75f) return bilinear(l + 1, x, y);
+    return lerp(bilinear(l, x, y), bilinear(l + 1, x, y), static_cast<uint32_t>((frac - 0.25f) * 512.0f));
+  }
+
+  /// Bilinear lookup in level `l` at (x, y) level-0 texels, packed.
+  uint32_t bilinear(int l, float x, float y) const {
+    const float scale = inverse_scale_[l];
+    const float fx = x * scale - 0.5f, fy = y * scale - 0.5f;
+    const float x0 = floor_fast(fx), y0 = floor_fast(fy);
+    const uint32_t wx = static_cast<uint32_t>((fx - x0) * 256.0f), wy = static_cast<uint32_t>((fy - y0) * 256.0f);
+    const uint32_t mask = static_cast<uint32_t>((size_ >> l) - 1);
+    const int shift = log2_size_ - l;
+    const uint32_t ix = static_cast<uint32_t>(static_cast<int64_t>(x0)) & mask;
+    const uint32_t iy = static_cast<uint32_t>(static_cast<int64_t>(y0)) & mask;
+    const uint32_t ix1 = (ix + 1) & mask, iy1 = (iy + 1) & mask;
+    const uint32_t* d = levels_[l].data();
+    const uint32_t top = lerp(d[(iy << shift) | ix], d[(iy << shift) | ix1], wx);
+    const uint32_t bottom = lerp(d[(iy1 << shift) | ix], d[(iy1 << shift) | ix1], wx);
+    return lerp(top, bottom, wy);
+  }
+
+  /// The first channel of a grey texture at (x, y), bilinear in the level nearest `lod`.
+  float sample_grey(float x, float y, float lod) const {
+    const int l = std::clamp(static_cast<int>(lod + 0.5f), 0, levels() - 1);
+    return static_cast<float>(bilinear(l, x, y) & 255u);
+  }
+
+  /// Per-channel a + (b - a) * w / 256 on packed texels, two channels per multiply.
+  static uint32_t lerp(uint32_t a, uint32_t b, uint32_t w) {
+    const uint32_t iw = 256u - w;
+    const uint32_t rb = (((a & 0x00ff00ffu) * iw + (b & 0x00ff00ffu) * w) >> 8) & 0x00ff00ffu;
+    const uint32_t g = (((a & 0x0000ff00u) * iw + (b & 0x0000ff00u) * w) >> 8) & 0x0000ff00u;
+    return rb | g;
+  }
+
+ private:
+  static float floor_fast(float v) {
+    const float t = static_cast<float>(static_cast<int64_t>(v));
+    return t > v ? t - 1.0f : t;
+  }
+
+  int size_ = 0;
+  int log2_size_ = 0;
+  std::vector<std::vector<uint32_t>> levels_;
+  std::vector<float> inverse_scale_;
+  Eigen::Vector3f mean_ = Eigen::Vector3f::Zero();
+};
+
+}  // namespace kestrel::sim

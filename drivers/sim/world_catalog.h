@@ -1,0 +1,24 @@
+#pragma once
+// Finding a world by name: the worlds shipped in drivers/sim/worlds/ (embedded in the library
+// at build time, so the tools work wherever they are installed), `stata` (extruded from a ROS
+// occupancy map given by path), a world file, or any occupancy map YAML.
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "drivers/sim/world.h"
+
+namespace kestrel::sim {
+
+/// Names of the embedded worlds (room, floor, office).
+std::vector<std::string> builtin_world_names();
+/// Text of an embedded world, or empty if there is none of that name.
+std::optional<std::string> builtin_world_text(const std::string& name);
+
+/// `what` is an embedded world's name, "stata" (built from `map_yaml`), a path to a world file
+/// (*.world) or a path to an occupancy map (*.yaml). `map_seed` sets the appearance of worlds
+/// built from maps. Throws InputError for an unknown name or bad file (naming it).
+World load_world(const std::string& what, const std::string& map_yaml = "", uint64_t map_seed = 1);
+
+}  // namespace kestrel::sim
