@@ -1,0 +1,169 @@
+#pragma once
+// The onboard state estimator: IMU propagation at IMU rate, visual odometry relative to a
+// cloned keyframe pose, and late SLAM corrections, with either filter.
+//
+// Time model. The filter state is a deterministic function of the time-ordered inputs: the
+// IMU stream defines "now"; every other input is an event at its own utime. The estimator
+// keeps, for the last history_s seconds, the state after every IMU sample (a snapshot) and
+// every event. An event that arrives late (visual odometry always does, by its processing
+// time; a SLAM correction by seconds) is inserted at its utime and the states after it are
+// recomputed from the snapshot before it. The result is therefore identical, bit for bit, to
+// what the same inputs arriving on time would have given. Within an IMU interval, an event
+// splits the step at its utime with the reading interpolated there.
+//
+// Keyframes. A VO update is T_refcam_curcam against its reference frame. The body pose at
+// the reference's utime is cloned into the state (a clone event at that utime, inserted when
+// the first update that needs it arrives) and every update against that reference is a
+// relative-pose measurement between the clone and now, however long the keyframe is kept.
+// When the reference is older than the history (or than the estimator), the first update
+// against it becomes an anchor instead: the pose is cloned at that update, and later updates
+// are measured against it through the anchor's own VO estimate.
+//
+// Robustness: non-finite or malformed inputs are rejected; IMU samples that repeat or go
+// back in time are dropped; VO failures only count (the filter keeps predicting and its
+// covariance grows); gaps in the IMU add noise; everything is counted in counters().
+
+#include <cstdint>
+#include <deque>
+#include <map>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "common/geometry/se3.h"
+#include "estimator/filter.h"
+#include "estimator/initializer.h"
+#include "estimator/options.h"
+
+namespace kestrel::estimator {
+
+/// One visual-odometry result (vo_update_t without the diagnostics).
+struct VoUpdate {
+  int64_t utime = 0;
+  int64_t reference_utime = 0;
+  bool ok = false;  ///< status OK: the motion below is an estimate
+  Eigen::Isometry3d T_refcam_curcam = Eigen::Isometry3d::Identity();
+  Matrix6d covariance = Matrix6d::Zero();  ///< [dp (reference camera); dtheta (current camera)]
+  Eigen::Isometry3d T_body_camera = Eigen::Isometry3d::Identity();
+};
+
+/// A SLAM correction: the body pose at a past utime.
+struct PoseCorrection {
+  int64_t utime = 0;
+  int64_t revision = 0;  ///< a newer revision replaces an older one for the same utime
+  Eigen::Isometry3d T_world_body = Eigen::Isometry3d::Identity();
+  Matrix6d covariance = Matrix6d::Zero();  ///< [dp (world); dtheta (body)]; zero = unknown
+};
+
+/// kDegraded: no VO fused for vo_timeout_s, the state runs on the IMU alone. (A diverged filter
+/// is not reported as failed: it starts initialising again, so there is no state to publish.)
+enum class Status { kInitializing, kOk, kDegraded };
+
+struct EstimatorOutput {
+  int64_t utime = 0;
+  Status status = Status::kInitializing;
+  NavState nav;
+  Matrix15d covariance = Matrix15d::Zero();
+  Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();  ///< body, bias-corrected
+};
+
+/// What happened to an input when it was handed over.
+enum class Verdict {
+  kAccepted,
+  kInvalid,          ///< non-finite or malformed (see the message of validate_*)
+  kDuplicate,        ///< same utime as one already received
+  kOutOfOrder,       ///< older than the newest of its stream
+  kTooOld,           ///< before the kept history
+  kNotInitialized,   ///< arrived before the filter had a state
+  kNoMeasurement,    ///< a VO failure: nothing to fuse, counted
+};
+
+struct EstimatorCounters {
+  int64_t imu_accepted = 0, imu_invalid = 0, imu_duplicate = 0, imu_out_of_order = 0;
+  int64_t imu_gaps = 0;
+  int64_t vo_received = 0, vo_failed = 0, vo_invalid = 0, vo_duplicate = 0,
+          vo_out_of_order = 0, vo_too_old = 0, vo_before_init = 0, vo_anchors = 0;
+  int64_t vo_applied = 0, vo_gated = 0, vo_unreferenced = 0;
+  int64_t corrections_received = 0, corrections_invalid = 0, corrections_duplicate = 0,
+          corrections_too_old = 0, corrections_before_init = 0;
+  int64_t corrections_applied = 0, corrections_gated = 0;
+  int64_t replays = 0, replayed_steps = 0, resets = 0, filter_failures = 0, init_restarts = 0;
+};
+
+class Estimator {
+ public:
+  explicit Estimator(const EstimatorOptions& options);
+  ~Estimator();
+  Estimator(const Estimator&) = delete;
+  Estimator& operator=(const Estimator&) = delete;
+
+  /// Starts from a known state at `sample` (its utime and reading), instead of waiting for a
+  /// still vehicle. Clears everything received before.
+  void initialize(const NavState& nav, const Matrix15d& P, const ImuSample& sample);
+
+  Verdict add_imu(const ImuSample& sample);
+  Verdict add_vo(const VoUpdate& update);
+  Verdict add_correction(const PoseCorrection& correction);
+  /// Drops all state and history; the next IMU samples initialise again.
+  void reset();
+
+  bool initialized() const { return !history_.empty(); }
+  /// The state at the newest IMU sample; empty while initialising.
+  std::optional<EstimatorOutput> output() const;
+  /// The full filter state (with clones) at the newest IMU sample; empty while initialising.
+  const FilterState* filter_state() const;
+  EstimatorCounters counters() const;
+  const EstimatorOptions& options() const { return options_; }
+
+ private:
+  struct CloneSpec {
+    int64_t clone_utime = 0;
+    bool anchored = false;
+    Eigen::Isometry3d anchor = Eigen::Isometry3d::Identity();  ///< T_refcam_anchorcam
+    Matrix6d anchor_covariance = Matrix6d::Zero();
+  };
+  enum class EventKind { kCorrection = 0, kVo = 1, kClone = 2 };  // order at equal utime
+  enum class Outcome { kPending, kApplied, kGated, kUnreferenced };
+  struct Event {
+    int64_t utime = 0;
+    EventKind kind = EventKind::kVo;
+    int64_t seq = 0;
+    VoUpdate vo;
+    PoseCorrection correction;
+    Outcome outcome = Outcome::kPending;
+  };
+  struct Snapshot {
+    ImuSample imu;
+    FilterState state;
+  };
+
+  void start(const NavState& nav, const Matrix15d& P, const ImuSample& sample);
+  void insert_event(Event event);
+  void replay_from(int64_t utime);
+  void step(const Snapshot& previous, Snapshot& next);
+  void apply(Event& event, FilterState& s);
+  void trim();
+  void retire(const Event& event);
+  Matrix6d vo_noise(const VoUpdate& update) const;
+  int64_t oldest_utime() const { return history_.front().imu.utime; }
+
+  EstimatorOptions options_;
+  std::unique_ptr<Filter> filter_;
+  StaticInitializer initializer_;
+  std::deque<Snapshot> history_;
+  std::vector<Event> events_;  // sorted by (utime, kind, seq)
+  std::map<int64_t, CloneSpec> clone_specs_;  // by VO reference utime
+  int64_t next_seq_ = 0;
+  int64_t last_imu_utime_ = -1;
+  int64_t last_vo_utime_ = -1;
+  int64_t last_retired_vo_applied_ = -1;
+  EstimatorCounters counters_;  // inputs, and outcomes of retired events
+};
+
+/// Throws InputError (naming `what`) unless the input is usable: finite values, a proper
+/// rotation, a symmetric positive semi-definite covariance (all zero allowed where noted).
+void validate_imu(const ImuSample& sample, const std::string& what);
+void validate_vo(const VoUpdate& update, bool need_covariance, const std::string& what);
+void validate_correction(const PoseCorrection& correction, const std::string& what);
+
+}  // namespace kestrel::estimator

@@ -1,0 +1,41 @@
+#pragma once
+// A visual-odometry stand-in with known noise, for Monte-Carlo consistency runs: from true
+// body poses it produces what the VO publishes (T_refcam_curcam against a keyframe, with a
+// covariance), perturbed by exactly that covariance. A frame becomes the new keyframe once
+// the camera has moved more than a distance or angle from the current one, as the real VO
+// does when it runs out of overlap. Reproducible: all randomness comes from the seed.
+
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <random>
+
+#include "estimator/estimator.h"
+
+namespace kestrel::estimator {
+
+struct SyntheticVoOptions {
+  Eigen::Isometry3d T_body_camera = Eigen::Isometry3d::Identity();
+  /// Noise standard deviations of [dp (reference camera, m); dtheta (current camera, rad)].
+  Eigen::Matrix<double, 6, 1> sigma =
+      (Eigen::Matrix<double, 6, 1>() << 0.004, 0.004, 0.006, 0.003, 0.003, 0.002).finished();
+  double keyframe_distance_m = 0.25;
+  double keyframe_angle_rad = 10.0 * M_PI / 180.0;
+  double failure_probability = 0.0;  ///< per frame: a failed update, as the VO reports it
+};
+
+class SyntheticVo {
+ public:
+  SyntheticVo(const SyntheticVoOptions& options, uint64_t seed);
+  /// The update for the frame at `utime` whose true body pose is T_world_body.
+  VoUpdate next(int64_t utime, const Eigen::Isometry3d& T_world_body);
+  const SyntheticVoOptions& options() const { return options_; }
+
+ private:
+  SyntheticVoOptions options_;
+  std::mt19937_64 rng_;
+  bool has_keyframe_ = false;
+  int64_t keyframe_utime_ = 0;
+  Eigen::Isometry3d T_world_keycam_ = Eigen::Isometry3d::Identity();
+};
+
+}  // namespace kestrel::estimator

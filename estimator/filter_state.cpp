@@ -1,0 +1,102 @@
+#include "estimator/filter_state.h"
+
+#include <cmath>
+
+#include "common/geometry/so3.h"
+
+namespace kestrel::estimator {
+
+int FilterMean::find_clone(int64_t t) const {
+  for (int i = 0; i < num_clones; ++i)
+    if (clones[static_cast<size_t>(i)].utime == t) return i;
+  return -1;
+}
+
+FilterMean boxplus(const FilterMean& x, const Eigen::Ref<const ErrorVector>& dx) {
+  FilterMean out = x;
+  out.nav = boxplus(x.nav, dx.head<idx::kNav>());
+  for (int i = 0; i < x.num_clones; ++i) {
+    const int o = FilterMean::clone_offset(i);
+    Clone& c = out.clones[static_cast<size_t>(i)];
+    c.p_world_body += dx.segment<3>(o);
+    c.R_world_body = c.R_world_body * so3::exp(dx.segment<3>(o + 3));
+  }
+  return out;
+}
+
+ErrorVector boxminus(const FilterMean& a, const FilterMean& b) {
+  ErrorVector dx(a.dim());
+  dx.head<idx::kNav>() = boxminus(a.nav, b.nav);
+  for (int i = 0; i < a.num_clones; ++i) {
+    const int o = FilterMean::clone_offset(i);
+    const Clone& ca = a.clones[static_cast<size_t>(i)];
+    const Clone& cb = b.clones[static_cast<size_t>(i)];
+    dx.segment<3>(o) = ca.p_world_body - cb.p_world_body;
+    dx.segment<3>(o + 3) = so3::log(cb.R_world_body.transpose() * ca.R_world_body);
+  }
+  return dx;
+}
+
+bool FilterState::is_valid() const {
+  const int n = mean.dim();
+  if (P.rows() != n || P.cols() != n || !P.allFinite() || !mean.nav.all_finite()) return false;
+  if ((P.diagonal().array() < 0.0).any()) return false;
+  const double scale = std::max(1e-300, P.cwiseAbs().maxCoeff());
+  return (P - P.transpose()).cwiseAbs().maxCoeff() <= 1e-9 * scale;
+}
+
+void remove_clone(FilterState& s, int i) {
+  const int n = s.mean.dim();
+  const int o = FilterMean::clone_offset(i);
+  const int tail = n - o - 6;
+  // Shift the later blocks up and left over the removed one.
+  if (tail > 0) {
+    s.P.block(o, 0, tail, n) = s.P.block(o + 6, 0, tail, n).eval();
+    s.P.block(0, o, n, tail) = s.P.block(0, o + 6, n, tail).eval();
+  }
+  s.P.conservativeResize(n - 6, n - 6);
+  for (int k = i; k + 1 < s.mean.num_clones; ++k)
+    s.mean.clones[static_cast<size_t>(k)] = s.mean.clones[static_cast<size_t>(k + 1)];
+  --s.mean.num_clones;
+}
+
+void add_clone(FilterState& s) {
+  if (s.mean.find_clone(s.mean.utime) >= 0) return;
+  if (s.mean.num_clones == kMaxClones) remove_clone(s, 0);  // the oldest: clones sorted by utime
+  const int n = s.mean.dim();
+  Clone c;
+  c.utime = s.mean.utime;
+  c.p_world_body = s.mean.nav.p_world_body;
+  c.R_world_body = s.mean.nav.R_world_body;
+  s.mean.clones[static_cast<size_t>(s.mean.num_clones)] = c;
+  ++s.mean.num_clones;
+  // The clone's error is a copy of the current [dp; dtheta]: rows and columns copied.
+  s.P.conservativeResize(n + 6, n + 6);
+  s.P.block(n, 0, 3, n) = s.P.block(idx::kP, 0, 3, n);
+  s.P.block(n + 3, 0, 3, n) = s.P.block(idx::kTheta, 0, 3, n);
+  s.P.block(0, n, n, 3) = s.P.block(0, idx::kP, n, 3);
+  s.P.block(0, n + 3, n, 3) = s.P.block(0, idx::kTheta, n, 3);
+  s.P.block<3, 3>(n, n) = s.P.block<3, 3>(idx::kP, idx::kP);
+  s.P.block<3, 3>(n, n + 3) = s.P.block<3, 3>(idx::kP, idx::kTheta);
+  s.P.block<3, 3>(n + 3, n) = s.P.block<3, 3>(idx::kTheta, idx::kP);
+  s.P.block<3, 3>(n + 3, n + 3) = s.P.block<3, 3>(idx::kTheta, idx::kTheta);
+}
+
+void inject(FilterState& s, const Eigen::Ref<const ErrorVector>& dx) {
+  s.mean = boxplus(s.mean, dx);
+  const int n = s.mean.dim();
+  for (int b = -1; b < s.mean.num_clones; ++b) {
+    const int o = b < 0 ? idx::kTheta : FilterMean::clone_offset(b) + 3;
+    const Eigen::Matrix3d G = Eigen::Matrix3d::Identity() - 0.5 * so3::hat(dx.segment<3>(o));
+    s.P.block(o, 0, 3, n) = (G * s.P.block(o, 0, 3, n)).eval();
+    s.P.block(0, o, n, 3) = (s.P.block(0, o, n, 3) * G.transpose()).eval();
+  }
+  symmetrize(s.P);
+}
+
+void symmetrize(Covariance& P) {
+  const Covariance Pt = P.transpose();
+  P = 0.5 * (P + Pt);
+}
+
+}  // namespace kestrel::estimator

@@ -1,0 +1,77 @@
+#pragma once
+// The full filter state: the navigation state, up to kMaxClones cloned body poses, and the
+// joint covariance.
+//
+// A clone is a copy of T_world_body taken at a past utime (a visual-odometry keyframe):
+// stochastic cloning (Roumeliotis & Burdick 2002). Its error [dp (world); dtheta (body)]
+// follows the navigation error in the state vector:
+//   [nav (15) | clone 0 (6) | clone 1 (6) | ...]
+// so the dimension is 15 + 6 * num_clones. A relative-pose measurement between a clone and
+// now is then an ordinary measurement of the state, however long the keyframe is kept.
+// Invariants: clones are ordered by utime, no two share a utime, P is symmetric and has the
+// dimension of the mean.
+
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+
+#include "estimator/nav_state.h"
+
+namespace kestrel::estimator {
+
+inline constexpr int kMaxClones = 3;
+inline constexpr int kMaxDim = idx::kNav + 6 * kMaxClones;
+
+/// Dynamic size up to kMaxDim, stored inline (no allocation at IMU rate).
+using Covariance = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor,
+                                 kMaxDim, kMaxDim>;
+using ErrorVector = Eigen::Matrix<double, Eigen::Dynamic, 1, Eigen::ColMajor, kMaxDim, 1>;
+
+struct Clone {
+  int64_t utime = 0;
+  Eigen::Vector3d p_world_body = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d R_world_body = Eigen::Matrix3d::Identity();
+};
+
+struct FilterMean {
+  int64_t utime = 0;
+  NavState nav;
+  std::array<Clone, kMaxClones> clones{};
+  int num_clones = 0;
+
+  int dim() const { return idx::kNav + 6 * num_clones; }
+  /// Index of the clone taken at `utime`, or -1.
+  int find_clone(int64_t utime) const;
+  /// Offset of clone i in the error state.
+  static int clone_offset(int i) { return idx::kNav + 6 * i; }
+};
+
+/// x ⊞ dx for the whole state (dx has x.dim() entries).
+FilterMean boxplus(const FilterMean& x, const Eigen::Ref<const ErrorVector>& dx);
+/// a ⊟ b; a and b must hold clones at the same utimes.
+ErrorVector boxminus(const FilterMean& a, const FilterMean& b);
+
+struct FilterState {
+  FilterMean mean;
+  Covariance P;
+
+  /// Symmetric, finite, of the right size, with a non-negative diagonal.
+  bool is_valid() const;
+};
+
+/// Clones the current body pose at mean.utime (P grows by the copied rows and columns). When
+/// kMaxClones are held already, the oldest is marginalised first. Does nothing if a clone at
+/// this utime exists.
+void add_clone(FilterState& s);
+/// Marginalises clone i out of the state.
+void remove_clone(FilterState& s, int i);
+
+/// Moves the mean by an estimated error dx (after an update) and maps P into the error state
+/// around the new mean: for each rotation block, dtheta_new = dtheta - dx_theta - dx_theta x
+/// dtheta / 2 to first order, so P <- G P G^T with G = I - [dx_theta]x / 2 on those blocks.
+void inject(FilterState& s, const Eigen::Ref<const ErrorVector>& dx);
+
+/// Makes P exactly symmetric (rounding in the updates breaks it slowly).
+void symmetrize(Covariance& P);
+
+}  // namespace kestrel::estimator

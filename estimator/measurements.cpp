@@ -1,0 +1,71 @@
+#include "estimator/measurements.h"
+
+#include "common/geometry/so3.h"
+
+namespace kestrel::estimator {
+namespace {
+
+// g for a pose prediction T_h against an observation T_z: [t_h - t_z; Log(R_z^T R_h)].
+Residual pose_residual(const Eigen::Isometry3d& T_h, const Eigen::Isometry3d& T_z) {
+  Residual g(6);
+  g.head<3>() = T_h.translation() - T_z.translation();
+  g.tail<3>() = so3::log(T_z.linear().transpose() * T_h.linear());
+  return g;
+}
+
+}  // namespace
+
+RelativePoseMeasurement::RelativePoseMeasurement(int clone_index,
+                                                 const Eigen::Isometry3d& T_refcam_curcam,
+                                                 const Matrix6d& covariance,
+                                                 const Eigen::Isometry3d& T_body_camera)
+    : clone_(clone_index), z_(T_refcam_curcam), Q_(covariance), T_body_camera_(T_body_camera) {}
+
+Eigen::Isometry3d RelativePoseMeasurement::predict(const FilterMean& x) const {
+  const Clone& c = x.clones[static_cast<size_t>(clone_)];
+  const Eigen::Isometry3d T_world_ref = se3::make(c.R_world_body, c.p_world_body);
+  return T_body_camera_.inverse() * T_world_ref.inverse() * x.nav.T_world_body() * T_body_camera_;
+}
+
+Residual RelativePoseMeasurement::residual(const FilterMean& x) const {
+  return pose_residual(predict(x), z_);
+}
+
+MeasurementJacobian RelativePoseMeasurement::jacobian(const FilterMean& x) const {
+  const Clone& c = x.clones[static_cast<size_t>(clone_)];
+  const Eigen::Matrix3d& Rr = c.R_world_body;
+  const Eigen::Matrix3d& Rc = x.nav.R_world_body;
+  const Eigen::Matrix3d R_bc = T_body_camera_.linear();
+  const Eigen::Vector3d t_bc = T_body_camera_.translation();
+  // Camera centre now, seen from the reference body frame.
+  const Eigen::Vector3d d = Rr.transpose() * (x.nav.p_world_body + Rc * t_bc - c.p_world_body);
+  const Eigen::Matrix3d A = R_bc.transpose() * Rr.transpose();
+  const Eigen::Matrix3d Jr_inv = so3::right_jacobian_inverse(residual(x).tail<3>());
+  const int o = FilterMean::clone_offset(clone_);
+
+  MeasurementJacobian H = MeasurementJacobian::Zero(6, x.dim());
+  H.block<3, 3>(0, idx::kP) = A;
+  H.block<3, 3>(0, idx::kTheta) = -A * Rc * so3::hat(t_bc);
+  H.block<3, 3>(0, o) = -A;
+  H.block<3, 3>(0, o + 3) = R_bc.transpose() * so3::hat(d);
+  H.block<3, 3>(3, idx::kTheta) = Jr_inv * R_bc.transpose();
+  H.block<3, 3>(3, o + 3) = -Jr_inv * R_bc.transpose() * Rc.transpose() * Rr;
+  return H;
+}
+
+AbsolutePoseMeasurement::AbsolutePoseMeasurement(const Eigen::Isometry3d& T_world_body,
+                                                 const Matrix6d& covariance)
+    : z_(T_world_body), Q_(covariance) {}
+
+Residual AbsolutePoseMeasurement::residual(const FilterMean& x) const {
+  return pose_residual(x.nav.T_world_body(), z_);
+}
+
+MeasurementJacobian AbsolutePoseMeasurement::jacobian(const FilterMean& x) const {
+  MeasurementJacobian H = MeasurementJacobian::Zero(6, x.dim());
+  H.block<3, 3>(0, idx::kP).setIdentity();
+  H.block<3, 3>(3, idx::kTheta) = so3::right_jacobian_inverse(residual(x).tail<3>());
+  return H;
+}
+
+}  // namespace kestrel::estimator

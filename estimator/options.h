@@ -1,0 +1,65 @@
+#pragma once
+// Every option of the estimator, with its default and unit. The processes expose each of
+// them on the command line and in --config files (estimator/cli_options.h).
+
+#include <Eigen/Core>
+
+#include "estimator/filter.h"
+#include "estimator/imu.h"
+#include "estimator/unscented.h"
+
+namespace kestrel::estimator {
+
+/// Where the noise of a visual-odometry measurement comes from.
+struct VoNoiseOptions {
+  enum class Source {
+    kReported,  ///< the 6x6 covariance the VO sends with each update (times reported_scale)
+    kConstant,  ///< the paper's constant model: constant_sigma, fitted by kestrel-fit-vo-noise
+  };
+  Source source = Source::kReported;
+  double reported_scale = 1.0;  ///< multiplies the reported covariance
+  /// Standard deviations of [dp (reference camera frame, m); dtheta (current camera, rad)].
+  Eigen::Matrix<double, 6, 1> constant_sigma =
+      (Eigen::Matrix<double, 6, 1>() << 0.005, 0.005, 0.008, 0.004, 0.004, 0.003).finished();
+};
+
+/// How the filter starts when no state is given: averaging the IMU over a still period.
+struct InitOptions {
+  double duration_s = 0.5;        ///< IMU time averaged for attitude and gyro bias
+  double max_accel_std = 0.3;     ///< m/s^2: above this the vehicle is moving; wait
+  double max_gyro_std = 0.05;     ///< rad/s
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();  ///< world frame origin choice, m
+  double yaw = 0.0;               ///< rad: yaw is unobservable, so it is given
+  // Prior standard deviations of the initial state.
+  double sigma_position = 1e-3;   ///< m
+  double sigma_velocity = 0.05;   ///< m/s
+  double sigma_tilt = 0.02;       ///< rad, roll and pitch
+  double sigma_yaw = 1e-3;        ///< rad
+  double sigma_gyro_bias = 5e-3;  ///< rad/s (after subtracting the averaged rate)
+  double sigma_accel_bias = 0.1;  ///< m/s^2
+};
+
+struct EstimatorOptions {
+  FilterKind filter = FilterKind::kEkf;
+  UnscentedParams unscented;
+  ImuNoise imu;
+  double gravity = kStandardGravity;  ///< m/s^2
+  VoNoiseOptions vo_noise;
+  /// Gate on the squared Mahalanobis distance of a VO innovation (chi^2, 6 dof); 0 = off.
+  /// 30 lets through all but 1 in 25,000 correct measurements.
+  double vo_gate_chi2 = 30.0;
+  /// The same for SLAM corrections; off by default: a loop closure may move the state far.
+  double correction_gate_chi2 = 0.0;
+  /// Used for a correction that carries no covariance (all zero): sigmas of [dp; dtheta].
+  double correction_sigma_position = 0.05;  ///< m
+  double correction_sigma_rotation = 0.02;  ///< rad
+  /// How far back states and measurements are kept: a measurement older than this is dropped.
+  double history_s = 3.0;
+  /// An IMU interval longer than this is a gap: readings are held and the gap noise is added.
+  double max_imu_dt_s = 0.02;
+  /// Without an accepted VO update for this long the state is DEGRADED (IMU only).
+  double vo_timeout_s = 0.5;
+  InitOptions init;
+};
+
+}  // namespace kestrel::estimator
