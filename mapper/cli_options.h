@@ -1,0 +1,19 @@
+#pragma once
+// The mapper's options on a command line (and so in --config files and --print-config), shared
+// by kestrel-mapper and kestrel-map so the two spell every option the same way. Every option
+// shows its default in --help; values are checked by MapperOptions::validate(), whose error
+// names the key.
+
+#include "common/cli.h"
+#include "mapper/mapper.h"
+
+namespace kestrel::mapper {
+
+/// Adds the map, scan and keyframe options of `o` to `app` (bound by reference: `o` must
+/// outlive the parse).
+void add_mapper_options(CLI::App& app, MapperOptions& o);
+
+/// Runs o.validate(), turning its std::invalid_argument into a CLI::ValidationError (exit 2).
+void check_mapper_options(const MapperOptions& o);
+
+}  // namespace kestrel::mapper

@@ -1,0 +1,64 @@
+#pragma once
+// Cell addressing, exactly as OctoMap does it (OcTreeBaseImpl::coordToKeyChecked, keyToCoord),
+// so that a key computed here names the same cell as one computed by an octomap::OcTree of
+// the same resolution: key = floor(coordinate / resolution) + 32768, 16 bits per axis, tree
+// depth 16. Cell k covers [ (k - 32768) * res, (k - 32767) * res ).
+
+// OcTreeKey.h uses size_t and std::vector without including their headers.
+#include <cstddef>
+#include <vector>
+
+#include <octomap/OcTreeKey.h>
+#include <octomap/octomap_types.h>
+
+#include <cmath>
+#include <cstdint>
+
+namespace kestrel::mapper {
+
+using Key = octomap::OcTreeKey;
+
+class KeySpace {
+ public:
+  static constexpr int kTreeDepth = 16;
+  static constexpr int kMaxVal = 32768;  ///< key of the cell whose lower corner is at 0
+
+  explicit KeySpace(double resolution_m)
+      : resolution_(resolution_m), factor_(1.0 / resolution_m) {}
+
+  double resolution() const { return resolution_; }
+
+  /// The key along one axis; false outside the tree (or for a non-finite coordinate).
+  bool key(double coordinate, uint16_t& k) const {
+    const double scaled = std::floor(factor_ * coordinate);
+    // The negated comparison also rejects NaN before the cast, which would be undefined.
+    if (!(scaled >= -kMaxVal && scaled < kMaxVal)) return false;
+    k = static_cast<uint16_t>(static_cast<int>(scaled) + kMaxVal);
+    return true;
+  }
+  bool key(const octomap::point3d& p, Key& k) const {
+    return key(static_cast<double>(p.x()), k[0]) && key(static_cast<double>(p.y()), k[1]) &&
+           key(static_cast<double>(p.z()), k[2]);
+  }
+  bool key(double x, double y, double z, Key& k) const {
+    return key(x, k[0]) && key(y, k[1]) && key(z, k[2]);
+  }
+
+  /// Centre of cell k along one axis (OctoMap's keyToCoord).
+  double centre(uint16_t k) const {
+    return (static_cast<double>(static_cast<int>(k) - kMaxVal) + 0.5) * resolution_;
+  }
+  /// Lower and upper bound of cell k along one axis.
+  double lower(uint16_t k) const {
+    return static_cast<double>(static_cast<int>(k) - kMaxVal) * resolution_;
+  }
+  double upper(uint16_t k) const {
+    return static_cast<double>(static_cast<int>(k) - kMaxVal + 1) * resolution_;
+  }
+
+ private:
+  double resolution_;
+  double factor_;
+};
+
+}  // namespace kestrel::mapper

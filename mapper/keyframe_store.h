@@ -1,0 +1,72 @@
+#pragma once
+// The keyframes the map is built from, kept so that the map can be rebuilt when SLAM moves
+// them (a loop closure), within a memory budget.
+//
+// A keyframe is stored as the decimated frame that was inserted (depth at insertion
+// resolution, colour for the point cloud), so a rebuild inserts exactly the same rays again;
+// at 128x96 that is about 61 kB a keyframe (0.5 GB holds about 8,500 of them).
+//
+// Policy when the budget is exceeded: keyframes are binned by position (bin_size_m cells) and
+// viewing direction (bin_angle_deg sectors of the optical axis); the oldest keyframe of the
+// fullest bin is dropped. So places seen from many nearby, similar viewpoints are thinned
+// first, and a place seen once keeps its only view. The newest keyframe is never dropped.
+
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <map>
+#include <tuple>
+#include <vector>
+
+#include "common/rgbd_frame.h"
+
+namespace kestrel::mapper {
+
+struct KeyframeOptions {
+  double max_megabytes = 512.0;  ///< budget for the stored frames
+  double bin_size_m = 0.5;       ///< thinning bins: position cell size
+  double bin_angle_deg = 30.0;   ///< thinning bins: optical-axis sector size
+  void validate() const;
+};
+
+struct StoredKeyframe {
+  int64_t id = 0;
+  int64_t utime = 0;
+  Eigen::Isometry3d T_world_camera = Eigen::Isometry3d::Identity();
+  RgbdFrame frame;  ///< as inserted (decimated)
+  size_t bytes() const;
+};
+
+class KeyframeStore {
+ public:
+  explicit KeyframeStore(const KeyframeOptions& options = {});
+
+  /// Adds a keyframe (replacing one with the same id), then drops keyframes by the policy above
+  /// while over budget.
+  void add(StoredKeyframe keyframe);
+  /// Moves a keyframe; false if it is not stored.
+  bool set_pose(int64_t id, const Eigen::Isometry3d& T_world_camera);
+  const StoredKeyframe* find(int64_t id) const;
+  bool contains(int64_t id) const { return keyframes_.count(id) != 0; }
+  /// Stored keyframes, ordered by sensor time (the order to rebuild in).
+  std::vector<const StoredKeyframe*> in_time_order() const;
+
+  size_t size() const { return keyframes_.size(); }
+  size_t bytes() const { return bytes_; }
+  size_t dropped() const { return dropped_; }
+  void clear();
+
+ private:
+  using Bin = std::tuple<int, int, int, int, int>;  // position cell, axis azimuth and elevation
+  Bin bin_of(const Eigen::Isometry3d& T) const;
+  void unbin(int64_t id, const Bin& bin);
+  void drop_one(int64_t keep);
+
+  KeyframeOptions options_;
+  std::map<int64_t, StoredKeyframe> keyframes_;
+  std::map<int64_t, Bin> bin_of_id_;
+  std::map<Bin, std::vector<int64_t>> bins_;  // ids in insertion order
+  size_t bytes_ = 0;
+  size_t dropped_ = 0;
+};
+
+}  // namespace kestrel::mapper

@@ -1,0 +1,105 @@
+// kestrel-mapper: the occupancy map process. Reads CAMERA_RGBD and SLAM_GRAPH (or, with
+// --pose-source ground-truth, GROUND_TRUTH) and publishes MAP_OCTOMAP, rate-limited in sensor
+// time, with heartbeats and lock-step replay (RESET forgets the map). On exit it can write the
+// final map (--save) . The logic is MapNode (map_node.h); this file only wires it to LCM.
+
+#include <spdlog/spdlog.h>
+
+#include <memory>
+#include <stdexcept>
+#include <string>
+
+#include "common/cli.h"
+#include "common/error.h"
+#include "common/transport/channels.h"
+#include "common/transport/node.h"
+#include "mapper/cli_options.h"
+#include "mapper/map_node.h"
+#include "mapper/octree_io.h"
+
+namespace {
+
+using namespace kestrel;
+
+struct Options {
+  std::string name = "mapper";
+  std::string lcm_url;
+  std::string pose_source = "slam";
+  std::string format = "binary";
+  std::string save;
+  mapper::NodeOptions node;
+};
+
+int serve(Options& o) {
+  mapper::check_mapper_options(o.node.mapper);
+  o.node.pose_source = o.pose_source == "slam" ? mapper::PoseSource::kSlamGraph : mapper::PoseSource::kGroundTruth;
+  o.node.full_format = o.format == "full";
+  if (!o.save.empty()) mapper::format_of(o.save);  // a bad extension is an error now, not at exit
+  mapper::MapNode map(o.node);
+
+  std::unique_ptr<transport::Node> node;
+  try {
+    node = std::make_unique<transport::Node>(o.name, o.lcm_url);
+  } catch (const std::runtime_error& e) {
+    spdlog::error("{}", e.what());
+    return kExitUnavailable;
+  }
+  node->advertise(channel::kMapOctomap);
+  node->on_reset([&] { map.reset(); });
+  auto publish = [&](const std::optional<octomap_t>& msg) {
+    if (msg) node->publish(channel::kMapOctomap, *msg);
+  };
+  node->subscribe<rgbd_frame_t>(channel::kCameraRgbd, [&](const rgbd_frame_t& m) {
+    publish(map.on_frame(m, channel::kCameraRgbd));
+  });
+  if (o.node.pose_source == mapper::PoseSource::kSlamGraph) {
+    // Graphs are rare and each may trigger a rebuild: never drop one.
+    node->subscribe<slam_graph_t>(channel::kSlamGraph, [&](const slam_graph_t& m) {
+      publish(map.on_graph(m, channel::kSlamGraph));
+    }, 0);
+  } else {
+    node->subscribe<ground_truth_t>(channel::kGroundTruth, [&](const ground_truth_t& m) {
+      publish(map.on_ground_truth(m, channel::kGroundTruth));
+    }, 0);
+  }
+  node->set_health(process_status_t::STATE_RUNNING, "");
+  spdlog::info("{}: CAMERA_RGBD + {} -> MAP_OCTOMAP at {} m", o.name,
+               o.pose_source == "slam" ? "SLAM_GRAPH" : "GROUND_TRUTH", o.node.mapper.map.resolution_m);
+  const int status = node->spin();
+  const auto& s = map.stats();
+  spdlog::info("{} frames ({} inserted, {} without pose), {} graphs, {} rebuilds, {} maps published, {} rejected",
+               s.frames, s.frames_inserted, s.frames_without_pose, s.graphs, s.rebuilds, s.published,
+               node->counters().messages_rejected);
+  if (!o.save.empty()) {
+    mapper::write_map_file(map.mapper().map(), o.save);
+    spdlog::info("wrote {}", o.save);
+  }
+  return status;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  cli::App app("mapper",
+               "Occupancy voxel map (OctoMap): CAMERA_RGBD + SLAM_GRAPH (or GROUND_TRUTH) -> MAP_OCTOMAP");
+  Options o;
+  app.add_option("--name", o.name, "Process name in heartbeats")->capture_default_str();
+  app.add_option("--lcm-url", o.lcm_url, "LCM URL (default: $LCM_DEFAULT_URL or kestrel's)");
+  app.add_option("--pose-source", o.pose_source,
+                 "slam: keyframes and poses from SLAM_GRAPH (rebuilt on loop closure); ground-truth: "
+                 "every frame at its GROUND_TRUTH pose")
+      ->check(CLI::IsMember({"slam", "ground-truth"}))
+      ->capture_default_str();
+  app.add_option("--publish-period", o.node.publish_period_s, "MAP_OCTOMAP at most this often, s of sensor time")
+      ->check(CLI::Range(0.0, 1e6))
+      ->capture_default_str();
+  app.add_option("--format", o.format, "MAP_OCTOMAP stream: binary (.bt, free/occupied) or full (.ot, log-odds)")
+      ->check(CLI::IsMember({"binary", "full"}))
+      ->capture_default_str();
+  app.add_option("--max-pose-gap", o.node.max_pose_gap_s, "ground-truth: largest gap to interpolate across, s")
+      ->check(cli::Positive)
+      ->capture_default_str();
+  app.add_option("--save", o.save, "Write the final map here on exit (.bt or .ot)");
+  mapper::add_mapper_options(app, o.node.mapper);
+  return app.run(argc, argv, [&] { return serve(o); });
+}

@@ -1,0 +1,158 @@
+#include "mapper/map_node.h"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "common/error.h"
+#include "common/transport/convert.h"
+#include "common/transport/rgbd_codec.h"
+#include "mapper/octree_io.h"
+
+namespace kestrel::mapper {
+
+namespace {
+// The rebuilt map replaces the old one: the revision jumps to the next thousand, so a viewer
+// can tell a rebuild from an increment.
+constexpr int64_t kRebuildRevisionStep = 1000;
+}  // namespace
+
+void NodeOptions::validate() const {
+  mapper.validate();
+  if (!(std::isfinite(publish_period_s) && publish_period_s >= 0.0))
+    throw std::invalid_argument("publish-period: must be >= 0");
+  if (!(std::isfinite(max_pose_gap_s) && max_pose_gap_s > 0.0))
+    throw std::invalid_argument("max-pose-gap: must be > 0");
+  if (max_pending_frames < 1) throw std::invalid_argument("max-pending-frames: must be >= 1");
+}
+
+MapNode::MapNode(const NodeOptions& options)
+    : options_((options.validate(), options)), mapper_(options.mapper) {}
+
+void MapNode::reset() {
+  mapper_.reset();
+  stats_ = {};
+  last_frame_utime_ = 0;
+  last_published_utime_ = -1;
+  revision_ = 0;
+  last_graph_revision_ = -1;
+  pending_.clear();
+  poses_ = Trajectory();
+}
+
+kestrel::octomap_t MapNode::map_message() {
+  const VoxelMap& map = mapper_.map();
+  kestrel::octomap_t msg;
+  msg.utime = map.utime();
+  msg.revision = ++revision_;
+  msg.resolution = map.resolution();
+  msg.format = options_.full_format ? kestrel::octomap_t::FORMAT_FULL : kestrel::octomap_t::FORMAT_BINARY;
+  const auto bytes = encode_octree(map, options_.full_format ? OctreeFormat::kFull : OctreeFormat::kBinary);
+  msg.data.assign(bytes.begin(), bytes.end());
+  msg.size = static_cast<int32_t>(msg.data.size());
+  last_published_utime_ = map.utime();
+  ++stats_.published;
+  return msg;
+}
+
+std::optional<kestrel::octomap_t> MapNode::maybe_publish(bool now) {
+  const int64_t utime = mapper_.map().utime();
+  if (mapper_.map().num_cells() == 0) return std::nullopt;
+  const bool due = last_published_utime_ < 0 ||
+                   1e-6 * static_cast<double>(utime - last_published_utime_) >= options_.publish_period_s;
+  if (!now && !due) return std::nullopt;
+  return map_message();
+}
+
+std::optional<kestrel::octomap_t> MapNode::on_frame(const kestrel::rgbd_frame_t& msg, const char* channel) {
+  RgbdFrame frame = transport::decode_rgbd(msg, channel);
+  if (frame.depth_mm.empty()) throw InputError(std::string(channel) + ": frame has no depth image");
+  if (stats_.frames > 0 && frame.utime <= last_frame_utime_) {
+    throw InputError(std::string(channel) + ": frame utime " + std::to_string(frame.utime) +
+                     " is not after the previous frame's " + std::to_string(last_frame_utime_));
+  }
+  last_frame_utime_ = frame.utime;
+  ++stats_.frames;
+  if (options_.pose_source == PoseSource::kSlamGraph) {
+    mapper_.buffer_frame(frame, channel);
+    return std::nullopt;
+  }
+  pending_.push_back(std::move(frame));
+  while (static_cast<int>(pending_.size()) > options_.max_pending_frames) {
+    pending_.pop_front();
+    ++stats_.frames_without_pose;
+  }
+  insert_pending();
+  return maybe_publish(false);
+}
+
+void MapNode::insert_pending() {
+  if (poses_.empty()) return;
+  const int64_t newest = poses_.poses().back().utime;
+  const int64_t max_gap = static_cast<int64_t>(std::llround(options_.max_pose_gap_s * 1e6));
+  while (!pending_.empty()) {
+    const RgbdFrame& f = pending_.front();
+    const int64_t t = f.depth_utime != 0 ? f.depth_utime : f.utime;
+    if (t > newest) return;  // its pose has not arrived yet
+    if (const auto T_world_body = poses_.at(t, max_gap)) {
+      mapper_.insert(f, *T_world_body * f.T_body_camera, "CAMERA_RGBD");
+      ++stats_.frames_inserted;
+    } else {
+      ++stats_.frames_without_pose;
+    }
+    pending_.pop_front();
+  }
+}
+
+std::optional<kestrel::octomap_t> MapNode::on_ground_truth(const kestrel::ground_truth_t& msg,
+                                                           const char* channel) {
+  if (options_.pose_source != PoseSource::kGroundTruth) return std::nullopt;
+  Eigen::Isometry3d T = transport::from_message(msg.T_world_frame, channel);
+  // Frames are placed by T_world_body * T_body_camera; camera-frame truth (TUM) is turned into a
+  // body pose for frames whose body is their camera, which is every TUM frame.
+  if (msg.frame != kestrel::ground_truth_t::FRAME_BODY && msg.frame != kestrel::ground_truth_t::FRAME_CAMERA) {
+    throw InputError(std::string(channel) + ": unknown frame " + std::to_string(msg.frame));
+  }
+  if (!poses_.empty() && msg.utime <= poses_.poses().back().utime) {
+    throw InputError(std::string(channel) + ": utime " + std::to_string(msg.utime) +
+                     " is not after the previous pose's");
+  }
+  if (poses_.size() >= 4000) {  // keep the last ~20 s at 100 Hz
+    std::vector<StampedPose> recent(poses_.poses().end() - 2000, poses_.poses().end());
+    poses_ = Trajectory(std::move(recent));
+  }
+  poses_.push_back(msg.utime, T);
+  insert_pending();
+  return maybe_publish(false);
+}
+
+std::optional<kestrel::octomap_t> MapNode::on_graph(const kestrel::slam_graph_t& msg, const char* channel) {
+  if (options_.pose_source != PoseSource::kSlamGraph) return std::nullopt;
+  if (msg.revision < last_graph_revision_) {
+    throw InputError(std::string(channel) + ": revision " + std::to_string(msg.revision) +
+                     " is older than the previous " + std::to_string(last_graph_revision_));
+  }
+  if (msg.num_keyframes != static_cast<int32_t>(msg.keyframes.size())) {
+    throw InputError(std::string(channel) + ": num_keyframes does not match the keyframes sent");
+  }
+  std::vector<GraphKeyframe> keyframes;
+  keyframes.reserve(msg.keyframes.size());
+  for (const auto& k : msg.keyframes) {
+    GraphKeyframe g;
+    g.id = k.id;
+    g.utime = k.utime;
+    g.T_world_camera = transport::from_message(k.T_world_camera, channel);
+    keyframes.push_back(g);
+  }
+  last_graph_revision_ = msg.revision;
+  ++stats_.graphs;
+  const GraphResult result = mapper_.apply_graph(keyframes);
+  if (result.rebuilt) {
+    ++stats_.rebuilds;
+    stats_.last_rebuild_keyframes = static_cast<double>(result.rebuild_keyframes);
+    revision_ = (revision_ / kRebuildRevisionStep + 1) * kRebuildRevisionStep - 1;
+  }
+  return maybe_publish(result.rebuilt);
+}
+
+}  // namespace kestrel::mapper

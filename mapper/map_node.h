@@ -1,0 +1,84 @@
+#pragma once
+// The mapper process's logic on decoded messages, without LCM itself: main.cpp only subscribes
+// and publishes, and the tests drive this class with messages directly.
+//
+// Pose sources:
+//  * kSlamGraph (default): CAMERA_RGBD frames are buffered; every SLAM_GRAPH revision inserts
+//    its new keyframes and rebuilds the map when keyframes moved (Mapper::apply_graph).
+//  * kGroundTruth: each frame is inserted at the GROUND_TRUTH pose interpolated at its depth
+//    time, once poses on both sides of that time have arrived (for bench runs before SLAM
+//    exists, and to compare maps). A frame in a gap of the ground truth is dropped and counted.
+//
+// MAP_OCTOMAP is produced at most once per publish_period_s of sensor time, and at once after
+// a rebuild. Everything is driven by the messages' utime, so a lock-step replay publishes the
+// same maps at the same points every time. Bad messages throw InputError naming the channel
+// (the Node counts and drops them); a frame older than the previous one is one of those.
+
+#include <cstdint>
+#include <deque>
+#include <optional>
+
+#include "common/trajectory.h"
+#include "kestrel/ground_truth_t.hpp"
+#include "kestrel/octomap_t.hpp"
+#include "kestrel/rgbd_frame_t.hpp"
+#include "kestrel/slam_graph_t.hpp"
+#include "mapper/mapper.h"
+
+namespace kestrel::mapper {
+
+enum class PoseSource { kSlamGraph, kGroundTruth };
+
+struct NodeOptions {
+  MapperOptions mapper;
+  PoseSource pose_source = PoseSource::kSlamGraph;
+  double publish_period_s = 1.0;    ///< MAP_OCTOMAP at most this often (sensor time)
+  bool full_format = false;         ///< FORMAT_FULL (.ot, log-odds) instead of FORMAT_BINARY (.bt)
+  double max_pose_gap_s = 0.1;      ///< kGroundTruth: largest gap to interpolate across
+  int max_pending_frames = 90;      ///< kGroundTruth: frames waiting for a pose after theirs
+  void validate() const;
+};
+
+struct NodeStats {
+  int64_t frames = 0;             ///< frames accepted
+  int64_t frames_inserted = 0;    ///< kGroundTruth: frames put into the map
+  int64_t frames_without_pose = 0;
+  int64_t graphs = 0;
+  int64_t rebuilds = 0;
+  int64_t published = 0;
+  double last_rebuild_keyframes = 0;
+};
+
+class MapNode {
+ public:
+  explicit MapNode(const NodeOptions& options);
+
+  /// Each returns the MAP_OCTOMAP message to publish now, if one is due.
+  std::optional<kestrel::octomap_t> on_frame(const kestrel::rgbd_frame_t& msg, const char* channel);
+  std::optional<kestrel::octomap_t> on_graph(const kestrel::slam_graph_t& msg, const char* channel);
+  std::optional<kestrel::octomap_t> on_ground_truth(const kestrel::ground_truth_t& msg,
+                                                    const char* channel);
+  /// The map as a message now, regardless of the rate limit (e.g. at shutdown).
+  kestrel::octomap_t map_message();
+  /// Forgets everything (lock-step replay RESET).
+  void reset();
+
+  const Mapper& mapper() const { return mapper_; }
+  const NodeStats& stats() const { return stats_; }
+
+ private:
+  std::optional<kestrel::octomap_t> maybe_publish(bool now);
+  void insert_pending();
+
+  NodeOptions options_;
+  Mapper mapper_;
+  NodeStats stats_;
+  int64_t last_frame_utime_ = 0;
+  int64_t last_published_utime_ = -1;
+  int64_t revision_ = 0;
+  int64_t last_graph_revision_ = -1;
+  std::deque<RgbdFrame> pending_;  // kGroundTruth: frames waiting for their pose
+  Trajectory poses_;               // kGroundTruth: T_world_camera, recent
+};
+
+}  // namespace kestrel::mapper

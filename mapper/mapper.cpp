@@ -1,0 +1,161 @@
+#include "mapper/mapper.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "common/error.h"
+#include "common/geometry/se3.h"
+#include "mapper/scan.h"
+
+namespace kestrel::mapper {
+
+namespace {
+constexpr double kDegree = M_PI / 180.0;
+
+bool moved(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b, double metres, double degrees) {
+  return se3::translation_distance(a, b) > metres || se3::rotation_distance(a, b) > degrees * kDegree;
+}
+}  // namespace
+
+void MapperOptions::validate() const {
+  map.validate();
+  scan.validate();
+  keyframes.validate();
+  auto positive = [](double v, const char* name) {
+    if (!(std::isfinite(v) && v > 0.0)) throw std::invalid_argument(std::string(name) + ": must be > 0");
+  };
+  auto non_negative = [](double v, const char* name) {
+    if (!(std::isfinite(v) && v >= 0.0)) throw std::invalid_argument(std::string(name) + ": must be >= 0");
+  };
+  non_negative(keyframe_translation_m, "keyframe-translation");
+  non_negative(keyframe_rotation_deg, "keyframe-rotation");
+  non_negative(rebuild_translation_m, "rebuild-translation");
+  non_negative(rebuild_rotation_deg, "rebuild-rotation");
+  non_negative(rebuild_interval_s, "rebuild-interval");
+  positive(frame_buffer_s, "frame-buffer");
+}
+
+Mapper::Mapper(const MapperOptions& options)
+    : options_((options.validate(), options)),
+      integrator_(options.map.resolution_m, options.scan),
+      map_(options.map),
+      keyframes_(options.keyframes) {}
+
+void Mapper::integrate(const RgbdFrame& decimated, const Eigen::Isometry3d& T_world_camera,
+                       int64_t utime, const char* what) {
+  ScanOptions at_full = options_.scan;
+  at_full.stride = 1;  // already decimated
+  const Scan scan = make_scan(decimated, T_world_camera, at_full, what);
+  integrator_.compute(scan, update_);
+  map_.integrate(update_, utime);
+  ++frames_inserted_;
+}
+
+const ScanUpdate& Mapper::insert(const RgbdFrame& frame, const Eigen::Isometry3d& T_world_camera,
+                                 const char* what) {
+  frame.validate(what);
+  RgbdFrame small = decimate(frame, options_.scan.stride);
+  const int64_t utime = frame.depth_utime != 0 ? frame.depth_utime : frame.utime;
+  integrate(small, T_world_camera, utime, what);
+  if (!have_last_keyframe_ || moved(last_keyframe_pose_, T_world_camera,
+                                    options_.keyframe_translation_m, options_.keyframe_rotation_deg)) {
+    StoredKeyframe kf;
+    kf.id = next_keyframe_id_++;
+    kf.utime = utime;
+    kf.T_world_camera = T_world_camera;
+    kf.frame = std::move(small);
+    keyframes_.add(std::move(kf));
+    last_keyframe_pose_ = T_world_camera;
+    have_last_keyframe_ = true;
+  }
+  return update_;
+}
+
+void Mapper::buffer_frame(const RgbdFrame& frame, const char* what) {
+  frame.validate(what);
+  if (frame.depth_mm.empty()) throw InputError(std::string(what) + ": frame has no depth image");
+  if (!buffer_.empty() && frame.utime <= buffer_.back().utime) {
+    throw InputError(std::string(what) + ": frame utime " + std::to_string(frame.utime) +
+                     " is not after the previous frame's");
+  }
+  buffer_.push_back(decimate(frame, options_.scan.stride));
+  const int64_t keep_us = static_cast<int64_t>(options_.frame_buffer_s * 1e6);
+  while (!buffer_.empty() && buffer_.front().utime < frame.utime - keep_us) buffer_.pop_front();
+}
+
+const RgbdFrame* Mapper::buffered(int64_t utime) const {
+  auto it = std::lower_bound(buffer_.begin(), buffer_.end(), utime,
+                             [](const RgbdFrame& f, int64_t t) { return f.utime < t; });
+  return it != buffer_.end() && it->utime == utime ? &*it : nullptr;
+}
+
+GraphResult Mapper::apply_graph(const std::vector<GraphKeyframe>& graph) {
+  GraphResult result;
+  std::vector<GraphKeyframe> fresh;
+  int64_t newest = 0;
+  for (const GraphKeyframe& g : graph) {
+    newest = std::max(newest, g.utime);
+    if (const StoredKeyframe* kf = keyframes_.find(g.id)) {
+      if (moved(kf->T_world_camera, g.T_world_camera, options_.rebuild_translation_m,
+                options_.rebuild_rotation_deg)) {
+        keyframes_.set_pose(g.id, g.T_world_camera);
+        ++result.moved;
+      }
+    } else {
+      fresh.push_back(g);
+    }
+  }
+  std::sort(fresh.begin(), fresh.end(),
+            [](const GraphKeyframe& a, const GraphKeyframe& b) { return a.utime < b.utime; });
+  if (result.moved > 0) rebuild_pending_ = true;
+  const bool may_rebuild =
+      last_rebuild_utime_ < 0 ||
+      1e-6 * static_cast<double>(newest - last_rebuild_utime_) >= options_.rebuild_interval_s;
+
+  for (const GraphKeyframe& g : fresh) {
+    const RgbdFrame* frame = buffered(g.utime);
+    if (frame == nullptr) {
+      ++result.missing;
+      continue;
+    }
+    StoredKeyframe kf;
+    kf.id = g.id;
+    kf.utime = g.utime;
+    kf.T_world_camera = g.T_world_camera;
+    kf.frame = *frame;
+    // Inserted now unless the whole map is about to be rebuilt anyway.
+    if (!(rebuild_pending_ && may_rebuild)) integrate(kf.frame, kf.T_world_camera, kf.utime, "keyframe");
+    keyframes_.add(std::move(kf));
+    ++result.inserted;
+  }
+  if (rebuild_pending_ && may_rebuild) {
+    rebuild();
+    last_rebuild_utime_ = newest;
+    result.rebuilt = true;
+    result.rebuild_keyframes = keyframes_.size();
+  }
+  return result;
+}
+
+void Mapper::rebuild() {
+  map_.clear();
+  for (const StoredKeyframe* kf : keyframes_.in_time_order()) {
+    integrate(kf->frame, kf->T_world_camera, kf->utime, "keyframe");
+  }
+  rebuild_pending_ = false;
+  ++rebuilds_;
+}
+
+void Mapper::reset() {
+  map_.clear();
+  keyframes_.clear();
+  buffer_.clear();
+  have_last_keyframe_ = false;
+  next_keyframe_id_ = 0;
+  last_rebuild_utime_ = -1;
+  rebuild_pending_ = false;
+  frames_inserted_ = 0;
+}
+
+}  // namespace kestrel::mapper

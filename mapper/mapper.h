@@ -1,0 +1,107 @@
+#pragma once
+// Frames and poses in, occupancy map out: the mapper as the process and the offline tool use
+// it (no LCM, no files, no clock).
+//
+// Two ways to feed it:
+//  * insert(frame, T_world_camera) with poses from any source (ground truth, the estimator,
+//    a trajectory file): the frame goes into the map at once; every frame that moved more than
+//    keyframe_translation_m / keyframe_rotation_deg since the last keyframe (the paper's rule,
+//    25 cm / 10 degrees) is also stored as a keyframe.
+//  * SLAM: buffer_frame(frame) for every frame, then apply_graph(keyframes) for every
+//    SLAM_GRAPH revision. A keyframe seen for the first time is stored (its frame is found in
+//    the buffer by utime) and inserted; if a stored keyframe moved by more than
+//    rebuild_translation_m / rebuild_rotation_deg (a loop closure, a re-optimisation), the map
+//    is rebuilt from all stored keyframes at their new poses, at most once per
+//    rebuild_interval_s of sensor time (later moves wait for the next allowed rebuild).
+//
+// The log-odds of a frame cannot be taken out of a clamped map, so moved keyframes mean a
+// rebuild rather than an update; at 128x96 a rebuild costs about one insertion per keyframe.
+
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <deque>
+#include <vector>
+
+#include "common/rgbd_frame.h"
+#include "mapper/keyframe_store.h"
+#include "mapper/options.h"
+#include "mapper/scan_integrator.h"
+#include "mapper/voxel_map.h"
+
+namespace kestrel::mapper {
+
+struct MapperOptions {
+  MapOptions map;
+  ScanOptions scan;
+  KeyframeOptions keyframes;
+  double keyframe_translation_m = 0.25;  ///< insert(): store a keyframe after this much motion
+  double keyframe_rotation_deg = 10.0;   ///< ... or this much rotation
+  double rebuild_translation_m = 0.02;   ///< apply_graph(): a keyframe moved by more -> rebuild
+  double rebuild_rotation_deg = 0.5;
+  double rebuild_interval_s = 1.0;       ///< at most one rebuild per this much sensor time
+  double frame_buffer_s = 5.0;           ///< frames kept for SLAM keyframes to refer to
+  void validate() const;
+};
+
+/// One keyframe of a SLAM graph revision.
+struct GraphKeyframe {
+  int64_t id = 0;
+  int64_t utime = 0;
+  Eigen::Isometry3d T_world_camera = Eigen::Isometry3d::Identity();
+};
+
+struct GraphResult {
+  size_t inserted = 0;   ///< new keyframes put into the map
+  size_t moved = 0;      ///< stored keyframes that moved beyond the threshold
+  size_t missing = 0;    ///< new keyframes whose frame was not (or no longer) buffered
+  bool rebuilt = false;  ///< the map was rebuilt from the stored keyframes
+  size_t rebuild_keyframes = 0;
+};
+
+class Mapper {
+ public:
+  /// Throws std::invalid_argument naming the option for bad options.
+  explicit Mapper(const MapperOptions& options = {});
+
+  /// Inserts a frame seen from T_world_camera (of its depth image). Throws InputError (naming
+  /// `what`) for a frame without depth, a broken frame or pose. Returns the scan's update.
+  const ScanUpdate& insert(const RgbdFrame& frame, const Eigen::Isometry3d& T_world_camera,
+                           const char* what = "frame");
+
+  /// SLAM mode: keeps the frame (decimated) for keyframes that name its utime later.
+  void buffer_frame(const RgbdFrame& frame, const char* what = "frame");
+  /// SLAM mode: one graph revision.
+  GraphResult apply_graph(const std::vector<GraphKeyframe>& keyframes);
+  /// Rebuilds the map from the stored keyframes at their current poses.
+  void rebuild();
+
+  /// Forgets the map, the keyframes and the buffered frames.
+  void reset();
+
+  const VoxelMap& map() const { return map_; }
+  const KeyframeStore& keyframes() const { return keyframes_; }
+  const MapperOptions& options() const { return options_; }
+  size_t frames_inserted() const { return frames_inserted_; }
+  size_t rebuilds() const { return rebuilds_; }
+
+ private:
+  void integrate(const RgbdFrame& decimated, const Eigen::Isometry3d& T_world_camera, int64_t utime,
+                 const char* what);
+  const RgbdFrame* buffered(int64_t utime) const;
+
+  MapperOptions options_;
+  ScanIntegrator integrator_;
+  VoxelMap map_;
+  KeyframeStore keyframes_;
+  ScanUpdate update_;
+  std::deque<RgbdFrame> buffer_;   // decimated, by increasing utime
+  bool have_last_keyframe_ = false;
+  Eigen::Isometry3d last_keyframe_pose_ = Eigen::Isometry3d::Identity();
+  int64_t next_keyframe_id_ = 0;
+  int64_t last_rebuild_utime_ = -1;
+  bool rebuild_pending_ = false;
+  size_t frames_inserted_ = 0;
+  size_t rebuilds_ = 0;
+};
+
+}  // namespace kestrel::mapper

@@ -1,0 +1,144 @@
+// kestrel-map: builds the occupancy map offline from a TUM RGB-D folder and a trajectory
+// (ground truth, VO, SLAM: any TUM-format file of T_world_camera), writes it as .bt / .ot,
+// and optionally renders it (top view, perspective, slice), exports the registered keyframes
+// as a coloured PLY cloud, and compares it with another map. Same library as kestrel-mapper,
+// no LCM. Prints what it did and how long the insertion took per frame (thread CPU time).
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <ctime>
+#include <cstdio>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include "common/cli.h"
+#include "common/error.h"
+#include "common/trajectory.h"
+#include "drivers/tum/tum_sequence.h"
+#include "mapper/cli_options.h"
+#include "mapper/export_ply.h"
+#include "mapper/map_compare.h"
+#include "mapper/mapper.h"
+#include "mapper/octree_io.h"
+#include "mapper/render.h"
+
+namespace {
+
+using namespace kestrel;
+
+struct Options {
+  std::string tum, poses, out, png, view_png, slice_png, ply, compare;
+  double slice_z_m = 1.0;
+  double max_pose_gap_s = 0.05;
+  double depth_scale = 1.0;
+  size_t every = 1;
+  mapper::MapperOptions mapper;
+  mapper::RenderOptions render;
+};
+
+void write_png(const std::string& path, const cv::Mat& image) {
+  if (!cv::imwrite(path, image)) throw InputError(path + ": cannot write the PNG");
+  std::cout << "wrote " << path << " (" << image.cols << "x" << image.rows << ")\n";
+}
+
+// CPU time of this thread: on a shared machine wall-clock time mostly measures the others.
+double thread_cpu_ms() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return 1e3 * static_cast<double>(ts.tv_sec) + 1e-6 * static_cast<double>(ts.tv_nsec);
+}
+
+double percentile(std::vector<double> v, double q) {
+  if (v.empty()) return 0.0;
+  const size_t i = std::min(v.size() - 1, static_cast<size_t>(q * static_cast<double>(v.size())));
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(i), v.end());
+  return v[i];
+}
+
+int run(Options& o) {
+  mapper::check_mapper_options(o.mapper);
+  mapper::format_of(o.out);  // a bad extension is an error before any work
+  tum::SequenceOptions so;
+  so.depth_scale_correction = o.depth_scale;
+  const tum::TumSequence sequence(o.tum, so);
+  const Trajectory poses = read_tum_trajectory(o.poses);
+  mapper::Mapper mapper(o.mapper);
+  const int64_t max_gap = static_cast<int64_t>(o.max_pose_gap_s * 1e6);
+
+  std::vector<double> ms;
+  size_t without_pose = 0;
+  for (size_t i = 0; i < sequence.size(); i += o.every) {
+    const RgbdFrame frame = sequence.frame(i);
+    const auto T_world_camera = poses.at(frame.depth_utime, max_gap);
+    if (!T_world_camera) {
+      ++without_pose;
+      continue;
+    }
+    const double t0 = thread_cpu_ms();
+    mapper.insert(frame, *T_world_camera, sequence.folder().c_str());
+    ms.push_back(thread_cpu_ms() - t0);
+  }
+  if (ms.empty()) throw InputError(o.poses + ": no frame of " + o.tum + " has a pose within --max-pose-gap");
+  const mapper::VoxelMap& map = mapper.map();
+  mapper::write_map_file(map, o.out);
+
+  const double cell3 = map.resolution() * map.resolution() * map.resolution();
+  const double volume = static_cast<double>(map.num_cells()) * cell3;
+  std::printf("frames inserted: %zu (%zu without a pose), keyframes kept: %zu\n", ms.size(), without_pose,
+              mapper.keyframes().size());
+  std::printf("insertion (decimate + scan + cells + update), CPU ms per frame: median %.3f, p95 %.3f\n",
+              percentile(ms, 0.5), percentile(ms, 0.95));
+  std::printf("cells known: %zu (%.1f m^3), occupied: %zu; map memory %.2f MB (%.2f MB per 100 m^3)\n",
+              map.num_cells(), volume, map.num_occupied(), map.memory_bytes() / 1e6,
+              volume > 0 ? map.memory_bytes() / 1e6 * 100.0 / volume : 0.0);
+  std::cout << "wrote " << o.out << "\n";
+
+  if (!o.png.empty()) write_png(o.png, mapper::render_top_view(map, o.render));
+  if (!o.view_png.empty()) write_png(o.view_png, mapper::render_perspective(map, o.render));
+  if (!o.slice_png.empty()) write_png(o.slice_png, mapper::render_slice(map, o.slice_z_m, o.render));
+  if (!o.ply.empty()) {
+    const size_t n = mapper::write_ply(mapper.keyframes(), o.ply, o.mapper.scan.max_range_m);
+    std::cout << "wrote " << o.ply << " (" << n << " points from " << mapper.keyframes().size() << " keyframes)\n";
+  }
+  if (!o.compare.empty()) {
+    const mapper::VoxelMap other = mapper::read_map_file(o.compare, o.mapper.map);
+    const mapper::MapAgreement a = mapper::compare_maps(map, other);
+    std::printf("against %s: class agreement %.4f on %zu cells known in both; occupied: %zu here, %zu there, "
+                "%zu the same cell; within one cell: precision %.4f, recall %.4f\n",
+                o.compare.c_str(), a.class_agreement(), a.known_both, a.occupied_a, a.occupied_b,
+                a.occupied_both, a.precision(), a.recall());
+  }
+  return kExitOk;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  cli::App app("map", "Build the occupancy map from a TUM RGB-D folder and a trajectory; write .bt/.ot, PNG renders, PLY");
+  Options o;
+  app.add_option("--tum", o.tum, "TUM RGB-D sequence folder")->required();
+  app.add_option("--poses", o.poses, "Trajectory of the camera, TUM format (ground truth or any estimate)")->required();
+  app.add_option("--out", o.out, "Map file to write (.bt binary or .ot full)")->required();
+  app.add_option("--png", o.png, "Top view PNG (height-coloured)");
+  app.add_option("--view-png", o.view_png, "Perspective view PNG");
+  app.add_option("--slice-png", o.slice_png, "Horizontal slice PNG (see --slice-z)");
+  app.add_option("--slice-z", o.slice_z_m, "Height of the slice, m")->capture_default_str();
+  app.add_option("--ply", o.ply, "Coloured point cloud of the registered keyframes (PLY)");
+  app.add_option("--compare", o.compare, "Report agreement with this map (.bt/.ot, same resolution)");
+  app.add_option("--max-pose-gap", o.max_pose_gap_s, "Largest trajectory gap to interpolate across, s")
+      ->check(cli::Positive)
+      ->capture_default_str();
+  app.add_option("--depth-scale", o.depth_scale, "Depth scale correction (fr1: about 1.035)")
+      ->check(cli::Positive)
+      ->capture_default_str();
+  app.add_option("--every", o.every, "Insert every n-th frame")->check(CLI::Range(1, 1000))->capture_default_str();
+  app.add_option("--pixels-per-cell", o.render.pixels_per_cell, "Top view and slice scale")
+      ->check(CLI::Range(1, 64))
+      ->capture_default_str();
+  mapper::add_mapper_options(app, o.mapper);
+  return app.run(argc, argv, [&] { return run(o); });
+}

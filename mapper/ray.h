@@ -1,0 +1,72 @@
+#pragma once
+// One ray exactly as OctoMap's OccupancyOcTreeBase::computeUpdate treats it, and the cells it
+// clears, found by the same 3-D DDA (Amanatides & Woo) with the same float / double arithmetic
+// as OcTreeBaseImpl::computeRayKeys. The fast integrator (scan_integrator.h) falls back to
+// trace() whenever a ray passes too close to a cell edge for geometry alone to say what
+// OctoMap would do, so these two functions are what "the same map as OctoMap" rests on.
+//
+// OctoMap's rules, restated:
+//  * a point within max range is a hit: its cell becomes occupied and the cells from the
+//    origin's up to (excluding) the point's are cleared;
+//  * a point beyond max range only clears, along its direction, up to max range;
+//  * the traversal stops on reaching the end cell, or when the cell it has stepped into is
+//    left only after the ray's length (so that cell is not cleared either);
+//  * a point or origin outside the tree's 16-bit key range contributes nothing.
+
+#include <octomap/octomap_types.h>
+
+#include "mapper/key_space.h"
+
+namespace kestrel::mapper {
+
+struct Ray {
+  octomap::point3d end;     ///< the point, or the cut at max range
+  Key key_end;
+  octomap::point3d dir;     ///< (end - origin) / length, in float as OctoMap computes it
+  float length = 0.0f;      ///< |end - origin|, float
+  bool hit = false;         ///< the end is a measurement: its cell is occupied
+  bool clears = false;      ///< the traversal adds at least the origin's cell
+  int8_t step[3] = {0, 0, 0};
+};
+
+/// The ray from `origin` (whose key is `key_origin`, already checked) to the measured point `p`.
+Ray make_ray(const KeySpace& keys, const octomap::point3d& origin, const Key& key_origin,
+             const octomap::point3d& p, double max_range_m);
+
+/// Calls visit(key) for every cell the ray clears, in order, starting with the origin's cell.
+template <class Visit>
+void trace(const KeySpace& keys, const octomap::point3d& origin, const Key& key_origin,
+           const Ray& ray, Visit&& visit) {
+  if (!ray.clears) return;
+  const double res = keys.resolution();
+  double t_max[3];
+  double t_delta[3];
+  for (int a = 0; a < 3; ++a) {
+    if (ray.step[a] != 0) {
+      // Same operations as OctoMap: the border is the cell centre plus half a cell rounded to
+      // float, and the crossing times are accumulated by repeated addition below.
+      double border = keys.centre(key_origin[a]);
+      border += static_cast<double>(static_cast<float>(ray.step[a] * res * 0.5));
+      const double d = static_cast<double>(ray.dir(a));
+      t_max[a] = (border - static_cast<double>(origin(a))) / d;
+      t_delta[a] = res / std::fabs(d);
+    } else {
+      t_max[a] = std::numeric_limits<double>::max();
+      t_delta[a] = std::numeric_limits<double>::max();
+    }
+  }
+  const double length = static_cast<double>(ray.length);
+  Key key = key_origin;
+  visit(key);
+  for (;;) {
+    const int a = t_max[0] < t_max[1] ? (t_max[0] < t_max[2] ? 0 : 2)
+                                      : (t_max[1] < t_max[2] ? 1 : 2);
+    key[a] = static_cast<uint16_t>(key[a] + ray.step[a]);
+    t_max[a] += t_delta[a];
+    if (key == ray.key_end) return;
+    if (std::min(std::min(t_max[0], t_max[1]), t_max[2]) > length) return;
+    visit(key);
+  }
+}
+
+}  // namespace kestrel::mapper

@@ -1,0 +1,110 @@
+#include "mapper/scan.h"
+
+#include <string>
+
+#include "common/error.h"
+#include "common/geometry/se3.h"
+
+namespace kestrel::mapper {
+
+octomap::Pointcloud Scan::valid_points() const {
+  octomap::Pointcloud cloud;
+  cloud.reserve(num_points);
+  for (size_t i = 0; i < points.size(); ++i) {
+    if (valid[i]) cloud.push_back(points[i]);
+  }
+  return cloud;
+}
+
+namespace {
+
+// First picked pixel and count along an axis of `size` pixels, so that the picked grid is
+// centred: 640 px at stride 5 -> pixels 2, 7, ..., 637 (128 of them).
+void pick_grid(int size, int stride, int& offset, int& count) {
+  count = size / stride;
+  offset = (size - stride * (count - 1) - 1) / 2;
+}
+
+cv::Mat pick(const cv::Mat& image, int stride, int u0, int v0, int cols, int rows) {
+  if (image.empty()) return {};
+  cv::Mat out(rows, cols, image.type());
+  const size_t elem = image.elemSize();
+  for (int r = 0; r < rows; ++r) {
+    const uint8_t* in = image.ptr<uint8_t>(v0 + r * stride);
+    uint8_t* o = out.ptr<uint8_t>(r);
+    for (int c = 0; c < cols; ++c) {
+      const uint8_t* px = in + (u0 + c * stride) * elem;
+      for (size_t b = 0; b < elem; ++b) o[c * elem + b] = px[b];
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+RgbdFrame decimate(const RgbdFrame& frame, int stride) {
+  if (stride < 1) throw std::invalid_argument("decimate: stride must be >= 1");
+  if (stride == 1) return frame;
+  int u0 = 0, v0 = 0, cols = 0, rows = 0;
+  pick_grid(frame.camera.width, stride, u0, cols);
+  pick_grid(frame.camera.height, stride, v0, rows);
+  if (cols < 1 || rows < 1) {
+    throw std::invalid_argument("decimate: stride " + std::to_string(stride) +
+                                " is larger than the image");
+  }
+  RgbdFrame out = frame;
+  out.rgb = pick(frame.rgb, stride, u0, v0, cols, rows);
+  out.depth_mm = pick(frame.depth_mm, stride, u0, v0, cols, rows);
+  // Picked pixel c sits at u = u0 + stride * c of the original image.
+  out.camera.width = cols;
+  out.camera.height = rows;
+  out.camera.fx = frame.camera.fx / stride;
+  out.camera.fy = frame.camera.fy / stride;
+  out.camera.cx = (frame.camera.cx - u0) / stride;
+  out.camera.cy = (frame.camera.cy - v0) / stride;
+  return out;
+}
+
+Scan make_scan(const RgbdFrame& frame, const Eigen::Isometry3d& T_world_camera,
+               const ScanOptions& options, const char* what) {
+  frame.validate(what);
+  if (frame.depth_mm.empty()) throw InputError(std::string(what) + ": frame has no depth image");
+  if (!se3::is_valid(T_world_camera, 1e-6)) {
+    throw InputError(std::string(what) + ": camera pose is not a finite rigid transform");
+  }
+  Scan scan;
+  scan.utime = frame.depth_utime != 0 ? frame.depth_utime : frame.utime;
+  scan.T_world_camera = T_world_camera;
+  scan.camera = frame.camera;
+  scan.cols = frame.camera.width;
+  scan.rows = frame.camera.height;
+  const Eigen::Vector3d t = T_world_camera.translation();
+  scan.origin = octomap::point3d(static_cast<float>(t.x()), static_cast<float>(t.y()),
+                                 static_cast<float>(t.z()));
+  const size_t n = static_cast<size_t>(scan.cols) * static_cast<size_t>(scan.rows);
+  scan.points.resize(n);
+  scan.valid.assign(n, 0);
+
+  const Eigen::Matrix3d R = T_world_camera.linear();
+  const PinholeCamera& cam = frame.camera;
+  const double min_depth_mm = options.min_range_m * 1000.0;
+  for (int v = 0; v < scan.rows; ++v) {
+    const uint16_t* depth = frame.depth_mm.ptr<uint16_t>(v);
+    const double y_over_z = (v - cam.cy) / cam.fy;
+    for (int u = 0; u < scan.cols; ++u) {
+      const uint16_t mm = depth[u];
+      if (mm == 0 || mm < min_depth_mm) continue;
+      const double z = 0.001 * mm;
+      const Eigen::Vector3d p_in_camera((u - cam.cx) / cam.fx * z, y_over_z * z, z);
+      const Eigen::Vector3d p = R * p_in_camera + t;
+      const size_t i = static_cast<size_t>(v) * static_cast<size_t>(scan.cols) + u;
+      scan.points[i] = octomap::point3d(static_cast<float>(p.x()), static_cast<float>(p.y()),
+                                        static_cast<float>(p.z()));
+      scan.valid[i] = 1;
+      ++scan.num_points;
+    }
+  }
+  return scan;
+}
+
+}  // namespace kestrel::mapper

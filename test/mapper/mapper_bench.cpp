@@ -1,0 +1,135 @@
+// Insertion speed: kestrel's exact cell search against OcTree::insertPointCloud on the same
+// rays, in one run, one thread (Release). Frames: every 10th frame of the real fr1_xyz sequence
+// at its ground-truth poses (or the synthetic room of the tests when ../shared/data is absent),
+// at 128x96 (stride 5, the paper's size) and 640x480 (stride 1), 10 cm, max range 4 m.
+//
+// Each iteration inserts the next frame into a map that keeps growing, as a mapper does.
+// "Insert" is the whole update (decimated frame -> rays -> cells -> log-odds); "Cells" is the
+// cell computation alone; "Octomap" is the insertPointCloud call alone (its own rays in, its
+// tree updated and pruned), i.e. the comparison favours OctoMap. The rebuild benchmark times
+// Mapper::rebuild() over every stored keyframe (what a loop closure costs).
+//
+// Run: ./kestrel bench mapper   (or build/<dir>/bench/mapper_bench --benchmark_repetitions=5)
+
+#include <benchmark/benchmark.h>
+
+#include <filesystem>
+#include <memory>
+#include <octomap/OcTree.h>
+
+#include "drivers/tum/tum_sequence.h"
+#include "mapper/mapper.h"
+#include "mapper/scan.h"
+#include "mapper/scan_integrator.h"
+#include "test/mapper/scene.h"
+
+namespace {
+
+using namespace kestrel;
+using namespace kestrel::mapper;
+
+struct Frames {
+  std::vector<RgbdFrame> frames;
+  std::vector<Eigen::Isometry3d> poses;
+  std::string source;
+};
+
+const Frames& frames() {
+  static const Frames f = [] {
+    Frames out;
+    const std::filesystem::path dir = std::filesystem::path(KESTREL_SHARED_DATA) / "tum/rgbd_dataset_freiburg1_xyz";
+    if (std::filesystem::exists(dir / "rgb.txt")) {
+      const tum::TumSequence seq(dir.string());
+      for (size_t i = 0; i < seq.size(); i += 10) {
+        const RgbdFrame frame = seq.frame(i);
+        const auto T = seq.ground_truth().at(frame.depth_utime, 50000);
+        if (!T) continue;
+        out.frames.push_back(frame);
+        out.poses.push_back(*T);
+      }
+      out.source = "fr1_xyz, every 10th frame, ground truth";
+    } else {
+      test::Scene scene(Eigen::Vector3d(-2.0, -2.0, 0.0), Eigen::Vector3d(3.0, 2.0, 2.5));
+      scene.add_box(Eigen::Vector3d(0.8, -0.4, 0.0), Eigen::Vector3d(1.4, 0.3, 0.9));
+      for (int i = 0; i < 40; ++i) {
+        const Eigen::Isometry3d T = test::look_at({-1.2 + 0.02 * i, 0.013, 1.2}, {2.0, 0.5 - 0.025 * i, 0.7});
+        out.frames.push_back(scene.render(test::kinect_camera(), T, 1000 + 33333 * i));
+        out.poses.push_back(T);
+      }
+      out.source = "synthetic room (../shared/data absent)";
+    }
+    return out;
+  }();
+  return f;
+}
+
+std::vector<Scan> scans(int stride) {
+  ScanOptions o;
+  o.stride = stride;
+  std::vector<Scan> out;
+  for (size_t i = 0; i < frames().frames.size(); ++i)
+    out.push_back(make_scan(decimate(frames().frames[i], stride), frames().poses[i], o, "bench"));
+  return out;
+}
+
+void BM_Insert(benchmark::State& state) {
+  MapperOptions o;
+  o.scan.stride = static_cast<int>(state.range(0));
+  Mapper mapper(o);
+  const Frames& f = frames();
+  size_t i = 0;
+  for (auto _ : state) {
+    mapper.insert(f.frames[i % f.frames.size()], f.poses[i % f.frames.size()]);
+    ++i;
+  }
+  state.SetLabel(f.source);
+  state.counters["occupied"] = static_cast<double>(mapper.map().num_occupied());
+}
+
+void BM_Cells(benchmark::State& state, ScanIntegrator::Method method) {
+  const std::vector<Scan> s = scans(static_cast<int>(state.range(0)));
+  ScanOptions o;
+  o.stride = static_cast<int>(state.range(0));
+  ScanIntegrator integrator(0.1, o);
+  ScanUpdate update;
+  size_t i = 0, rays = 0;
+  for (auto _ : state) {
+    integrator.compute(s[i++ % s.size()], update, method);
+    rays += update.rays;
+  }
+  state.counters["rays/frame"] = static_cast<double>(rays) / static_cast<double>(i);
+}
+
+void BM_Octomap(benchmark::State& state) {
+  const std::vector<Scan> s = scans(static_cast<int>(state.range(0)));
+  std::vector<octomap::Pointcloud> clouds;
+  for (const Scan& scan : s) clouds.push_back(scan.valid_points());
+  octomap::OcTree tree(0.1);
+  size_t i = 0;
+  for (auto _ : state) {
+    const size_t k = i++ % s.size();
+    tree.insertPointCloud(clouds[k], s[k].origin, 4.0);
+  }
+  state.SetLabel(frames().source);
+}
+
+void BM_Rebuild(benchmark::State& state) {
+  MapperOptions o;
+  o.keyframe_translation_m = 0.0;  // every frame is a keyframe
+  o.keyframe_rotation_deg = 0.0;
+  Mapper mapper(o);
+  const Frames& f = frames();
+  for (size_t i = 0; i < f.frames.size(); ++i) mapper.insert(f.frames[i], f.poses[i]);
+  for (auto _ : state) mapper.rebuild();
+  state.counters["keyframes"] = static_cast<double>(mapper.keyframes().size());
+}
+
+BENCHMARK(BM_Insert)->Arg(5)->Arg(1)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Cells, cell_search, ScanIntegrator::Method::kCellSearch)->Arg(5)->Arg(1)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Cells, ray_trace, ScanIntegrator::Method::kRayTrace)->Arg(5)->Arg(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Octomap)->Arg(5)->Arg(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Rebuild)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+
+BENCHMARK_MAIN();

@@ -1,0 +1,172 @@
+// The Mapper: SLAM keyframes, the rebuild after a loop closure (the rebuilt map equals the map
+// built at the corrected poses from the start), the keyframe budget, and bad input (NaN or
+// zero depth never marks a cell; a NaN pose or a frame without depth is an InputError).
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "common/error.h"
+#include "mapper/mapper.h"
+#include "mapper/scan.h"
+#include "test/mapper/scene.h"
+
+namespace kestrel::mapper {
+namespace {
+
+using test::Scene;
+
+Scene room() {
+  Scene scene(Eigen::Vector3d(-2.0, -2.0, 0.0), Eigen::Vector3d(3.0, 2.0, 2.5));
+  scene.add_box(Eigen::Vector3d(0.8, -0.4, 0.0), Eigen::Vector3d(1.4, 0.3, 0.9));
+  return scene;
+}
+
+// Camera poses sweeping the room, 0.2 s apart.
+std::vector<Eigen::Isometry3d> sweep(int n) {
+  std::vector<Eigen::Isometry3d> poses;
+  for (int i = 0; i < n; ++i) {
+    const double a = -0.8 + 1.6 * i / (n - 1);
+    poses.push_back(test::look_at({-1.2 + 0.05 * i, 0.013, 1.2},
+                                  {-1.2 + 3.0 * std::cos(a), 3.0 * std::sin(a), 0.7}));
+  }
+  return poses;
+}
+
+void expect_same_maps(const VoxelMap& a, const VoxelMap& b) {
+  ASSERT_EQ(a.num_cells(), b.num_cells());
+  a.for_each_cell([&](const Key& k, float v) { ASSERT_EQ(b.log_odds(k), v); });
+}
+
+TEST(Mapper, RebuildAfterLoopClosureEqualsTheMapAtTheCorrectedPoses) {
+  const Scene scene = room();
+  const auto truth = sweep(8);
+  MapperOptions options;
+  options.rebuild_interval_s = 0.0;
+  Mapper drifted(options), direct(options);
+  std::vector<GraphKeyframe> graph, true_graph;
+  for (size_t i = 0; i < truth.size(); ++i) {
+    const int64_t utime = 1000000 + 200000 * static_cast<int64_t>(i);
+    const RgbdFrame frame = scene.render(test::kinect_camera(), truth[i], utime);
+    drifted.buffer_frame(frame);
+    direct.buffer_frame(frame);
+    // Odometry drift: 3 cm and 0.5 degrees more per keyframe.
+    Eigen::Isometry3d T = truth[i];
+    T.translation() += Eigen::Vector3d(0.03, -0.02, 0.01) * static_cast<double>(i);
+    T.rotate(Eigen::AngleAxisd(0.5 * M_PI / 180.0 * i, Eigen::Vector3d::UnitY()));
+    graph.push_back({static_cast<int64_t>(i), utime, T});
+    true_graph.push_back({static_cast<int64_t>(i), utime, truth[i]});
+    const GraphResult r = drifted.apply_graph(graph);
+    EXPECT_EQ(r.inserted, 1u);
+    EXPECT_FALSE(r.rebuilt);
+    direct.apply_graph(true_graph);
+  }
+  ASSERT_GT(direct.map().num_occupied(), 100u);
+  // The loop closes: SLAM moves every keyframe back to the truth.
+  const GraphResult r = drifted.apply_graph(true_graph);
+  EXPECT_EQ(r.moved, truth.size() - 1);  // keyframe 0 did not drift
+  EXPECT_TRUE(r.rebuilt);
+  EXPECT_EQ(r.rebuild_keyframes, truth.size());
+  expect_same_maps(drifted.map(), direct.map());
+}
+
+TEST(Mapper, RebuildsAreRateLimitedAndMissingFramesCounted) {
+  const Scene scene = room();
+  const auto truth = sweep(3);
+  MapperOptions options;
+  options.rebuild_interval_s = 1.0;
+  Mapper mapper(options);
+  std::vector<GraphKeyframe> graph;
+  for (int i = 0; i < 3; ++i) {
+    const int64_t utime = 200000 * (i + 1);
+    mapper.buffer_frame(scene.render(test::kinect_camera(160, 120), truth[static_cast<size_t>(i)], utime));
+    graph.push_back({i, utime, truth[static_cast<size_t>(i)]});
+  }
+  graph.push_back({99, 123, truth[0]});  // names a frame that never came
+  GraphResult r = mapper.apply_graph(graph);
+  EXPECT_EQ(r.inserted, 3u);
+  EXPECT_EQ(r.missing, 1u);
+  graph[1].T_world_camera.translation().x() += 0.1;
+  r = mapper.apply_graph(graph);
+  EXPECT_TRUE(r.rebuilt);  // the first rebuild is always allowed
+  graph[1].T_world_camera.translation().x() += 0.1;
+  r = mapper.apply_graph(graph);
+  EXPECT_EQ(r.moved, 1u);
+  EXPECT_FALSE(r.rebuilt) << "a second rebuild within 1 s of sensor time waits";
+  EXPECT_EQ(mapper.rebuilds(), 1u);
+}
+
+TEST(Mapper, OutOfOrderFramesAndBadPosesAreInputErrors) {
+  const Scene scene = room();
+  Mapper mapper;
+  const RgbdFrame frame = scene.render(test::kinect_camera(64, 48), sweep(2)[0], 1000);
+  mapper.buffer_frame(frame);
+  EXPECT_THROW(mapper.buffer_frame(frame), InputError);  // same utime again
+  Eigen::Isometry3d nan_pose = Eigen::Isometry3d::Identity();
+  nan_pose.translation().x() = NAN;
+  EXPECT_THROW(mapper.insert(frame, nan_pose), InputError);
+  RgbdFrame no_depth = frame;
+  no_depth.depth_mm = cv::Mat();
+  EXPECT_THROW(mapper.insert(no_depth, Eigen::Isometry3d::Identity()), InputError);
+  EXPECT_EQ(mapper.map().num_cells(), 0u);
+}
+
+TEST(Mapper, NanAndZeroDepthNeverMarkCells) {
+  const Scene scene = room();
+  const Eigen::Isometry3d T = sweep(2)[1];
+  const RgbdFrame frame = scene.render(test::kinect_camera(160, 120), T, 1000);
+  // Depth from a float source with holes: NaN, infinities, zero and negative readings.
+  cv::Mat metres = depth_to_metres(frame.depth_mm);
+  cv::Mat holes = frame.depth_mm.clone();
+  const float bad[] = {NAN, INFINITY, -INFINITY, 0.0f, -1.0f};
+  for (int v = 0; v < metres.rows; ++v)
+    for (int u = 0; u < metres.cols; ++u)
+      if ((u * 7 + v * 3) % 4 == 0) {
+        metres.at<float>(v, u) = bad[(u + v) % 5];
+        holes.at<uint16_t>(v, u) = 0;
+      }
+  RgbdFrame with_nan = frame;
+  with_nan.depth_mm = depth_to_millimetres(metres);
+  RgbdFrame with_zero = frame;
+  with_zero.depth_mm = holes;
+  MapperOptions options;
+  options.scan.stride = 1;
+  Mapper a(options), b(options);
+  a.insert(with_nan, T);
+  b.insert(with_zero, T);
+  expect_same_maps(a.map(), b.map());  // a NaN reading is no reading
+  ASSERT_GT(a.map().num_cells(), 0u);
+
+  // All depth missing: nothing at all, not even the camera's own cell.
+  RgbdFrame empty = frame;
+  metres.setTo(NAN);
+  empty.depth_mm = depth_to_millimetres(metres);
+  Mapper c(options);
+  c.insert(empty, T);
+  EXPECT_EQ(c.map().num_cells(), 0u);
+}
+
+TEST(KeyframeStore, BudgetThinsCrowdedViewsFirst) {
+  RgbdFrame frame;
+  frame.camera = test::kinect_camera(128, 96);
+  frame.depth_mm = cv::Mat(96, 128, CV_16UC1, cv::Scalar(1000));
+  KeyframeOptions options;
+  options.max_megabytes = 10.5 * 128 * 96 * 2 / 1e6;  // room for about 10 keyframes
+  KeyframeStore store(options);
+  Eigen::Isometry3d lone = Eigen::Isometry3d::Identity();
+  lone.translation() = Eigen::Vector3d(5.0, 5.0, 1.0);
+  store.add({0, 0, lone, frame});
+  for (int i = 1; i <= 30; ++i) {
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    T.translation().x() = 0.01 * i;  // all in one bin
+    store.add({i, i, T, frame});
+  }
+  EXPECT_LE(store.bytes(), options.max_megabytes * 1e6);
+  EXPECT_GT(store.size(), 5u);
+  EXPECT_TRUE(store.contains(0)) << "the only view of a place is kept";
+  EXPECT_TRUE(store.contains(30)) << "the newest keyframe is kept";
+  EXPECT_FALSE(store.contains(1)) << "the oldest of the crowded bin goes first";
+  EXPECT_EQ(store.dropped() + store.size(), 31u);
+}
+
+}  // namespace
+}  // namespace kestrel::mapper

@@ -1,0 +1,40 @@
+#pragma once
+// OctoMap's own answers, for comparison: the cells computeUpdate would clear and mark
+// occupied for a scan, and differences between those and a ScanUpdate.
+
+#include <octomap/OcTree.h>
+
+#include <string>
+
+#include "mapper/scan.h"
+#include "mapper/scan_integrator.h"
+
+namespace kestrel::mapper::test {
+
+struct OctomapUpdate {
+  octomap::KeySet free, occupied;
+};
+
+inline OctomapUpdate octomap_update(const Scan& scan, double resolution, double max_range) {
+  octomap::OcTree tree(resolution);
+  OctomapUpdate u;
+  tree.computeUpdate(scan.valid_points(), scan.origin, u.free, u.occupied, max_range);
+  return u;
+}
+
+/// Number of cells on which `mine` and OctoMap's answer differ (0 = identical sets).
+inline size_t count_differences(const ScanUpdate& mine, const OctomapUpdate& theirs) {
+  auto diff = [](const std::vector<Key>& a, const octomap::KeySet& b) {
+    octomap::KeySet seen;
+    size_t d = 0;
+    for (const Key& k : a) {
+      if (!seen.insert(k).second) ++d;  // duplicates count as differences too
+      if (!b.count(k)) ++d;
+    }
+    for (const Key& k : b) d += seen.count(k) ? 0 : 1;
+    return d;
+  };
+  return diff(mine.free, theirs.free) + diff(mine.occupied, theirs.occupied);
+}
+
+}  // namespace kestrel::mapper::test

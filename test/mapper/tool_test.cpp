@@ -1,0 +1,107 @@
+// kestrel-map and kestrel-mapper as built tools: the offline map of a small synthetic TUM
+// folder equals the library's, renders and the PLY are written, and usage errors and bad
+// input give the documented exit codes.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <opencv2/imgcodecs.hpp>
+
+#include "common/trajectory.h"
+#include "mapper/mapper.h"
+#include "mapper/octree_io.h"
+#include "test/mapper/scene.h"
+#include "test/support/test_support.h"
+
+namespace kestrel::mapper {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A TUM-format folder (ROS default intrinsics, 640x480) of the synthetic room seen from 6
+// poses, and its trajectory; returns the frames as the tool will read them.
+std::vector<std::pair<RgbdFrame, Eigen::Isometry3d>> write_sequence(const fs::path& dir) {
+  test::Scene scene(Eigen::Vector3d(-2.0, -2.0, 0.0), Eigen::Vector3d(3.0, 2.0, 2.5));
+  scene.add_box(Eigen::Vector3d(0.8, -0.4, 0.0), Eigen::Vector3d(1.4, 0.3, 0.9));
+  fs::create_directories(dir / "rgb");
+  fs::create_directories(dir / "depth");
+  std::ofstream rgb_list(dir / "rgb.txt"), depth_list(dir / "depth.txt");
+  Trajectory truth;
+  std::vector<std::pair<RgbdFrame, Eigen::Isometry3d>> frames;
+  for (int i = 0; i < 6; ++i) {
+    const int64_t utime = 1000000 + 100000 * i;
+    const Eigen::Isometry3d T = test::look_at({-1.2 + 0.1 * i, 0.013, 1.2}, {2.0, 0.6 - 0.3 * i, 0.7});
+    RgbdFrame f = scene.render(test::kinect_camera(), T, utime);
+    const std::string name = std::to_string(utime / 1000000) + "." + std::to_string(utime % 1000000);
+    cv::Mat raw;
+    f.depth_mm.convertTo(raw, CV_16UC1, 5.0);  // TUM's 1/5000 m units
+    cv::imwrite((dir / "depth" / (name + ".png")).string(), raw);
+    cv::imwrite((dir / "rgb" / (name + ".png")).string(), cv::Mat(480, 640, CV_8UC3, cv::Scalar(90, 120, 150)));
+    rgb_list << name << " rgb/" << name << ".png\n";
+    depth_list << name << " depth/" << name << ".png\n";
+    truth.push_back(utime, T);
+    frames.emplace_back(std::move(f), T);
+  }
+  write_tum_trajectory((dir / "truth.txt").string(), truth);
+  return frames;
+}
+
+TEST(MapTool, BuildsTheLibrarysMapAndRendersIt) {
+  kestrel::test::TempDir tmp;
+  const auto frames = write_sequence(tmp / "seq");
+  const auto r = kestrel::test::run({kestrel::test::tool("map").string(), "--tum", (tmp / "seq").string(),
+                                     "--poses", (tmp / "seq/truth.txt").string(), "--out",
+                                     (tmp / "map.ot").string(), "--png", (tmp / "top.png").string(),
+                                     "--view-png", (tmp / "view.png").string(), "--slice-png",
+                                     (tmp / "slice.png").string(), "--ply", (tmp / "cloud.ply").string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("frames inserted: 6"), std::string::npos) << r.out;
+  Mapper reference;
+  for (const auto& [frame, T] : frames) reference.insert(frame, T);
+  const VoxelMap map = read_map_file((tmp / "map.ot").string());
+  ASSERT_EQ(map.num_cells(), reference.map().num_cells());
+  reference.map().for_each_cell([&](const Key& k, float v) { ASSERT_EQ(map.log_odds(k), v); });
+  for (const char* png : {"top.png", "view.png", "slice.png"}) {
+    EXPECT_FALSE(cv::imread((tmp / png).string()).empty()) << png;
+  }
+  std::ifstream ply(tmp / "cloud.ply");
+  std::string magic;
+  ply >> magic;
+  EXPECT_EQ(magic, "ply");
+
+  // Compared with itself, the map agrees completely.
+  const auto again = kestrel::test::run({kestrel::test::tool("map").string(), "--tum", (tmp / "seq").string(),
+                                         "--poses", (tmp / "seq/truth.txt").string(), "--out",
+                                         (tmp / "again.bt").string(), "--compare", (tmp / "map.ot").string()});
+  ASSERT_EQ(again.exit_code, 0) << again.err;
+  EXPECT_NE(again.out.find("class agreement 1.0000"), std::string::npos) << again.out;
+}
+
+TEST(MapTool, UsageErrorsAndBadInput) {
+  kestrel::test::TempDir tmp;
+  const std::string map = kestrel::test::tool("map").string();
+  EXPECT_EQ(kestrel::test::run({map, "--help"}).exit_code, 0);
+  EXPECT_EQ(kestrel::test::run({map, "--tum", tmp.path().string()}).exit_code, 2);  // no --poses/--out
+  EXPECT_EQ(kestrel::test::run({map, "--tum", (tmp / "nothing").string(), "--poses", "x.txt", "--out",
+                                (tmp / "m.bt").string()})
+                .exit_code,
+            3);
+  write_sequence(tmp / "seq");
+  const auto bad_ext = kestrel::test::run({map, "--tum", (tmp / "seq").string(), "--poses",
+                                           (tmp / "seq/truth.txt").string(), "--out", (tmp / "m.txt").string()});
+  EXPECT_EQ(bad_ext.exit_code, 3);
+  EXPECT_NE(bad_ext.err.find("m.txt"), std::string::npos) << bad_ext.err;
+  const auto bad_value = kestrel::test::run({map, "--tum", (tmp / "seq").string(), "--poses",
+                                             (tmp / "seq/truth.txt").string(), "--out", (tmp / "m.bt").string(),
+                                             "--prob-hit", "0.3"});
+  EXPECT_EQ(bad_value.exit_code, 2);
+  EXPECT_NE(bad_value.err.find("prob-hit"), std::string::npos) << bad_value.err;
+
+  const std::string mapper = kestrel::test::tool("mapper").string();
+  EXPECT_EQ(kestrel::test::run({mapper, "--help"}).exit_code, 0);
+  EXPECT_EQ(kestrel::test::run({mapper, "--pose-source", "magic"}).exit_code, 2);
+  EXPECT_EQ(kestrel::test::run({mapper, "--resolution", "-1"}).exit_code, 2);
+}
+
+}  // namespace
+}  // namespace kestrel::mapper
