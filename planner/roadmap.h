@@ -1,0 +1,74 @@
+#pragma once
+// The roadmap shared by PRM and BRM: nodes (start, goal, samples), straight collision-free
+// edges between nodes closer than a radius, and for BRM each directed edge's transfer
+// function, computed once when the graph is built.
+//
+// Along an edge the vehicle moves in steps of at most `step_m`, facing its direction of
+// travel (so a forward-looking sensor looks where it flies); each step adds process noise
+// R = V W V^T with W proportional to the distance flown (estimator/information.h), G = I for
+// the holonomic model, and gathers the sensor's information at the step's end.
+
+#include <functional>
+#include <vector>
+
+#include "planner/configuration_space.h"
+#include "planner/sampler.h"
+#include "planner/transfer.h"
+
+namespace kestrel::planner {
+
+struct MotionOptions {
+  double step_m = 0.25;
+  /// Variance added per metre flown, per coordinate (x, y, z: m^2/m; yaw: rad^2/m).
+  Eigen::Vector4d variance_per_m = Eigen::Vector4d(0.1, 0.1, 0.02, 0.01);
+};
+
+/// What an edge does to the belief: the motion model plus a sensor's information M(q).
+class BeliefModel {
+ public:
+  BeliefModel(MotionOptions motion, std::function<Mat4(const Config&)> information)
+      : motion_(std::move(motion)), information_(std::move(information)) {}
+  /// Steps of the straight edge a -> b (empty if a == b).
+  std::vector<BeliefStep> steps(const Config& a, const Config& b) const;
+  const MotionOptions& motion() const { return motion_; }
+
+ private:
+  MotionOptions motion_;
+  std::function<Mat4(const Config&)> information_;
+};
+
+struct Edge {
+  int to = -1;
+  double length_m = 0.0;
+  ScatteringTransfer transfer;  ///< identity when built without a belief model
+};
+
+struct RoadmapOptions {
+  int samples = 100;
+  double connect_radius_m = 5.0;
+};
+
+class Roadmap {
+ public:
+  int add_node(const Config& q);
+  /// Adds a -> b (and b -> a) with transfers from `model` when given.
+  void connect(int a, int b, const BeliefModel* model);
+  /// Adds a directed edge with an explicit transfer (hand-built graphs, tests).
+  void add_edge(int from, int to, double length_m, const ScatteringTransfer& transfer);
+
+  int size() const { return static_cast<int>(nodes_.size()); }
+  const Config& node(int i) const { return nodes_[i]; }
+  const std::vector<Edge>& edges(int i) const { return adjacency_[i]; }
+  int edge_count() const;
+
+ private:
+  std::vector<Config> nodes_;
+  std::vector<std::vector<Edge>> adjacency_;
+};
+
+/// Node 0 = start, node 1 = goal, then up to options.samples samples; connects every pair
+/// within the radius whose motion is valid. `model` may be null (PRM).
+Roadmap build_roadmap(const ConfigurationSpace& space, Sampler& sampler, const Config& start,
+                      const Config& goal, const RoadmapOptions& options, const BeliefModel* model, Rng& rng);
+
+}  // namespace kestrel::planner

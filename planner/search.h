@@ -1,0 +1,45 @@
+#pragma once
+// Searches over a Roadmap: PRM's shortest path, and the Belief Roadmap's search (the paper's
+// Algorithm 1) with either objective.
+//
+// BRM labels are (node, Sigma, path); a label never revisits a node on its own path.
+//  * kMinGoalUncertainty — Algorithm 1: breadth-first; a label reaching node n is kept when its
+//    tr(Sigma) is below the best seen at n; the goal's best label is the answer.
+//  * kShortestBounded — shortest path with tr(Sigma) < max_trace at every node: labels in order
+//    of length, dropped when over the bound or dominated at their node by a label that is both
+//    shorter and better localised (tr). The bound is checked at nodes, as in the paper.
+
+#include <limits>
+#include <vector>
+
+#include "planner/roadmap.h"
+
+namespace kestrel::planner {
+
+enum class BrmObjective { kMinGoalUncertainty, kShortestBounded };
+
+struct PlanResult {
+  bool found = false;
+  std::vector<int> nodes;          ///< start ... goal
+  std::vector<double> traces;      ///< predicted tr(Sigma) at each node (empty for PRM)
+  double length_m = 0.0;
+  Mat4 goal_covariance = Mat4::Zero();
+  long expansions = 0;             ///< labels expanded
+};
+
+/// Dijkstra on edge length.
+PlanResult shortest_path(const Roadmap& map, int start, int goal);
+
+struct BrmQuery {
+  Mat4 start_covariance = Mat4::Identity();
+  BrmObjective objective = BrmObjective::kMinGoalUncertainty;
+  double max_trace = std::numeric_limits<double>::infinity();
+};
+
+PlanResult belief_search(const Roadmap& map, int start, int goal, const BrmQuery& query);
+
+/// tr(Sigma) at each node of `nodes` flown from `start_covariance` (fills traces and
+/// goal_covariance of a PRM result). Throws std::invalid_argument if two nodes are not joined.
+void predict_along(const Roadmap& map, const Mat4& start_covariance, PlanResult& path);
+
+}  // namespace kestrel::planner

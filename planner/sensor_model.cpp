@@ -1,0 +1,124 @@
+// FeatureSensor: range / azimuth / elevation of point features, and the information it gives.
+#include "planner/sensor_model.h"
+
+#include <cmath>
+#include <stdexcept>
+
+#include "estimator/information.h"
+
+namespace kestrel::planner {
+
+FeatureSensorOptions FeatureSensorOptions::paper_camera() { return {}; }
+
+FeatureSensorOptions FeatureSensorOptions::kinect() {
+  FeatureSensorOptions o;
+  o.max_range_m = 4.0;
+  o.min_range_m = 0.5;
+  o.horizontal_fov_rad = 57.0 * M_PI / 180.0;
+  o.vertical_fov_rad = 43.0 * M_PI / 180.0;
+  o.range_sigma_m = 0.0;
+  o.range_sigma_per_m2 = 1.4e-3;
+  o.bearing_sigma_rad = 1e-3;  // about one pixel at 580 px focal length
+  return o;
+}
+
+FeatureSensorOptions FeatureSensorOptions::planar_laser(double range_m) {
+  FeatureSensorOptions o;
+  o.max_range_m = range_m;
+  o.min_range_m = 0.1;
+  o.horizontal_fov_rad = 2.0 * M_PI;
+  o.vertical_fov_rad = M_PI;
+  o.range_sigma_m = 0.01;
+  o.bearing_sigma_rad = 0.5 * M_PI / 180.0;
+  return o;
+}
+
+FeatureSensor::FeatureSensor(const Environment& env, FeatureSensorOptions options)
+    : env_(env), options_(options) {
+  const auto& o = options_;
+  if (!(o.max_range_m > o.min_range_m) || !(o.min_range_m >= 0.0) || !(o.horizontal_fov_rad > 0.0) ||
+      !(o.vertical_fov_rad > 0.0) || !(o.bearing_sigma_rad > 0.0) ||
+      !(o.range_sigma_m > 0.0 || o.range_sigma_per_m2 > 0.0))
+    throw std::invalid_argument("FeatureSensor: ranges, fields of view and noise must be positive");
+}
+
+std::vector<int> FeatureSensor::visible(const Config& q) const {
+  std::vector<int> out;
+  const Eigen::Vector3d p = position(q);
+  const auto& features = env_.features();
+  const double half_h = 0.5 * options_.horizontal_fov_rad, half_v = 0.5 * options_.vertical_fov_rad;
+  for (int i = 0; i < static_cast<int>(features.size()); ++i) {
+    const Eigen::Vector3d d = features[i].position - p;
+    const double r = d.norm();
+    if (r > options_.max_range_m || r < options_.min_range_m) continue;
+    if (features[i].normal.dot(d) >= 0.0) continue;  // seen from behind its surface
+    const double rho = d.head<2>().norm();
+    if (half_h < M_PI && std::abs(wrap_angle(std::atan2(d.y(), d.x()) - q[3])) > half_h) continue;
+    if (std::abs(std::atan2(d.z(), rho)) > half_v) continue;
+    if (!env_.line_of_sight(p, features[i].position)) continue;
+    out.push_back(i);
+  }
+  return out;
+}
+
+Eigen::Vector3d FeatureSensor::predict(const Config& q, int index, double reference_azimuth) const {
+  const Eigen::Vector3d d = env_.features()[index].position - position(q);
+  const double rho = d.head<2>().norm();
+  const double az = reference_azimuth + wrap_angle(std::atan2(d.y(), d.x()) - q[3] - reference_azimuth);
+  return {d.norm(), az, std::atan2(d.z(), rho)};
+}
+
+FeatureMeasurement FeatureSensor::measure(const Config& q, int index) const {
+  const Eigen::Vector3d d = env_.features()[index].position - position(q);
+  const double r2 = d.squaredNorm(), r = std::sqrt(r2);
+  const double rho2 = std::max(d.head<2>().squaredNorm(), 1e-12), rho = std::sqrt(rho2);
+  FeatureMeasurement m;
+  m.z = {r, wrap_angle(std::atan2(d.y(), d.x()) - q[3]), std::atan2(d.z(), rho)};
+  // d = f - p, so every derivative with respect to p is minus the one with respect to d.
+  m.H.setZero();
+  m.H.block<1, 3>(0, 0) = -d.transpose() / r;
+  m.H.block<1, 3>(1, 0) << d.y() / rho2, -d.x() / rho2, 0.0;
+  m.H(1, 3) = -1.0;
+  m.H.block<1, 3>(2, 0) << d.z() * d.x() / (rho * r2), d.z() * d.y() / (rho * r2), -rho / r2;
+  const double sr = options_.range_sigma_m + options_.range_sigma_per_m2 * r2;
+  const double sb = options_.bearing_sigma_rad;
+  m.variances = {sr * sr, sb * sb, sb * sb};
+  return m;
+}
+
+Mat4 FeatureSensor::information(const Config& q) const {
+  Mat4 M = Mat4::Zero();
+  for (int i : visible(q)) {
+    const FeatureMeasurement m = measure(q, i);
+    M += estimator::measurement_information(m.H, Eigen::Matrix3d(m.variances.asDiagonal()));
+  }
+  return M;
+}
+
+Mat4 FeatureSensor::ukf_information(const Config& q, const Mat4& prior) const {
+  const std::vector<int> seen = visible(q);
+  if (seen.empty()) return Mat4::Zero();
+  const int m = 3 * static_cast<int>(seen.size());
+  Eigen::VectorXd variances(m);
+  Eigen::VectorXd reference(seen.size());
+  for (size_t k = 0; k < seen.size(); ++k) {
+    const FeatureMeasurement fm = measure(q, seen[k]);
+    variances.segment<3>(3 * k) = fm.variances;
+    reference[k] = fm.z[1];
+  }
+  const auto h = [&](const Config& x) {
+    Eigen::VectorXd z(m);
+    for (size_t k = 0; k < seen.size(); ++k) z.segment<3>(3 * k) = predict(x, seen[k], reference[k]);
+    return z;
+  };
+  const Eigen::MatrixXd Q = variances.asDiagonal();
+  return estimator::ukf_measurement_information(q, prior, h, Q);
+}
+
+double FeatureSensor::ukf_information_gain(const Config& q, const Mat4& prior) const {
+  const Mat4 M = ukf_information(q, prior);
+  const Mat4 posterior = estimator::update_covariance(prior, M);
+  return 0.5 * (std::log(prior.determinant()) - std::log(posterior.determinant()));
+}
+
+}  // namespace kestrel::planner

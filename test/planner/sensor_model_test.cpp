@@ -1,0 +1,119 @@
+// The feature sensor: visibility rules, analytic Jacobians, and M against its definition.
+#include <gtest/gtest.h>
+
+#include "estimator/information.h"
+#include "planner/grid_environment.h"
+#include "planner/sensor_model.h"
+#include "test_environments.h"
+
+namespace kestrel::planner {
+namespace {
+
+using testing::PredicateEnvironment;
+
+PredicateEnvironment open_space() {
+  return PredicateEnvironment({Eigen::Vector3d(-10, -10, 0), Eigen::Vector3d(10, 10, 3)},
+                              [](const Eigen::Vector3d&) { return true; });
+}
+
+Feature feature(double x, double y, double z, Eigen::Vector3d normal) {
+  Feature f;
+  f.position = {x, y, z};
+  f.normal = normal.normalized();
+  return f;
+}
+
+TEST(FeatureSensor, SeesOnlyFeaturesInRangeInViewAndFacingIt) {
+  PredicateEnvironment env = open_space();
+  const Eigen::Vector3d towards(-1, 0, 0);
+  env.set_features({feature(1.5, 0, 1, towards),      // ahead, 1.5 m: seen
+                    feature(2.5, 0, 1, towards),      // beyond 2 m
+                    feature(1.5, 0.6, 1, towards),    // 21.8 deg off axis: outside 30 deg FOV
+                    feature(1.5, 0.3, 1, towards),    // 11.3 deg: inside
+                    feature(1.0, 0, 1, -towards),     // seen from behind its surface
+                    feature(1.0, 0, 1.5, towards)});  // 26.6 deg above: outside the vertical FOV
+  const FeatureSensor sensor(env, FeatureSensorOptions::paper_camera());
+  EXPECT_EQ(sensor.visible(Config(0, 0, 1, 0)), (std::vector<int>{0, 3}));
+  EXPECT_TRUE(sensor.visible(Config(0, 0, 1, M_PI)).empty());  // facing away
+  const FeatureSensor laser(env, FeatureSensorOptions::planar_laser(3.0));
+  EXPECT_EQ(laser.visible(Config(0, 0, 1, M_PI)), (std::vector<int>{0, 1, 2, 3, 5}));
+}
+
+TEST(FeatureSensor, WallsHideFeatures) {
+  OccupancyGrid g = make_grid(60, 40, 0.1, 0.05, 0.05);
+  fill_rect(g, 2.95, 0.0, 3.05, 2.0, OccupancyGrid::kOccupied);
+  GridEnvironment env(g, 0.0, 3.0);
+  env.set_features({feature(4.0, 1.0, 1.0, {-1, 0, 0}), feature(4.0, 3.0, 1.0, {-1, 0, 0})});
+  FeatureSensorOptions o = FeatureSensorOptions::planar_laser(5.0);
+  const FeatureSensor sensor(env, o);
+  EXPECT_EQ(sensor.visible(Config(1.0, 1.0, 1.0, 0.0)), (std::vector<int>{1}));
+}
+
+TEST(FeatureSensor, JacobianMatchesNumericalDifferentiation) {
+  PredicateEnvironment env = open_space();
+  Rng rng(3);
+  std::uniform_real_distribution<double> u(-3.0, 3.0);
+  std::vector<Feature> features;
+  for (int i = 0; i < 20; ++i) features.push_back(feature(u(rng), u(rng), 1.0 + 0.3 * u(rng), {1, 0, 0}));
+  env.set_features(features);
+  const FeatureSensor sensor(env, FeatureSensorOptions::kinect());
+  for (int i = 0; i < 20; ++i) {
+    const Config q(0.1 * u(rng), 0.1 * u(rng), 1.0, u(rng));
+    const FeatureMeasurement m = sensor.measure(q, i);
+    Eigen::Matrix<double, 3, 4> numeric;
+    for (int k = 0; k < 4; ++k) {
+      const double h = 1e-6;
+      Config a = q, b = q;
+      a[k] += h;
+      b[k] -= h;
+      numeric.col(k) = (sensor.predict(a, i, m.z[1]) - sensor.predict(b, i, m.z[1])) / (2 * h);
+    }
+    EXPECT_LT((numeric - m.H).norm(), 1e-6) << i;
+    EXPECT_NEAR(sensor.predict(q, i, m.z[1])[1], m.z[1], 1e-12);
+  }
+}
+
+TEST(FeatureSensor, InformationOfAFeatureStraightAheadIsKnown) {
+  // From (0, 0, 1, 0) a feature at distance d straight ahead: H rows are
+  // range [-1 0 0 0], azimuth [0 -1/d 0 -1], elevation [0 0 -1/d 0].
+  PredicateEnvironment env = open_space();
+  const double d = 1.5;
+  env.set_features({feature(d, 0, 1, {-1, 0, 0})});
+  const FeatureSensorOptions o = FeatureSensorOptions::paper_camera();
+  const FeatureSensor sensor(env, o);
+  const double ir = 1.0 / (o.range_sigma_m * o.range_sigma_m), ib = 1.0 / (o.bearing_sigma_rad * o.bearing_sigma_rad);
+  Mat4 expected = Mat4::Zero();
+  expected(0, 0) = ir;
+  expected(1, 1) = ib / (d * d);
+  expected(1, 3) = expected(3, 1) = ib / d;
+  expected(3, 3) = ib;
+  expected(2, 2) = ib / (d * d);
+  EXPECT_LT((sensor.information(Config(0, 0, 1, 0)) - expected).norm(), 1e-12);
+  EXPECT_EQ(sensor.information(Config(0, 0, 1, M_PI)), Mat4::Zero());
+}
+
+TEST(FeatureSensor, UkfInformationTendsToTheEkfsForASmallPrior) {
+  PredicateEnvironment env = open_space();
+  env.set_features({feature(1.5, 0.2, 1.1, {-1, 0, 0}), feature(1.2, -0.3, 0.8, {-1, 0, 0}),
+                    feature(1.8, 0.1, 1.0, {-1, 0, 0})});
+  const FeatureSensor sensor(env, FeatureSensorOptions::paper_camera());
+  const Config q(0, 0, 1, 0.05);
+  const Mat4 ekf = sensor.information(q);
+  const Mat4 ukf = sensor.ukf_information(q, 1e-6 * Mat4::Identity());
+  EXPECT_LT((ukf - ekf).norm(), 1e-3 * ekf.norm());
+  EXPECT_GT(sensor.ukf_information_gain(q, 0.1 * Mat4::Identity()), 0.0);
+  EXPECT_EQ(sensor.ukf_information_gain(Config(0, 0, 1, M_PI), 0.1 * Mat4::Identity()), 0.0);
+}
+
+TEST(FeatureSensor, RejectsNonsenseOptions) {
+  PredicateEnvironment env = open_space();
+  FeatureSensorOptions o;
+  o.max_range_m = 0.1;
+  EXPECT_THROW(FeatureSensor(env, o), std::invalid_argument);
+  o = {};
+  o.bearing_sigma_rad = 0.0;
+  EXPECT_THROW(FeatureSensor(env, o), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace kestrel::planner
