@@ -163,7 +163,8 @@ void time_series(cv::Mat& img, const cv::Rect& area, int64_t t0_us, double durat
   for (double v : values) top = std::max(top, v);
   const bool show_threshold = std::isfinite(threshold) && threshold <= 2.0 * top;
   if (show_threshold) top = std::max(top, threshold);
-  top = top > 0.0 ? 1.1 * top : 1.0;
+  // A floor of 1 mm (or 1 mm/s, 1e-3 deg): below it the ticks would be rounding noise.
+  top = std::max(1.1 * top, 1e-3);
   const Axes axes{area, 0.0, std::max(duration_s, 1e-3), 0.0, top};
   std::string full_label = label;
   if (show_threshold) full_label += fmt::format("; dashed: {:g}", threshold);
