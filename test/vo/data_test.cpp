@@ -1,0 +1,47 @@
+// The odometry on the real Kinect sequences (label `data`; skips without ../shared/data):
+// accuracy with thresholds 10 % above the figures measured when this test was written
+// (vo/README.md), so that a regression of more than 10 % on any of them fails; and each at
+// least as good as the best peer of ../shared/BASELINES.md where kestrel reached it.
+
+#include <gtest/gtest.h>
+
+#include <iostream>
+
+#include "test/support/test_support.h"
+#include "vo/sequence_run.h"
+
+namespace kestrel::vo {
+namespace {
+
+struct Expected {
+  double ate_m, rpe_mps, rpe_degps, velocity_mps;
+  size_t max_gross;
+};
+
+void check(const std::filesystem::path& folder, const Expected& measured) {
+  const LoadedSequence sequence = load_tum_sequence(folder.string());
+  const SequenceRun run = run_sequence(sequence.frames, VoOptions{});
+  const RunFigures f = score(run, sequence.ground_truth);
+  std::cout << folder.filename().string() << ": ATE " << f.ate_rmse_m << " m, RPE " << f.rpe_translation_mps
+            << " m/s " << f.rpe_rotation_degps << " deg/s, vel " << f.velocity_error_mps << " m/s, gross "
+            << f.gross << ", NEES " << f.mean_nees << ", ok " << f.ok << "/" << f.frames << "\n";
+  EXPECT_LE(f.ate_rmse_m, 1.1 * measured.ate_m);
+  EXPECT_LE(f.rpe_translation_mps, 1.1 * measured.rpe_mps);
+  EXPECT_LE(f.rpe_rotation_degps, 1.1 * measured.rpe_degps);
+  EXPECT_LE(f.velocity_error_mps, 1.1 * measured.velocity_mps);
+  EXPECT_LE(f.gross, measured.max_gross);
+  EXPECT_GE(f.ok + 2, f.frames) << "at most the first frame and one more without a motion";
+}
+
+TEST(VoData, Fr1Xyz) {
+  KESTREL_REQUIRE_TUM(folder, "rgbd_dataset_freiburg1_xyz");
+  check(folder, {0.0199, 0.0245, 1.069, 0.1445, 1});
+}
+
+TEST(VoData, Fr1Rpy) {
+  KESTREL_REQUIRE_TUM(folder, "rgbd_dataset_freiburg1_rpy");
+  check(folder, {0.0580, 0.0612, 2.849, 0.1514, 0});
+}
+
+}  // namespace
+}  // namespace kestrel::vo

@@ -1,0 +1,42 @@
+#pragma once
+// The grey-level Gaussian pyramid a frame is described by: level 0 is the grey image blurred
+// with sigma = PyramidOptions::blur_sigma, each next level halves the previous one (5-tap
+// Gaussian and decimation). Extra coarse levels, beyond the feature levels, serve the rotation
+// prior, which works on heavily down-sampled images.
+//
+// Invariants: level(i) is CV_8UC1 of size ceil(size / 2^i); buffers are reused from one build()
+// to the next when the image size does not change, so a steady stream allocates nothing.
+
+#include <opencv2/core/mat.hpp>
+#include <vector>
+
+namespace kestrel::vo {
+
+class ImagePyramid {
+ public:
+  /// Builds `levels` levels (>= 1) from an 8-bit RGB (CV_8UC3, R,G,B) or grey (CV_8UC1) image.
+  void build(const cv::Mat& image, int levels, double blur_sigma);
+
+  int levels() const { return static_cast<int>(levels_.size()); }
+  const cv::Mat& level(int i) const { return levels_[static_cast<size_t>(i)]; }
+
+  /// Exchanges contents with `other` (buffers included), for frame recycling.
+  void swap(ImagePyramid& other) noexcept;
+
+ private:
+  cv::Mat grey_;
+  std::vector<cv::Mat> levels_;
+};
+
+/// Pixel coordinates of level `level` mapped to level 0 (pixel centres, not corners, scale).
+inline float to_level0(float x, int level) {
+  const float s = static_cast<float>(1 << level);
+  return (x + 0.5f) * s - 0.5f;
+}
+/// Level-0 pixel coordinates mapped to level `level`.
+inline float from_level0(float x, int level) {
+  const float s = static_cast<float>(1 << level);
+  return (x + 0.5f) / s - 0.5f;
+}
+
+}  // namespace kestrel::vo

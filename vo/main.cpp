@@ -1,0 +1,132 @@
+// kestrel-vo: visual odometry. As a process (default) it reads CAMERA_RGBD and publishes one
+// VO_UPDATE per frame (relative motion, covariance, status and counts), with heartbeats and
+// lock-step replay. With --tum DIR it runs in process over a TUM RGB-D folder instead and
+// writes the camera trajectory (TUM format, at the RGB time stamps) and optional statistics.
+// See vo/README.md.
+
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <stdexcept>
+#include <string>
+
+#include "common/cli.h"
+#include "common/error.h"
+#include "common/transport/channels.h"
+#include "common/transport/node.h"
+#include "common/transport/rgbd_codec.h"
+#include "kestrel/rgbd_frame_t.hpp"
+#include "vo/sequence_run.h"
+#include "vo/update_message.h"
+#include "vo/variants.h"
+
+namespace {
+
+using namespace kestrel;
+
+struct Options {
+  std::string variant = "default";
+  // Offline.
+  std::string tum;
+  std::string out;
+  std::string stats;
+  // Process.
+  std::string name = "vo";
+  std::string lcm_url;
+  std::string in_channel = channel::kCameraRgbd;
+  std::string out_channel = channel::kVoUpdate;
+};
+
+int run_offline(const Options& o, const vo::VoOptions& options) {
+  if (o.out.empty()) throw CLI::RequiredError("--out (with --tum)");
+  const vo::LoadedSequence sequence = vo::load_tum_sequence(o.tum);
+  const vo::SequenceRun run = vo::run_sequence(sequence.frames, options);
+  write_tum_trajectory(o.out, run.trajectory);
+  const vo::RunFigures f = vo::score(run, sequence.ground_truth);
+  std::cout << "frames: " << f.frames << ", with a motion: " << f.ok << "\n"
+            << "ms per frame: median " << f.median_ms << ", p95 " << f.p95_ms << "\n";
+  if (!sequence.ground_truth.empty()) {
+    std::cout << "ATE RMSE: " << f.ate_rmse_m << " m\n"
+              << "RPE (1 s): " << f.rpe_translation_mps << " m/s, " << f.rpe_rotation_degps << " deg/s\n"
+              << "mean velocity error: " << f.velocity_error_mps << " m/s\n"
+              << "gross failures: " << f.gross << " (" << f.gross_percent << " %)\n"
+              << "NEES: mean " << f.mean_nees << " (6 if consistent), " << 100.0 * f.nees_within_95
+              << " % under the 95 % bound, " << f.nees_frames << " frames\n";
+  }
+  if (!o.stats.empty()) {
+    std::ofstream out(o.stats);
+    out << vo::stats_json(run, f, o.variant) << "\n";
+    if (!out) throw InputError(o.stats + ": cannot write");
+  }
+  return kExitOk;
+}
+
+int serve(const Options& o, const vo::VoOptions& options) {
+  if (!o.out.empty() || !o.stats.empty()) throw CLI::ValidationError("--out/--stats", "only with --tum");
+  vo::VisualOdometry odometry(options);
+  std::unique_ptr<transport::Node> node;
+  try {
+    node = std::make_unique<transport::Node>(o.name, o.lcm_url);
+  } catch (const std::runtime_error& e) {
+    spdlog::error("{}", e.what());
+    return kExitUnavailable;
+  }
+  node->advertise(o.out_channel);
+  node->on_reset([&] { odometry.reset(); });
+  int64_t frames = 0, ok = 0;
+  node->subscribe<rgbd_frame_t>(o.in_channel, [&](const rgbd_frame_t& message) {
+    RgbdFrame frame;
+    try {
+      frame = transport::decode_rgbd(message, o.in_channel.c_str());
+    } catch (const InputError&) {
+      // Consumers learn that a frame was lost; the Node counts and logs the reason.
+      node->publish(o.out_channel, vo::bad_input_message(message.utime, message.seq));
+      throw;
+    }
+    const auto t0 = std::chrono::steady_clock::now();
+    const vo::VoResult r = odometry.process(frame);
+    const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    node->publish(o.out_channel, vo::to_message(r, frame.T_body_camera, ms));
+    ++frames;
+    ok += r.status == vo::VoStatus::kOk;
+    if (r.status != vo::VoStatus::kOk && r.status != vo::VoStatus::kNoReference)
+      spdlog::debug("{}: frame {}: {}", o.in_channel, r.utime, r.message);
+  });
+  node->set_health(process_status_t::STATE_RUNNING, "");
+  spdlog::info("{}: {} -> {} (variant {})", o.name, o.in_channel, o.out_channel, o.variant);
+  const int status = node->spin();
+  spdlog::info("{} frames, {} with a motion, {} rejected", frames, ok, node->counters().messages_rejected);
+  return status;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  cli::App app("vo",
+               "Visual odometry (fovis pipeline): CAMERA_RGBD -> VO_UPDATE, or with --tum an "
+               "offline run over a TUM RGB-D folder that writes the trajectory.");
+  Options o;
+  std::string known;
+  for (const auto& v : vo::variants()) known += (known.empty() ? "" : ", ") + v.name;
+  app.add_option("--variant", o.variant, "Pipeline variant (paper's Table 1): " + known)
+      ->capture_default_str();
+  app.add_option("--tum", o.tum, "Offline: TUM RGB-D sequence folder to run over");
+  app.add_option("--out", o.out, "Offline: write the camera trajectory here (TUM format)");
+  app.add_option("--stats", o.stats, "Offline: write figures and per-frame status here (JSON)");
+  app.add_option("--name", o.name, "Process name in heartbeats")->capture_default_str();
+  app.add_option("--lcm-url", o.lcm_url, "LCM URL (default: $LCM_DEFAULT_URL or kestrel's)");
+  app.add_option("--in", o.in_channel, "Channel of rgbd_frame_t")->capture_default_str();
+  app.add_option("--out-channel", o.out_channel, "Channel of vo_update_t")->capture_default_str();
+  return app.run(argc, argv, [&] {
+    vo::VoOptions options;
+    try {
+      options = vo::variant(o.variant).options;
+    } catch (const std::invalid_argument& e) {
+      throw CLI::ValidationError("--variant", e.what());
+    }
+    return o.tum.empty() ? serve(o, options) : run_offline(o, options);
+  });
+}

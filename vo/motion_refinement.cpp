@@ -1,0 +1,192 @@
+#include "vo/motion_refinement.h"
+
+#include <Eigen/Cholesky>
+#include <cmath>
+#include <limits>
+
+#include "common/geometry/so3.h"
+
+namespace kestrel::vo {
+namespace {
+
+using Matrix26d = Eigen::Matrix<double, 2, 6>;
+
+struct Projection {
+  Eigen::Vector2d pixel;
+  Eigen::Matrix<double, 2, 3> J;  // d pixel / d point
+};
+
+// Projection of X and its Jacobian; for ESM the Jacobian is taken halfway to the measurement,
+// the pixel the projection reaches at the optimum (at the same depth).
+Projection project(const Eigen::Vector3d& X, const PinholeCamera& cam,
+                   const Eigen::Vector2d& measured, bool esm) {
+  Projection p;
+  const double iz = 1.0 / X.z();
+  p.pixel = Eigen::Vector2d(cam.fx * X.x() * iz + cam.cx, cam.fy * X.y() * iz + cam.cy);
+  const Eigen::Vector2d at = esm ? 0.5 * (p.pixel + measured) : p.pixel;
+  p.J << cam.fx * iz, 0.0, -(at.x() - cam.cx) * iz, 0.0, cam.fy * iz, -(at.y() - cam.cy) * iz;
+  return p;
+}
+
+struct Accumulator {
+  Matrix6d H = Matrix6d::Zero();
+  Matrix6d information = Matrix6d::Zero();  // H with each measurement counted once
+  Vector6d g = Vector6d::Zero();
+  double cost = 0.0;         // robust, whitened
+  double sq_px = 0.0;        // unwhitened squared pixel error
+  int residuals = 0;
+};
+
+// Adds one scalar residual r with Jacobian J and standard deviation sigma.
+void add_scalar(Accumulator& acc, double r, const Eigen::Matrix<double, 1, 6>& J, double sigma,
+                const RefinementOptions& o) {
+  const double rw = r / sigma;
+  const double e = std::abs(rw);
+  double weight = 1.0, rho = e * e;
+  if (o.huber_px > 0.0 && e > o.huber_px) {
+    weight = o.huber_px / e;
+    rho = 2.0 * o.huber_px * e - o.huber_px * o.huber_px;
+  }
+  const Eigen::Matrix<double, 1, 6> Jw = J / sigma;
+  acc.H.noalias() += weight * Jw.transpose() * Jw;
+  acc.information.noalias() += weight * Jw.transpose() * Jw;
+  acc.g.noalias() += weight * Jw.transpose() * rw;
+  acc.cost += rho;
+}
+
+// Adds one residual r = pixel(T) - measured with Jacobian J (2x6), whitened by pixel noise
+// sigma and depth noise along g (the image motion per metre of depth of the projected point).
+// `information_share` is the part of its information that is new: a reprojection residual
+// involves two noisy pixels (the measured one and the ray the point lies on), and the two
+// directions of a bidirectional refinement measure the same pair again.
+
+void add(Accumulator& acc, const Eigen::Vector2d& r, const Matrix26d& J, const Eigen::Vector2d& g,
+         double sigma_z, double information_share, const RefinementOptions& o) {
+  const double s = o.pixel_sigma;
+  Eigen::Matrix2d W = Eigen::Matrix2d::Identity() / s;  // Sigma^-1/2
+  if (o.depth_weighted && sigma_z > 0.0) {
+    const double gn2 = g.squaredNorm();
+    if (gn2 > 1e-18) {
+      const Eigen::Vector2d u = g / std::sqrt(gn2);
+      const double along = std::sqrt(s * s + sigma_z * sigma_z * gn2);
+      W = (Eigen::Matrix2d::Identity() - u * u.transpose()) / s + u * u.transpose() / along;
+    }
+  }
+  const Eigen::Vector2d rw = W * r;
+  const Matrix26d Jw = W * J;
+  const double e = rw.norm();
+  double weight = 1.0, rho = e * e;
+  if (o.huber_px > 0.0 && e > o.huber_px) {
+    weight = o.huber_px / e;
+    rho = 2.0 * o.huber_px * e - o.huber_px * o.huber_px;
+  }
+  acc.H.noalias() += weight * Jw.transpose() * Jw;
+  acc.information.noalias() += information_share * weight * Jw.transpose() * Jw;
+  acc.g.noalias() += weight * Jw.transpose() * rw;
+  acc.cost += rho;
+  acc.sq_px += r.squaredNorm();
+  ++acc.residuals;
+}
+
+Accumulator linearise(const std::vector<Correspondence>& cs, const std::vector<int>& use,
+                      const PinholeCamera& cam, const Eigen::Isometry3d& T,
+                      const RefinementOptions& o) {
+  Accumulator acc;
+  const Eigen::Matrix3d R = T.linear();
+  const Eigen::Matrix3d Rt = R.transpose();
+  const Eigen::Vector3d p = T.translation();
+  const bool esm = o.solver == Solver::kEsm;
+  const double share = o.bidirectional ? 0.25 : 0.5;
+  for (int i : use) {
+    const Correspondence& c = cs[static_cast<size_t>(i)];
+    // Reference point into the current image: Y = R^T (P - p).
+    const Eigen::Vector3d Y = Rt * (c.ref_point - p);
+    if (Y.z() > 1e-6) {
+      const Projection pr = project(Y, cam, c.cur_pixel, esm);
+      Matrix26d J;
+      J.leftCols<3>() = -pr.J * Rt;
+      J.rightCols<3>() = pr.J * so3::hat(Y);
+      const Eigen::Vector3d dY_dz = Rt * (c.ref_point / c.ref_point.z());
+      add(acc, pr.pixel - c.cur_pixel, J, pr.J * dY_dz, c.ref_sigma_z, share, o);
+    }
+    // Current point in the reference frame: X = R Q + p.
+    const Eigen::Vector3d X = R * c.cur_point + p;
+    if (o.depth_residuals) {
+      // Its distance along the reference ray against the reference depth: the information the
+      // image residuals lack, which tells a sideways translation from a rotation.
+      const Eigen::Vector3d u = c.ref_point.normalized();
+      Eigen::Matrix<double, 1, 6> J;
+      J.leftCols<3>() = u.transpose();
+      J.rightCols<3>() = -u.transpose() * R * so3::hat(c.cur_point);
+      const double sigma = std::sqrt(c.ref_sigma_z * c.ref_sigma_z + c.cur_sigma_z * c.cur_sigma_z + 1e-6 * o.depth_sigma_floor_mm * o.depth_sigma_floor_mm);
+      add_scalar(acc, u.dot(X - c.ref_point), J, sigma, o);
+    }
+    if (!o.bidirectional) continue;
+    if (X.z() > 1e-6) {
+      const Projection pr = project(X, cam, c.ref_pixel, esm);
+      Matrix26d J;
+      J.leftCols<3>() = pr.J;
+      J.rightCols<3>() = -pr.J * R * so3::hat(c.cur_point);
+      const Eigen::Vector3d dX_dz = R * (c.cur_point / c.cur_point.z());
+      add(acc, pr.pixel - c.ref_pixel, J, pr.J * dX_dz, c.cur_sigma_z, share, o);
+    }
+  }
+  return acc;
+}
+
+}  // namespace
+
+double reprojection_error_px(const Correspondence& c, const PinholeCamera& cam,
+                             const Eigen::Isometry3d& T, bool bidirectional) {
+  auto project_px = [&](const Eigen::Vector3d& X) {
+    if (X.z() <= 1e-6) return Eigen::Vector2d(Eigen::Vector2d::Constant(1e9));
+    return Eigen::Vector2d(cam.fx * X.x() / X.z() + cam.cx, cam.fy * X.y() / X.z() + cam.cy);
+  };
+  const double forward = (project_px(T.inverse() * c.ref_point) - c.cur_pixel).norm();
+  if (!bidirectional) return forward;
+  const double backward = (project_px(T * c.cur_point) - c.ref_pixel).norm();
+  return std::max(forward, backward);
+}
+
+RefinementResult refine_motion(const std::vector<Correspondence>& cs, const std::vector<int>& use,
+                               const PinholeCamera& cam, const Eigen::Isometry3d& T_ref_cur,
+                               const RefinementOptions& o) {
+  RefinementResult result;
+  Eigen::Isometry3d T = T_ref_cur;
+  Accumulator acc = linearise(cs, use, cam, T, o);
+  double lambda = 0.0;  // Levenberg-Marquardt damping, only once a step fails
+  for (int it = 0; it < o.max_iterations && acc.residuals >= 6; ++it) {
+    result.iterations = it + 1;
+    Matrix6d A = acc.H;
+    A.diagonal() *= 1.0 + lambda;
+    const Vector6d delta = A.ldlt().solve(-acc.g);
+    if (!delta.allFinite()) break;
+    const Eigen::Isometry3d T_new = se3::boxplus(T, delta);
+    const Accumulator acc_new = linearise(cs, use, cam, T_new, o);
+    if (acc_new.residuals < acc.residuals || acc_new.cost > acc.cost) {
+      lambda = lambda == 0.0 ? 1e-3 : lambda * 10.0;
+      if (lambda > 1e3) break;
+      continue;
+    }
+    lambda *= 0.1;
+    if (lambda < 1e-6) lambda = 0.0;
+    T = T_new;
+    acc = acc_new;
+    if (delta.head<3>().norm() < 1e-7 && delta.tail<3>().norm() < 1e-8) {
+      result.converged = true;
+      break;
+    }
+  }
+  if (!result.converged && acc.residuals >= 6) {
+    // Stopped by the iteration limit or a step that no damping could make descend: a local
+    // minimum to within what the data resolves.
+    const Vector6d step = acc.H.ldlt().solve(-acc.g);
+    result.converged = step.allFinite() && step.head<3>().norm() < 1e-4 && step.tail<3>().norm() < 1e-4;
+  }
+  result.T_ref_cur = T;
+  result.information = acc.information;
+  result.rms_error_px = acc.residuals > 0 ? std::sqrt(acc.sq_px / acc.residuals) : 0.0;
+  return result;
+}
+
+}  // namespace kestrel::vo

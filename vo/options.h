@@ -1,0 +1,122 @@
+#pragma once
+// Options of the visual odometry: one small struct per stage, every field with its default and
+// unit. `VoOptions{}` is kestrel's pipeline as measured in vo/README.md; vo/variants.h derives
+// the paper's Table 1 variants from it by changing one stage at a time.
+//
+// Invariant: validate() accepts every combination the variants produce and rejects, naming the
+// field, any value a stage cannot run with.
+
+#include <string>
+
+namespace kestrel::vo {
+
+/// Grey image, Gaussian blur and pyramid (one octave per level).
+struct PyramidOptions {
+  int levels = 3;             ///< feature pyramid levels, 1..4
+  double blur_sigma = 0.85;   ///< Gaussian blur of level 0, pixels (0 = none)
+};
+
+/// FAST-9 detection on every level and its adaptive threshold.
+struct FastOptions {
+  int threshold = 20;                 ///< initial (or fixed) intensity threshold, grey levels
+  bool adaptive = true;               ///< proportional controller on the number of detections
+  double target_pixels_per_feature = 250.0;  ///< target detections = width*height / this
+  double adaptive_gain = 0.005;       ///< threshold change per surplus detection
+  int min_threshold = 5;
+  int max_threshold = 70;
+};
+
+/// Keeps the strongest features of each image cell so that they spread over the image.
+struct BucketOptions {
+  bool enabled = true;
+  int width_px = 80;          ///< bucket size in the level's pixels
+  int height_px = 80;
+  int max_per_bucket = 25;
+};
+
+/// Depth at a feature, its uncertainty, and the RGB/depth time offset.
+struct DepthOptions {
+  double min_m = 0.3;                   ///< closer readings are dropped (Kinect minimum range)
+  double max_m = 6.0;                   ///< farther readings are dropped
+  double max_discontinuity = 0.05;      ///< drop a feature whose 3x3 depth spread exceeds this fraction of its depth
+  double sigma_z_coeff = 1.4e-3;        ///< depth noise sigma_z = coeff * z^2 (metres; Khoshelham 2011)
+  bool compensate_time_offset = false;  ///< look depth up where the point was at depth time
+  bool undistort = true;                ///< use the camera's lens distortion for rays and reprojection
+  double rolling_shutter_readout_s = 0.0;  ///< first-to-last row time; 0 = global shutter
+};
+
+/// Initial rotation by aligning heavily down-sampled images (Mei et al.).
+struct RotationPriorOptions {
+  bool enabled = true;
+  int downsample_level = 3;   ///< image of 1/2^level the size (3: 80 x 60 for VGA)
+  int max_iterations = 12;
+  bool predict_from_velocity = true;  ///< start from the previous frame-to-frame rotation
+};
+
+/// Patch descriptors, windowed matching and subpixel refinement.
+struct MatchOptions {
+  int window_size = 9;          ///< descriptor patch side, odd, 3..11 (9: 80 bytes)
+  double search_radius_px = 20.0;  ///< around the predicted position, level-0 pixels
+  int max_sad_per_pixel = 40;   ///< reject a match whose mean absolute difference is larger
+  bool subpixel = true;         ///< refine each match to subpixel precision
+  double max_subpixel_shift_px = 1.5;  ///< a refinement moving farther is rejected (level pixels)
+};
+
+enum class InlierMethod { kMaxClique, kRansac, kPreemptiveRansac };
+
+/// Inlier detection among the matches.
+struct InlierOptions {
+  InlierMethod method = InlierMethod::kMaxClique;
+  double clique_threshold_m = 0.02;   ///< floor on the distance-preservation tolerance
+  double clique_sigmas = 3.0;         ///< tolerance in depth-noise standard deviations
+  int ransac_hypotheses = 500;
+  double ransac_threshold_m = 0.03;   ///< 3D distance for a RANSAC inlier
+  int ransac_block_size = 100;        ///< preemptive RANSAC: observations scored per round
+  int min_inliers = 10;
+};
+
+enum class Solver { kGaussNewton, kEsm };
+
+/// Motion from the inliers: Horn, then non-linear reprojection refinement.
+struct RefinementOptions {
+  bool enabled = true;            ///< false: absolute orientation only
+  Solver solver = Solver::kEsm;
+  bool bidirectional = true;
+  bool depth_weighted = true;     ///< whiten residuals by the projected depth noise
+  bool depth_residuals = true;    ///< also compare the two depths of each match along its ray
+  double depth_sigma_floor_mm = 1.0;  ///< added in quadrature to the depth noise of a depth residual
+  double pixel_sigma = 0.7;       ///< measurement noise of a feature position, pixels
+  double huber_px = 1.5;          ///< robust loss threshold on a whitened residual (sigmas); 0 = none
+  double outlier_threshold_px = 2.0;   ///< residuals above this (pixels) are dropped before re-refining
+  int max_iterations = 10;
+  int min_inliers = 10;           ///< fewer after outlier removal = optimisation failure
+};
+
+/// Reference (key) frame policy.
+struct KeyframeOptions {
+  int min_inliers_to_keep = 150;  ///< below this, the current frame becomes the reference
+  bool fall_back_to_previous = true;
+};
+
+struct VoOptions {
+  PyramidOptions pyramid;
+  FastOptions fast;
+  BucketOptions bucket;
+  DepthOptions depth;
+  RotationPriorOptions rotation_prior;
+  MatchOptions match;
+  InlierOptions inliers;
+  RefinementOptions refinement;
+  KeyframeOptions keyframe;
+  int min_features = 30;          ///< fewer detections: "too few features"
+  int min_features_with_depth = 20;  ///< fewer with valid depth: "too little valid depth"
+  int min_matches = 15;            ///< fewer mutual matches: "too few matches"
+
+  /// Throws std::invalid_argument naming the first unusable field.
+  void validate() const;
+};
+
+const char* to_string(InlierMethod m);
+const char* to_string(Solver s);
+
+}  // namespace kestrel::vo

@@ -1,0 +1,146 @@
+#include "vo/sequence_run.h"
+
+#include <algorithm>
+#include <ctime>
+#include <cmath>
+#include <nlohmann/json.hpp>
+
+#include "drivers/tum/tum_sequence.h"
+#include "tools/eval/evaluate.h"
+#include "vo/pose_chain.h"
+
+namespace kestrel::vo {
+namespace {
+
+// 95 % quantile of chi-square with 6 degrees of freedom.
+constexpr double kChi2_6_95 = 12.592;
+
+// CPU time of this thread: on a machine shared with other jobs it still measures the work of
+// one core, where wall time would measure the contention.
+double thread_cpu_ms() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return 1e3 * double(ts.tv_sec) + 1e-6 * double(ts.tv_nsec);
+}
+
+double percentile(std::vector<double> v, double q) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const double pos = q * double(v.size() - 1);
+  const size_t i = static_cast<size_t>(pos);
+  const double a = pos - double(i);
+  return i + 1 < v.size() ? (1 - a) * v[i] + a * v[i + 1] : v[i];
+}
+
+// [dp; dtheta] taking the estimate to the truth, in the convention of every kestrel covariance.
+Vector6d pose_error(const Eigen::Isometry3d& T_est, const Eigen::Isometry3d& T_true) {
+  Vector6d e;
+  e.head<3>() = T_true.translation() - T_est.translation();
+  const Eigen::AngleAxisd aa(Eigen::Matrix3d(T_est.linear().transpose() * T_true.linear()));
+  e.tail<3>() = aa.angle() * aa.axis();
+  return e;
+}
+
+}  // namespace
+
+LoadedSequence load_tum_sequence(const std::string& folder) {
+  const tum::TumSequence sequence(folder);
+  LoadedSequence out;
+  out.folder = folder;
+  out.frames.reserve(sequence.size());
+  for (size_t i = 0; i < sequence.size(); ++i) out.frames.push_back(sequence.frame(i));
+  if (sequence.has_ground_truth()) out.ground_truth = sequence.ground_truth();
+  return out;
+}
+
+SequenceRun run_sequence(const std::vector<RgbdFrame>& frames, const VoOptions& options) {
+  SequenceRun run;
+  VisualOdometry vo(options);
+  PoseChain chain;
+  run.results.reserve(frames.size());
+  for (const RgbdFrame& frame : frames) {
+    const double t0 = thread_cpu_ms();
+    VoResult r = vo.process(frame);
+    run.process_ms.push_back(thread_cpu_ms() - t0);
+    run.frame_utimes.push_back(frame.utime);
+    if (const auto pose = chain.add(r)) run.trajectory.push_back(frame.utime, *pose);
+    run.results.push_back(std::move(r));
+  }
+  return run;
+}
+
+RunFigures score(const SequenceRun& run, const Trajectory& gt) {
+  RunFigures f;
+  f.frames = run.results.size();
+  for (const VoResult& r : run.results) f.ok += r.status == VoStatus::kOk;
+  f.median_ms = percentile(run.process_ms, 0.5);
+  f.p95_ms = percentile(run.process_ms, 0.95);
+  if (gt.empty() || run.trajectory.empty()) return f;
+
+  const eval::EvalOptions options;
+  const eval::Evaluation e = eval::evaluate(run.frame_utimes, run.trajectory, gt, options);
+  f.ate_rmse_m = e.ate.error_m.rmse;
+  f.rpe_translation_mps = e.rpe.translation_mps.rmse;
+  f.rpe_rotation_degps = e.rpe.rotation_degps.rmse;
+  f.velocity_error_mps = e.velocity.error_mps.mean;
+  f.gross = e.velocity.gross.total();
+  f.gross_percent = e.velocity.gross.percent();
+
+  // NEES of each relative motion against the ground truth's motion over the same frames.
+  double sum = 0.0;
+  size_t within = 0;
+  for (const VoResult& r : run.results) {
+    if (r.status != VoStatus::kOk) continue;
+    const auto g_ref = gt.at(r.reference_utime, options.gt_max_gap_us);
+    const auto g_cur = gt.at(r.utime, options.gt_max_gap_us);
+    if (!g_ref || !g_cur) continue;
+    const Vector6d err = pose_error(r.T_reference_current, g_ref->inverse() * *g_cur);
+    const double nees = err.dot(r.covariance.ldlt().solve(err));
+    if (!std::isfinite(nees)) continue;
+    sum += nees;
+    within += nees < kChi2_6_95;
+    ++f.nees_frames;
+  }
+  if (f.nees_frames > 0) {
+    f.mean_nees = sum / double(f.nees_frames);
+    f.nees_within_95 = double(within) / double(f.nees_frames);
+  }
+  return f;
+}
+
+std::string stats_json(const SequenceRun& run, const RunFigures& f, const std::string& variant) {
+  nlohmann::json j;
+  j["variant"] = variant;
+  j["frames"] = f.frames;
+  j["ok"] = f.ok;
+  j["ms"] = {{"median", f.median_ms}, {"p95", f.p95_ms}};
+  j["accuracy"] = {{"ate_rmse_m", f.ate_rmse_m},
+                   {"rpe_translation_mps", f.rpe_translation_mps},
+                   {"rpe_rotation_degps", f.rpe_rotation_degps},
+                   {"velocity_error_mps", f.velocity_error_mps},
+                   {"gross_percent", f.gross_percent},
+                   {"gross", f.gross}};
+  j["nees"] = {{"mean", f.mean_nees}, {"within_95", f.nees_within_95}, {"frames", f.nees_frames}};
+  nlohmann::json per_frame = nlohmann::json::array();
+  for (size_t i = 0; i < run.results.size(); ++i) {
+    const VoResult& r = run.results[i];
+    per_frame.push_back({{"utime", r.utime},
+                         {"status", to_string(r.status)},
+                         {"message", r.message},
+                         {"reference_utime", r.reference_utime},
+                         {"new_reference", r.new_reference},
+                         {"fell_back", r.fell_back_to_previous},
+                         {"features", r.num_features},
+                         {"with_depth", r.num_features_with_depth},
+                         {"matches", r.num_matches},
+                         {"inliers", r.num_inliers},
+                         {"reprojection_inliers", r.num_reprojection_inliers},
+                         {"reprojection_error_px", r.mean_reprojection_error_px},
+                         {"fast_threshold", r.fast_threshold},
+                         {"ms", run.process_ms[i]}});
+  }
+  j["per_frame"] = std::move(per_frame);
+  return j.dump(1);
+}
+
+}  // namespace kestrel::vo

@@ -1,0 +1,60 @@
+#pragma once
+// Runs the odometry over a recorded RGB-D sequence in one process and scores it: the engine of
+// `kestrel vo --tum`, `kestrel vo-ablation` and the data tests. Not part of kestrel_vo (it
+// reads files and a clock); it times process() alone, the figure the baselines report, as the
+// CPU time of the calling thread (one core, insensitive to other jobs on a shared machine).
+//
+// Invariants: frames are fed in sequence order; the trajectory holds T_world_camera (world =
+// first frame's camera) at exactly the frames whose status is ok, plus the first frame.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "common/rgbd_frame.h"
+#include "common/trajectory.h"
+#include "vo/odometry.h"
+
+namespace kestrel::vo {
+
+struct SequenceRun {
+  std::vector<VoResult> results;     ///< one per frame
+  std::vector<double> process_ms;    ///< thread CPU time of VisualOdometry::process(), per frame
+  std::vector<int64_t> frame_utimes; ///< every frame fed, in order
+  Trajectory trajectory;             ///< T_world_camera where the odometry gave one
+};
+
+struct RunFigures {
+  size_t frames = 0;
+  size_t ok = 0;                    ///< frames with status ok
+  double ate_rmse_m = 0.0;
+  double rpe_translation_mps = 0.0; ///< RMSE over 1 s pairs
+  double rpe_rotation_degps = 0.0;
+  double velocity_error_mps = 0.0;  ///< mean frame-to-frame velocity error
+  double gross_percent = 0.0;
+  size_t gross = 0;
+  double median_ms = 0.0;
+  double p95_ms = 0.0;
+  double mean_nees = 0.0;           ///< over frames with ground truth at both ends (6 if consistent)
+  double nees_within_95 = 0.0;      ///< fraction of frames with NEES under the 95 % chi2(6) bound
+  size_t nees_frames = 0;
+};
+
+/// Decoded frames of a TUM sequence folder (all of them; about 1.5 MB each at VGA).
+struct LoadedSequence {
+  std::string folder;
+  std::vector<RgbdFrame> frames;
+  Trajectory ground_truth;  ///< empty if the folder has none
+};
+LoadedSequence load_tum_sequence(const std::string& folder);
+
+/// Feeds every frame to a fresh VisualOdometry(options).
+SequenceRun run_sequence(const std::vector<RgbdFrame>& frames, const VoOptions& options);
+
+/// The figures of ../shared/BASELINES.md (tools/eval with its defaults) plus timing and NEES.
+RunFigures score(const SequenceRun& run, const Trajectory& ground_truth);
+
+/// Per-frame status and counts, the figures and the options as JSON text.
+std::string stats_json(const SequenceRun& run, const RunFigures& figures, const std::string& variant);
+
+}  // namespace kestrel::vo
