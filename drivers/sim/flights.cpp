@@ -197,10 +197,10 @@ PathPoint SplineFlight::path(double tau) const {
   out.p = position_.derivative(tau, 0);
   out.v = position_.derivative(tau, 1);
   out.a = position_.derivative(tau, 2);
-  // B-splines reproduce linear functions: sum_j (i + j) B_j(u) = i + u + degree / 2.
+  // B-splines reproduce linear functions: sum_j (i + j) B_j(u) = i + u + (degree - 1) / 2.
   const double n = static_cast<double>(position_.control_points().size());
   const double knot_dt = position_.period_s() / n;
-  out.yaw = yaw_.position(tau).x() + yaw_turn_ * (tau / knot_dt + 0.5 * PeriodicBSpline::kDegree) / n;
+  out.yaw = yaw_.position(tau).x() + yaw_turn_ * (tau / knot_dt + 0.5 * (PeriodicBSpline::kDegree - 1)) / n;
   return out;
 }
 

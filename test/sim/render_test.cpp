@@ -1,0 +1,142 @@
+// The renderer against geometry known in closed form: depth of a plane and of a box equals
+// the analytic depth within the Kinect's disparity quantisation; every pixel back-projects
+// onto the surface it shows; textured walls give FAST corners at several pyramid levels and
+// the blank wall few.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <opencv2/features2d.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "drivers/sim/kinect_depth.h"
+#include "drivers/sim/renderer.h"
+#include "sim_fixture.h"
+
+namespace kestrel::sim {
+namespace {
+
+using test::exact_camera;
+using test::look;
+
+// Half a disparity step at depth z, plus the millimetre rounding.
+double quantisation_tolerance_m(const DepthOptions& o, double z) { return 0.5 * inverse_depth_step(o) * z * z + 6e-4; }
+
+Eigen::Vector3d ray_world(const Eigen::Isometry3d& T_world_camera, const PinholeCamera& c, int u, int v) {
+  return T_world_camera.linear() * Eigen::Vector3d((u - c.cx) / c.fx, (v - c.cy) / c.fy, 1.0);
+}
+
+TEST(RenderTest, DepthOfATiltedPlaneIsAnalytic) {
+  const World& world = test::plane_world(false);
+  const CameraOptions options = exact_camera();
+  Renderer renderer(world, options, 1);
+  // Turned 25 degrees and pitched 10 degrees, so the depth varies across the image.
+  const Eigen::Isometry3d T = look({0.0, 0.2, 1.5}, 0.44, 0.17);
+  const RgbdFrame frame = renderer.render(T, 0, 0);
+  const PinholeCamera& c = options.camera;
+  int valid = 0, expected = 0;
+  for (int v = 0; v < c.height; v += 3)
+    for (int u = 0; u < c.width; u += 3) {
+      const uint16_t mm = frame.depth_mm.at<uint16_t>(v, u);
+      const Eigen::Vector3d d = ray_world(T, c, u, v);
+      const double z = (3.0 - T.translation().x()) / d.x();  // the plane x = 3
+      const Eigen::Vector3d hit = T.translation() + z * d;
+      // On the wall's rectangle and well within range, a reading must be there.
+      if (std::abs(hit.y()) < 3.9 && hit.z() > -0.9 && hit.z() < 3.9 && z < 3.5) ++expected;
+      if (mm == 0) continue;
+      ++valid;
+      ASSERT_NEAR(mm * 1e-3, z, quantisation_tolerance_m(options.depth, z)) << "pixel " << u << ", " << v;
+    }
+  EXPECT_GT(expected, 10000);
+  EXPECT_GT(valid, 0.95 * expected);
+}
+
+TEST(RenderTest, DepthOfABoxMatchesRayCasting) {
+  const World& world = test::plane_world(true);
+  const CameraOptions options = exact_camera();
+  Renderer renderer(world, options, 1);
+  const Eigen::Isometry3d T = look({0.2, 0.0, 1.6}, 0.05, 0.1);
+  const RgbdFrame frame = renderer.render(T, 0, 0);
+  const PinholeCamera& c = options.camera;
+  int box_pixels = 0, checked = 0, disagree = 0;
+  for (int v = 0; v < c.height; v += 2)
+    for (int u = 0; u < c.width; u += 2) {
+      const uint16_t mm = frame.depth_mm.at<uint16_t>(v, u);
+      if (mm == 0) continue;
+      const Eigen::Vector3d d = ray_world(T, c, u, v);
+      const auto hit = world.raycast(T.translation(), d.normalized(), 20.0);
+      ASSERT_TRUE(hit.has_value()) << "pixel " << u << ", " << v << " has depth but its ray hits nothing";
+      const double z = hit->distance / d.norm();
+      ++checked;
+      if (world.surfaces()[hit->surface].box >= 0) ++box_pixels;
+      if (std::abs(mm * 1e-3 - z) > quantisation_tolerance_m(options.depth, z)) ++disagree;
+    }
+  EXPECT_GT(box_pixels, 2000);  // the box is well in view (a 0.5 m cube at ~1.8 m)
+  // Only pixels whose centre lies within float rounding of a silhouette may disagree.
+  EXPECT_LT(disagree, 0.002 * checked) << disagree << " of " << checked;
+}
+
+TEST(RenderTest, PixelsBackProjectOntoTheSurfacesTheyShow) {
+  const World& world = test::builtin("room");
+  const CameraOptions options = exact_camera();
+  Renderer renderer(world, options, 1);
+  const PinholeCamera& c = options.camera;
+  for (const Eigen::Isometry3d& T : {look({8.0, 3.5, 1.3}, 0.0, 0.2), look({3.0, 4.5, 1.0}, -2.0, 0.35),
+                                     look({5.5, 2.0, 2.0}, 1.7, -0.3)}) {
+    const RgbdFrame frame = renderer.render(T, 0, 0);
+    const cv::Mat ideal = renderer.ideal_depth();
+    const cv::Mat ids = renderer.surface_ids();
+    int seen = 0;
+    for (int v = 0; v < c.height; v += 4)
+      for (int u = 0; u < c.width; u += 4) {
+        const int id = ids.at<int>(v, u);
+        if (id < 0) continue;
+        ++seen;
+        const Surface& s = world.surfaces()[id];
+        const double z = ideal.at<float>(v, u);
+        const Eigen::Vector3d p = T * c.backproject(u, v, z);
+        ASSERT_LT(std::abs(s.plane_distance(p)), 1e-4 * z + 1e-5) << "pixel " << u << ", " << v;
+        const double ss = s.axis_s.dot(p - s.origin), tt = s.axis_t.dot(p - s.origin);
+        ASSERT_TRUE(ss > -1e-3 && ss < s.width + 1e-3 && tt > -1e-3 && tt < s.height + 1e-3)
+            << "pixel " << u << ", " << v << " lies outside surface " << id;
+        const uint16_t mm = frame.depth_mm.at<uint16_t>(v, u);
+        if (mm == 0) continue;
+        const Eigen::Vector3d q = T * c.backproject(u, v, mm * 1e-3);
+        ASSERT_LT(std::abs(s.plane_distance(q)), 1.5 * quantisation_tolerance_m(options.depth, z));
+      }
+    EXPECT_EQ(seen, (c.width / 4) * (c.height / 4));  // a closed room: every pixel sees a surface
+  }
+}
+
+// FAST corners (threshold 20, non-max suppression) at pyramid levels 0, 1, 2.
+std::array<int, 3> fast_per_level(const cv::Mat& rgb) {
+  cv::Mat grey;
+  cv::cvtColor(rgb, grey, cv::COLOR_RGB2GRAY);
+  std::array<int, 3> counts{};
+  for (int level = 0; level < 3; ++level) {
+    std::vector<cv::KeyPoint> corners;
+    cv::FAST(grey, corners, 20, true);
+    counts[level] = static_cast<int>(corners.size());
+    cv::Mat down;
+    cv::pyrDown(grey, down);
+    grey = down;
+  }
+  return counts;
+}
+
+TEST(RenderTest, TexturedWallsHaveCornersAtSeveralScalesAndTheBlankWallFew) {
+  const World& world = test::builtin("room");
+  Renderer renderer(world, CameraOptions{}, 3);
+  // 2 m from the brick wall (south, cluttered) and from the blank wall (north), level.
+  const auto textured = fast_per_level(renderer.render(look({8.0, 2.0, 1.5}, -1.5708), 0, 0).rgb);
+  const auto blank = fast_per_level(renderer.render(look({7.5, 5.0, 1.8}, 1.5708, -0.1), 0, 1).rgb);
+  const int minimum[3] = {300, 100, 25};
+  for (int level = 0; level < 3; ++level) {
+    SCOPED_TRACE("pyramid level " + std::to_string(level));
+    EXPECT_GT(textured[level], minimum[level]);
+    EXPECT_LT(blank[level] * 5, textured[level]);
+  }
+}
+
+}  // namespace
+}  // namespace kestrel::sim
