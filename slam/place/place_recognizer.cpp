@@ -40,6 +40,7 @@ void PlaceRecognizer::retrain() {
   std::vector<cv::Mat> images = descriptors_;
   size_t total = 0;
   for (const auto& d : images) total += static_cast<size_t>(d.rows);
+  if (total == 0) return;  // nothing to learn words from yet (keyframes without texture)
   std::mt19937_64 rng(options_.seed + static_cast<uint64_t>(trainings_));
   if (total > static_cast<size_t>(options_.online_max_training)) {
     const double keep = static_cast<double>(options_.online_max_training) / static_cast<double>(total);

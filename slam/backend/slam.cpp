@@ -1,0 +1,157 @@
+#include "slam/backend/slam.h"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "common/error.h"
+#include "common/geometry/se3.h"
+
+namespace kestrel::slam {
+namespace {
+
+void check_options(const SlamOptions& o) {
+  auto require = [](bool ok, const char* what) {
+    if (!ok) throw std::invalid_argument(std::string("slam: ") + what);
+  };
+  require(o.keyframes.min_translation_m >= 0.0 && o.keyframes.min_rotation_rad >= 0.0,
+          "keyframe thresholds must be >= 0");
+  require(o.loops.min_age_s >= 0.0, "loops.min_age_s must be >= 0");
+  require(o.loops.max_candidates >= 1, "loops.max_candidates must be >= 1");
+  const OdometryNoise& n = o.odometry;
+  require(n.translation_floor_m > 0.0 && n.rotation_floor_rad > 0.0, "odometry noise floors must be > 0");
+  require(n.translation_per_m >= 0.0 && n.rotation_per_rad >= 0.0 && n.rotation_per_m >= 0.0,
+          "odometry noise rates must be >= 0");
+  require(n.break_translation_m > 0.0 && n.break_rotation_rad > 0.0, "odometry break noise must be > 0");
+}
+
+// Information of an odometry edge in the pose graph's error convention (spaces.h): the
+// rotational part of the error is vec(q) ~ phi / 2, hence the factor 4.
+Matrix6d odometry_information(const Eigen::Isometry3d& T_prev_cur, const OdometryNoise& n, bool broken) {
+  double sigma_t, sigma_r;
+  if (broken) {
+    sigma_t = n.break_translation_m;
+    sigma_r = n.break_rotation_rad;
+  } else {
+    const double distance = T_prev_cur.translation().norm();
+    const double angle = so3::angle(T_prev_cur.linear());
+    sigma_t = n.translation_floor_m + n.translation_per_m * distance;
+    sigma_r = n.rotation_floor_rad + n.rotation_per_rad * angle + n.rotation_per_m * distance;
+  }
+  Matrix6d info = Matrix6d::Zero();
+  info.diagonal().head<3>().setConstant(1.0 / (sigma_t * sigma_t));
+  info.diagonal().tail<3>().setConstant(4.0 / (sigma_r * sigma_r));
+  return info;
+}
+
+}  // namespace
+
+Slam::Slam(const SlamOptions& options, std::shared_ptr<const Vocabulary> vocabulary)
+    : options_(options), vocabulary_(std::move(vocabulary)), extractor_(options.features) {
+  check_options(options_);
+  reset();
+}
+
+void Slam::reset() {
+  places_ = std::make_unique<PlaceRecognizer>(options_.place, vocabulary_);
+  keyframes_.clear();
+  graph_ = PoseGraph3d{};
+  revision_ = 0;
+  loop_closures_ = 0;
+  last_utime_ = 0;
+  have_frame_ = false;
+  gate_by_pose_ = true;
+}
+
+bool Slam::wants_keyframe(const Eigen::Isometry3d& T_odom_camera, bool odometry_broken) const {
+  if (!T_odom_camera.matrix().allFinite()) return false;
+  if (keyframes_.empty() || odometry_broken) return true;
+  const Eigen::Isometry3d T_last_cur = keyframes_.back().T_odom_camera.inverse() * T_odom_camera;
+  return T_last_cur.translation().norm() >= options_.keyframes.min_translation_m ||
+         so3::angle(T_last_cur.linear()) >= options_.keyframes.min_rotation_rad;
+}
+
+Eigen::Isometry3d Slam::world_pose(const Eigen::Isometry3d& T_odom_camera) const {
+  if (keyframes_.empty()) return T_odom_camera;
+  return graph_.poses.back() * keyframes_.back().T_odom_camera.inverse() * T_odom_camera;
+}
+
+void Slam::add_odometry_edge(const Keyframe& previous, const Keyframe& current, bool broken) {
+  // After a break the odometry poses of the two are unrelated: assume no motion, weakly.
+  const Eigen::Isometry3d T_prev_cur =
+      broken ? Eigen::Isometry3d::Identity() : previous.T_odom_camera.inverse() * current.T_odom_camera;
+  graph_.add_edge(static_cast<int>(previous.id), static_cast<int>(current.id), T_prev_cur,
+                  odometry_information(T_prev_cur, options_.odometry, broken), EdgeKind::kOdometry);
+}
+
+SlamStep Slam::add(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera, bool odometry_broken) {
+  if (have_frame_ && frame.utime <= last_utime_) {
+    throw InputError("slam: frame utime " + std::to_string(frame.utime) + " does not follow " +
+                     std::to_string(last_utime_));
+  }
+  if (!se3::is_valid(T_odom_camera, 1e-6)) {
+    throw InputError("slam: odometry pose of frame " + std::to_string(frame.utime) + " is not a rigid transform");
+  }
+  have_frame_ = true;
+  last_utime_ = frame.utime;
+  if (odometry_broken) gate_by_pose_ = false;
+  SlamStep step;
+  if (!wants_keyframe(T_odom_camera, odometry_broken)) return step;
+
+  Keyframe kf;
+  kf.id = static_cast<int64_t>(keyframes_.size());
+  kf.utime = frame.utime;
+  kf.T_odom_camera = T_odom_camera;
+  kf.T_body_camera = frame.T_body_camera;
+  kf.features = extractor_.extract(frame);
+  const Eigen::Isometry3d T_world_camera =
+      keyframes_.empty() ? T_odom_camera
+                         : (odometry_broken ? graph_.poses.back() : world_pose(T_odom_camera));
+  graph_.add_vertex(kf.id, T_world_camera, keyframes_.empty());
+  if (!keyframes_.empty()) add_odometry_edge(keyframes_.back(), kf, odometry_broken);
+  keyframes_.push_back(std::move(kf));
+  step.keyframe = true;
+  step.keyframe_id = keyframes_.back().id;
+  step = close_loop(std::move(step));
+  places_->add(keyframes_.back().features.descriptors);
+  return step;
+}
+
+SlamStep Slam::close_loop(SlamStep step) {
+  const Keyframe& query = keyframes_.back();
+  const Eigen::Isometry3d& T_world_query = graph_.poses.back();
+  const auto min_age_us = static_cast<int64_t>(std::llround(options_.loops.min_age_s * 1e6));
+  const LoopSearchOptions& lo = options_.loops;
+  const bool gate = gate_by_pose_ && lo.max_distance_m > 0.0;
+  auto allowed = [&](int entry) {
+    const Keyframe& k = keyframes_[static_cast<size_t>(entry)];
+    if (k.utime > query.utime - min_age_us) return false;
+    if (!gate) return true;
+    const Eigen::Isometry3d& T_world_k = graph_.poses[static_cast<size_t>(entry)];
+    return se3::translation_distance(T_world_k, T_world_query) <= lo.max_distance_m &&
+           se3::rotation_distance(T_world_k, T_world_query) <= lo.max_angle_rad;
+  };
+  const std::vector<BowMatch> candidates =
+      places_->query(query.features.descriptors, lo.max_candidates, allowed);
+  for (const BowMatch& candidate : candidates) {
+    if (candidate.score < lo.min_score) break;
+    ++step.candidates;
+    const Keyframe& earlier = keyframes_[static_cast<size_t>(candidate.entry)];
+    // The seed depends on the pair only, so that a replay verifies identically.
+    const uint64_t seed = static_cast<uint64_t>(earlier.id) * 1000003u + static_cast<uint64_t>(query.id);
+    step.loop = verify_loop(query.features, earlier.features, options_.verification, seed);
+    if (!step.loop.accepted) continue;
+    graph_.add_edge(static_cast<int>(earlier.id), static_cast<int>(query.id), step.loop.T_candidate_query,
+                    step.loop.information, EdgeKind::kLoopClosure);
+    step.loop_closed = true;
+    step.loop_keyframe_id = earlier.id;
+    ++loop_closures_;
+    step.optimisation = optimize(graph_, options_.optimizer);
+    ++revision_;
+    gate_by_pose_ = true;
+    break;  // the paper stops at the first success
+  }
+  return step;
+}
+
+}  // namespace kestrel::slam

@@ -1,0 +1,93 @@
+#pragma once
+// The SLAM back-end (PAPER.md section 3): frames with their odometry poses in; keyframes,
+// verified loop closures and an optimised pose graph of the keyframes out. LCM-free: the
+// process (slam/main.cpp) and the offline tools feed it.
+//
+// Frames: the odometry pose T_odom_camera of every frame (VO chained, odometry_chain.h). A
+// frame becomes a keyframe when it moved or turned enough since the last keyframe; only then
+// are its image features needed (wants_keyframe() lets a caller skip decoding the rest).
+// Loop closure: the new keyframe is compared by appearance with older keyframes near its
+// estimated pose; the best candidates are verified geometrically, best first, and the first
+// that passes adds a loop-closure edge and the graph is optimised.
+//
+// Frames: "world" is the odometry frame of the first keyframe, so before any loop closure the
+// optimised poses equal the odometry poses. Invariants: keyframe k is vertex k of graph();
+// vertex 0 is fixed; edge k - 1 -> k is odometry; revision() grows by one with every change of
+// the optimised poses other than appending a keyframe.
+
+#include <Eigen/Geometry>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "common/rgbd_frame.h"
+#include "slam/backend/slam_options.h"
+#include "slam/posegraph/pose_graph.h"
+
+namespace kestrel::slam {
+
+struct Keyframe {
+  int64_t id = 0;                 ///< = its index
+  int64_t utime = 0;
+  Eigen::Isometry3d T_odom_camera = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d T_body_camera = Eigen::Isometry3d::Identity();
+  FrameFeatures features;
+};
+
+/// What one call of Slam::add did.
+struct SlamStep {
+  bool keyframe = false;          ///< the frame became a keyframe
+  int64_t keyframe_id = -1;
+  int candidates = 0;             ///< loop candidates verified
+  bool loop_closed = false;
+  int64_t loop_keyframe_id = -1;  ///< the earlier keyframe it closed with
+  LoopConstraint loop;            ///< the accepted constraint, or the last rejection
+  std::optional<OptimizerSummary> optimisation;  ///< when the graph was optimised
+};
+
+class Slam {
+ public:
+  /// With `vocabulary` null, place recognition builds its vocabulary online. Throws
+  /// std::invalid_argument naming an unusable option.
+  explicit Slam(const SlamOptions& options = {}, std::shared_ptr<const Vocabulary> vocabulary = nullptr);
+
+  /// Would a frame at this odometry pose become a keyframe? (false for a frame whose pose is
+  /// not finite).
+  bool wants_keyframe(const Eigen::Isometry3d& T_odom_camera, bool odometry_broken = false) const;
+
+  /// Adds a frame seen at T_odom_camera. `odometry_broken` says the odometry restarted since the
+  /// last frame, so its pose is not related to the earlier ones. Throws InputError when the
+  /// frame's utime does not increase or the pose is not a finite rigid transform.
+  SlamStep add(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera, bool odometry_broken = false);
+
+  const std::vector<Keyframe>& keyframes() const { return keyframes_; }
+  /// Vertices are keyframes (poses T_world_camera); edges odometry and loop closures.
+  const PoseGraph3d& graph() const { return graph_; }
+  int64_t revision() const { return revision_; }
+  int num_loop_closures() const { return loop_closures_; }
+
+  /// The optimised estimate of a camera seen at T_odom_camera after the newest keyframe: the
+  /// newest keyframe's optimised pose composed with the odometry since.
+  Eigen::Isometry3d world_pose(const Eigen::Isometry3d& T_odom_camera) const;
+
+  /// Forgets everything (as after construction).
+  void reset();
+
+ private:
+  void add_odometry_edge(const Keyframe& previous, const Keyframe& current, bool broken);
+  SlamStep close_loop(SlamStep step);
+
+  SlamOptions options_;
+  std::shared_ptr<const Vocabulary> vocabulary_;
+  FeatureExtractor extractor_;
+  std::unique_ptr<PlaceRecognizer> places_;
+  std::vector<Keyframe> keyframes_;
+  PoseGraph3d graph_;
+  int64_t revision_ = 0;
+  int loop_closures_ = 0;
+  int64_t last_utime_ = 0;
+  bool have_frame_ = false;
+  bool gate_by_pose_ = true;  ///< off from an odometry break until a loop closure re-anchors
+};
+
+}  // namespace kestrel::slam

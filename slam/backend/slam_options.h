@@ -1,0 +1,66 @@
+#pragma once
+// Options of the SLAM back-end (slam.h), grouped by concern; every field has its default and
+// unit. Defaults follow PAPER.md section 3 (keyframes every 10 degrees or 25 cm; loop
+// candidates older than 4 s, within 90 degrees and 5 m, 15 best by appearance).
+
+#include <cmath>
+
+#include "slam/place/frame_features.h"
+#include "slam/place/loop_verifier.h"
+#include "slam/place/place_recognizer.h"
+#include "slam/posegraph/optimizer.h"
+
+namespace kestrel::slam {
+
+struct KeyframeOptions {
+  double min_translation_m = 0.25;           ///< a keyframe when the camera moved this far...
+  double min_rotation_rad = 10.0 * M_PI / 180.0;  ///< ...or turned this much since the last
+};
+
+struct LoopSearchOptions {
+  double min_age_s = 4.0;       ///< candidates are keyframes at least this much older
+  /// Candidates lie within this distance and angle of the current estimate; <= 0 disables the
+  /// gate (for when the estimate is not trustworthy, e.g. after the odometry broke).
+  double max_distance_m = 5.0;
+  double max_angle_rad = M_PI / 2;
+  int max_candidates = 15;      ///< by appearance score, verified best first
+  double min_score = 0.0;       ///< appearance score below which a candidate is not verified
+};
+
+/// Uncertainty of the odometry between consecutive keyframes (a constant model, as the paper's
+/// "constant noise model fitted from data"): sigma = floor + rate * motion.
+struct OdometryNoise {
+  double translation_floor_m = 0.01;
+  double translation_per_m = 0.05;       ///< m of error per m travelled
+  double rotation_floor_rad = 0.005;
+  double rotation_per_rad = 0.05;        ///< rad of error per rad turned
+  double rotation_per_m = 0.02;          ///< rad of error per m travelled
+  /// When the odometry broke (VO restarted), the edge that bridges the gap.
+  double break_translation_m = 1.0;
+  double break_rotation_rad = 0.5;
+};
+
+struct SlamOptions {
+  KeyframeOptions keyframes;
+  LoopSearchOptions loops;
+  OdometryNoise odometry;
+  FeatureOptions features;
+  PlaceOptions place;
+  VerificationOptions verification;
+  OptimizerOptions optimizer = default_optimizer();
+
+  /// Dynamic covariance scaling on loop closures: a false loop that passed verification is
+  /// down-weighted instead of bending the map. The chordal start is tried and kept only when it
+  /// costs less than the previous solution extended by odometry (after a long loop with much
+  /// drift it does).
+  static OptimizerOptions default_optimizer() {
+    OptimizerOptions o;
+    o.kernel.type = KernelType::kDcs;
+    o.kernel.width = 3.0;
+    o.max_iterations = 50;
+    o.function_tolerance = 1e-6;
+    return o;
+  }
+};
+
+}  // namespace kestrel::slam

@@ -1,0 +1,142 @@
+// kestrel-slam: keyframes, loop closure and pose-graph optimisation (PAPER.md section 3).
+// As a process (default) it reads CAMERA_RGBD and VO_UPDATE and publishes SLAM_GRAPH after every
+// new keyframe and SLAM_CORRECTION after every optimisation, with heartbeats and lock-step
+// replay. With --tum DIR it runs VO and SLAM in process over a TUM RGB-D folder and writes the
+// optimised trajectory (TUM format). See slam/README.md.
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <iostream>
+#include <memory>
+
+#include "common/cli.h"
+#include "common/error.h"
+#include "common/transport/channels.h"
+#include "common/transport/node.h"
+#include "slam/slam_adapter.h"
+#if KESTREL_SLAM_OFFLINE
+#include "slam/sequence_run.h"
+#include "vo/sequence_run.h"
+#endif
+
+namespace {
+
+using namespace kestrel;
+using namespace kestrel::slam;
+
+struct Options {
+  std::string vocabulary;
+  std::string kernel = "dcs";
+  // Offline.
+  std::string tum, out, vo_out;
+  // Process.
+  std::string name = "slam";
+  std::string lcm_url;
+  AdapterOptions adapter;
+  std::string graph_channel = channel::kSlamGraph;
+  std::string correction_channel = channel::kSlamCorrection;
+};
+
+void add_options(cli::App& app, Options& o, SlamOptions& s) {
+  app.add_option("--vocabulary", o.vocabulary, "Vocabulary file (kestrel-slam-vocabulary); default: built online");
+  app.add_option("--keyframe-distance", s.keyframes.min_translation_m, "New keyframe after this motion, m")
+      ->check(CLI::NonNegativeNumber)->capture_default_str();
+  app.add_option("--keyframe-angle", s.keyframes.min_rotation_rad, "New keyframe after this rotation, rad")
+      ->check(CLI::NonNegativeNumber)->capture_default_str();
+  app.add_option("--loop-min-age", s.loops.min_age_s, "Loop candidates are at least this much older, s")
+      ->check(CLI::NonNegativeNumber)->capture_default_str();
+  app.add_option("--loop-max-distance", s.loops.max_distance_m,
+                 "Loop candidates lie this close to the current estimate, m (0: no gate)")
+      ->check(CLI::NonNegativeNumber)->capture_default_str();
+  app.add_option("--loop-max-angle", s.loops.max_angle_rad, "... and turned at most this much, rad")
+      ->check(CLI::NonNegativeNumber)->capture_default_str();
+  app.add_option("--candidates", s.loops.max_candidates, "Loop candidates verified at most, best first")
+      ->check(CLI::PositiveNumber)->capture_default_str();
+  app.add_option("--min-inliers", s.verification.min_inliers, "Inliers a loop closure needs")
+      ->check(CLI::PositiveNumber)->capture_default_str();
+  app.add_option("--kernel", o.kernel, "Robust kernel on loop closures: none, huber, cauchy or dcs")
+      ->check(CLI::IsMember({"none", "huber", "cauchy", "dcs"}))->capture_default_str();
+  app.add_option("--tum", o.tum, "Offline: run VO + SLAM over this TUM RGB-D folder");
+  app.add_option("--out", o.out, "Offline: write the optimised camera trajectory here (TUM format)");
+  app.add_option("--vo-out", o.vo_out, "Offline: write the odometry-only trajectory here too");
+  app.add_option("--name", o.name, "Process name in heartbeats")->capture_default_str();
+  app.add_option("--lcm-url", o.lcm_url, "LCM URL (default: $LCM_DEFAULT_URL or kestrel's)");
+  app.add_option("--camera-channel", o.adapter.camera_channel, "Channel of rgbd_frame_t")->capture_default_str();
+  app.add_option("--vo-channel", o.adapter.vo_channel, "Channel of vo_update_t")->capture_default_str();
+  app.add_option("--graph-channel", o.graph_channel, "Channel of slam_graph_t")->capture_default_str();
+  app.add_option("--correction-channel", o.correction_channel, "Channel of slam_correction_t")
+      ->capture_default_str();
+}
+
+int run_offline(const Options& o, const SlamOptions& options, std::shared_ptr<const Vocabulary> vocabulary) {
+  if (o.out.empty()) throw CLI::RequiredError("--out (with --tum)");
+#if !KESTREL_SLAM_OFFLINE
+  (void)vocabulary;
+  throw CLI::ValidationError("--tum", "this build has no visual odometry (vo/ was absent)");
+#else
+  const vo::LoadedSequence sequence = vo::load_tum_sequence(o.tum);
+  const SlamRun run = run_slam_sequence(sequence.frames, vo::VoOptions{}, options, std::move(vocabulary));
+  write_tum_trajectory(o.out, run.slam);
+  if (!o.vo_out.empty()) write_tum_trajectory(o.vo_out, run.vo);
+  std::vector<double> ms = run.keyframe_ms;
+  std::sort(ms.begin(), ms.end());
+  std::cout << "frames: " << sequence.frames.size() << ", with a pose: " << run.slam.size() << "\n"
+            << "keyframes: " << run.keyframes << ", loop closures: " << run.loop_closures
+            << " (" << run.candidates_verified << " candidates verified)\n";
+  if (!ms.empty()) {
+    std::cout << "ms per keyframe: median " << ms[ms.size() / 2] << ", p95 " << ms[ms.size() * 95 / 100] << "\n";
+  }
+  return kExitOk;
+#endif
+}
+
+int serve(const Options& o, const SlamOptions& options, std::shared_ptr<const Vocabulary> vocabulary) {
+  if (!o.out.empty() || !o.vo_out.empty()) throw CLI::ValidationError("--out/--vo-out", "only with --tum");
+  SlamAdapter adapter(options, std::move(vocabulary), o.adapter);
+  std::unique_ptr<transport::Node> node;
+  try {
+    node = std::make_unique<transport::Node>(o.name, o.lcm_url);
+  } catch (const std::runtime_error& e) {
+    spdlog::error("{}", e.what());
+    return kExitUnavailable;
+  }
+  node->advertise(o.graph_channel);
+  node->advertise(o.correction_channel);
+  node->on_reset([&] { adapter.reset(); });
+  auto publish = [&](const AdapterOutputs& out) {
+    if (out.graph) node->publish(o.graph_channel, *out.graph);
+    if (out.correction) node->publish(o.correction_channel, *out.correction);
+    if (out.step && out.step->loop_closed) {
+      spdlog::info("keyframe {} closes a loop with keyframe {} ({} inliers, {:.2f} px); chi2 {:.4g} -> {:.4g}",
+                   out.step->keyframe_id, out.step->loop_keyframe_id, out.step->loop.inliers,
+                   out.step->loop.rms_px, out.step->optimisation->start_chi2, out.step->optimisation->final_chi2);
+    }
+  };
+  node->subscribe<rgbd_frame_t>(o.adapter.camera_channel, [&](const rgbd_frame_t& m) { publish(adapter.on_frame(m)); });
+  node->subscribe<vo_update_t>(o.adapter.vo_channel, [&](const vo_update_t& m) { publish(adapter.on_vo_update(m)); });
+  node->set_health(process_status_t::STATE_RUNNING, "");
+  spdlog::info("{}: {} + {} -> {}, {}", o.name, o.adapter.camera_channel, o.adapter.vo_channel,
+               o.graph_channel, o.correction_channel);
+  const int status = node->spin();
+  spdlog::info("{} keyframes, {} loop closures, {} messages rejected", adapter.slam().keyframes().size(),
+               adapter.slam().num_loop_closures(), node->counters().messages_rejected);
+  return status;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  cli::App app("slam",
+               "SLAM: keyframes, loop closure and pose-graph optimisation. CAMERA_RGBD + VO_UPDATE -> "
+               "SLAM_GRAPH + SLAM_CORRECTION, or with --tum an offline VO + SLAM run over a TUM folder.");
+  Options o;
+  SlamOptions options;
+  add_options(app, o, options);
+  return app.run(argc, argv, [&] {
+    options.optimizer.kernel.type = parse_kernel_type(o.kernel);
+    std::shared_ptr<const Vocabulary> vocabulary;
+    if (!o.vocabulary.empty()) vocabulary = std::make_shared<const Vocabulary>(Vocabulary::load(o.vocabulary));
+    return o.tum.empty() ? serve(o, options, vocabulary) : run_offline(o, options, vocabulary);
+  });
+}

@@ -1,0 +1,52 @@
+#include "slam/sequence_run.h"
+
+#include <chrono>
+
+#include "slam/backend/odometry_chain.h"
+#include "vo/odometry.h"
+
+namespace kestrel::slam {
+
+SlamRun run_slam_sequence(const std::vector<RgbdFrame>& frames, const vo::VoOptions& vo_options,
+                          const SlamOptions& options, std::shared_ptr<const Vocabulary> vocabulary) {
+  vo::VisualOdometry odometry(vo_options);
+  OdometryChain chain;
+  Slam slam(options, std::move(vocabulary));
+  SlamRun run;
+  struct Placed {
+    int64_t utime;
+    int keyframe;                        // newest keyframe when the frame came
+    Eigen::Isometry3d T_keyframe_camera;  // odometry since that keyframe
+  };
+  std::vector<Placed> placed;
+  for (const RgbdFrame& frame : frames) {
+    const vo::VoResult r = odometry.process(frame);
+    VoMotion m;
+    m.utime = r.utime;
+    m.reference_utime = r.reference_utime;
+    m.ok = r.status == vo::VoStatus::kOk;
+    m.new_reference = r.new_reference;
+    m.T_reference_current = r.T_reference_current;
+    m.T_body_camera = frame.T_body_camera;
+    const std::optional<OdometryPose> pose = chain.add(m);
+    if (!pose) continue;
+    if (slam.wants_keyframe(pose->T_odom_camera, pose->broken)) {
+      const auto t0 = std::chrono::steady_clock::now();
+      const SlamStep step = slam.add(frame, pose->T_odom_camera, pose->broken);
+      run.keyframe_ms.push_back(
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+      run.candidates_verified += step.candidates;
+    }
+    const Keyframe& kf = slam.keyframes().back();
+    run.vo.push_back(frame.utime, pose->T_odom_camera);
+    placed.push_back({frame.utime, static_cast<int>(kf.id), kf.T_odom_camera.inverse() * pose->T_odom_camera});
+  }
+  for (const Placed& p : placed) {
+    run.slam.push_back(p.utime, slam.graph().poses[static_cast<size_t>(p.keyframe)] * p.T_keyframe_camera);
+  }
+  run.keyframes = static_cast<int>(slam.keyframes().size());
+  run.loop_closures = slam.num_loop_closures();
+  return run;
+}
+
+}  // namespace kestrel::slam

@@ -1,0 +1,86 @@
+#include "slam/slam_adapter.h"
+
+#include "common/error.h"
+#include "common/transport/rgbd_codec.h"
+
+namespace kestrel::slam {
+
+SlamAdapter::SlamAdapter(const SlamOptions& options, std::shared_ptr<const Vocabulary> vocabulary,
+                         const AdapterOptions& adapter)
+    : options_(adapter), slam_(options, std::move(vocabulary)) {
+  if (adapter.buffer_frames < 1) throw std::invalid_argument("slam: buffer_frames must be >= 1");
+}
+
+void SlamAdapter::reset() {
+  slam_.reset();
+  chain_.reset();
+  frames_.clear();
+  poses_.clear();
+  last_processed_utime_ = 0;
+  lost_break_ = false;
+}
+
+void SlamAdapter::trim_frames() {
+  while (static_cast<int>(frames_.size()) > options_.buffer_frames) frames_.erase(frames_.begin());
+}
+
+void SlamAdapter::drop_poses(std::map<int64_t, OdometryPose>::iterator end) {
+  for (auto it = poses_.begin(); it != end; ++it) lost_break_ |= it->second.broken;
+  poses_.erase(poses_.begin(), end);
+}
+
+AdapterOutputs SlamAdapter::on_frame(const kestrel::rgbd_frame_t& frame) {
+  if (frame.utime <= last_processed_utime_) {
+    throw InputError(options_.camera_channel + ": frame " + std::to_string(frame.utime) +
+                     " is older than one already processed");
+  }
+  const auto pose = poses_.find(frame.utime);
+  if (pose == poses_.end()) {
+    frames_[frame.utime] = frame;
+    trim_frames();
+    return {};
+  }
+  const OdometryPose p = pose->second;
+  poses_.erase(pose);
+  drop_poses(poses_.lower_bound(frame.utime));  // older poses will get no frame now
+  return process(frame, p);
+}
+
+AdapterOutputs SlamAdapter::on_vo_update(const kestrel::vo_update_t& update) {
+  const VoMotion motion = motion_from_message(update, options_.vo_channel.c_str());
+  std::optional<OdometryPose> pose;
+  try {
+    pose = chain_.add(motion);
+  } catch (const InputError& e) {
+    throw InputError(options_.vo_channel + ": " + e.what());
+  }
+  if (!pose) return {};
+  const auto frame = frames_.find(update.utime);
+  if (frame == frames_.end()) {
+    poses_[update.utime] = *pose;
+    if (static_cast<int>(poses_.size()) > options_.buffer_frames) drop_poses(std::next(poses_.begin()));
+    return {};
+  }
+  const kestrel::rgbd_frame_t message = std::move(frame->second);
+  frames_.erase(frames_.begin(), std::next(frame));  // older frames will get no pose now
+  return process(message, *pose);
+}
+
+AdapterOutputs SlamAdapter::process(const kestrel::rgbd_frame_t& message, const OdometryPose& pose) {
+  AdapterOutputs out;
+  last_processed_utime_ = message.utime;
+  const bool broken = pose.broken || lost_break_;
+  if (!slam_.wants_keyframe(pose.T_odom_camera, broken)) return out;
+  const RgbdFrame frame = transport::decode_rgbd(message, options_.camera_channel.c_str());
+  const SlamStep step = slam_.add(frame, pose.T_odom_camera, broken);
+  lost_break_ = false;
+  if (!step.keyframe) return out;
+  out.graph = graph_message(slam_);
+  if (step.optimisation) {
+    out.correction = correction_message(slam_, options_.correction_sigma_m, options_.correction_sigma_rad);
+  }
+  out.step = step;
+  return out;
+}
+
+}  // namespace kestrel::slam

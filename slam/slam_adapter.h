@@ -1,0 +1,63 @@
+#pragma once
+// The message side of kestrel-slam, without LCM: CAMERA_RGBD and VO_UPDATE messages in (in
+// any interleaving), SLAM_GRAPH and SLAM_CORRECTION messages out. main.cpp wires it to a Node;
+// tests feed it directly.
+//
+// A frame and its VO update are paired by utime. Frames wait (encoded) in a bounded buffer and
+// are decoded only when their pose makes them a keyframe; an update whose frame has not come
+// yet waits likewise. Invariants: at most `buffer_frames` frames and updates wait; a frame is
+// given to SLAM at most once, in increasing utime.
+
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "kestrel/rgbd_frame_t.hpp"
+#include "slam/slam_messages.h"
+
+namespace kestrel::slam {
+
+struct AdapterOptions {
+  int buffer_frames = 90;                 ///< frames (and updates) waiting for their partner
+  double correction_sigma_m = 0.05;       ///< covariance of SLAM_CORRECTION (metres)
+  double correction_sigma_rad = 0.02;     ///< and radians
+  std::string camera_channel = "CAMERA_RGBD";  ///< named in error messages
+  std::string vo_channel = "VO_UPDATE";
+};
+
+struct AdapterOutputs {
+  std::optional<kestrel::slam_graph_t> graph;            ///< after a new keyframe or optimisation
+  std::optional<kestrel::slam_correction_t> correction;  ///< after an optimisation
+  std::optional<SlamStep> step;                          ///< what SLAM did (a keyframe was made)
+};
+
+class SlamAdapter {
+ public:
+  SlamAdapter(const SlamOptions& options, std::shared_ptr<const Vocabulary> vocabulary,
+              const AdapterOptions& adapter = {});
+
+  /// Throw InputError naming the channel for a message that cannot be used (the state is
+  /// unchanged then).
+  AdapterOutputs on_frame(const kestrel::rgbd_frame_t& frame);
+  AdapterOutputs on_vo_update(const kestrel::vo_update_t& update);
+  void reset();
+
+  const Slam& slam() const { return slam_; }
+
+ private:
+  AdapterOutputs process(const kestrel::rgbd_frame_t& frame, const OdometryPose& pose);
+  void trim_frames();
+  /// Drops waiting poses [begin, end), remembering an odometry break among them.
+  void drop_poses(std::map<int64_t, OdometryPose>::iterator end);
+
+  AdapterOptions options_;
+  Slam slam_;
+  OdometryChain chain_;
+  std::map<int64_t, kestrel::rgbd_frame_t> frames_;  ///< utime -> waiting frame
+  std::map<int64_t, OdometryPose> poses_;            ///< utime -> waiting pose
+  int64_t last_processed_utime_ = 0;
+  bool lost_break_ = false;  ///< a pose flagged broken was dropped: flag the next one
+};
+
+}  // namespace kestrel::slam

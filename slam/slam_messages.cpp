@@ -1,0 +1,60 @@
+#include "slam/slam_messages.h"
+
+#include "common/transport/convert.h"
+
+namespace kestrel::slam {
+
+VoMotion motion_from_message(const kestrel::vo_update_t& m, const char* channel) {
+  VoMotion motion;
+  motion.utime = m.utime;
+  motion.reference_utime = m.reference_utime;
+  motion.ok = m.status == kestrel::vo_update_t::STATUS_OK;
+  motion.new_reference = (m.flags & kestrel::vo_update_t::FLAG_NEW_REFERENCE) != 0;
+  motion.T_body_camera = transport::from_message(m.T_body_camera, channel);
+  if (motion.ok) motion.T_reference_current = transport::from_message(m.T_reference_current, channel);
+  return motion;
+}
+
+kestrel::slam_graph_t graph_message(const Slam& slam) {
+  kestrel::slam_graph_t m{};
+  const auto& keyframes = slam.keyframes();
+  const PoseGraph3d& graph = slam.graph();
+  m.utime = keyframes.empty() ? 0 : keyframes.back().utime;
+  m.revision = slam.revision();
+  for (size_t k = 0; k < keyframes.size(); ++k) {
+    kestrel::slam_keyframe_t kf{};
+    kf.id = keyframes[k].id;
+    kf.utime = keyframes[k].utime;
+    kf.T_world_camera = transport::to_message(graph.poses[k]);
+    m.keyframes.push_back(kf);
+  }
+  m.num_keyframes = static_cast<int32_t>(m.keyframes.size());
+  for (const auto& e : graph.edges) {
+    kestrel::slam_edge_t edge{};
+    edge.from_id = graph.ids[static_cast<size_t>(e.from)];
+    edge.to_id = graph.ids[static_cast<size_t>(e.to)];
+    edge.kind = e.kind == EdgeKind::kLoopClosure ? kestrel::slam_edge_t::KIND_LOOP_CLOSURE
+                                                 : kestrel::slam_edge_t::KIND_ODOMETRY;
+    edge.T_from_to = transport::to_message(e.measurement);
+    m.edges.push_back(edge);
+  }
+  m.num_edges = static_cast<int32_t>(m.edges.size());
+  return m;
+}
+
+kestrel::slam_correction_t correction_message(const Slam& slam, double sigma_translation_m,
+                                              double sigma_rotation_rad) {
+  const Keyframe& kf = slam.keyframes().back();
+  kestrel::slam_correction_t m{};
+  m.utime = kf.utime;
+  m.keyframe_id = kf.id;
+  m.graph_revision = slam.revision();
+  m.T_world_body = transport::to_message(slam.graph().poses.back() * kf.T_body_camera.inverse());
+  Matrix6d covariance = Matrix6d::Zero();
+  covariance.diagonal().head<3>().setConstant(sigma_translation_m * sigma_translation_m);
+  covariance.diagonal().tail<3>().setConstant(sigma_rotation_rad * sigma_rotation_rad);
+  transport::covariance_to(covariance, m.covariance);
+  return m;
+}
+
+}  // namespace kestrel::slam

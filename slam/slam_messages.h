@@ -1,0 +1,27 @@
+#pragma once
+// The SLAM process's message conversions (process side: the library knows no LCM):
+// vo_update_t -> VoMotion, and the library's graph -> slam_graph_t / slam_correction_t.
+//
+// Frames: SLAM_GRAPH carries T_world_camera of each keyframe; SLAM_CORRECTION carries
+// T_world_body = T_world_camera * T_body_camera^-1 of the newest keyframe, world being the
+// body frame at the first keyframe (odometry_chain.h).
+
+#include "kestrel/slam_correction_t.hpp"
+#include "kestrel/slam_graph_t.hpp"
+#include "kestrel/vo_update_t.hpp"
+#include "slam/backend/odometry_chain.h"
+#include "slam/backend/slam.h"
+
+namespace kestrel::slam {
+
+/// Throws InputError naming `channel` for a pose that is not a finite rigid transform.
+VoMotion motion_from_message(const kestrel::vo_update_t& m, const char* channel);
+
+kestrel::slam_graph_t graph_message(const Slam& slam);
+
+/// The correction for the newest keyframe, with a diagonal covariance of the given standard
+/// deviations (metres, radians); the slam must have a keyframe.
+kestrel::slam_correction_t correction_message(const Slam& slam, double sigma_translation_m,
+                                              double sigma_rotation_rad);
+
+}  // namespace kestrel::slam

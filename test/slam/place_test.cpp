@@ -1,0 +1,197 @@
+// Place recognition and loop verification on the synthetic room (synthetic_room.h), whose
+// poses are exact: the true revisit is found and verified with the right relative pose, views
+// of different places are rejected, a loop-free path yields no loop, and the vocabulary file
+// round-trips and refuses corrupt files.
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+
+#include "common/error.h"
+#include "common/geometry/se3.h"
+#include "slam/place/loop_verifier.h"
+#include "slam/place/place_recognizer.h"
+#include "test/slam/synthetic_room.h"
+#include "test/support/test_support.h"
+
+namespace kestrel::slam {
+namespace {
+
+using test::SyntheticRoom;
+
+struct View {
+  Eigen::Isometry3d T_world_camera;
+  FrameFeatures features;
+};
+
+std::vector<View> views_along(const SyntheticRoom& room, const std::vector<Eigen::Isometry3d>& path) {
+  const FeatureExtractor extractor;
+  std::vector<View> views;
+  int64_t utime = 1'000'000;
+  for (const auto& T : path) {
+    views.push_back({T, extractor.extract(room.render(T, test::test_camera(), utime))});
+    utime += 200'000;
+  }
+  return views;
+}
+
+void expect_pose_near(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b, double metres, double radians) {
+  EXPECT_LT(se3::translation_distance(a, b), metres);
+  EXPECT_LT(se3::rotation_distance(a, b), radians);
+}
+
+TEST(FrameFeatures, PointsLieOnTheRenderedSurfaces) {
+  const SyntheticRoom room(3, 3.0, 2.5, 2.5);
+  const Eigen::Isometry3d T = test::level_camera({0.5, 0.2, 1.0}, 0.3);
+  const FrameFeatures f = FeatureExtractor().extract(room.render(T, test::test_camera(), 1));
+  ASSERT_GT(f.num_points(), 100u);
+  for (size_t i = 0; i < f.size(); ++i) {
+    if (!f.has_point(i)) continue;
+    const Eigen::Vector3d p = T * f.points[i];
+    // On a wall (|x| = 3 or |y| = 2.5), the floor or the ceiling, within the depth quantisation.
+    const double off = std::min({std::abs(std::abs(p.x()) - 3.0), std::abs(std::abs(p.y()) - 2.5),
+                                 std::abs(p.z()), std::abs(p.z() - 2.5)});
+    EXPECT_LT(off, 0.01) << "point " << i << " at " << p.transpose();
+  }
+}
+
+TEST(LoopVerifier, AcceptsTheSamePlaceFromAnotherViewWithTheTrueRelativePose) {
+  const SyntheticRoom room(3, 3.0, 2.5, 2.5);
+  const auto views = views_along(room, {test::level_camera({0.0, 0.0, 1.0}, 0.0),
+                                        test::level_camera({0.4, 0.3, 1.1}, 0.25)});
+  const LoopConstraint c = verify_loop(views[1].features, views[0].features, VerificationOptions{}, 7);
+  ASSERT_TRUE(c.accepted) << c.reason;
+  EXPECT_GE(c.inliers, 10);
+  const Eigen::Isometry3d truth = views[0].T_world_camera.inverse() * views[1].T_world_camera;
+  expect_pose_near(c.T_candidate_query, truth, 0.02, 0.01);
+  // The information is positive definite (a usable pose-graph edge).
+  EXPECT_GT(Eigen::SelfAdjointEigenSolver<Matrix6d>(c.information).eigenvalues().minCoeff(), 0.0);
+}
+
+TEST(LoopVerifier, RejectsViewsOfDifferentPlaces) {
+  const SyntheticRoom room(3, 3.0, 2.5, 2.5);
+  const auto views = views_along(room, {test::level_camera({0.0, 0.0, 1.0}, 0.0),
+                                        test::level_camera({0.0, 0.0, 1.0}, M_PI),
+                                        test::level_camera({0.0, 0.0, 1.0}, M_PI / 2)});
+  for (const auto& [q, c] : {std::pair{1, 0}, std::pair{2, 0}, std::pair{2, 1}}) {
+    const LoopConstraint r = verify_loop(views[q].features, views[c].features, VerificationOptions{}, 7);
+    EXPECT_FALSE(r.accepted) << "views " << q << " and " << c << " see different walls";
+  }
+}
+
+TEST(LoopVerifier, RejectsAViewWhoseDepthDisagrees) {
+  // The same image with every depth scaled by 1.3 (a depth camera out of calibration): the
+  // pixels match perfectly, no rigid motion explains the 3-D points.
+  const SyntheticRoom room(3, 3.0, 2.5, 2.5);
+  const auto views = views_along(room, {test::level_camera({0.0, 0.0, 1.0}, 0.0)});
+  FrameFeatures warped = views[0].features;
+  for (size_t i = 0; i < warped.size(); ++i) {
+    if (warped.has_point(i)) warped.points[i] *= 1.3;
+  }
+  const LoopConstraint r = verify_loop(warped, views[0].features, VerificationOptions{}, 7);
+  EXPECT_FALSE(r.accepted) << r.inliers << " inliers";
+}
+
+TEST(PlaceRecognizer, FindsTheTrueRevisitOfALoop) {
+  // Round a circle once and a quarter: the last views revisit the first ones.
+  const SyntheticRoom room(5, 3.0, 2.5, 2.5);
+  const int n = 45;
+  const auto path = test::circle_path(n, 1.0, 1.25);
+  const auto views = views_along(room, path);
+  PlaceRecognizer places;
+  int revisits_found = 0;
+  for (int k = 0; k < n; ++k) {
+    // Only views at least 20 steps (4 s) older are candidates, as in SLAM.
+    const auto matches = places.query(views[k].features.descriptors, 15, [k](int e) { return e <= k - 20; });
+    for (const BowMatch& m : matches) {
+      const LoopConstraint c = verify_loop(views[k].features, views[m.entry].features, VerificationOptions{}, 1);
+      if (!c.accepted) continue;
+      // Every accepted closure is a true one with the true relative pose.
+      expect_pose_near(c.T_candidate_query, views[m.entry].T_world_camera.inverse() * views[k].T_world_camera,
+                       0.05, 0.02);
+      ++revisits_found;
+      break;
+    }
+    places.add(views[k].features.descriptors);
+  }
+  // Steps 36..44 revisit steps 0..8 (a full turn is 36 steps).
+  EXPECT_GE(revisits_found, 5);
+  EXPECT_GE(places.trainings(), 3) << "the online vocabulary is retrained as keyframes double";
+}
+
+TEST(PlaceRecognizer, FindsNoLoopOnALoopFreePath) {
+  // Along a 12 m wall, looking at it from 1.5 m: each stretch of wall is seen once.
+  const SyntheticRoom room(5, 7.0, 1.5, 2.5);
+  const int n = 40;
+  const auto views = views_along(room, test::straight_path(n, 12.0));
+  PlaceRecognizer places;
+  for (int k = 0; k < n; ++k) {
+    const auto matches = places.query(views[k].features.descriptors, 15, [k](int e) { return e <= k - 20; });
+    for (const BowMatch& m : matches) {
+      const LoopConstraint c = verify_loop(views[k].features, views[m.entry].features, VerificationOptions{}, 1);
+      EXPECT_FALSE(c.accepted) << "view " << k << " closed a loop with view " << m.entry;
+    }
+    places.add(views[k].features.descriptors);
+  }
+}
+
+TEST(Vocabulary, TrainsSavesAndLoadsTheSameWords) {
+  const SyntheticRoom room(5, 3.0, 2.5, 2.5);
+  const auto views = views_along(room, test::circle_path(6, 1.0, 1.0));
+  std::vector<cv::Mat> images;
+  for (const auto& v : views) images.push_back(v.features.descriptors);
+  const Vocabulary vocabulary = Vocabulary::train(images, VocabularyOptions{8, 3, 5}, 42);
+  EXPECT_GT(vocabulary.num_words(), 100);
+  kestrel::test::TempDir dir;
+  const std::string path = (dir.path() / "words.voc").string();
+  vocabulary.save(path);
+  const Vocabulary loaded = Vocabulary::load(path);
+  EXPECT_EQ(loaded.num_words(), vocabulary.num_words());
+  EXPECT_EQ(loaded.words(images[3]), vocabulary.words(images[3]));
+  const BowVector a = vocabulary.transform(images[2]);
+  EXPECT_NEAR(bow_score(a, loaded.transform(images[2])), 1.0, 1e-12);
+  EXPECT_LT(bow_score(a, vocabulary.transform(images[5])), 0.5) << "views of different walls";
+
+  // Truncated, and not a vocabulary at all: errors naming the file.
+  std::string bytes(std::filesystem::file_size(path), '\0');
+  std::ifstream(path, std::ios::binary).read(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  const std::string truncated = (dir.path() / "truncated.voc").string();
+  std::ofstream(truncated, std::ios::binary) << bytes.substr(0, bytes.size() / 2);
+  const std::string text = (dir.path() / "text.voc").string();
+  std::ofstream(text) << "hello\n";
+  for (const std::string& bad : {truncated, text, (dir.path() / "missing.voc").string()}) {
+    try {
+      Vocabulary::load(bad);
+      ADD_FAILURE() << bad << " loaded";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(bad), std::string::npos) << e.what();
+    }
+  }
+}
+
+TEST(TwoViewAdjustment, RecoversAnExactRelativePoseFromAPerturbedStart) {
+  const PinholeCamera camera = test::test_camera();
+  Eigen::Isometry3d T_a_b = se3::exp((Vector6d() << 0.3, -0.1, 0.2, 0.05, -0.2, 0.1).finished());
+  std::vector<TwoViewObservation> observations;
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  while (observations.size() < 40) {
+    const Eigen::Vector3d X_b(u(rng), 0.7 * u(rng), 3.0 + u(rng));
+    const Eigen::Vector3d X_a = T_a_b * X_b;
+    if (X_a.z() < 0.5) continue;
+    const Eigen::Vector2d pa = camera.project(X_a), pb = camera.project(X_b);
+    if (!camera.contains(pa.x(), pa.y()) || !camera.contains(pb.x(), pb.y())) continue;
+    observations.push_back({pa, pb, X_a.z(), X_b.z()});
+  }
+  const Eigen::Isometry3d start = T_a_b * se3::exp((Vector6d() << 0.03, 0.02, -0.02, 0.01, 0.02, -0.01).finished());
+  const TwoViewResult r = adjust_two_views(camera, camera, observations, start);
+  ASSERT_TRUE(r.ok);
+  expect_pose_near(r.T_a_b, T_a_b, 1e-6, 1e-7);
+  EXPECT_LT(r.rms_px, 1e-6);
+}
+
+}  // namespace
+}  // namespace kestrel::slam

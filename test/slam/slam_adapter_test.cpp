@@ -1,0 +1,129 @@
+// The message side of kestrel-slam (slam_adapter.h): frames and VO updates paired by utime in
+// either order, SLAM_GRAPH after each keyframe with the odometry poses, and bad messages
+// refused with the channel named and no change of state.
+
+#include <gtest/gtest.h>
+
+#include "common/error.h"
+#include "common/transport/convert.h"
+#include "common/transport/rgbd_codec.h"
+#include "slam/slam_adapter.h"
+#include "test/slam/synthetic_room.h"
+
+namespace kestrel::slam {
+namespace {
+
+class AdapterTest : public ::testing::Test {
+ protected:
+  AdapterTest() : room_(5, 3.0, 2.5, 2.5), adapter_(SlamOptions{}, nullptr) {}
+
+  kestrel::rgbd_frame_t frame(int k) const {
+    return transport::encode_rgbd(room_.render(pose(k), test::test_camera(), utime(k)));
+  }
+  // Every frame is the reference of the next: T_reference_current is one step.
+  kestrel::vo_update_t update(int k) const {
+    kestrel::vo_update_t m{};
+    m.utime = utime(k);
+    m.reference_utime = k == 0 ? 0 : utime(k - 1);
+    m.status = k == 0 ? kestrel::vo_update_t::STATUS_NO_REFERENCE : kestrel::vo_update_t::STATUS_OK;
+    m.flags = kestrel::vo_update_t::FLAG_NEW_REFERENCE;
+    m.T_reference_current = transport::to_message(k == 0 ? Eigen::Isometry3d::Identity() : pose(k - 1).inverse() * pose(k));
+    m.T_body_camera = transport::to_message(Eigen::Isometry3d::Identity());
+    return m;
+  }
+  static int64_t utime(int k) { return 1'000'000 + 100'000 * k; }
+  // 10 cm steps along the optical axis of the first pose.
+  static Eigen::Isometry3d pose(int k) {
+    Eigen::Isometry3d T = test::level_camera({-1.0, 0.0, 1.0}, 0.0);
+    T.translation().x() += 0.1 * k;
+    return T;
+  }
+
+  test::SyntheticRoom room_;
+  SlamAdapter adapter_;
+};
+
+TEST_F(AdapterTest, PairsFramesAndUpdatesInEitherOrderAndPublishesTheGraph) {
+  std::vector<kestrel::slam_graph_t> graphs;
+  for (int k = 0; k < 8; ++k) {
+    // Even frames come before their update, odd ones after.
+    AdapterOutputs a, b;
+    if (k % 2 == 0) {
+      a = adapter_.on_frame(frame(k));
+      b = adapter_.on_vo_update(update(k));
+    } else {
+      a = adapter_.on_vo_update(update(k));
+      b = adapter_.on_frame(frame(k));
+    }
+    EXPECT_FALSE(a.graph) << "nothing happens until both halves of frame " << k << " are in";
+    EXPECT_FALSE(b.correction) << "no loop, no correction";
+    if (b.graph) graphs.push_back(*b.graph);
+  }
+  // Keyframes at 0, 0.3, 0.6 m (frames 0, 3, 6): world = the first camera's odometry frame.
+  ASSERT_EQ(graphs.size(), 3u);
+  const kestrel::slam_graph_t& g = graphs.back();
+  ASSERT_EQ(g.num_keyframes, 3);
+  ASSERT_EQ(g.num_edges, 2);
+  EXPECT_EQ(g.utime, utime(6));
+  EXPECT_EQ(g.keyframes[1].utime, utime(3));
+  const Eigen::Isometry3d T1 = transport::from_message(g.keyframes[1].T_world_camera, "test");
+  EXPECT_NEAR(T1.translation().z(), 0.3, 1e-9);
+  EXPECT_EQ(g.edges[1].from_id, 1);
+  EXPECT_EQ(g.edges[1].to_id, 2);
+  EXPECT_EQ(g.edges[1].kind, kestrel::slam_edge_t::KIND_ODOMETRY);
+}
+
+TEST_F(AdapterTest, RefusesBadMessagesNamingTheChannelAndCarriesOn) {
+  adapter_.on_frame(frame(0));
+  adapter_.on_vo_update(update(0));
+  // A frame older than one processed.
+  try {
+    adapter_.on_frame(frame(0));
+    ADD_FAILURE() << "an old frame was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("CAMERA_RGBD"), std::string::npos) << e.what();
+  }
+  // A VO update with a quaternion that is not a rotation, and one going back in time.
+  kestrel::vo_update_t bad = update(1);
+  bad.T_reference_current.orientation[0] = std::nan("");
+  EXPECT_THROW(adapter_.on_vo_update(bad), InputError);
+  try {
+    adapter_.on_vo_update(update(0));
+    ADD_FAILURE() << "an update going back in time was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("VO_UPDATE"), std::string::npos) << e.what();
+  }
+  // A keyframe whose depth image is cut short: refused when decoded, naming the channel.
+  kestrel::rgbd_frame_t corrupt = frame(3);
+  corrupt.depth.resize(corrupt.depth.size() / 2);
+  corrupt.depth_size = static_cast<int32_t>(corrupt.depth.size());
+  adapter_.on_vo_update(update(1));
+  adapter_.on_vo_update(update(2));
+  adapter_.on_vo_update(update(3));
+  try {
+    adapter_.on_frame(corrupt);
+    ADD_FAILURE() << "a corrupt frame was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("CAMERA_RGBD"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(adapter_.slam().keyframes().size(), 1u);
+  // The stream carries on.
+  adapter_.on_vo_update(update(4));
+  const AdapterOutputs out = adapter_.on_frame(frame(4));
+  ASSERT_TRUE(out.graph);
+  EXPECT_EQ(out.graph->num_keyframes, 2);
+}
+
+TEST_F(AdapterTest, ResetForgetsEverything) {
+  adapter_.on_frame(frame(0));
+  adapter_.on_vo_update(update(0));
+  ASSERT_EQ(adapter_.slam().keyframes().size(), 1u);
+  adapter_.reset();
+  EXPECT_TRUE(adapter_.slam().keyframes().empty());
+  // The same stream again is accepted from the start (a replay).
+  adapter_.on_frame(frame(0));
+  EXPECT_TRUE(adapter_.on_vo_update(update(0)).graph);
+}
+
+}  // namespace
+}  // namespace kestrel::slam

@@ -1,0 +1,176 @@
+// The SLAM back-end on the synthetic room with drifting odometry (known ground truth): loop
+// closures cut the trajectory error to a fraction of the odometry's, every accepted closure is
+// a true one, a loop-free run closes none, and bad input is refused. Also the odometry chain
+// that turns VO updates into poses.
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "common/error.h"
+#include "common/geometry/align.h"
+#include "common/geometry/se3.h"
+#include "slam/backend/odometry_chain.h"
+#include "slam/backend/slam.h"
+#include "test/slam/synthetic_room.h"
+
+namespace kestrel::slam {
+namespace {
+
+using test::SyntheticRoom;
+
+// The true path corrupted as a drifting odometry would: every step's motion gets a yaw bias
+// and random noise, so the error grows with the distance travelled.
+std::vector<Eigen::Isometry3d> drifting_odometry(const std::vector<Eigen::Isometry3d>& truth, double yaw_bias_rad,
+                                                 double noise_m, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> n(0.0, 1.0);
+  std::vector<Eigen::Isometry3d> odometry{truth.front()};
+  for (size_t k = 1; k < truth.size(); ++k) {
+    const Eigen::Isometry3d step = truth[k - 1].inverse() * truth[k];
+    Vector6d e;
+    e << noise_m * n(rng), noise_m * n(rng), noise_m * n(rng), 0.2 * noise_m * n(rng), yaw_bias_rad,
+        0.2 * noise_m * n(rng);  // optical y is the vertical: the bias is a yaw
+    odometry.push_back(odometry.back() * step * se3::exp(e));
+  }
+  return odometry;
+}
+
+double ate_rmse(const std::vector<Eigen::Isometry3d>& estimate, const std::vector<Eigen::Isometry3d>& truth) {
+  Eigen::Matrix3Xd est(3, static_cast<Eigen::Index>(estimate.size())), gt(3, est.cols());
+  for (size_t k = 0; k < estimate.size(); ++k) {
+    est.col(static_cast<Eigen::Index>(k)) = estimate[k].translation();
+    gt.col(static_cast<Eigen::Index>(k)) = truth[k].translation();
+  }
+  const Eigen::Isometry3d T = align_rigid(est, gt).value();
+  return std::sqrt(((T * est) - gt).colwise().squaredNorm().mean());
+}
+
+struct LoopRun {
+  std::vector<Eigen::Isometry3d> truth, odometry, optimised;
+  int loop_closures = 0;
+  int false_closures = 0;
+};
+
+LoopRun run(const SyntheticRoom& room, const std::vector<Eigen::Isometry3d>& truth, double yaw_bias_rad) {
+  LoopRun r;
+  r.truth = truth;
+  r.odometry = drifting_odometry(truth, yaw_bias_rad, 0.004, 9);
+  Slam slam;
+  std::vector<std::pair<int, Eigen::Isometry3d>> placed;  // keyframe, T_keyframe_camera
+  for (size_t k = 0; k < truth.size(); ++k) {
+    const RgbdFrame frame = room.render(truth[k], test::test_camera(), 1'000'000 + 200'000 * static_cast<int64_t>(k));
+    const SlamStep step = slam.add(frame, r.odometry[k]);
+    if (step.loop_closed) {
+      ++r.loop_closures;
+      // The closure's relative pose against the truth of the two keyframes' frames.
+      const auto& kfs = slam.keyframes();
+      const auto frame_of = [&](int64_t id) { return static_cast<size_t>((kfs[static_cast<size_t>(id)].utime - 1'000'000) / 200'000); };
+      const Eigen::Isometry3d true_rel =
+          truth[frame_of(step.loop_keyframe_id)].inverse() * truth[frame_of(step.keyframe_id)];
+      if (se3::translation_distance(true_rel, step.loop.T_candidate_query) > 0.1 ||
+          se3::rotation_distance(true_rel, step.loop.T_candidate_query) > 0.05) {
+        ++r.false_closures;
+      }
+    }
+    const Keyframe& kf = slam.keyframes().back();
+    placed.emplace_back(static_cast<int>(kf.id), kf.T_odom_camera.inverse() * r.odometry[k]);
+  }
+  for (const auto& [kf, T] : placed) r.optimised.push_back(slam.graph().poses[static_cast<size_t>(kf)] * T);
+  return r;
+}
+
+TEST(Slam, LoopClosureCutsTheDriftOfAClosedLoop) {
+  const SyntheticRoom room(5, 3.0, 2.5, 2.5);
+  const LoopRun r = run(room, test::circle_path(60, 1.0, 1.2), 0.006);
+  const double vo = ate_rmse(r.odometry, r.truth), slam = ate_rmse(r.optimised, r.truth);
+  EXPECT_GT(vo, 0.1) << "the odometry should drift for this test to mean anything";
+  EXPECT_LE(slam, 0.3 * vo) << "VO-only ATE " << vo << " m";
+  EXPECT_GE(r.loop_closures, 1);
+  EXPECT_EQ(r.false_closures, 0);
+  std::cout << "ATE: VO only " << vo << " m, SLAM " << slam << " m, " << r.loop_closures << " loop closures\n";
+}
+
+TEST(Slam, ALoopFreeRunClosesNoLoop) {
+  const SyntheticRoom room(5, 7.0, 1.5, 2.5);
+  const LoopRun r = run(room, test::straight_path(40, 12.0), 0.004);
+  EXPECT_EQ(r.loop_closures, 0);
+  // Without loops the optimised poses are the odometry's.
+  for (size_t k = 0; k < r.odometry.size(); ++k) {
+    EXPECT_LT(se3::translation_distance(r.optimised[k], r.odometry[k]), 1e-9);
+  }
+}
+
+TEST(Slam, MakesKeyframesEvery25CmOr10Degrees) {
+  Slam slam;
+  RgbdFrame frame;  // no image: keyframes without features
+  frame.camera = test::test_camera();
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  for (int k = 0; k < 20; ++k) {
+    frame.utime = 1000 + k;
+    T.translation().z() = 0.1 * k;  // 10 cm per frame: a keyframe every third frame
+    slam.add(frame, T);
+  }
+  ASSERT_EQ(slam.keyframes().size(), 7u);
+  EXPECT_NEAR(slam.keyframes()[1].T_odom_camera.translation().z(), 0.3, 1e-12);
+  EXPECT_TRUE(slam.wants_keyframe(T * se3::exp((Vector6d() << 0, 0, 0, 0, 0.18, 0).finished())));
+  EXPECT_FALSE(slam.wants_keyframe(T * se3::exp((Vector6d() << 0.1, 0, 0, 0, 0.16, 0).finished())));
+  EXPECT_EQ(slam.graph().num_edges(), 6);
+}
+
+TEST(Slam, RefusesTimeGoingBackAndPosesThatAreNotRigid) {
+  Slam slam;
+  RgbdFrame frame;
+  frame.utime = 100;
+  slam.add(frame, Eigen::Isometry3d::Identity());
+  frame.utime = 100;
+  EXPECT_THROW(slam.add(frame, Eigen::Isometry3d::Identity()), InputError);
+  frame.utime = 200;
+  Eigen::Isometry3d bad = Eigen::Isometry3d::Identity();
+  bad.translation().x() = std::nan("");
+  EXPECT_THROW(slam.add(frame, bad), InputError);
+  EXPECT_FALSE(slam.wants_keyframe(bad));
+  EXPECT_EQ(slam.keyframes().size(), 1u);
+}
+
+VoMotion motion(int64_t utime, int64_t reference, bool ok, bool new_reference, double x = 0.0) {
+  VoMotion m;
+  m.utime = utime;
+  m.reference_utime = reference;
+  m.ok = ok;
+  m.new_reference = new_reference;
+  m.T_reference_current.translation().x() = x;
+  return m;
+}
+
+TEST(OdometryChain, ChainsMotionsThroughReferencesAndFlagsRestarts) {
+  OdometryChain chain;
+  auto x = [](const std::optional<OdometryPose>& p) { return p.value().T_odom_camera.translation().x(); };
+  auto first = chain.add(motion(10, 0, false, true));  // first frame: the reference
+  ASSERT_TRUE(first.has_value());
+  EXPECT_FALSE(first->broken);
+  EXPECT_NEAR(x(chain.add(motion(20, 10, true, false, 0.1))), 0.1, 1e-12);
+  EXPECT_NEAR(x(chain.add(motion(30, 10, true, true, 0.3))), 0.3, 1e-12);  // the new reference
+  EXPECT_NEAR(x(chain.add(motion(40, 30, true, false, 0.2))), 0.5, 1e-12);
+  EXPECT_FALSE(chain.add(motion(50, 30, false, false)).has_value());  // a failed frame: no pose
+  const auto restart = chain.add(motion(60, 0, false, true));  // the odometry restarted
+  ASSERT_TRUE(restart.has_value());
+  EXPECT_TRUE(restart->broken);
+  EXPECT_NEAR(x(restart), 0.5, 1e-12) << "a restart continues from the last pose";
+  const auto next = chain.add(motion(70, 60, true, false, 0.1));
+  ASSERT_TRUE(next.has_value());
+  EXPECT_FALSE(next->broken);
+  EXPECT_NEAR(x(next), 0.6, 1e-12);
+}
+
+TEST(OdometryChain, RefusesTimeGoingBackAndNonRigidMotion) {
+  OdometryChain chain;
+  chain.add(motion(10, 0, false, true));
+  EXPECT_THROW(chain.add(motion(10, 10, true, false)), InputError);
+  VoMotion bad = motion(20, 10, true, false);
+  bad.T_reference_current.linear() *= 2.0;
+  EXPECT_THROW(chain.add(bad), InputError);
+}
+
+}  // namespace
+}  // namespace kestrel::slam
