@@ -12,6 +12,7 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "common/cli.h"
 #include "common/error.h"
@@ -19,6 +20,7 @@
 #include "common/transport/node.h"
 #include "common/transport/rgbd_codec.h"
 #include "kestrel/rgbd_frame_t.hpp"
+#include "vo/option_keys.h"
 #include "vo/sequence_run.h"
 #include "vo/update_message.h"
 #include "vo/variants.h"
@@ -29,6 +31,7 @@ using namespace kestrel;
 
 struct Options {
   std::string variant = "default";
+  std::vector<std::string> settings;  // KEY=VALUE over the variant
   // Offline.
   std::string tum;
   std::string out;
@@ -113,6 +116,10 @@ int main(int argc, char** argv) {
   for (const auto& v : vo::variants()) known += (known.empty() ? "" : ", ") + v.name;
   app.add_option("--variant", o.variant, "Pipeline variant (paper's Table 1): " + known)
       ->capture_default_str();
+  app.add_option("--set", o.settings,
+                 "Change one option of the variant, KEY=VALUE (repeatable; --list-options shows them)");
+  bool list = false;
+  app.add_flag("--list-options", list, "Print every pipeline option of the variant with its value and exit");
   app.add_option("--tum", o.tum, "Offline: TUM RGB-D sequence folder to run over");
   app.add_option("--out", o.out, "Offline: write the camera trajectory here (TUM format)");
   app.add_option("--stats", o.stats, "Offline: write figures and per-frame status here (JSON)");
@@ -120,12 +127,25 @@ int main(int argc, char** argv) {
   app.add_option("--lcm-url", o.lcm_url, "LCM URL (default: $LCM_DEFAULT_URL or kestrel's)");
   app.add_option("--in", o.in_channel, "Channel of rgbd_frame_t")->capture_default_str();
   app.add_option("--out-channel", o.out_channel, "Channel of vo_update_t")->capture_default_str();
-  return app.run(argc, argv, [&] {
+  return app.run(argc, argv, [&]() -> int {
     vo::VoOptions options;
     try {
       options = vo::variant(o.variant).options;
     } catch (const std::invalid_argument& e) {
       throw CLI::ValidationError("--variant", e.what());
+    }
+    for (const std::string& kv : o.settings) {
+      const auto eq = kv.find('=');
+      if (eq == std::string::npos) throw CLI::ValidationError("--set", "'" + kv + "' is not KEY=VALUE");
+      try {
+        vo::set_option(options, kv.substr(0, eq), kv.substr(eq + 1));
+      } catch (const std::invalid_argument& e) {
+        throw CLI::ValidationError("--set", e.what());
+      }
+    }
+    if (list) {
+      for (const std::string& line : vo::describe_options(options)) std::cout << line << "\n";
+      return kExitOk;
     }
     return o.tum.empty() ? serve(o, options) : run_offline(o, options);
   });

@@ -8,6 +8,7 @@
 
 #include "test/vo/synthetic_scene.h"
 #include "vo/odometry.h"
+#include "vo/option_keys.h"
 
 namespace kestrel::vo {
 namespace {
@@ -109,6 +110,28 @@ TEST(Options, UnusableValuesAreRejectedByName) {
   o = VoOptions{};
   o.pyramid.levels = 5;
   EXPECT_THROW(VisualOdometry{o}, std::invalid_argument);
+}
+
+TEST(Options, SetByNameAndRejectedByName) {
+  VoOptions o;
+  set_option(o, "fast.threshold", "15");
+  set_option(o, "inliers.method", "ransac");
+  set_option(o, "refinement.bidirectional", "false");
+  EXPECT_EQ(o.fast.threshold, 15);
+  EXPECT_EQ(o.inliers.method, InlierMethod::kRansac);
+  EXPECT_FALSE(o.refinement.bidirectional);
+  for (const auto& [key, value] : std::vector<std::pair<std::string, std::string>>{
+           {"fast.thresh", "15"}, {"fast.threshold", "fifteen"}, {"match.window_size", "8"},
+           {"refinement.solver", "lm"}, {"bucket.enabled", "yes"}}) {
+    try {
+      set_option(o, key, value);
+      ADD_FAILURE() << key << "=" << value << " was accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(key.substr(0, 10)), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_EQ(o.fast.threshold, 15) << "a rejected value changes nothing";
+  EXPECT_EQ(describe_options(o).size(), 51u);
 }
 
 }  // namespace

@@ -1,0 +1,95 @@
+// kestrel-vo as a process, in a private network namespace: a log of synthetic frames (one of
+// them corrupt) is replayed in lock-step through it twice; each frame gets one VO_UPDATE with
+// the right status and motion, the corrupt one STATUS_BAD_INPUT, and the two replays (with
+// a RESET between them) give identical answers.
+
+#include <gtest/gtest.h>
+
+#include "common/geometry/se3.h"
+#include "common/transport/channels.h"
+#include "common/transport/convert.h"
+#include "common/transport/log_file.h"
+#include "common/transport/rgbd_codec.h"
+#include "kestrel/vo_update_t.hpp"
+#include "test/support/test_support.h"
+#include "test/vo/synthetic_scene.h"
+
+namespace kestrel::vo {
+namespace {
+
+constexpr int kFrames = 5;
+constexpr int kCorrupt = 3;  // this frame's depth is cut short on the wire
+
+Eigen::Isometry3d truth(int k) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.translation() = Eigen::Vector3d(0.01 * k, -0.005 * k, 0.0);
+  return T;
+}
+
+void write_input_log(const std::string& path) {
+  const test::SyntheticScene scene(31);
+  transport::LogWriter log(path);
+  for (int k = 0; k < kFrames; ++k) {
+    const RgbdFrame frame = scene.render(truth(k), test::test_camera(), 1000000 + 33333 * k);
+    kestrel::rgbd_frame_t message = transport::encode_rgbd(frame);
+    if (k == kCorrupt) message.depth.resize(message.depth.size() / 2);
+    message.depth_size = static_cast<int32_t>(message.depth.size());
+    log.write_message(channel::kCameraRgbd, frame.utime, message);
+  }
+  log.close();
+}
+
+std::vector<kestrel::vo_update_t> updates(const std::string& path) {
+  std::vector<kestrel::vo_update_t> out;
+  transport::LogReader log(path);
+  while (auto e = log.next())
+    if (e->channel == channel::kVoUpdate)
+      out.push_back(transport::decode_message<kestrel::vo_update_t>(e->data.data(), e->data.size(), e->channel));
+  return out;
+}
+
+TEST(VoProcess, LockStepReplayGivesOneUpdatePerFrameAndRepeats) {
+  if (!kestrel::test::can_isolate_network()) GTEST_SKIP() << "cannot create a network namespace here";
+  kestrel::test::TempDir dir;
+  const std::string in = (dir / "in.lcmlog").string();
+  write_input_log(in);
+  const std::string vo = kestrel::test::tool("vo").string(), replay = kestrel::test::tool("replay").string();
+  const std::string script =
+      "'" + vo + "' -q & VO=$!; "
+      "'" + replay + "' '" + in + "' --expect vo --record '" + (dir / "a.lcmlog").string() + "' >/dev/null && "
+      "'" + replay + "' '" + in + "' --expect vo --record '" + (dir / "b.lcmlog").string() + "' >/dev/null; "
+      "R=$?; kill $VO; wait $VO; exit $R";
+  const kestrel::test::RunResult r =
+      kestrel::test::run({kestrel::test::tool("isolated").string(), "--", "sh", "-c", script}, 120.0);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+
+  const auto a = updates((dir / "a.lcmlog").string()), b = updates((dir / "b.lcmlog").string());
+  ASSERT_EQ(a.size(), size_t(kFrames));
+  ASSERT_EQ(b.size(), a.size());
+  for (int k = 0; k < kFrames; ++k) {
+    const auto& u = a[size_t(k)];
+    EXPECT_EQ(u.utime, 1000000 + 33333 * k);
+    if (k == 0) {
+      EXPECT_EQ(u.status, kestrel::vo_update_t::STATUS_NO_REFERENCE);
+      EXPECT_TRUE(u.flags & kestrel::vo_update_t::FLAG_NEW_REFERENCE);
+    } else if (k == kCorrupt) {
+      EXPECT_EQ(u.status, kestrel::vo_update_t::STATUS_BAD_INPUT);
+    } else {
+      ASSERT_EQ(u.status, kestrel::vo_update_t::STATUS_OK) << "frame " << k;
+      const Eigen::Isometry3d T = transport::from_message(u.T_reference_current, "VO_UPDATE");
+      const Eigen::Isometry3d T_true = truth(0).inverse() * truth(k);  // reference: the first frame
+      EXPECT_EQ(u.reference_utime, 1000000);
+      EXPECT_LT(se3::translation_distance(T, T_true), 0.003) << "frame " << k;
+      EXPECT_GT(u.covariance[0], 0.0);
+      EXPECT_GT(u.num_reprojection_inliers, 50);
+      EXPECT_GE(u.elapsed_ms, 0.0f);
+    }
+    // The replay after a RESET starts over and gives the same answers.
+    EXPECT_EQ(b[size_t(k)].status, u.status);
+    EXPECT_EQ(b[size_t(k)].reference_utime, u.reference_utime);
+    EXPECT_EQ(b[size_t(k)].num_inliers, u.num_inliers);
+  }
+}
+
+}  // namespace
+}  // namespace kestrel::vo
