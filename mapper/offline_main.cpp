@@ -31,7 +31,7 @@ namespace {
 using namespace kestrel;
 
 struct Options {
-  std::string tum, poses, out, png, view_png, slice_png, ply, compare;
+  std::string tum, poses, anchor, out, png, view_png, slice_png, ply, compare;
   double slice_z_m = 1.0;
   double max_pose_gap_s = 0.05;
   double depth_scale = 1.0;
@@ -59,13 +59,28 @@ double percentile(std::vector<double> v, double q) {
   return v[i];
 }
 
+// `poses` moved rigidly so that its first pose coincides with `anchor`'s at the same time: a
+// VO or SLAM trajectory that starts at the identity, placed in the ground truth's world frame
+// (as if the estimator had been started at the true pose), with no further alignment.
+Trajectory anchored(const Trajectory& poses, const Trajectory& anchor, const std::string& anchor_path) {
+  const StampedPose& first = poses.poses().front();
+  const auto T_world_first = anchor.at(first.utime, 50000);
+  if (!T_world_first) throw InputError(anchor_path + ": no pose at the first pose's time");
+  const Eigen::Isometry3d T_world_poses = *T_world_first * first.T.inverse();
+  Trajectory out;
+  for (const StampedPose& p : poses.poses()) out.push_back(p.utime, T_world_poses * p.T);
+  return out;
+}
+
 int run(Options& o) {
   mapper::check_mapper_options(o.mapper);
   mapper::format_of(o.out);  // a bad extension is an error before any work
   tum::SequenceOptions so;
   so.depth_scale_correction = o.depth_scale;
   const tum::TumSequence sequence(o.tum, so);
-  const Trajectory poses = read_tum_trajectory(o.poses);
+  Trajectory poses = read_tum_trajectory(o.poses);
+  if (poses.empty()) throw InputError(o.poses + ": no poses");
+  if (!o.anchor.empty()) poses = anchored(poses, read_tum_trajectory(o.anchor), o.anchor);
   mapper::Mapper mapper(o.mapper);
   const int64_t max_gap = static_cast<int64_t>(o.max_pose_gap_s * 1e6);
 
@@ -95,6 +110,9 @@ int run(Options& o) {
   std::printf("cells known: %zu (%.1f m^3), occupied: %zu; map memory %.2f MB (%.2f MB per 100 m^3)\n",
               map.num_cells(), volume, map.num_occupied(), map.memory_bytes() / 1e6,
               volume > 0 ? map.memory_bytes() / 1e6 * 100.0 / volume : 0.0);
+  const double tree_mb = static_cast<double>(mapper::to_octree(map)->memoryUsage()) / 1e6;
+  std::printf("as an OctoMap OcTree (pruned): %.2f MB (%.2f MB per 100 m^3)\n", tree_mb,
+              volume > 0 ? tree_mb * 100.0 / volume : 0.0);
   std::cout << "wrote " << o.out << "\n";
 
   if (!o.png.empty()) write_png(o.png, mapper::render_top_view(map, o.render));
@@ -122,6 +140,8 @@ int main(int argc, char** argv) {
   Options o;
   app.add_option("--tum", o.tum, "TUM RGB-D sequence folder")->required();
   app.add_option("--poses", o.poses, "Trajectory of the camera, TUM format (ground truth or any estimate)")->required();
+  app.add_option("--anchor", o.anchor,
+                 "Trajectory (e.g. ground truth) whose pose at --poses' first time places --poses in its world");
   app.add_option("--out", o.out, "Map file to write (.bt binary or .ot full)")->required();
   app.add_option("--png", o.png, "Top view PNG (height-coloured)");
   app.add_option("--view-png", o.view_png, "Perspective view PNG");

@@ -92,12 +92,24 @@ void BM_Cells(benchmark::State& state, ScanIntegrator::Method method) {
   o.stride = static_cast<int>(state.range(0));
   ScanIntegrator integrator(0.1, o);
   ScanUpdate update;
-  size_t i = 0, rays = 0;
+  size_t i = 0;
+  double rays = 0, free = 0, occupied = 0, tested = 0, traced = 0, tests = 0;
   for (auto _ : state) {
     integrator.compute(s[i++ % s.size()], update, method);
     rays += update.rays;
+    free += update.free.size();
+    occupied += update.occupied.size();
+    tested += update.cells_tested;
+    traced += update.rays_traced;
+    tests += update.ray_tests;
   }
-  state.counters["rays/frame"] = static_cast<double>(rays) / static_cast<double>(i);
+  const double n = static_cast<double>(i);
+  state.counters["rays"] = rays / n;
+  state.counters["free"] = free / n;
+  state.counters["occ"] = occupied / n;
+  state.counters["tested"] = tested / n;
+  state.counters["traced"] = traced / n;
+  state.counters["tests"] = tests / n;
 }
 
 void BM_Octomap(benchmark::State& state) {
