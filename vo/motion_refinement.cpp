@@ -172,7 +172,7 @@ RefinementResult refine_motion(const std::vector<Correspondence>& cs, const std:
     if (lambda < 1e-6) lambda = 0.0;
     T = T_new;
     acc = acc_new;
-    if (delta.head<3>().norm() < 1e-7 && delta.tail<3>().norm() < 1e-8) {
+    if (delta.head<3>().norm() < 1e-6 && delta.tail<3>().norm() < 1e-7) {  // a micrometre
       result.converged = true;
       break;
     }

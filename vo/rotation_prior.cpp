@@ -92,11 +92,20 @@ RotationPriorResult RotationPrior::estimate(const cv::Mat& prev, const cv::Mat& 
         // b x (R^T a).
         const Eigen::Vector3f a(gx * fx * iz, gy * fy * iz, -(gx * fx * q.x() + gy * fy * q.y()) * iz * iz);
         const Eigen::Vector3f jcur = b.cross(Rt * a);
-        Eigen::Vector4f J;
-        J.head<3>() = 0.5f * (jcur + jref_[static_cast<size_t>(y * w + x)]);
-        J(3) = -1.0f;
-        H.selfadjointView<Eigen::Lower>().rankUpdate(J);
-        g += J * r;
+        const Eigen::Vector3f j = 0.5f * (jcur + jref_[static_cast<size_t>(y * w + x)]);
+        // J = (j, -1): the upper triangle of J J^T and J r, written out (see subpixel.cpp).
+        H(0, 0) += j.x() * j.x();
+        H(0, 1) += j.x() * j.y();
+        H(0, 2) += j.x() * j.z();
+        H(1, 1) += j.y() * j.y();
+        H(1, 2) += j.y() * j.z();
+        H(2, 2) += j.z() * j.z();
+        H(0, 3) -= j.x();
+        H(1, 3) -= j.y();
+        H(2, 3) -= j.z();
+        H(3, 3) += 1.0f;
+        g.head<3>() += j * r;
+        g(3) -= r;
         cost += double(r) * double(r);
         ++n;
       }
@@ -107,13 +116,13 @@ RotationPriorResult RotationPrior::estimate(const cv::Mat& prev, const cv::Mat& 
     last_cost = cost / n;
     result.R_cur_prev = R;
     result.rms_error = std::sqrt(cost / n);
-    H.triangularView<Eigen::Upper>() = H.transpose();
+    H.triangularView<Eigen::StrictlyLower>() = H.transpose();
     const Eigen::Vector4d delta = H.cast<double>().ldlt().solve(-g.cast<double>());
     if (!delta.allFinite()) return result;
     R = so3::orthonormalize(R * so3::exp(delta.head<3>()));
     bias += delta(3);
     result.iterations = it + 1;
-    if (delta.head<3>().norm() < 2e-5) {
+    if (delta.head<3>().norm() < 1e-4) {  // 0.006 degrees: far below what the windows need
       result.converged = true;
       break;
     }

@@ -48,24 +48,32 @@ SubpixelResult refine_subpixel(const cv::Mat& ref, const Eigen::Vector2i& ref_px
       for (int x = 0; x < side; ++x)
         s[static_cast<size_t>(y * side + x)] = w00 * r0[x] + w01 * r0[x + 1] + w10 * r1[x] + w11 * r1[x + 1];
     }
-    Eigen::Matrix3f H = Eigen::Matrix3f::Zero();
-    Eigen::Vector3f g = Eigen::Vector3f::Zero();
-    float cost = 0.0f;
+    // The normal equations of J = (gx, gy, -1) accumulated as scalars: the compiler keeps
+    // them in registers, where a generic rank update per pixel would not.
+    float hxx = 0, hxy = 0, hyy = 0, sx = 0, sy = 0, ex = 0, ey = 0, se = 0, cost = 0;
+    const size_t sd = static_cast<size_t>(side);
     for (int y = 1; y <= window; ++y) {
       for (int x = 1; x <= window; ++x) {
         const size_t i = static_cast<size_t>(y * side + x);
-        const size_t sd = static_cast<size_t>(side);
         const float gx = 0.25f * (s[i + 1] - s[i - 1] + t[i + 1] - t[i - 1]);
         const float gy = 0.25f * (s[i + sd] - s[i - sd] + t[i + sd] - t[i - sd]);
         const float e = s[i] - t[i] - bias;
-        const Eigen::Vector3f J(gx, gy, -1.0f);
-        H.selfadjointView<Eigen::Lower>().rankUpdate(J);
-        g += J * e;
+        hxx += gx * gx;
+        hxy += gx * gy;
+        hyy += gy * gy;
+        sx += gx;
+        sy += gy;
+        ex += gx * e;
+        ey += gy * e;
+        se += e;
         cost += e * e;
       }
     }
-    result.rms_error = std::sqrt(cost / float(window * window));
-    H.triangularView<Eigen::Upper>() = H.transpose();
+    const float n = float(window * window);
+    result.rms_error = std::sqrt(cost / n);
+    Eigen::Matrix3f H;
+    H << hxx, hxy, -sx, hxy, hyy, -sy, -sx, -sy, n;
+    const Eigen::Vector3f g(ex, ey, -se);
     const Eigen::Vector3f delta = H.ldlt().solve(-g);
     if (!delta.allFinite()) return result;
     pos += delta.head<2>();
