@@ -1,0 +1,71 @@
+#include "drivers/sim/realism.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <opencv2/features2d.hpp>
+#include <opencv2/imgproc.hpp>
+
+namespace kestrel::sim {
+namespace {
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  const size_t mid = v.size() / 2;
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(mid), v.end());
+  return v[mid];
+}
+
+}  // namespace
+
+FrameStats frame_stats(const RgbdFrame& frame) {
+  FrameStats s;
+  cv::Mat grey;
+  cv::cvtColor(frame.rgb, grey, cv::COLOR_RGB2GRAY);
+  std::vector<cv::KeyPoint> corners;
+  cv::FAST(grey, corners, 20, true);
+  s.fast_corners = static_cast<int>(corners.size());
+  s.valid_depth = static_cast<double>(cv::countNonZero(frame.depth_mm)) / static_cast<double>(frame.depth_mm.total());
+  constexpr int kBlock = 8;
+  Eigen::Matrix<double, kBlock * kBlock, 3> A;
+  Eigen::Matrix<double, kBlock * kBlock, 1> z;
+  for (int v0 = 0; v0 + kBlock <= frame.depth_mm.rows; v0 += kBlock)
+    for (int u0 = 0; u0 + kBlock <= frame.depth_mm.cols; u0 += kBlock) {
+      bool usable = true;
+      for (int dv = 0; dv < kBlock && usable; ++dv)
+        for (int du = 0; du < kBlock; ++du) {
+          const double m = frame.depth_mm.at<uint16_t>(v0 + dv, u0 + du) * 1e-3;
+          if (m < 1.0 || m > 3.0) {
+            usable = false;
+            break;
+          }
+          const int i = dv * kBlock + du;
+          A.row(i) << du, dv, 1.0;
+          z(i) = m;
+        }
+      if (!usable) continue;
+      const Eigen::Vector3d plane = A.colPivHouseholderQr().solve(z);
+      const double rms = std::sqrt((A * plane - z).squaredNorm() / (kBlock * kBlock - 3));
+      if (rms > 0.05) continue;
+      const double mean_z = z.mean();
+      s.noise_k.push_back(rms / (mean_z * mean_z));
+    }
+  return s;
+}
+
+SequenceStats summarise(const std::vector<FrameStats>& frames) {
+  SequenceStats out;
+  out.frames = static_cast<int>(frames.size());
+  std::vector<double> fast, valid, noise;
+  for (const FrameStats& f : frames) {
+    fast.push_back(f.fast_corners);
+    valid.push_back(f.valid_depth);
+    noise.insert(noise.end(), f.noise_k.begin(), f.noise_k.end());
+  }
+  out.fast_corners_median = median(fast);
+  out.valid_depth_median = median(valid);
+  out.noise_k_median = median(noise);
+  out.noise_blocks = static_cast<int>(noise.size());
+  return out;
+}
+
+}  // namespace kestrel::sim
