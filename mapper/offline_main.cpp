@@ -25,6 +25,7 @@
 #include "mapper/mapper.h"
 #include "mapper/octree_io.h"
 #include "mapper/render.h"
+#include "mapper/scan.h"
 
 namespace {
 
@@ -36,6 +37,7 @@ struct Options {
   double max_pose_gap_s = 0.05;
   double depth_scale = 1.0;
   size_t every = 1;
+  bool surface_only = false;
   mapper::MapperOptions mapper;
   mapper::RenderOptions render;
 };
@@ -72,6 +74,20 @@ Trajectory anchored(const Trajectory& poses, const Trajectory& anchor, const std
   return out;
 }
 
+// --surface-only: the cells holding a measured point within max range, occupied, and nothing
+// else (no free space). With noiseless depth this is the true surface within sensor range,
+// the reference for a map's voxel precision and recall.
+void mark_surface(const RgbdFrame& frame, const Eigen::Isometry3d& T_world_camera,
+                  const mapper::MapperOptions& o, mapper::VoxelMap& surface) {
+  const mapper::Scan scan = mapper::make_scan(mapper::decimate(frame, o.scan.stride), T_world_camera, o.scan, "frame");
+  for (size_t i = 0; i < scan.points.size(); ++i) {
+    mapper::Key k;
+    if (scan.valid[i] && (scan.points[i] - scan.origin).norm() <= o.scan.max_range_m &&
+        surface.keys().key(scan.points[i], k))
+      surface.set(k, surface.clamp_max());
+  }
+}
+
 int run(Options& o) {
   mapper::check_mapper_options(o.mapper);
   mapper::format_of(o.out);  // a bad extension is an error before any work
@@ -84,6 +100,7 @@ int run(Options& o) {
   mapper::Mapper mapper(o.mapper);
   const int64_t max_gap = static_cast<int64_t>(o.max_pose_gap_s * 1e6);
 
+  mapper::VoxelMap surface(o.mapper.map);
   std::vector<double> ms;
   size_t without_pose = 0;
   for (size_t i = 0; i < sequence.size(); i += o.every) {
@@ -94,11 +111,15 @@ int run(Options& o) {
       continue;
     }
     const double t0 = thread_cpu_ms();
-    mapper.insert(frame, *T_world_camera, sequence.folder().c_str());
+    if (o.surface_only) {
+      mark_surface(frame, *T_world_camera, o.mapper, surface);
+    } else {
+      mapper.insert(frame, *T_world_camera, sequence.folder().c_str());
+    }
     ms.push_back(thread_cpu_ms() - t0);
   }
   if (ms.empty()) throw InputError(o.poses + ": no frame of " + o.tum + " has a pose within --max-pose-gap");
-  const mapper::VoxelMap& map = mapper.map();
+  const mapper::VoxelMap& map = o.surface_only ? surface : mapper.map();
   mapper::write_map_file(map, o.out);
 
   const double cell3 = map.resolution() * map.resolution() * map.resolution();
@@ -156,6 +177,8 @@ int main(int argc, char** argv) {
       ->check(cli::Positive)
       ->capture_default_str();
   app.add_option("--every", o.every, "Insert every n-th frame")->check(CLI::Range(1, 1000))->capture_default_str();
+  app.add_flag("--surface-only", o.surface_only,
+               "Only mark the cells holding a point, occupied, no free space (a reference from noiseless depth)");
   app.add_option("--pixels-per-cell", o.render.pixels_per_cell, "Top view and slice scale")
       ->check(CLI::Range(1, 64))
       ->capture_default_str();

@@ -75,6 +75,18 @@ TEST(MapTool, BuildsTheLibrarysMapAndRendersIt) {
                                          (tmp / "again.bt").string(), "--compare", (tmp / "map.ot").string()});
   ASSERT_EQ(again.exit_code, 0) << again.err;
   EXPECT_NE(again.out.find("class agreement 1.0000"), std::string::npos) << again.out;
+
+  // The surface-only reference: every hit cell occupied, no free space at all.
+  const auto surface = kestrel::test::run({kestrel::test::tool("map").string(), "--tum", (tmp / "seq").string(),
+                                           "--poses", (tmp / "seq/truth.txt").string(), "--out",
+                                           (tmp / "surface.ot").string(), "--surface-only"});
+  ASSERT_EQ(surface.exit_code, 0) << surface.err;
+  const VoxelMap truth = read_map_file((tmp / "surface.ot").string());
+  EXPECT_GT(truth.num_cells(), 100u);
+  EXPECT_EQ(truth.num_occupied(), truth.num_cells());
+  size_t hit_cells = 0;
+  reference.map().for_each_cell([&](const Key& k, float) { hit_cells += truth.occupancy(k) == Occupancy::kOccupied; });
+  EXPECT_EQ(hit_cells, truth.num_cells()) << "every surface cell was seen by the full map too";
 }
 
 TEST(MapTool, UsageErrorsAndBadInput) {
