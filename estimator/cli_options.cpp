@@ -1,0 +1,78 @@
+#include "estimator/cli_options.h"
+
+#include <map>
+#include <string>
+
+namespace kestrel::estimator {
+namespace {
+
+// CLI11 binds vectors, not Eigen types: shows an Eigen vector as its default.
+std::string joined(const double* v, int n) {
+  std::string out;
+  for (int i = 0; i < n; ++i) out += (i ? "," : "") + CLI::detail::to_string(v[i]);
+  return out;
+}
+
+}  // namespace
+
+void add_estimator_options(CLI::App& app, EstimatorOptions& o) {
+  static const std::map<std::string, FilterKind> kFilters{{"ekf", FilterKind::kEkf},
+                                                          {"ukf", FilterKind::kUkf}};
+  static const std::map<std::string, VoNoiseOptions::Source> kSources{
+      {"reported", VoNoiseOptions::Source::kReported},
+      {"constant", VoNoiseOptions::Source::kConstant}};
+  const CLI::Range non_negative(0.0, 1e9);
+  const CLI::Range positive(1e-12, 1e9);
+
+  app.add_option("--filter", o.filter, "State filter: ekf (Appendix A) or ukf (Appendix B)")
+      ->transform(CLI::CheckedTransformer(kFilters, CLI::ignore_case))
+      ->default_str("ekf");
+  app.add_option("--vo-noise", o.vo_noise.source,
+                 "VO measurement noise: the covariance each update reports, or the constant "
+                 "model (--vo-sigma, fitted by kestrel fit-vo-noise)")
+      ->transform(CLI::CheckedTransformer(kSources, CLI::ignore_case))
+      ->default_str("reported");
+  app.add_option("--vo-scale", o.vo_noise.reported_scale, "Multiplies the reported VO covariance")
+      ->check(positive)->capture_default_str();
+  app.add_option_function<std::vector<double>>(
+         "--vo-sigma",
+         [&o](const std::vector<double>& v) {
+           o.vo_noise.constant_sigma = Eigen::Map<const Eigen::Matrix<double, 6, 1>>(v.data());
+         },
+         "Constant VO model: sigmas of dx,dy,dz (m, reference camera),rx,ry,rz (rad)")
+      ->expected(6)->delimiter(',')->check(positive)
+      ->default_str(joined(o.vo_noise.constant_sigma.data(), 6));
+  app.add_option("--vo-gate", o.vo_gate_chi2, "Chi-square (6 dof) gate on VO innovations, 0 = off")
+      ->check(non_negative)->capture_default_str();
+  app.add_option("--correction-gate", o.correction_gate_chi2,
+                 "Chi-square (6 dof) gate on SLAM corrections, 0 = off")
+      ->check(non_negative)->capture_default_str();
+  app.add_option("--correction-sigma-position", o.correction_sigma_position,
+                 "m, for a correction without covariance")->check(positive)->capture_default_str();
+  app.add_option("--correction-sigma-rotation", o.correction_sigma_rotation,
+                 "rad, for a correction without covariance")->check(positive)->capture_default_str();
+  app.add_option("--history", o.history_s, "Seconds of states kept for late measurements")
+      ->check(CLI::Range(0.05, 60.0))->capture_default_str();
+  app.add_option("--max-imu-dt", o.max_imu_dt_s, "An IMU interval longer than this is a gap, s")
+      ->check(positive)->capture_default_str();
+  app.add_option("--vo-timeout", o.vo_timeout_s, "DEGRADED after this long without VO, s")
+      ->check(positive)->capture_default_str();
+  app.add_option("--gyro-noise", o.imu.gyro_noise_density, "rad/s/sqrt(Hz)")->check(positive)->capture_default_str();
+  app.add_option("--accel-noise", o.imu.accel_noise_density, "m/s^2/sqrt(Hz)")->check(positive)->capture_default_str();
+  app.add_option("--gyro-bias-walk", o.imu.gyro_bias_random_walk, "rad/s^2/sqrt(Hz)")->check(positive)->capture_default_str();
+  app.add_option("--accel-bias-walk", o.imu.accel_bias_random_walk, "m/s^3/sqrt(Hz)")->check(positive)->capture_default_str();
+  app.add_option("--ukf-alpha", o.unscented.alpha, "UKF sigma-point spread")->check(positive)->capture_default_str();
+  app.add_option("--ukf-beta", o.unscented.beta, "UKF prior-distribution weight")->check(non_negative)->capture_default_str();
+  app.add_option("--ukf-kappa", o.unscented.kappa, "UKF secondary scaling")->capture_default_str();
+  app.add_option("--init-duration", o.init.duration_s, "Still IMU time averaged to start, s")
+      ->check(positive)->capture_default_str();
+  app.add_option("--init-yaw", o.init.yaw, "Yaw of the initial attitude (unobservable), rad")
+      ->capture_default_str();
+  app.add_option_function<std::vector<double>>(
+         "--init-position",
+         [&o](const std::vector<double>& v) { o.init.position = Eigen::Map<const Eigen::Vector3d>(v.data()); },
+         "Initial position x,y,z, m")
+      ->expected(3)->delimiter(',')->default_str(joined(o.init.position.data(), 3));
+}
+
+}  // namespace kestrel::estimator

@@ -1,0 +1,65 @@
+// kestrel-estimate: the estimator in process over an LCM log's IMU, VO_UPDATE and
+// SLAM_CORRECTION messages, written as a TUM trajectory of T_world_body (README.md).
+
+#include <spdlog/spdlog.h>
+
+#include <iostream>
+
+#include "common/cli.h"
+#include "common/error.h"
+#include "estimator/cli_options.h"
+#include "estimator/log_run.h"
+
+namespace {
+
+using namespace kestrel;
+using namespace kestrel::estimator;
+
+struct Options {
+  std::string log;
+  std::string out;
+  LogChannels channels;
+  EstimatorOptions estimator;
+};
+
+int run(const Options& o) {
+  const LogRunResult r = run_log(o.log, o.estimator, o.channels);
+  if (!r.skips.damage.empty()) spdlog::warn("{}", r.skips.damage);
+  if (r.skips.rejected > 0)
+    spdlog::warn("{} messages skipped; the first: {}", r.skips.rejected, r.skips.first_reason);
+  if (r.trajectory.empty())
+    throw InputError(o.log + ": the filter never initialised (" + std::to_string(r.imu_messages) +
+                     " IMU messages; it needs " + std::to_string(o.estimator.init.duration_s) +
+                     " s of a still IMU)");
+  write_tum_trajectory(o.out, r.trajectory);
+  const EstimatorCounters& c = r.counters;
+  std::cout << "states written: " << r.trajectory.size() << " to " << o.out << "\n"
+            << "IMU messages: " << r.imu_messages << " (" << c.imu_duplicate << " duplicate, "
+            << c.imu_out_of_order << " out of order, " << c.imu_gaps << " gaps)\n"
+            << "VO updates: " << r.vo_messages << " (" << c.vo_applied << " applied, "
+            << c.vo_failed << " failed, " << c.vo_gated << " gated, "
+            << c.vo_duplicate + c.vo_out_of_order + c.vo_too_old + c.vo_before_init
+            << " dropped)\n"
+            << "SLAM corrections: " << r.correction_messages << " (" << c.corrections_applied
+            << " applied, " << c.corrections_too_old << " too old)\n"
+            << "messages skipped: " << r.skips.rejected << "\n"
+            << "filter restarts: " << c.filter_failures << "\n";
+  return kExitOk;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  kestrel::cli::App app("estimate",
+                        "Run the state estimator over an LCM log and write its TUM trajectory");
+  Options o;
+  app.add_option("--log", o.log, "LCM log with IMU and VO_UPDATE (and SLAM_CORRECTION)")
+      ->required()->check(CLI::ExistingFile);
+  app.add_option("--out", o.out, "TUM trajectory file to write (T_world_body)")->required();
+  app.add_option("--imu-channel", o.channels.imu, "IMU channel")->capture_default_str();
+  app.add_option("--vo-channel", o.channels.vo, "VO channel")->capture_default_str();
+  app.add_option("--correction-channel", o.channels.correction, "SLAM correction channel")
+      ->capture_default_str();
+  add_estimator_options(app, o.estimator);
+  return app.run(argc, argv, [&] { return run(o); });
+}

@@ -1,0 +1,74 @@
+// kestrel-fit-vo-noise: fits the paper's constant VO noise model from a log holding
+// VO_UPDATE and GROUND_TRUTH (or a separate TUM ground truth), and prints it in the form the
+// estimator takes (--vo-noise constant --vo-sigma ...). See README.md.
+
+#include <spdlog/spdlog.h>
+
+#include <cstdio>
+#include <iostream>
+
+#include "common/cli.h"
+#include "common/error.h"
+#include "estimator/log_run.h"
+#include "estimator/vo_noise_fit.h"
+
+namespace {
+
+using namespace kestrel;
+using namespace kestrel::estimator;
+
+struct Options {
+  std::string log;
+  std::string ground_truth;
+  double max_gap_s = 0.05;
+  LogChannels channels;
+};
+
+std::string row(const Eigen::Matrix<double, 6, 1>& v, const char* separator) {
+  std::string s;
+  char buffer[32];
+  for (int i = 0; i < 6; ++i) {
+    std::snprintf(buffer, sizeof buffer, "%s%.6g", i ? separator : "", v[i]);
+    s += buffer;
+  }
+  return s;
+}
+
+int run(const Options& o) {
+  VoAndTruth input = read_vo_and_truth(o.log, o.channels);
+  if (!input.skips.damage.empty()) spdlog::warn("{}", input.skips.damage);
+  if (input.skips.rejected > 0)
+    spdlog::warn("{} messages skipped; the first: {}", input.skips.rejected, input.skips.first_reason);
+  // A separate file is T_world_body, like the GROUND_TRUTH body frame.
+  if (!o.ground_truth.empty()) input.truth = read_tum_trajectory(o.ground_truth);
+  if (input.truth.empty())
+    throw InputError(o.log + ": no ground truth on " + o.channels.ground_truth +
+                     " (give one with --ground-truth)");
+  const VoNoiseFit fit =
+      fit_vo_noise(input.updates, input.truth, static_cast<int64_t>(o.max_gap_s * 1e6));
+  std::cout << "updates used: " << fit.used << " (" << fit.failed << " failed, " << fit.uncovered
+            << " without ground truth)\n"
+            << "mean keyframe-to-frame interval: " << fit.mean_interval_s << " s\n"
+            << "error mean  [dx dy dz m, rx ry rz rad]: " << row(fit.mean, " ") << "\n"
+            << "error sigma [dx dy dz m, rx ry rz rad]: " << row(fit.sigma, " ") << "\n"
+            << "estimator options: --vo-noise constant --vo-sigma " << row(fit.sigma, ",") << "\n";
+  return kExitOk;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  kestrel::cli::App app("fit-vo-noise",
+                        "Fit the constant VO noise model (sigmas of [dp; dtheta]) against ground truth");
+  Options o;
+  app.add_option("--log", o.log, "LCM log with VO_UPDATE (and GROUND_TRUTH)")
+      ->required()->check(CLI::ExistingFile);
+  app.add_option("--ground-truth", o.ground_truth, "TUM file of T_world_body instead of GROUND_TRUTH")
+      ->check(CLI::ExistingFile);
+  app.add_option("--max-gap", o.max_gap_s, "Largest ground-truth gap to interpolate across, s")
+      ->check(cli::Positive)->capture_default_str();
+  app.add_option("--vo-channel", o.channels.vo, "VO channel")->capture_default_str();
+  app.add_option("--ground-truth-channel", o.channels.ground_truth, "Ground-truth channel")
+      ->capture_default_str();
+  return app.run(argc, argv, [&] { return run(o); });
+}

@@ -1,0 +1,103 @@
+// kestrel-estimator: the onboard state estimator process. IMU, VO_UPDATE and SLAM_CORRECTION
+// in; STATE out after every IMU sample once the filter has a state (README.md). A thin
+// adapter: decode -> estimator library -> encode; lock-step replay resets it through Node.
+
+#include <spdlog/spdlog.h>
+
+#include <iostream>
+#include <optional>
+
+#include "common/cli.h"
+#include "common/error.h"
+#include "common/transport/channels.h"
+#include "common/transport/node.h"
+#include "estimator/cli_options.h"
+#include "estimator/estimator.h"
+#include "estimator/messages.h"
+
+namespace {
+
+using namespace kestrel;
+using namespace kestrel::estimator;
+
+struct Options {
+  std::string lcm_url;
+  EstimatorOptions estimator;
+};
+
+// Health follows the filter: RUNNING while VO is being fused, DEGRADED on the IMU alone.
+void report_health(transport::Node& node, const std::optional<EstimatorOutput>& out) {
+  if (!out) {
+    node.set_health(kestrel::process_status_t::STATE_STARTING, "initialising: waiting for a still IMU");
+  } else if (out->status == Status::kDegraded) {
+    node.set_health(kestrel::process_status_t::STATE_DEGRADED, "no VO fused recently: IMU only");
+  } else {
+    node.set_health(kestrel::process_status_t::STATE_RUNNING, "");
+  }
+}
+
+int run(const Options& o) {
+  std::optional<transport::Node> node;
+  try {
+    node.emplace("estimator", o.lcm_url);
+  } catch (const std::runtime_error& e) {
+    std::cerr << "kestrel-estimator: error: " << e.what() << "\n";
+    return kExitUnavailable;
+  }
+  Estimator estimator(o.estimator);
+  int64_t seq = 0;
+  node->advertise(channel::kState);
+  node->on_reset([&] {
+    estimator.reset();
+    seq = 0;
+  });
+  report_health(*node, std::nullopt);
+
+  node->subscribe<kestrel::imu_t>(channel::kImu, [&](const kestrel::imu_t& m) {
+    const ImuSample s = imu_from_message(m, channel::kImu);  // throws: Node counts and logs
+    const Verdict v = estimator.add_imu(s);
+    if (v != Verdict::kAccepted) {
+      spdlog::debug("IMU: sample at utime {} dropped (duplicate or out of order)", s.utime);
+      return;
+    }
+    const auto out = estimator.output();
+    report_health(*node, out);
+    if (out && out->utime == s.utime)
+      node->publish(channel::kState, state_to_message(*out, o.estimator.filter, seq++));
+  }, 400);
+  node->subscribe<kestrel::vo_update_t>(channel::kVoUpdate, [&](const kestrel::vo_update_t& m) {
+    const VoUpdate u = vo_from_message(m, channel::kVoUpdate);
+    validate_vo(u, o.estimator.vo_noise.source == VoNoiseOptions::Source::kReported,
+                channel::kVoUpdate);
+    const Verdict v = estimator.add_vo(u);
+    if (v == Verdict::kDuplicate || v == Verdict::kOutOfOrder || v == Verdict::kTooOld)
+      spdlog::debug("VO_UPDATE: update at utime {} dropped (duplicate, out of order or too old)", u.utime);
+  });
+  node->subscribe<kestrel::slam_correction_t>(channel::kSlamCorrection,
+                                              [&](const kestrel::slam_correction_t& m) {
+    const PoseCorrection c = correction_from_message(m, channel::kSlamCorrection);
+    validate_correction(c, channel::kSlamCorrection);
+    if (estimator.add_correction(c) == Verdict::kTooOld)
+      spdlog::warn("SLAM_CORRECTION: correction for utime {} is older than the {} s history; dropped",
+                   c.utime, o.estimator.history_s);
+  });
+
+  const int code = node->spin();
+  const EstimatorCounters c = estimator.counters();
+  spdlog::info("IMU {} accepted, {} duplicate, {} out of order, {} gaps; VO {} applied, {} failed, "
+               "{} gated, {} dropped; corrections {} applied, {} too old; filter restarts {}",
+               c.imu_accepted, c.imu_duplicate, c.imu_out_of_order, c.imu_gaps, c.vo_applied,
+               c.vo_failed, c.vo_gated, c.vo_duplicate + c.vo_out_of_order + c.vo_too_old,
+               c.corrections_applied, c.corrections_too_old, c.filter_failures);
+  return code;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  kestrel::cli::App app("estimator", "State estimator: IMU + VO_UPDATE + SLAM_CORRECTION -> STATE");
+  Options options;
+  app.add_option("--lcm-url", options.lcm_url, "LCM URL (default: $LCM_DEFAULT_URL or kestrel's)");
+  add_estimator_options(app, options.estimator);
+  return app.run(argc, argv, [&] { return run(options); });
+}

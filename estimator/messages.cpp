@@ -1,0 +1,76 @@
+#include "estimator/messages.h"
+
+#include "common/error.h"
+#include "common/transport/convert.h"
+
+namespace kestrel::estimator {
+namespace {
+
+Eigen::Vector3d vec3(const double (&v)[3]) { return {v[0], v[1], v[2]}; }
+void copy3(const Eigen::Vector3d& v, double (&out)[3]) {
+  for (int i = 0; i < 3; ++i) out[i] = v[i];
+}
+
+}  // namespace
+
+ImuSample imu_from_message(const kestrel::imu_t& m, const std::string& channel) {
+  constexpr int8_t kBoth = kestrel::imu_t::HAS_GYRO | kestrel::imu_t::HAS_ACCEL;
+  if ((m.fields & kBoth) != kBoth)
+    throw InputError(channel + ": IMU sample at utime " + std::to_string(m.utime) +
+                     " lacks the gyro or the accelerometer (fields = " +
+                     std::to_string(static_cast<int>(m.fields)) + "); the estimator needs both");
+  ImuSample s;
+  s.utime = m.utime;
+  s.gyro = vec3(m.angular_velocity);
+  s.accel = vec3(m.linear_acceleration);
+  validate_imu(s, channel);
+  return s;
+}
+
+VoUpdate vo_from_message(const kestrel::vo_update_t& m, const std::string& channel) {
+  VoUpdate u;
+  u.utime = m.utime;
+  u.reference_utime = m.reference_utime;
+  u.ok = m.status == kestrel::vo_update_t::STATUS_OK;
+  if (!u.ok) return u;  // a failure's pose and covariance are meaningless
+  const std::string what = channel + " (utime " + std::to_string(m.utime) + ")";
+  u.T_refcam_curcam = transport::from_message(m.T_reference_current, what.c_str());
+  u.T_body_camera = transport::from_message(m.T_body_camera, what.c_str());
+  u.covariance = transport::covariance_from(m.covariance);
+  return u;
+}
+
+PoseCorrection correction_from_message(const kestrel::slam_correction_t& m,
+                                       const std::string& channel) {
+  const std::string what = channel + " (utime " + std::to_string(m.utime) + ")";
+  PoseCorrection c;
+  c.utime = m.utime;
+  c.revision = m.graph_revision;
+  c.T_world_body = transport::from_message(m.T_world_body, what.c_str());
+  c.covariance = transport::covariance_from(m.covariance);
+  return c;
+}
+
+kestrel::state_t state_to_message(const EstimatorOutput& out, FilterKind filter, int64_t seq) {
+  kestrel::state_t m;
+  m.utime = out.utime;
+  m.seq = seq;
+  m.filter = filter == FilterKind::kUkf ? kestrel::state_t::FILTER_UKF : kestrel::state_t::FILTER_EKF;
+  switch (out.status) {
+    case Status::kInitializing: m.status = kestrel::state_t::STATUS_INITIALIZING; break;
+    case Status::kOk: m.status = kestrel::state_t::STATUS_OK; break;
+    case Status::kDegraded: m.status = kestrel::state_t::STATUS_DEGRADED; break;
+  }
+  m.T_world_body = transport::to_message(out.nav.T_world_body());
+  copy3(out.nav.v_world_body, m.velocity);
+  copy3(out.angular_velocity, m.angular_velocity);
+  copy3(out.nav.gyro_bias, m.gyro_bias);
+  copy3(out.nav.accel_bias, m.accel_bias);
+  m.cov_dim = idx::kNav;
+  m.covariance.assign(idx::kNav, std::vector<double>(idx::kNav, 0.0));
+  for (int r = 0; r < idx::kNav; ++r)
+    for (int c = 0; c < idx::kNav; ++c) m.covariance[r][c] = out.covariance(r, c);
+  return m;
+}
+
+}  // namespace kestrel::estimator

@@ -1,0 +1,42 @@
+#pragma once
+// The paper's constant VO noise model (§2: "a constant noise model fitted from data"),
+// fitted against ground truth: for every successful VO update the true camera motion
+// T_refcam_curcam is computed from the true body poses at the reference's and the frame's
+// utimes (through the update's own camera mounting), and the error is expressed as the
+// filter's residual [dp (reference camera, m); dtheta (current camera, rad)] with
+// true = measured ⊞ error. The fitted sigma of each axis is the RMS of its errors (a
+// bias is an error the zero-mean model must cover too); the mean is reported separately so
+// that a biased VO is visible.
+//
+// Updates whose times the truth does not cover (outside it, or in a gap wider than
+// max_gap_us) are skipped and counted.
+
+#include <cstdint>
+#include <vector>
+
+#include "common/trajectory.h"
+#include "estimator/estimator.h"
+
+namespace kestrel::estimator {
+
+struct VoNoiseFit {
+  Eigen::Matrix<double, 6, 1> sigma = Eigen::Matrix<double, 6, 1>::Zero();  ///< RMS per axis
+  Eigen::Matrix<double, 6, 1> mean = Eigen::Matrix<double, 6, 1>::Zero();
+  /// Mean over updates of the keyframe-to-frame interval, s: the model is per update, so it
+  /// only transfers to a VO with similar keyframe spacing.
+  double mean_interval_s = 0.0;
+  int64_t used = 0;
+  int64_t failed = 0;     ///< VO failures (nothing to fit)
+  int64_t uncovered = 0;  ///< no ground truth at one of the two times
+};
+
+/// The error of one update against the true motion (see the file comment).
+Vector6d vo_error(const VoUpdate& update, const Eigen::Isometry3d& T_world_refbody,
+                  const Eigen::Isometry3d& T_world_curbody);
+
+/// Fits the model to `updates` with `truth` = T_world_body over time. Throws InputError when
+/// no update can be used (the message says why).
+VoNoiseFit fit_vo_noise(const std::vector<VoUpdate>& updates, const Trajectory& truth,
+                        int64_t max_gap_us = 50000);
+
+}  // namespace kestrel::estimator
