@@ -11,7 +11,7 @@
 namespace kestrel::planner {
 
 struct SpaceOptions {
-  double radius_m = 0.35;  ///< vehicle radius (the paper's vehicle is 70 cm across)
+  double radius_m = 0.3;   ///< vehicle radius (the paper's vehicle is about 70 cm across)
   double z_min_m = 1.0;    ///< flight band for sampling
   double z_max_m = 1.0;
 };

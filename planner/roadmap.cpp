@@ -1,6 +1,7 @@
 // Roadmap construction and the holonomic belief model of its edges.
 #include "planner/roadmap.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "estimator/information.h"
@@ -66,11 +67,23 @@ Roadmap build_roadmap(const ConfigurationSpace& space, Sampler& sampler, const C
     if (!q) break;  // the sampler cannot find more: plan on what there is
     map.add_node(*q);
   }
-  for (int a = 0; a < map.size(); ++a)
-    for (int b = a + 1; b < map.size(); ++b)
-      if (ConfigurationSpace::distance(map.node(a), map.node(b)) <= options.connect_radius_m &&
-          space.motion_valid(map.node(a), map.node(b)))
-        map.connect(a, b, model);
+  // Candidate pairs: each node's nearest neighbours within the radius; a pair is tried once.
+  std::vector<std::pair<int, int>> pairs;
+  for (int a = 0; a < map.size(); ++a) {
+    std::vector<std::pair<double, int>> near;
+    for (int b = 0; b < map.size(); ++b) {
+      const double d = ConfigurationSpace::distance(map.node(a), map.node(b));
+      if (b != a && d <= options.connect_radius_m) near.push_back({d, b});
+    }
+    std::sort(near.begin(), near.end());
+    if (options.max_neighbours > 0 && static_cast<int>(near.size()) > options.max_neighbours)
+      near.resize(options.max_neighbours);
+    for (const auto& [d, b] : near) pairs.push_back({std::min(a, b), std::max(a, b)});
+  }
+  std::sort(pairs.begin(), pairs.end());
+  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+  for (const auto& [a, b] : pairs)
+    if (space.motion_valid(map.node(a), map.node(b))) map.connect(a, b, model);
   return map;
 }
 

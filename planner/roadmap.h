@@ -20,7 +20,7 @@ namespace kestrel::planner {
 struct MotionOptions {
   double step_m = 0.25;
   /// Variance added per metre flown, per coordinate (x, y, z: m^2/m; yaw: rad^2/m).
-  Eigen::Vector4d variance_per_m = Eigen::Vector4d(0.1, 0.1, 0.02, 0.01);
+  Eigen::Vector4d variance_per_m = Eigen::Vector4d(0.5, 0.5, 0.1, 0.05);
 };
 
 /// What an edge does to the belief: the motion model plus a sensor's information M(q).
@@ -45,7 +45,8 @@ struct Edge {
 
 struct RoadmapOptions {
   int samples = 100;
-  double connect_radius_m = 5.0;
+  double connect_radius_m = 6.0;
+  int max_neighbours = 20;  ///< each node tries its nearest this many within the radius (0: all)
 };
 
 class Roadmap {
@@ -66,8 +67,9 @@ class Roadmap {
   std::vector<std::vector<Edge>> adjacency_;
 };
 
-/// Node 0 = start, node 1 = goal, then up to options.samples samples; connects every pair
-/// within the radius whose motion is valid. `model` may be null (PRM).
+/// Node 0 = start, node 1 = goal, then up to options.samples samples; each node is joined to
+/// its nearest max_neighbours within the radius whose motion is valid (the union of both
+/// directions' choices). `model` may be null (PRM).
 Roadmap build_roadmap(const ConfigurationSpace& space, Sampler& sampler, const Config& start,
                       const Config& goal, const RoadmapOptions& options, const BeliefModel* model, Rng& rng);
 

@@ -1,6 +1,7 @@
 // FeatureSensor: range / azimuth / elevation of point features, and the information it gives.
 #include "planner/sensor_model.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -40,24 +41,43 @@ FeatureSensor::FeatureSensor(const Environment& env, FeatureSensorOptions option
       !(o.vertical_fov_rad > 0.0) || !(o.bearing_sigma_rad > 0.0) ||
       !(o.range_sigma_m > 0.0 || o.range_sigma_per_m2 > 0.0))
     throw std::invalid_argument("FeatureSensor: ranges, fields of view and noise must be positive");
+  const auto& features = env_.features();
+  if (features.empty()) return;
+  Eigen::AlignedBox2d box;
+  for (const Feature& f : features) box.extend(f.position.head<2>());
+  cell_m_ = o.max_range_m;
+  cell_origin_ = box.min();
+  nx_ = static_cast<int>(std::floor((box.max().x() - box.min().x()) / cell_m_)) + 1;
+  ny_ = static_cast<int>(std::floor((box.max().y() - box.min().y()) / cell_m_)) + 1;
+  cells_.assign(static_cast<size_t>(nx_) * ny_, {});
+  for (int i = 0; i < static_cast<int>(features.size()); ++i) {
+    const Eigen::Vector2d c = (features[i].position.head<2>() - cell_origin_) / cell_m_;
+    cells_[static_cast<size_t>(c.y()) * nx_ + static_cast<size_t>(c.x())].push_back(i);
+  }
 }
 
 std::vector<int> FeatureSensor::visible(const Config& q) const {
   std::vector<int> out;
+  if (cells_.empty() || !q.allFinite()) return out;
   const Eigen::Vector3d p = position(q);
   const auto& features = env_.features();
   const double half_h = 0.5 * options_.horizontal_fov_rad, half_v = 0.5 * options_.vertical_fov_rad;
-  for (int i = 0; i < static_cast<int>(features.size()); ++i) {
-    const Eigen::Vector3d d = features[i].position - p;
-    const double r = d.norm();
-    if (r > options_.max_range_m || r < options_.min_range_m) continue;
-    if (features[i].normal.dot(d) >= 0.0) continue;  // seen from behind its surface
-    const double rho = d.head<2>().norm();
-    if (half_h < M_PI && std::abs(wrap_angle(std::atan2(d.y(), d.x()) - q[3])) > half_h) continue;
-    if (std::abs(std::atan2(d.z(), rho)) > half_v) continue;
-    if (!env_.line_of_sight(p, features[i].position)) continue;
-    out.push_back(i);
-  }
+  const Eigen::Vector2d c = (p.head<2>() - cell_origin_) / cell_m_;
+  const int cx = static_cast<int>(std::floor(c.x())), cy = static_cast<int>(std::floor(c.y()));
+  for (int y = std::max(0, cy - 1); y <= std::min(ny_ - 1, cy + 1); ++y)
+    for (int x = std::max(0, cx - 1); x <= std::min(nx_ - 1, cx + 1); ++x)
+      for (int i : cells_[static_cast<size_t>(y) * nx_ + x]) {
+        const Eigen::Vector3d d = features[i].position - p;
+        const double r = d.norm();
+        if (r > options_.max_range_m || r < options_.min_range_m) continue;
+        if (features[i].normal.dot(d) >= 0.0) continue;  // seen from behind its surface
+        const double rho = d.head<2>().norm();
+        if (half_h < M_PI && std::abs(wrap_angle(std::atan2(d.y(), d.x()) - q[3])) > half_h) continue;
+        if (std::abs(std::atan2(d.z(), rho)) > half_v) continue;
+        if (!env_.line_of_sight(p, features[i].position)) continue;
+        out.push_back(i);
+      }
+  std::sort(out.begin(), out.end());  // a stable order: sums do not depend on the bucketing
   return out;
 }
 

@@ -62,6 +62,11 @@ class FeatureSensor {
  private:
   const Environment& env_;
   FeatureSensorOptions options_;
+  // Features bucketed in square cells of max_range_m over x-y, so a query looks at 3 x 3 cells.
+  double cell_m_ = 1.0;
+  Eigen::Vector2d cell_origin_ = Eigen::Vector2d::Zero();
+  int nx_ = 0, ny_ = 0;
+  std::vector<std::vector<int>> cells_;
 };
 
 }  // namespace kestrel::planner
