@@ -80,6 +80,29 @@ TEST(SimToolTest, SameSeedGivesTheSameLogBytes) {
   EXPECT_FALSE(a == c);
 }
 
+// Live: published inside a private network namespace, recorded by the stock lcm-logger, and
+// read back by kestrel-eval (GROUND_TRUTH at 200 Hz).
+TEST(SimToolTest, LivePublishingReachesAnLcmLogger) {
+  if (!kestrel::test::can_isolate_network()) GTEST_SKIP() << "cannot create a network namespace here";
+  TempDir dir;
+  const std::string log = (dir / "live.lcmlog").string();
+  const std::string script =
+      "ip link set lo up && ip link set lo multicast on && ip route add 224.0.0.0/4 dev lo && "
+      "export LCM_DEFAULT_URL='udpm://239.255.76.67:7667?ttl=0' && "
+      "(lcm-logger -f '" + log + "' >/dev/null 2>&1 & echo $! > '" + (dir / "pid").string() + "') && sleep 1 && '" +
+      tool("sim").string() + "' --world office --flight hover --duration 1 --rate 0 -q && sleep 1 && "
+      "kill $(cat '" + (dir / "pid").string() + "')";
+  const auto r = run({"unshare", "-n", "sh", "-c", script}, 200.0);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("frames: 31"), std::string::npos) << r.out;
+  if (!fs::exists(tool("eval"))) GTEST_SKIP() << "kestrel-eval is not built";
+  const auto eval = run({tool("eval").string(), "--est", log + ":GROUND_TRUTH", "--to-tum", (dir / "gt.txt").string()});
+  ASSERT_EQ(eval.exit_code, 0) << eval.err;
+  // 201 sent (0 .. 1 s at 200 Hz); UDP may drop a few when the logger falls behind.
+  EXPECT_GE(data_lines(dir / "gt.txt"), 180);
+  EXPECT_LE(data_lines(dir / "gt.txt"), 201);
+}
+
 TEST(SimToolTest, BadInputIsOneLineNamingTheFileWithExitCode3) {
   TempDir dir;
   const fs::path world = dir / "bad.world";
