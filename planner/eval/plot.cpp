@@ -1,0 +1,41 @@
+// draw_plans: OpenCV drawing of a grid, samples and paths with covariance ellipses.
+#include "planner/eval/plot.h"
+
+#include <Eigen/Eigenvalues>
+#include <opencv2/imgproc.hpp>
+
+namespace kestrel::planner::eval {
+
+cv::Mat draw_plans(const GridEnvironment& env, const std::vector<Config>& samples,
+                   const std::vector<DrawnPath>& paths, double ppm) {
+  const Eigen::AlignedBox3d b = env.bounds();
+  const int w = static_cast<int>(std::ceil((b.max().x() - b.min().x()) * ppm));
+  const int h = static_cast<int>(std::ceil((b.max().y() - b.min().y()) * ppm));
+  cv::Mat img(h, w, CV_8UC3);
+  const auto px = [&](const Eigen::Vector3d& p) {
+    return cv::Point(static_cast<int>((p.x() - b.min().x()) * ppm), static_cast<int>((b.max().y() - p.y()) * ppm));
+  };
+  for (int r = 0; r < h; ++r)
+    for (int c = 0; c < w; ++c) {
+      const Eigen::Vector3d p(b.min().x() + (c + 0.5) / ppm, b.max().y() - (r + 0.5) / ppm, 0.5 * (b.min().z() + b.max().z()));
+      const double clear = env.clearance(p);
+      img.at<cv::Vec3b>(r, c) = clear > 0.0 ? cv::Vec3b(255, 255, 255) : cv::Vec3b(40, 40, 40);
+    }
+  for (const Feature& f : env.features()) cv::circle(img, px(f.position), 1, cv::Scalar(0, 160, 0), cv::FILLED);
+  for (const Config& q : samples) cv::circle(img, px(position(q)), 3, cv::Scalar(200, 120, 0), cv::FILLED);
+  for (const DrawnPath& path : paths) {
+    for (size_t i = 1; i < path.nodes.size(); ++i)
+      cv::line(img, px(position(path.nodes[i - 1])), px(position(path.nodes[i])), path.colour, 2, cv::LINE_AA);
+    for (size_t i = 0; i < path.covariances.size() && i < path.nodes.size(); ++i) {
+      const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(path.covariances[i].topLeftCorner<2, 2>());
+      const Eigen::Vector2d axes = es.eigenvalues().cwiseMax(0.0).cwiseSqrt() * ppm;
+      const Eigen::Vector2d major = es.eigenvectors().col(1);
+      const double angle = -std::atan2(major.y(), major.x()) * 180.0 / M_PI;  // image y is down
+      cv::ellipse(img, px(position(path.nodes[i])), cv::Size(std::max(1, static_cast<int>(axes[1])), std::max(1, static_cast<int>(axes[0]))),
+                  angle, 0, 360, path.colour, 1, cv::LINE_AA);
+    }
+  }
+  return img;
+}
+
+}  // namespace kestrel::planner::eval

@@ -1,0 +1,85 @@
+// kestrel-plan: plans offline on a map (the built-in Stata-like floor or a ROS map yaml) with
+// BRM or PRM, prints the waypoints with their predicted tr(Sigma), and optionally draws them.
+// See planner/README.md.
+#include <spdlog/spdlog.h>
+
+#include <iostream>
+#include <opencv2/imgcodecs.hpp>
+
+#include "common/cli.h"
+#include "common/error.h"
+#include "planner/eval/experiment.h"
+#include "planner/eval/plot.h"
+#include "planner/floor_plan.h"
+#include "planner/map_sources.h"
+
+namespace {
+
+using namespace kestrel;
+using namespace kestrel::planner;
+
+Config to_config(const std::vector<double>& v) { return Config(v[0], v[1], v[2], v[3]); }
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  cli::App app("plan", "Plans a well-localised path offline (Belief Roadmap, or PRM for comparison)");
+  std::string map = "floor", planner = "brm", sampler = "su", sensor = "camera", png;
+  std::vector<double> start{2.5, 2.5, 1.0, 0.0}, goal{10.5, 20.0, 1.0, 0.0};
+  eval::Scenario sc;
+  int samples = 100;
+  uint64_t seed = 1;
+  double density = 4.0, laser_range = 5.0, z_max = 3.0, start_trace = 0.4;
+  app.add_option("--map", map, "'floor' (built in) or a ROS map YAML");
+  app.add_option("--start", start, "Start x y z yaw (m, rad)")->expected(4);
+  app.add_option("--goal", goal, "Goal x y z yaw (m, rad)")->expected(4);
+  app.add_option("--planner", planner, "brm or prm")->check(CLI::IsMember({"brm", "prm"}));
+  app.add_option("--sampler", sampler, "uniform, su, su-ukf, gaussian, bridge")
+      ->check(CLI::IsMember({"uniform", "su", "su-ukf", "gaussian", "bridge"}));
+  app.add_option("--sensor", sensor, "camera (the paper's), kinect, laser")->check(CLI::IsMember({"camera", "kinect", "laser"}));
+  app.add_option("--laser-range", laser_range, "Laser range (m)")->check(cli::Positive);
+  app.add_option("--samples", samples, "Roadmap samples")->check(cli::Positive);
+  app.add_option("--seed", seed, "Seed of the sampler and the features");
+  app.add_option("--radius", sc.space.radius_m, "Vehicle radius (m)")->check(cli::Positive);
+  app.add_option("--height", sc.space.z_min_m, "Flight height (m)")->check(cli::Positive);
+  app.add_option("--ceiling", z_max, "Height of the walls the map is extruded to (m)")->check(cli::Positive);
+  app.add_option("--feature-density", density, "Features per square metre of textured wall")->check(cli::Positive);
+  app.add_option("--connect-radius", sc.roadmap.connect_radius_m, "Longest edge (m)")->check(cli::Positive);
+  app.add_option("--start-trace", start_trace, "tr(Sigma) at the start (m^2, spread evenly)")->check(cli::Positive);
+  app.add_option("--png", png, "Draw the map, samples, path and covariance ellipses to this PNG");
+  return app.run(argc, argv, [&]() -> int {
+    sc.space.z_max_m = sc.space.z_min_m;
+    sc.start_covariance = (start_trace / 4.0) * Mat4::Identity();
+    GridEnvironment env(map == "floor" ? stata_like_floor() : read_ros_map(map), 0.0, z_max);
+    env.set_features(env.wall_features(density, 2.0, seed));
+    sc.env = &env;
+    sc.sensor = sensor == "camera" ? FeatureSensorOptions::paper_camera()
+                : sensor == "kinect" ? FeatureSensorOptions::kinect()
+                                     : FeatureSensorOptions::planar_laser(laser_range);
+    const Config q0 = to_config(start), q1 = to_config(goal);
+    const ConfigurationSpace space(env, sc.space);
+    if (!space.is_valid(q0)) throw CLI::ValidationError("--start", "start is not in free space");
+    if (!space.is_valid(q1)) throw CLI::ValidationError("--goal", "goal is not in free space");
+    const eval::Trial t = eval::run_trial(sc, eval::Setting{planner, sampler, samples}, q0, q1, seed);
+    spdlog::info("{} features, build {:.3f} s, search {:.2f} ms", env.features().size(), t.build_s, 1e3 * t.search_s);
+    if (!t.found) {
+      std::cerr << "kestrel-plan: no path found with " << samples << " samples\n";
+      return kExitFailure;
+    }
+    // Covariances at the waypoints, flown step by step with the same models.
+    const FeatureSensor fs(env, sc.sensor);
+    const BeliefModel model(sc.motion, [&](const Config& q) { return fs.information(q); });
+    std::vector<Mat4> covariances{sc.start_covariance};
+    for (size_t i = 1; i < t.path.size(); ++i)
+      covariances.push_back(propagate_ekf(covariances.back(), model.steps(t.path[i - 1], t.path[i])));
+    std::cout << "# x y z yaw tr(Sigma)   length " << t.length_m << " m, goal tr(Sigma) " << t.goal_trace << "\n";
+    for (size_t i = 0; i < t.path.size(); ++i)
+      std::cout << t.path[i][0] << " " << t.path[i][1] << " " << t.path[i][2] << " " << t.path[i][3] << " "
+                << covariances[i].trace() << "\n";
+    if (!png.empty()) {
+      eval::DrawnPath drawn{t.path, covariances, planner == "brm" ? cv::Scalar(200, 0, 0) : cv::Scalar(0, 0, 220)};
+      if (!cv::imwrite(png, eval::draw_plans(env, t.samples, {drawn}))) throw InputError(png + ": cannot write");
+    }
+    return kExitOk;
+  });
+}

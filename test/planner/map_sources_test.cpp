@@ -1,0 +1,100 @@
+// Maps from elsewhere: ROS maps (orientation, thresholds, malformed files named in errors)
+// and OctoMaps projected over a height band.
+#include <gtest/gtest.h>
+#include <octomap/OcTree.h>
+
+#include <fstream>
+#include <opencv2/imgcodecs.hpp>
+#include <sstream>
+
+#include "common/error.h"
+#include "planner/map_sources.h"
+#include "test/support/test_support.h"
+
+namespace kestrel::planner {
+namespace {
+
+void write(const std::filesystem::path& p, const std::string& text) { std::ofstream(p) << text; }
+
+template <class F>
+std::string error_of(F f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(RosMap, GridIsTheImageFlippedWithThresholdsApplied) {
+  kestrel::test::TempDir dir;
+  cv::Mat img(4, 6, CV_8UC1, cv::Scalar(254));  // free
+  img.at<uint8_t>(0, 0) = 0;                     // top-left: occupied
+  img.at<uint8_t>(3, 5) = 205;                   // bottom-right: unknown (p = 0.2)
+  cv::imwrite((dir / "m.png").string(), img);
+  write(dir / "m.yaml", "image: m.png\nresolution: 0.5\norigin: [1.0, 2.0, 0.0]\nnegate: 0\n"
+                        "occupied_thresh: 0.65\nfree_thresh: 0.196\n");
+  const OccupancyGrid g = read_ros_map((dir / "m.yaml").string());
+  ASSERT_EQ(g.width, 6);
+  ASSERT_EQ(g.height, 4);
+  EXPECT_EQ(g.at(0, 3), OccupancyGrid::kOccupied);  // the image's top row is the grid's last
+  EXPECT_EQ(g.at(5, 0), OccupancyGrid::kUnknown);
+  EXPECT_EQ(g.at(2, 2), OccupancyGrid::kFree);
+  // The lower-left pixel's centre sits half a cell inside the origin.
+  const Eigen::Vector2d p = g.T_world_grid * Eigen::Vector2d(0, 0);
+  EXPECT_NEAR(p.x(), 1.25, 1e-9);
+  EXPECT_NEAR(p.y(), 2.25, 1e-9);
+}
+
+TEST(RosMap, MalformedFilesGiveErrorsNamingTheFile) {
+  kestrel::test::TempDir dir;
+  const std::string missing = (dir / "missing.yaml").string();
+  EXPECT_NE(error_of([&] { read_ros_map(missing); }).find(missing), std::string::npos);
+  const std::string bad = (dir / "bad.yaml").string();
+  write(bad, "image: m.png\nresolution: [oops\n");
+  EXPECT_NE(error_of([&] { read_ros_map(bad); }).find(bad), std::string::npos);
+  const std::string no_image = (dir / "noimage.yaml").string();
+  write(no_image, "image: none.png\nresolution: 0.1\norigin: [0, 0, 0]\n");
+  EXPECT_NE(error_of([&] { read_ros_map(no_image); }).find("noimage.yaml"), std::string::npos);
+  const std::string nan = (dir / "nan.yaml").string();
+  write(nan, "image: m.png\nresolution: -1\norigin: [0, 0, 0]\n");
+  EXPECT_NE(error_of([&] { read_ros_map(nan); }).find(nan), std::string::npos);
+}
+
+TEST(OctoMap, ProjectsTheHeightBandOntoTheGrid) {
+  octomap::OcTree tree(0.1);
+  tree.updateNode(octomap::point3d(1.05f, 1.05f, 1.05f), true);    // in the band: a wall
+  tree.updateNode(octomap::point3d(2.05f, 1.05f, 1.05f), false);   // in the band: seen free
+  tree.updateNode(octomap::point3d(3.05f, 1.05f, 5.05f), true);    // above the band
+  tree.updateNode(octomap::point3d(3.05f, 1.05f, 1.05f), false);   // ... with free space below it
+  tree.updateNode(octomap::point3d(0.05f, 0.05f, 1.05f), false);   // extent
+  const OccupancyGrid g = project_octomap(tree, 0.5, 2.0, "test");
+  const GridEnvironment env(g, 0.5, 2.0);
+  const auto cell = [&](double x, double y) {
+    const Eigen::Vector2d c = g.T_world_grid.inverse() * Eigen::Vector2d(x, y);
+    return g.at(static_cast<int>(std::lround(c.x())), static_cast<int>(std::lround(c.y())));
+  };
+  EXPECT_EQ(cell(1.05, 1.05), OccupancyGrid::kOccupied);
+  EXPECT_EQ(cell(2.05, 1.05), OccupancyGrid::kFree);
+  EXPECT_EQ(cell(3.05, 1.05), OccupancyGrid::kFree);
+  EXPECT_EQ(cell(1.55, 1.05), OccupancyGrid::kUnknown);  // never observed
+}
+
+TEST(OctoMap, CorruptStreamsAndEmptyTreesAreErrorsNamingTheSource) {
+  const std::vector<uint8_t> junk{1, 2, 3, 4, 5};
+  EXPECT_NE(error_of([&] { decode_octomap(junk, true, "MAP_OCTOMAP"); }).find("MAP_OCTOMAP"), std::string::npos);
+  EXPECT_NE(error_of([&] { decode_octomap(junk, false, "MAP_OCTOMAP"); }).find("MAP_OCTOMAP"), std::string::npos);
+  octomap::OcTree empty(0.1);
+  EXPECT_NE(error_of([&] { project_octomap(empty, 0.0, 1.0, "MAP_OCTOMAP"); }).find("MAP_OCTOMAP"), std::string::npos);
+  // A real stream round-trips.
+  octomap::OcTree tree(0.1);
+  tree.updateNode(octomap::point3d(1.0f, 1.0f, 1.0f), true);
+  std::ostringstream out;
+  tree.writeBinary(out);
+  const std::string s = out.str();
+  const auto back = decode_octomap(std::vector<uint8_t>(s.begin(), s.end()), true, "MAP_OCTOMAP");
+  EXPECT_EQ(back->size(), tree.size());
+}
+
+}  // namespace
+}  // namespace kestrel::planner
