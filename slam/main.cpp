@@ -39,7 +39,7 @@ struct Options {
 };
 
 void add_options(cli::App& app, Options& o, SlamOptions& s) {
-  app.add_option("--vocabulary", o.vocabulary, "Vocabulary file (kestrel-slam-vocabulary); default: built online");
+  app.add_option("--vocabulary", o.vocabulary, "Vocabulary file (Vocabulary::save format); default: built online from the keyframes");
   app.add_option("--keyframe-distance", s.keyframes.min_translation_m, "New keyframe after this motion, m")
       ->check(CLI::NonNegativeNumber)->capture_default_str();
   app.add_option("--keyframe-angle", s.keyframes.min_rotation_rad, "New keyframe after this rotation, rad")

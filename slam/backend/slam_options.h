@@ -58,7 +58,7 @@ struct SlamOptions {
     o.kernel.type = KernelType::kDcs;
     o.kernel.width = 3.0;
     o.max_iterations = 50;
-    o.function_tolerance = 1e-6;
+    o.function_tolerance = 1e-4;
     return o;
   }
 };

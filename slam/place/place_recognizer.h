@@ -2,8 +2,8 @@
 // Place recognition: which earlier keyframes look like this one. Each keyframe's ORB
 // descriptors become a bag-of-words vector, indexed for retrieval (bow_database.h).
 //
-// Two vocabularies (slam/README.md measures both):
-//  * fixed: a vocabulary trained beforehand (kestrel-slam-vocabulary) and loaded from a file;
+// Two vocabularies (slam/README.md says which is used and why):
+//  * fixed: a vocabulary trained beforehand (Vocabulary::train) and loaded from a file;
 //  * online: built from the keyframes seen so far — retrained, and every keyframe re-indexed,
 //    each time their number doubles, so that the words fit the place being mapped; the cost
 //    stays proportional to n log n over a run.

@@ -1,0 +1,56 @@
+// VO + SLAM on the real TUM sequences (label data; skips without ../shared/data): on each, the
+// ATE of the optimised trajectory is no worse than the odometry's (issue 6), and on fr1_rpy,
+// where the camera sweeps back over the desk, loops are closed and the ATE drops.
+
+#include <gtest/gtest.h>
+
+#include "common/geometry/align.h"
+#include "slam/sequence_run.h"
+#include "test/support/test_support.h"
+#include "vo/sequence_run.h"
+
+namespace kestrel::slam {
+namespace {
+
+// RMSE of the positions after rigid alignment, over frames with ground truth within 20 ms.
+double ate_rmse(const Trajectory& estimate, const Trajectory& truth) {
+  std::vector<Eigen::Vector3d> est, gt;
+  for (const StampedPose& p : estimate.poses()) {
+    if (const auto T = truth.at(p.utime, 20'000)) {
+      est.push_back(p.T.translation());
+      gt.push_back(T->translation());
+    }
+  }
+  Eigen::Matrix3Xd E(3, static_cast<Eigen::Index>(est.size())), G(3, E.cols());
+  for (size_t k = 0; k < est.size(); ++k) {
+    E.col(static_cast<Eigen::Index>(k)) = est[k];
+    G.col(static_cast<Eigen::Index>(k)) = gt[k];
+  }
+  const Eigen::Isometry3d T = align_rigid(E, G).value();
+  return std::sqrt(((T * E) - G).colwise().squaredNorm().mean());
+}
+
+class SlamOnTum : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(SlamOnTum, AteIsNoWorseThanTheOdometrys) {
+  KESTREL_REQUIRE_TUM(folder, GetParam());
+  const vo::LoadedSequence sequence = vo::load_tum_sequence(folder.string());
+  ASSERT_FALSE(sequence.ground_truth.empty());
+  const SlamRun run = run_slam_sequence(sequence.frames, vo::VoOptions{}, SlamOptions{}, nullptr);
+  ASSERT_GT(run.slam.size(), sequence.frames.size() * 9 / 10);
+  const double vo_ate = ate_rmse(run.vo, sequence.ground_truth);
+  const double slam_ate = ate_rmse(run.slam, sequence.ground_truth);
+  std::cout << GetParam() << ": ATE VO " << vo_ate << " m, SLAM " << slam_ate << " m, " << run.keyframes
+            << " keyframes, " << run.loop_closures << " loop closures\n";
+  EXPECT_LE(slam_ate, vo_ate + 1e-9);
+  if (std::string(GetParam()) == "rgbd_dataset_freiburg1_rpy") {
+    EXPECT_GE(run.loop_closures, 1);
+    EXPECT_LT(slam_ate, 0.8 * vo_ate);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Sequences, SlamOnTum,
+                         ::testing::Values("rgbd_dataset_freiburg1_xyz", "rgbd_dataset_freiburg1_rpy"));
+
+}  // namespace
+}  // namespace kestrel::slam
