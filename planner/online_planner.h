@@ -1,0 +1,64 @@
+#pragma once
+// The planner behind the `kestrel-planner` process, free of LCM and clocks: it keeps the
+// latest map (as a grid with wall features) and the latest state, and answers requests with
+// BRM or PRM. Roadmaps are built per request from a seed derived from the request id, so the
+// same inputs always give the same plan (lock-step replay).
+
+#include <limits>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "planner/grid_environment.h"
+#include "planner/roadmap.h"
+#include "planner/search.h"
+#include "planner/sensor_model.h"
+
+namespace kestrel::planner {
+
+struct OnlinePlannerOptions {
+  SpaceOptions space;  ///< z_min_m / z_max_m: flight band for samples
+  FeatureSensorOptions sensor = FeatureSensorOptions::kinect();
+  MotionOptions motion;
+  RoadmapOptions roadmap;
+  double map_z_min_m = 0.3, map_z_max_m = 2.0;  ///< band of the map that matters for collisions
+  double feature_density_per_m2 = 4.0;          ///< features assumed on the map's walls
+  std::string sampler = "su";                   ///< uniform | su | gaussian | bridge
+};
+
+struct PlanQuery {
+  long request_id = 0;
+  std::optional<Config> start;  ///< nullopt: the latest state
+  double start_trace = 0.0;     ///< with `start`: tr(Sigma), spread evenly
+  Config goal = Config::Zero();
+  bool brm = true;
+  BrmObjective objective = BrmObjective::kMinGoalUncertainty;
+  double max_trace = std::numeric_limits<double>::infinity();
+};
+
+struct PlanAnswer {
+  enum Status { kOk, kNoPath, kStartInCollision, kGoalInCollision, kNoMap, kBadRequest } status = kNoMap;
+  std::string message;
+  std::vector<Config> waypoints;
+  std::vector<double> traces;  ///< predicted tr(Sigma) at each waypoint
+  double length_m = 0.0;
+};
+
+class OnlinePlanner {
+ public:
+  explicit OnlinePlanner(OnlinePlannerOptions options);
+  /// Replaces the map; features are placed on its walls (deterministic for the grid).
+  void set_map(OccupancyGrid grid);
+  /// The latest vehicle state: configuration and its 4 x 4 covariance.
+  void set_state(const Config& q, const Mat4& covariance);
+  PlanAnswer plan(const PlanQuery& query) const;
+  void reset();
+  bool has_map() const { return env_ != nullptr; }
+
+ private:
+  OnlinePlannerOptions options_;
+  std::unique_ptr<GridEnvironment> env_;
+  std::optional<std::pair<Config, Mat4>> state_;
+};
+
+}  // namespace kestrel::planner
