@@ -3,8 +3,9 @@
 // Algorithm 1) with either objective.
 //
 // BRM labels are (node, Sigma, path); a label never revisits a node on its own path.
-//  * kMinGoalUncertainty — Algorithm 1: breadth-first; a label reaching node n is kept when its
-//    tr(Sigma) is below the best seen at n; the goal's best label is the answer.
+//  * kMinGoalUncertainty — Algorithm 1: a label reaching node n is kept when its tr(Sigma) is
+//    below the best seen at n; the goal's best label is the answer. Labels are expanded in
+//    order of tr(Sigma) (the paper uses FIFO) and skipped once superseded at their node.
 //  * kShortestBounded — shortest path with tr(Sigma) < max_trace at every node: labels in order
 //    of length, dropped when over the bound or dominated at their node by a label that is both
 //    shorter and better localised (tr). The bound is checked at nodes, as in the paper.

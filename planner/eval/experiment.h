@@ -22,7 +22,7 @@ struct Scenario {
   RoadmapOptions roadmap;
   Mat4 start_covariance = 0.1 * Mat4::Identity();
   double max_trace = 100.0;  ///< success: a path whose nodes all stay below this tr(Sigma)
-  Mat4 ukf_prior = Mat4::Identity();  ///< the constant prior of the UKF information gain
+  Mat4 ukf_prior = 0.1 * Mat4::Identity();  ///< the constant prior of the UKF information gain
 };
 
 struct Setting {
