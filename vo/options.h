@@ -48,7 +48,7 @@ struct DepthOptions {
 /// Initial rotation by aligning heavily down-sampled images (Mei et al.).
 struct RotationPriorOptions {
   bool enabled = true;
-  int downsample_level = 3;   ///< image of 1/2^level the size (3: 80 x 60 for VGA)
+  int downsample_level = 4;   ///< image of 1/2^level the size (4: 40 x 30 for VGA)
   int max_iterations = 12;
   bool predict_from_velocity = true;  ///< start from the previous frame-to-frame rotation
 };
@@ -67,7 +67,7 @@ enum class InlierMethod { kMaxClique, kRansac, kPreemptiveRansac };
 /// Inlier detection among the matches.
 struct InlierOptions {
   InlierMethod method = InlierMethod::kMaxClique;
-  double clique_threshold_m = 0.02;   ///< floor on the distance-preservation tolerance
+  double clique_threshold_m = 0.04;   ///< floor on the distance-preservation tolerance, metres
   double clique_sigmas = 3.0;         ///< tolerance in depth-noise standard deviations
   int ransac_hypotheses = 500;
   double ransac_threshold_m = 0.03;   ///< 3D distance for a RANSAC inlier
@@ -85,16 +85,16 @@ struct RefinementOptions {
   bool depth_weighted = true;     ///< whiten residuals by the projected depth noise
   bool depth_residuals = true;    ///< also compare the two depths of each match along its ray
   double depth_sigma_floor_mm = 1.0;  ///< added in quadrature to the depth noise of a depth residual
-  double pixel_sigma = 0.7;       ///< measurement noise of a feature position, pixels
+  double pixel_sigma = 1.2;       ///< measurement noise of a feature position, pixels
   double huber_px = 1.5;          ///< robust loss threshold on a whitened residual (sigmas); 0 = none
   double outlier_threshold_px = 2.0;   ///< residuals above this (pixels) are dropped before re-refining
-  int max_iterations = 10;
+  int max_iterations = 5;
   int min_inliers = 10;           ///< fewer after outlier removal = optimisation failure
 };
 
 /// Reference (key) frame policy.
 struct KeyframeOptions {
-  int min_inliers_to_keep = 150;  ///< below this, the current frame becomes the reference
+  int min_inliers_to_keep = 300;  ///< below this, the current frame becomes the reference
   bool fall_back_to_previous = true;
 };
 
