@@ -84,8 +84,9 @@ PlanResult belief_search(const Roadmap& map, int start, int goal, const BrmQuery
     best[start] = query.start_covariance.trace();
     best_label[start] = 0;
     // Algorithm 1's acceptance rule, expanded best-first by tr(Sigma) rather than in FIFO order,
-    // and skipping labels superseded at their node before their turn: the same answers with
-    // far fewer re-expansions.
+    // and skipping labels superseded at their node before their turn: far fewer re-expansions.
+    // Like the FIFO original this is a heuristic (pruning by tr at a node can drop a label that
+    // would do better later), so the two may return different, equally plausible paths.
     using Item = std::pair<double, int>;
     std::priority_queue<Item, std::vector<Item>, std::greater<>> open;
     open.push({best[start], 0});
