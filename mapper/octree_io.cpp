@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "common/error.h"
+#include "mapper/octree_stream_check.h"
 
 namespace kestrel::mapper {
 
@@ -65,18 +66,18 @@ void write_stream(const VoxelMap& map, OctreeFormat format, std::ostream& out) {
   if (!ok) throw std::runtime_error("OctoMap could not write the tree");
 }
 
-VoxelMap read_stream(std::istream& in, OctreeFormat format, const std::string& what,
+VoxelMap read_stream(const std::string& bytes, OctreeFormat format, const std::string& what,
                      MapOptions options) {
-  // Check the first line here, so that a wrong file gets our one-line error only.
+  // Check the first line and the node structure here, so that a wrong file gets our one-line
+  // error only, and a corrupt one never reaches OctoMap's unbounded recursion.
   const char* header =
       format == OctreeFormat::kBinary ? "# Octomap OcTree binary file" : "# Octomap OcTree file";
-  std::string first;
-  std::getline(in, first);
-  if (first.compare(0, std::strlen(header), header) != 0) {
+  if (bytes.compare(0, std::strlen(header), header) != 0) {
     throw InputError(what + ": not an OctoMap " +
                      (format == OctreeFormat::kBinary ? "binary (.bt)" : "full (.ot)") + " stream");
   }
-  in.seekg(0);
+  check_octree_stream(bytes, format, what);
+  std::istringstream in(bytes, std::ios::binary);
   std::unique_ptr<octomap::OcTree> tree;
   if (format == OctreeFormat::kBinary) {
     tree = std::make_unique<octomap::OcTree>(0.1);
@@ -105,8 +106,7 @@ std::vector<uint8_t> encode_octree(const VoxelMap& map, OctreeFormat format) {
 
 VoxelMap decode_octree(const uint8_t* data, size_t size, OctreeFormat format, const char* what,
                        MapOptions options) {
-  std::istringstream in(std::string(reinterpret_cast<const char*>(data), size), std::ios::binary);
-  return read_stream(in, format, what, options);
+  return read_stream(std::string(reinterpret_cast<const char*>(data), size), format, what, options);
 }
 
 OctreeFormat format_of(const std::string& path) {
@@ -132,7 +132,10 @@ VoxelMap read_map_file(const std::string& path, MapOptions options) {
   const OctreeFormat format = format_of(path);
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path + ": cannot open map file");
-  return read_stream(in, format, path, options);
+  std::ostringstream all;
+  all << in.rdbuf();
+  if (!in) throw InputError(path + ": cannot read map file");
+  return read_stream(all.str(), format, path, options);
 }
 
 }  // namespace kestrel::mapper
