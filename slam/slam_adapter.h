@@ -37,8 +37,8 @@ class SlamAdapter {
   SlamAdapter(const SlamOptions& options, std::shared_ptr<const Vocabulary> vocabulary,
               const AdapterOptions& adapter = {});
 
-  /// Throw InputError naming the channel for a message that cannot be used (the state is
-  /// unchanged then).
+  /// Throw InputError naming the channel for a message that cannot be used: the message is
+  /// dropped (a corrupt keyframe is lost; the next frame that moved enough replaces it).
   AdapterOutputs on_frame(const kestrel::rgbd_frame_t& frame);
   AdapterOutputs on_vo_update(const kestrel::vo_update_t& update);
   void reset();
