@@ -7,6 +7,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <iostream>
 #include <optional>
@@ -47,6 +48,8 @@ struct Options {
   std::string rgb_encoding = "jpeg";
   std::string depth_encoding = "zstd";
   int jpeg_quality = 95;
+  std::vector<double> intrinsics;
+  double tilt_deg = 10.0;
   bool list = false;
 };
 
@@ -74,6 +77,12 @@ void add_options(cli::App& app, Options& o) {
       ->check(CLI::IsMember({"raw", "zstd"}))
       ->capture_default_str();
   app.add_option("--jpeg-quality", o.jpeg_quality, "JPEG quality")->check(CLI::Range(1, 100))->capture_default_str();
+  app.add_option("--intrinsics", o.intrinsics, "fx,fy,cx,cy of the 640x480 camera (default 525,525,319.5,239.5)")
+      ->expected(4)
+      ->delimiter(',');
+  app.add_option("--camera-tilt", o.tilt_deg, "Camera pitched down from body x, degrees")
+      ->check(CLI::Range(-90.0, 90.0))
+      ->capture_default_str();
   app.add_flag("--list", o.list, "List the built-in worlds and the flights, then exit");
 }
 
@@ -106,6 +115,13 @@ int run(const Options& o) {
   sim::SimulationOptions so;
   so.seed = o.seed;
   so.camera.rgb.motion_blur_samples = o.motion_blur;
+  so.camera.T_body_camera = sim::CameraOptions::default_T_body_camera(o.tilt_deg);
+  if (!o.intrinsics.empty()) {
+    PinholeCamera& c = so.camera.camera;
+    c.fx = o.intrinsics[0], c.fy = o.intrinsics[1], c.cx = o.intrinsics[2], c.cy = o.intrinsics[3];
+    if (!(c.fx > 0 && c.fy > 0 && std::isfinite(c.fx) && std::isfinite(c.fy) && std::isfinite(c.cx) && std::isfinite(c.cy)))
+      throw CLI::ValidationError("--intrinsics", "fx and fy must be > 0 and all values finite");
+  }
   if (o.exact) {
     so.camera.rgb.noise = false;
     so.camera.depth.noise = false;

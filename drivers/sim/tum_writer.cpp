@@ -62,7 +62,7 @@ TumFolderWriter::TumFolderWriter(const std::string& folder, const PinholeCamera&
   biases_ = open("imu_biases.txt", "# true imu biases (as added to the readings)\n# timestamp bgx bgy bgz bax bay baz\n");
   std::ofstream cam = open("camera.txt", "# fx fy cx cy width height\n");
   cam << camera.fx << ' ' << camera.fy << ' ' << camera.cx << ' ' << camera.cy << ' ' << camera.width << ' '
-      << camera.height << "\n# T_body_camera: x y z qx qy qz qw\n";
+      << camera.height << "\n# T_body_camera x y z qx qy qz qw\nT_body_camera";
   pose_line(cam, T_body_camera);
   cam << '\n';
   if (!cam) throw InputError(folder + "/camera.txt: write error");
