@@ -48,7 +48,12 @@ function(kestrel_benchmark name)
     return()
   endif()
   cmake_parse_arguments(ARG "" "" "SOURCES;DEPS" ${ARGN})
-  add_executable(${name} ${ARG_SOURCES})
+  # Not part of `all`: the test suite never needs them; `./kestrel bench` builds `benchmarks`.
+  add_executable(${name} EXCLUDE_FROM_ALL ${ARG_SOURCES})
+  if(NOT TARGET benchmarks)
+    add_custom_target(benchmarks)
+  endif()
+  add_dependencies(benchmarks ${name})
   target_link_libraries(${name} PRIVATE ${ARG_DEPS} benchmark::benchmark kestrel_options)
   target_compile_definitions(${name} PRIVATE
     KESTREL_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
