@@ -86,13 +86,15 @@ MotionEstimate MotionEstimator::estimate(const Frame& ref, const Frame& cur,
       if (reprojection_error_px(correspondences_[static_cast<size_t>(i)], cam, refined.T_ref_cur,
                                 ro.bidirectional) <= ro.outlier_threshold_px)
         kept.push_back(i);
+    const bool dropped_any = kept.size() != inliers_.size();
     inliers_.swap(kept);
     if (static_cast<int>(inliers_.size()) < ro.min_inliers) {
       out.num_reprojection_inliers = static_cast<int>(inliers_.size());
       out.status = VoStatus::kOptimizationFailure;
       return out;
     }
-    refined = refine_motion(correspondences_, inliers_, cam, refined.T_ref_cur, ro);
+    // With nothing dropped the second refinement would start at the first one's optimum.
+    if (dropped_any) refined = refine_motion(correspondences_, inliers_, cam, refined.T_ref_cur, ro);
     T = refined.T_ref_cur;
   } else {
     // Absolute orientation only: the information at Horn's estimate still gives a covariance.
