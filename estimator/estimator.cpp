@@ -3,6 +3,8 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <stdexcept>
 #include <string>
 #include <tuple>
 
@@ -129,10 +131,14 @@ Verdict Estimator::add_imu(const ImuSample& sample) {
   }
   if (sample.utime - history_.back().imu.utime > to_utime(options_.max_imu_dt_s))
     ++counters_.imu_gaps;
-  Snapshot next;
+  // Stepped in place at the back of the history: a snapshot is kilobytes (inline storage
+  // cannot be moved), and this runs at IMU rate.
+  history_.emplace_back();
+  Snapshot& next = history_.back();
   next.imu = sample;
-  step(history_.back(), next);
+  step(history_[history_.size() - 2], next);
   if (!next.state.is_valid()) {
+    history_.pop_back();
     // Divergence (absurd input or a bug): start over rather than publish garbage.
     ++counters_.filter_failures;
     const int64_t keep = last_imu_utime_;
@@ -141,7 +147,6 @@ Verdict Estimator::add_imu(const ImuSample& sample) {
     last_imu_utime_ = keep;
     return Verdict::kAccepted;
   }
-  history_.push_back(std::move(next));
   trim();
   return Verdict::kAccepted;
 }
@@ -270,7 +275,19 @@ void Estimator::replay_from(int64_t utime) {
 }
 
 void Estimator::step(const Snapshot& previous, Snapshot& next) {
-  FilterState s = previous.state;
+  try {
+    step_filter(previous, next);
+  } catch (const std::invalid_argument&) {
+    // The filter refused its own covariance (indefinite beyond rounding): mark the state
+    // invalid, so the caller counts a filter failure and starts over instead of crashing.
+    next.state = previous.state;
+    next.state.P(0, 0) = std::numeric_limits<double>::quiet_NaN();
+  }
+}
+
+void Estimator::step_filter(const Snapshot& previous, Snapshot& next) {
+  FilterState& s = next.state;  // written in place (see add_imu)
+  s = previous.state;
   const int64_t t0 = previous.imu.utime, t1 = next.imu.utime;
   const bool gap = t1 - t0 > to_utime(options_.max_imu_dt_s);
   ImuInterval u;
@@ -301,7 +318,6 @@ void Estimator::step(const Snapshot& previous, Snapshot& next) {
     filter_->predict(s, u);
     s.mean.utime = t1;
   }
-  next.state = std::move(s);
 }
 
 Matrix6d Estimator::vo_noise(const VoUpdate& u) const {

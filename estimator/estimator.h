@@ -141,6 +141,7 @@ class Estimator {
   void insert_event(Event event);
   void replay_from(int64_t utime);
   void step(const Snapshot& previous, Snapshot& next);
+  void step_filter(const Snapshot& previous, Snapshot& next);
   void apply(Event& event, FilterState& s);
   void trim();
   void retire(const Event& event);

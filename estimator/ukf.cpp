@@ -2,6 +2,8 @@
 // the same nonlinear process and measurement models as the EKF, and mapped back with ⊟.
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <stdexcept>
 
 #include "estimator/filter.h"
 
@@ -11,8 +13,28 @@ namespace {
 using SigmaMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, kMaxDim,
                                   2 * kMaxDim + 1>;
 
-SigmaMatrix offsets(const Covariance& P, const UnscentedWeights& w) {
-  const Covariance L = psd_square_root(P);
+// A square root of P. The pivoted LDL^T fails when rounding (P -= K S K^T on a covariance made
+// singular by its clones) has pushed a pivot below its tolerance; then P is replaced by its
+// nearest positive semi-definite matrix (negative eigenvalues set to zero), which moves it by
+// no more than that rounding, and the square root is taken from the eigen-decomposition.
+// A P negative beyond rounding (|lambda_min| > 1e-6 max|P|) is an error, not repaired.
+Covariance square_root(Covariance& P) {
+  try {
+    return psd_square_root(P);
+  } catch (const std::invalid_argument&) {
+    if (!P.allFinite()) throw;
+    const Eigen::SelfAdjointEigenSolver<Covariance> eig(P);
+    Eigen::Matrix<double, Eigen::Dynamic, 1, Eigen::ColMajor, kMaxDim, 1> d = eig.eigenvalues();
+    if (d.minCoeff() < -1e-6 * P.cwiseAbs().maxCoeff()) throw;
+    d = d.cwiseMax(0.0);
+    P = eig.eigenvectors() * d.asDiagonal() * eig.eigenvectors().transpose();
+    symmetrize(P);
+    return eig.eigenvectors() * d.cwiseSqrt().asDiagonal();
+  }
+}
+
+SigmaMatrix offsets(Covariance& P, const UnscentedWeights& w) {
+  const Covariance L = square_root(P);
   const int n = static_cast<int>(P.rows());
   SigmaMatrix X(n, 2 * n + 1);
   X.col(0).setZero();

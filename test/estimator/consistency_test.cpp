@@ -6,7 +6,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdlib>
+#include <vector>
 #include <iostream>
 
 #include "estimator/eval/consistency.h"
@@ -55,9 +58,18 @@ TEST(Consistency, NeesOfGaussianSamplesIsInTheBand) {
   EXPECT_FALSE(bad.summary().band.contains(bad.summary().mean));
 }
 
+// Runs and filters from the environment, so that the 50-run figure is measured by
+// the same code: KESTREL_NEES_RUNS=50 KESTREL_NEES_UKF=1 estimator_consistency_test.
+int nees_runs() {
+  const char* v = std::getenv("KESTREL_NEES_RUNS");
+  return v ? std::max(2, std::atoi(v)) : 12;
+}
+
 TEST(Consistency, FilterNeesIsInTheBandOverSeededRuns) {
-  const int runs = 12;
-  for (FilterKind kind : {FilterKind::kEkf}) {
+  const int runs = nees_runs();
+  std::vector<FilterKind> kinds{FilterKind::kEkf};
+  if (std::getenv("KESTREL_NEES_UKF")) kinds.push_back(FilterKind::kUkf);
+  for (FilterKind kind : kinds) {
     NeesAccumulator pose_velocity(9);
     for (int run = 0; run < runs; ++run) {
       EstimatorOptions options;
@@ -80,7 +92,7 @@ TEST(Consistency, FilterNeesIsInTheBandOverSeededRuns) {
                                          << ", " << s.band.high << "]";
     EXPECT_GT(s.fraction_in_band, 0.8) << "mean NEES " << s.mean;
     RecordProperty("mean_nees", std::to_string(s.mean));
-    std::cout << "mean NEES " << s.mean << " band [" << s.band.low << ", " << s.band.high
+    std::cout << (kind == FilterKind::kEkf ? "EKF" : "UKF") << " runs " << runs << ": mean NEES " << s.mean << " band [" << s.band.low << ", " << s.band.high
               << "], checkpoints in band " << s.fraction_in_band << "\n";
   }
 }
