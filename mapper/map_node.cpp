@@ -147,6 +147,7 @@ std::optional<kestrel::octomap_t> MapNode::on_graph(const kestrel::slam_graph_t&
   last_graph_revision_ = msg.revision;
   ++stats_.graphs;
   const GraphResult result = mapper_.apply_graph(keyframes);
+  stats_.frames_inserted += result.inserted;  // keyframes: the frames a SLAM map is made of
   if (result.rebuilt) {
     ++stats_.rebuilds;
     stats_.last_rebuild_keyframes = static_cast<double>(result.rebuild_keyframes);

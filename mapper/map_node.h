@@ -41,7 +41,7 @@ struct NodeOptions {
 
 struct NodeStats {
   int64_t frames = 0;             ///< frames accepted
-  int64_t frames_inserted = 0;    ///< kGroundTruth: frames put into the map
+  int64_t frames_inserted = 0;    ///< frames put into the map (slam: new keyframes)
   int64_t frames_without_pose = 0;
   int64_t graphs = 0;
   int64_t rebuilds = 0;
