@@ -88,12 +88,18 @@ TEST(Consistency, FilterNeesIsInTheBandOverSeededRuns) {
       }
     }
     const auto s = pose_velocity.summary();
-    EXPECT_TRUE(s.band.contains(s.mean)) << "mean NEES " << s.mean << " band [" << s.band.low
-                                         << ", " << s.band.high << "]";
+    // The checkpoints of one run are correlated, so the pooled band (all samples as if
+    // independent) is far too narrow to test against; the band of one checkpoint's mean over
+    // the runs is the honest one for the overall mean, and the fraction of checkpoints inside
+    // their own 95 % band must be near 95 %.
+    const Band per_checkpoint = mean_nees_band(9, runs);
+    EXPECT_TRUE(per_checkpoint.contains(s.mean)) << "mean NEES " << s.mean << " band ["
+                                                 << per_checkpoint.low << ", " << per_checkpoint.high << "]";
     EXPECT_GT(s.fraction_in_band, 0.8) << "mean NEES " << s.mean;
     RecordProperty("mean_nees", std::to_string(s.mean));
-    std::cout << (kind == FilterKind::kEkf ? "EKF" : "UKF") << " runs " << runs << ": mean NEES " << s.mean << " band [" << s.band.low << ", " << s.band.high
-              << "], checkpoints in band " << s.fraction_in_band << "\n";
+    std::cout << (kind == FilterKind::kEkf ? "EKF" : "UKF") << " runs " << runs << ": mean NEES "
+              << s.mean << " band [" << per_checkpoint.low << ", " << per_checkpoint.high
+              << "], checkpoints in their band " << s.fraction_in_band << "\n";
   }
 }
 
