@@ -4,14 +4,13 @@
 
 #include <spdlog/spdlog.h>
 
-#include <atomic>
 #include <chrono>
-#include <csignal>
 #include <iostream>
 #include <optional>
 
 #include "common/cli.h"
 #include "common/error.h"
+#include "common/interrupt.h"
 #include "common/transport/channels.h"
 #include "common/transport/log_file.h"
 #include "common/transport/node.h"
@@ -22,18 +21,6 @@
 namespace {
 
 using namespace kestrel;
-
-std::atomic<bool> g_interrupted{false};
-void on_signal(int) { g_interrupted = true; }
-
-// In --log mode there is no Node to catch SIGINT: stop between frames and close the log.
-void catch_interrupts() {
-  struct sigaction sa {};
-  sa.sa_handler = on_signal;
-  sigemptyset(&sa.sa_mask);
-  sigaction(SIGINT, &sa, nullptr);
-  sigaction(SIGTERM, &sa, nullptr);
-}
 
 struct Options {
   int device = 0;
@@ -123,7 +110,7 @@ int run(const Options& o) {
     sink.publish = [&](const std::string& channel, int64_t utime, const std::vector<uint8_t>& bytes) {
       log.write(channel, utime, bytes);
     };
-    sink.stopping = [] { return g_interrupted.load(); };
+    sink.stopping = [] { return interrupted(); };
     result = driver->run(sink);
     log.close();
   } else {

@@ -13,6 +13,7 @@
 #include <optional>
 #include <thread>
 
+#include "common/interrupt.h"
 #include "common/cli.h"
 #include "common/error.h"
 #include "common/transport/channels.h"
@@ -29,9 +30,6 @@ namespace {
 
 using namespace kestrel;
 using Clock = std::chrono::steady_clock;
-
-std::atomic<bool> g_interrupted{false};
-void on_signal(int) { g_interrupted = true; }
 
 struct Options {
   std::string world = "room";
@@ -142,8 +140,7 @@ int run(const Options& o) {
   if (!o.tum.empty()) sinks.tum.emplace(o.tum, so.camera.camera, so.camera.T_body_camera);
   bool restart = false;
   if (offline) {
-    std::signal(SIGINT, on_signal);
-    std::signal(SIGTERM, on_signal);
+    catch_interrupts();
   } else {
     try {
       sinks.node.emplace("sim", o.lcm_url);
@@ -155,7 +152,7 @@ int run(const Options& o) {
     sinks.node->on_reset([&] { restart = true; });
     sinks.node->set_health(kestrel::process_status_t::STATE_RUNNING, "");
   }
-  auto stopping = [&] { return g_interrupted.load() || (sinks.node && sinks.node->stopping()); };
+  auto stopping = [&] { return interrupted() || (sinks.node && sinks.node->stopping()); };
 
   const int64_t end_utime = so.start_utime + static_cast<int64_t>(o.duration_s * 1e6);
   int64_t frames = 0, imu_samples = 0;

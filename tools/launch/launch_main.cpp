@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "common/interrupt.h"
 #include "common/cli.h"
 #include "common/error.h"
 #include "common/transport/channels.h"
@@ -31,9 +32,6 @@ namespace {
 namespace fs = std::filesystem;
 using namespace kestrel::launch;
 using Clock = std::chrono::steady_clock;
-
-std::atomic<int> g_signal{0};
-void on_signal(int sig) { g_signal = sig; }
 
 struct Options {
   std::string set;
@@ -117,9 +115,7 @@ int launch(const Options& o) {
   HeartbeatListener listener{&board};
   lcm.subscribe(kestrel::channel::kProcessStatus, &HeartbeatListener::handle, &listener);
 
-  struct sigaction sa {};
-  sa.sa_handler = on_signal;
-  for (int sig : {SIGINT, SIGTERM, SIGHUP}) ::sigaction(sig, &sa, nullptr);
+  const auto& interrupted = kestrel::catch_interrupts();
 
   spdlog::info("{} process{} on {}; logs in {}", set.size(), set.size() == 1 ? "" : "es", url,
                so.log_dir.string());
@@ -160,7 +156,7 @@ int launch(const Options& o) {
   auto next_status = Clock::now() + std::chrono::duration_cast<Clock::duration>(
                                         std::chrono::duration<double>(o.status_period_s));
   bool announced_healthy = false;
-  while (g_signal == 0 && !source_ending) {
+  while (!interrupted && !source_ending) {
     lcm.handleTimeout(100);
     report(supervisor.poll(), false);
     const auto now = Clock::now();
@@ -181,10 +177,10 @@ int launch(const Options& o) {
       break;
     }
   }
-  if (g_signal != 0) spdlog::info("stopping on {}", sigabbrev_np(g_signal) ? sigabbrev_np(g_signal) : "signal");
+  if (interrupted) spdlog::info("stopping on SIG{}", sigabbrev_np(kestrel::interrupt_signal()));
   report(supervisor.stop_all(), true);
   fmt::print("{}", board.table(Clock::now()));
-  if (g_signal == SIGINT) return kestrel::kExitInterrupted;
+  if (kestrel::interrupt_signal() == SIGINT) return kestrel::kExitInterrupted;
   if (source_ending) return source_ending->code == 0 && !unexpected_end ? kestrel::kExitOk : kestrel::kExitFailure;
   return unexpected_end ? kestrel::kExitFailure : kestrel::kExitOk;
 }

@@ -11,6 +11,7 @@
 #include <iostream>
 #include <lcm/lcm-cpp.hpp>
 
+#include "common/interrupt.h"
 #include "common/cli.h"
 #include "common/error.h"
 #include "common/transport/lcm_url.h"
@@ -18,8 +19,6 @@
 
 namespace {
 
-std::atomic<bool> g_stop{false};
-void on_signal(int) { g_stop = true; }
 
 double now_s() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
@@ -67,10 +66,7 @@ int monitor(const Options& o) {
   kestrel::monitor::TrafficMonitor traffic(channel_types);
   Receiver receiver{&traffic, {}};
   lcm.subscribeFunction(o.channels, &Receiver::on, &receiver)->setQueueCapacity(0);
-  struct sigaction sa {};
-  sa.sa_handler = on_signal;
-  sigaction(SIGINT, &sa, nullptr);
-  sigaction(SIGTERM, &sa, nullptr);
+  kestrel::catch_interrupts();
   spdlog::info("listening on {} (channels {})", url, o.channels);
 
   // Periodic tables go to stdout, or to stderr when stdout carries the JSON summary.
@@ -78,7 +74,7 @@ int monitor(const Options& o) {
   const bool tty = ::isatty(o.json ? 2 : 1) != 0;
   const double start = now_s();
   double next_table = start + o.period_s;
-  while (!g_stop) {
+  while (!kestrel::interrupted()) {
     const double t = now_s();
     if (o.duration_s > 0.0 && t - start >= o.duration_s) break;
     if (o.count > 0 && traffic.total() >= o.count) break;

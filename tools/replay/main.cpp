@@ -8,24 +8,13 @@
 #include <csignal>
 #include <iostream>
 
+#include "common/interrupt.h"
 #include "common/cli.h"
 #include "common/error.h"
 #include "common/transport/log_file.h"
 #include "tools/replay/replayer.h"
 
 namespace {
-
-std::atomic<bool> g_interrupted{false};
-
-void on_signal(int) { g_interrupted = true; }
-
-void install_signal_handlers() {
-  struct sigaction sa {};
-  sa.sa_handler = on_signal;  // no SA_RESTART: waits return early and see the flag
-  sigemptyset(&sa.sa_mask);
-  sigaction(SIGINT, &sa, nullptr);
-  sigaction(SIGTERM, &sa, nullptr);
-}
 
 }  // namespace
 
@@ -82,15 +71,15 @@ int main(int argc, char** argv) {
     const bool timed = realtime || speed > 0.0;
     if (timed && !lockstep.record_path.empty())
       throw CLI::ValidationError("--record", "records only in lock-step mode (not with --realtime/--speed)");
-    install_signal_handlers();
+    const auto& interrupted = catch_interrupts();
     transport::LogReader log(log_path);
     replay::ReplayReport report;
     try {
       if (timed) {
         report = replay::replay_timed(log, {lockstep.lcm_url, realtime ? 1.0 : speed, lockstep.selection},
-                                      g_interrupted);
+                                      interrupted);
       } else {
-        report = replay::replay_lockstep(log, lockstep, g_interrupted);
+        report = replay::replay_lockstep(log, lockstep, interrupted);
       }
     } catch (const replay::NetworkUnavailable& e) {
       spdlog::error("{}", e.what());
