@@ -44,6 +44,9 @@ void add_estimator_options(CLI::App& app, EstimatorOptions& o) {
       ->default_str(joined(o.vo_noise.constant_sigma.data(), 6));
   app.add_option("--vo-gate", o.vo_gate_chi2, "Chi-square (6 dof) gate on VO innovations, 0 = off")
       ->check(non_negative)->capture_default_str();
+  app.add_option("--vo-max-gated-in-row", o.vo_max_gated_in_row,
+                 "After this many gated VO updates in a row, fuse the next ungated (0 = never)")
+      ->check(CLI::Range(0, 1000000))->capture_default_str();
   app.add_option("--correction-gate", o.correction_gate_chi2,
                  "Chi-square (6 dof) gate on SLAM corrections, 0 = off")
       ->check(non_negative)->capture_default_str();

@@ -37,7 +37,8 @@ int run(const Options& o) {
             << "IMU messages: " << r.imu_messages << " (" << c.imu_duplicate << " duplicate, "
             << c.imu_out_of_order << " out of order, " << c.imu_gaps << " gaps)\n"
             << "VO updates: " << r.vo_messages << " (" << c.vo_applied << " applied, "
-            << c.vo_failed << " failed, " << c.vo_gated << " gated, "
+            << c.vo_failed << " failed, " << c.vo_gated << " gated, " << c.vo_forced
+            << " forced past the gate, "
             << c.vo_duplicate + c.vo_out_of_order + c.vo_too_old + c.vo_before_init
             << " dropped)\n"
             << "SLAM corrections: " << r.correction_messages << " (" << c.corrections_applied

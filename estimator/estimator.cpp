@@ -346,8 +346,11 @@ void Estimator::apply(Event& e, FilterState& s) {
         z = spec->second.anchor.inverse() * z;
       }
       const RelativePoseMeasurement m(clone, z, Q, e.vo.T_body_camera);
-      const UpdateResult r = filter_->update(s, m, options_.vo_gate_chi2);
-      e.outcome = r.applied ? Outcome::kApplied : Outcome::kGated;
+      const int max_in_row = options_.vo_max_gated_in_row;
+      const bool force = max_in_row > 0 && s.vo_gated_in_row >= max_in_row;
+      const UpdateResult r = filter_->update(s, m, force ? 0.0 : options_.vo_gate_chi2);
+      e.outcome = r.applied ? (force ? Outcome::kForced : Outcome::kApplied) : Outcome::kGated;
+      s.vo_gated_in_row = r.applied ? 0 : s.vo_gated_in_row + 1;
       return;
     }
     case EventKind::kCorrection: {
@@ -382,7 +385,8 @@ void Estimator::trim() {
 
 void Estimator::retire(const Event& e) {
   if (e.kind == EventKind::kVo) {
-    if (e.outcome == Outcome::kApplied) {
+    if (e.outcome == Outcome::kForced) ++counters_.vo_forced;
+    if (e.outcome == Outcome::kApplied || e.outcome == Outcome::kForced) {
       ++counters_.vo_applied;
       last_retired_vo_applied_ = std::max(last_retired_vo_applied_, e.utime);
     }
@@ -397,8 +401,10 @@ void Estimator::retire(const Event& e) {
 EstimatorCounters Estimator::counters() const {
   EstimatorCounters c = counters_;
   for (const Event& e : events_) {
-    const bool applied = e.outcome == Outcome::kApplied, gated = e.outcome == Outcome::kGated;
+    const bool applied = e.outcome == Outcome::kApplied || e.outcome == Outcome::kForced;
+    const bool gated = e.outcome == Outcome::kGated;
     if (e.kind == EventKind::kVo) {
+      c.vo_forced += e.outcome == Outcome::kForced;
       c.vo_applied += applied;
       c.vo_gated += gated;
       c.vo_unreferenced += e.outcome == Outcome::kUnreferenced;
@@ -424,7 +430,8 @@ std::optional<EstimatorOutput> Estimator::output() const {
   out.angular_velocity = now.imu.gyro - out.nav.gyro_bias;
   int64_t last_vo = last_retired_vo_applied_;
   for (const Event& e : events_)
-    if (e.kind == EventKind::kVo && e.outcome == Outcome::kApplied && e.utime <= now.imu.utime)
+    if (e.kind == EventKind::kVo &&
+        (e.outcome == Outcome::kApplied || e.outcome == Outcome::kForced) && e.utime <= now.imu.utime)
       last_vo = std::max(last_vo, e.utime);
   const bool recent = last_vo >= 0 && now.imu.utime - last_vo <= to_utime(options_.vo_timeout_s);
   out.status = recent ? Status::kOk : Status::kDegraded;

@@ -19,7 +19,9 @@
 // against it becomes an anchor instead: the pose is cloned at that update, and later updates
 // are measured against it through the anchor's own VO estimate.
 //
-// Robustness: non-finite or malformed inputs are rejected; IMU samples that repeat or go
+// Robustness: non-finite or malformed inputs are rejected; a VO update failing the chi^2
+// gate is refused, but after vo_max_gated_in_row refusals in a row the next is fused anyway
+// (the filter, not the VO, is then the likely culprit); IMU samples that repeat or go
 // back in time are dropped; VO failures only count (the filter keeps predicting and its
 // covariance grows); gaps in the IMU add noise; everything is counted in counters().
 
@@ -84,6 +86,7 @@ struct EstimatorCounters {
   int64_t vo_received = 0, vo_failed = 0, vo_invalid = 0, vo_duplicate = 0,
           vo_out_of_order = 0, vo_too_old = 0, vo_before_init = 0, vo_anchors = 0;
   int64_t vo_applied = 0, vo_gated = 0, vo_unreferenced = 0;
+  int64_t vo_forced = 0;  ///< fused past the gate after vo_max_gated_in_row refusals (in vo_applied too)
   int64_t corrections_received = 0, corrections_invalid = 0, corrections_duplicate = 0,
           corrections_too_old = 0, corrections_before_init = 0;
   int64_t corrections_applied = 0, corrections_gated = 0;
@@ -123,7 +126,7 @@ class Estimator {
     Matrix6d anchor_covariance = Matrix6d::Zero();
   };
   enum class EventKind { kCorrection = 0, kVo = 1, kClone = 2 };  // order at equal utime
-  enum class Outcome { kPending, kApplied, kGated, kUnreferenced };
+  enum class Outcome { kPending, kApplied, kForced, kGated, kUnreferenced };
   struct Event {
     int64_t utime = 0;
     EventKind kind = EventKind::kVo;

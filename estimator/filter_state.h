@@ -54,6 +54,9 @@ ErrorVector boxminus(const FilterMean& a, const FilterMean& b);
 struct FilterState {
   FilterMean mean;
   Covariance P;
+  /// VO updates refused by the gate since the last one fused: kept with the state (not in
+  /// the estimator) so that re-playing history reproduces it exactly.
+  int vo_gated_in_row = 0;
 
   /// Symmetric, finite, of the right size, with a non-negative diagonal.
   bool is_valid() const;

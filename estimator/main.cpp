@@ -85,9 +85,9 @@ int run(const Options& o) {
   const int code = node->spin();
   const EstimatorCounters c = estimator.counters();
   spdlog::info("IMU {} accepted, {} duplicate, {} out of order, {} gaps; VO {} applied, {} failed, "
-               "{} gated, {} dropped; corrections {} applied, {} too old; filter restarts {}",
+               "{} gated ({} forced past the gate), {} dropped; corrections {} applied, {} too old; filter restarts {}",
                c.imu_accepted, c.imu_duplicate, c.imu_out_of_order, c.imu_gaps, c.vo_applied,
-               c.vo_failed, c.vo_gated, c.vo_duplicate + c.vo_out_of_order + c.vo_too_old,
+               c.vo_failed, c.vo_gated, c.vo_forced, c.vo_duplicate + c.vo_out_of_order + c.vo_too_old,
                c.corrections_applied, c.corrections_too_old, c.filter_failures);
   return code;
 }

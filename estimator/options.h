@@ -48,6 +48,11 @@ struct EstimatorOptions {
   /// Gate on the squared Mahalanobis distance of a VO innovation (chi^2, 6 dof); 0 = off.
   /// 30 lets through all but 1 in 25,000 correct measurements.
   double vo_gate_chi2 = 30.0;
+  /// After this many VO updates in a row refused by the gate, the next one is fused without
+  /// it: ten outliers in a row (a third of a second) are less likely than a filter that has
+  /// gone wrong (e.g. a gyro bias mistaken at start-up) and would otherwise never recover.
+  /// 0 = never.
+  int vo_max_gated_in_row = 10;
   /// The same for SLAM corrections; off by default: a loop closure may move the state far.
   double correction_gate_chi2 = 0.0;
   /// Used for a correction that carries no covariance (all zero): sigmas of [dp; dtheta].

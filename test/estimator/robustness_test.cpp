@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <limits>
 
 #include "common/error.h"
@@ -248,6 +249,41 @@ TEST(Robustness, ResetStartsOver) {
   for (const auto& s : imu.samples) r.estimator.add_imu(s);
   EXPECT_TRUE(r.estimator.output().has_value());
   EXPECT_EQ(r.estimator.output()->status, Status::kDegraded);
+}
+
+}  // namespace
+}  // namespace kestrel::estimator
+
+namespace kestrel::estimator {
+namespace {
+
+// After vo_max_gated_in_row updates refused by the gate in a row, the next is fused anyway (a
+// filter gone wrong, e.g. with a gyro bias mistaken at start-up, would otherwise never see VO
+// again); the count restarts after it. Off (0), the gate refuses them all.
+TEST(Robustness, AfterTooManyGatedUpdatesInARowTheNextIsFused) {
+  for (int max_in_row : {0, 3}) {
+    Running r;
+    r.options.vo_max_gated_in_row = max_in_row;
+    Estimator e(r.options);
+    const auto steps = test::run_scenario(e, AnalyticMotion::gentle(), scenario(3.0));
+    const int64_t now = e.output()->utime;
+    const auto gated_before = e.counters().vo_gated;
+    for (int k = 0; k < 5; ++k) {
+      // 2 m of motion in 30 ms: refused by the gate unless forced.
+      VoUpdate u = good_vo(now - 40000 + 5000 * k, now - 300000);
+      u.T_refcam_curcam.translation() = Eigen::Vector3d(2.0, 0.0, 0.0);
+      EXPECT_EQ(e.add_vo(u), Verdict::kAccepted);
+    }
+    const auto c = e.counters();
+    if (max_in_row == 0) {
+      EXPECT_EQ(c.vo_gated - gated_before, 5);
+      EXPECT_EQ(c.vo_forced, 0);
+    } else {
+      EXPECT_EQ(c.vo_gated - gated_before, 4);  // 3 refused, the 4th forced, the 5th refused
+      EXPECT_EQ(c.vo_forced, 1);
+      EXPECT_GT((e.output()->nav.p_world_body - steps.back().output.nav.p_world_body).norm(), 0.05);
+    }
+  }
 }
 
 }  // namespace
