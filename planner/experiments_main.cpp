@@ -4,9 +4,11 @@
 
 #include <fstream>
 #include <iostream>
+#include <opencv2/imgcodecs.hpp>
 
 #include "common/cli.h"
 #include "common/error.h"
+#include "planner/eval/plot.h"
 #include "planner/eval/tables.h"
 #include "planner/floor_plan.h"
 
@@ -22,9 +24,11 @@ int main(int argc, char** argv) {
   app.add_option("--seed", o.seed, "Seed of every random draw");
   app.add_option("--feature-density", density, "Features per square metre of textured wall")->check(cli::Positive);
   app.add_option("--wall-piece", wall_piece, "Length (m) of wall sharing one texture density")->check(cli::Positive);
-  app.add_option("--only", only, "One experiment: table3, table4, table5, fig7, fig12, laser, precision, or all")
-      ->check(CLI::IsMember({"all", "table3", "table4", "table5", "fig7", "fig12", "laser", "precision"}));
+  app.add_option("--only", only, "One experiment: table3, table4, table5, fig7, fig12, fig13, laser, precision, or all")
+      ->check(CLI::IsMember({"all", "table3", "table4", "table5", "fig7", "fig12", "fig13", "laser", "precision"}));
   app.add_option("--out", out_path, "Also write the Markdown to this file");
+  std::string png_path;
+  app.add_option("--png", png_path, "Draw path 1 planned by PRM (red) and BRM-SU (blue) to this PNG");
   return app.run(argc, argv, [&]() -> int {
     GridEnvironment env(stata_like_floor(), 0.0, 3.0);
     env.set_features(env.wall_features(density, wall_piece, o.seed));
@@ -52,10 +56,32 @@ int main(int argc, char** argv) {
             [&] { return eval::fig7_ukf_transfer(sc, o); });
     section("fig12", "Figs. 12/13: BRM-SU against the number of samples (paper camera)",
             [&] { return eval::fig12_sample_counts(sc, pairs, o, {10, 30, 100, 300, 500}); });
+    section("fig13", "Fig. 13: BRM-SU against the number of samples (Kinect model: 4 m, 57 x 43 deg)", [&] {
+      eval::Scenario kinect = sc;
+      kinect.sensor = FeatureSensorOptions::kinect();
+      return eval::fig12_sample_counts(kinect, pairs, o, {10, 30, 100, 300});
+    });
     section("laser", "Laser validation: shorter range, longer but localisable paths",
             [&] { return eval::laser_experiment(sc, pairs, o, 1.5, 5.0, 1.0); });
     section("precision", "Transfer precision on every roadmap edge (relative tr(Σ) error vs step-by-step EKF)",
             [&] { return eval::transfer_precision(sc, pairs, o); });
+    if (!png_path.empty()) {
+      // Path 1: PRM (red) and BRM-SU (blue) on the same seed, with covariance ellipses.
+      const FeatureSensor fs(env, sc.sensor);
+      const BeliefModel model(sc.motion, [&](const Config& q) { return fs.information(q); });
+      std::vector<eval::DrawnPath> drawn;
+      std::vector<Config> samples;
+      for (const char* planner : {"prm", "brm"}) {
+        const eval::Trial t = eval::run_trial(sc, eval::Setting{planner, planner[0] == 'b' ? "su" : "uniform", o.samples},
+                                              pairs[0].first, pairs[0].second, o.seed);
+        std::vector<Mat4> cov{sc.start_covariance};
+        for (size_t i = 1; i < t.path.size(); ++i)
+          cov.push_back(propagate_ekf(cov.back(), model.steps(t.path[i - 1], t.path[i])));
+        drawn.push_back({t.path, cov, planner[0] == 'b' ? cv::Scalar(200, 0, 0) : cv::Scalar(0, 0, 220)});
+        if (planner[0] == 'b') samples = t.samples;
+      }
+      if (!cv::imwrite(png_path, eval::draw_plans(env, samples, drawn))) throw InputError(png_path + ": cannot write");
+    }
     if (!out_path.empty()) {
       std::ofstream f(out_path);
       if (!(f << md.str())) throw InputError(out_path + ": cannot write");

@@ -185,7 +185,7 @@ std::string fig12_sample_counts(const Scenario& sc, const Pairs& pairs, const Ex
   out << "| samples | success % | goal tr(Σ) | build s (median) |\n|---|---|---|---|\n";
   for (int c : counts) {
     const Summary s = run_many(sc, Setting{"brm", "su", c}, pairs, o);
-    out << "| " << c << " | " << fmt("%.1f", s.success_pct()) << " | " << fmt("%.3f", s.mean_trace()) << " | "
+    out << "| " << c << " | " << fmt("%.1f", s.success_pct()) << " | " << fmt("%.2e", s.mean_trace()) << " | "
         << fmt("%.3f", median(s.build_s)) << " |\n";
   }
   return out.str();
