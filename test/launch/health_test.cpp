@@ -54,6 +54,18 @@ TEST(HealthBoard, FollowsEachProcessThroughItsLife) {
   EXPECT_EQ(rows.back().name, "vo (not launched here)");  // the stale pid, shown apart
 }
 
+TEST(HealthBoard, ASourceWithoutHeartbeatsIsRunningUntilItEnds) {
+  HealthBoard board(3.0);
+  const auto t0 = Clock::now();
+  board.started("vo", 1, t0);
+  board.started("source", 2, t0, /*heartbeats=*/false);
+  board.heartbeat(beat("vo", 1, process_status_t::STATE_RUNNING), t0 + milliseconds(100));
+  EXPECT_TRUE(board.all_running(t0 + milliseconds(200)));
+  EXPECT_EQ(board.rows(t0 + milliseconds(5000))[1].state, "running");
+  board.ended("source", "exited with status 0");
+  EXPECT_EQ(board.rows(t0 + milliseconds(5000))[1].state, "ended: exited with status 0");
+}
+
 TEST(HealthBoard, AProcessThatNeverBeatsIsNamed) {
   HealthBoard board(3.0);
   const auto t0 = Clock::now();

@@ -17,13 +17,14 @@ std::string state_name(int8_t state) {
   }
 }
 
-void HealthBoard::started(const std::string& name, pid_t pid, Clock::time_point now) {
+void HealthBoard::started(const std::string& name, pid_t pid, Clock::time_point now, bool heartbeats) {
   if (!entries_.count(name)) order_.push_back(name);
   Entry& e = entries_[name];
   e = Entry{};
   e.pid = pid;
   e.since = now;
   e.launched = true;
+  e.heartbeats = heartbeats;
 }
 
 void HealthBoard::ended(const std::string& name, const std::string& how) {
@@ -54,6 +55,9 @@ std::vector<HealthBoard::Row> HealthBoard::rows(Clock::time_point now) const {
     const double since_start = std::chrono::duration<double>(now - e.since).count();
     if (e.ended) {
       r.state = "ended: " + *e.ended;
+    } else if (!e.last && !e.heartbeats) {
+      r.state = "running";
+      r.healthy = true;
     } else if (!e.last) {
       r.state = since_start > silent_after_s_ ? "no heartbeat" : "starting";
     } else {

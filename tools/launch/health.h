@@ -24,8 +24,10 @@ class HealthBoard {
 
   explicit HealthBoard(double silent_after_s = 3.0) : silent_after_s_(silent_after_s) {}
 
-  /// A process the launcher (re)started; forgets the heartbeat of its previous pid.
-  void started(const std::string& name, pid_t pid, Clock::time_point now);
+  /// A process the launcher (re)started; forgets the heartbeat of its previous pid. A source
+  /// such as `kestrel replay` need not heartbeat (`heartbeats` false): it is then "running"
+  /// until it ends, and all_running() does not wait for it.
+  void started(const std::string& name, pid_t pid, Clock::time_point now, bool heartbeats = true);
   /// A process that ended, with how ("exited with status 1").
   void ended(const std::string& name, const std::string& how);
   void heartbeat(const process_status_t& status, Clock::time_point now);
@@ -51,6 +53,7 @@ class HealthBoard {
     Clock::time_point last_at{};
     std::optional<std::string> ended;
     bool launched = false;
+    bool heartbeats = true;
   };
   double silent_after_s_;
   std::map<std::string, Entry> entries_;  // by launch name

@@ -127,7 +127,7 @@ int launch(const Options& o) {
       switch (e.kind) {
         case ChildEvent::kStarted:
           spdlog::info("started {} (pid {})", e.name, e.pid);
-          board.started(e.name, e.pid, Clock::now());
+          board.started(e.name, e.pid, Clock::now(), /*heartbeats=*/e.name != "source");
           break;
         case ChildEvent::kEnded:
           board.ended(e.name, e.ending.description);
