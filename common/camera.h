@@ -19,6 +19,16 @@ struct PinholeCamera {
   double cy = 239.5;
   std::array<double, 5> distortion{};  ///< k1, k2, p1, p2, k3 (OpenCV order)
 
+  /// A 640 x 480 camera (Kinect-class sensors, TUM sequences) without distortion.
+  static PinholeCamera vga(double fx_, double fy_, double cx_, double cy_) {
+    PinholeCamera c;
+    c.fx = fx_;
+    c.fy = fy_;
+    c.cx = cx_;
+    c.cy = cy_;
+    return c;
+  }
+
   /// Point in the camera optical frame seen at pixel (u, v) with depth z (metres, along +z).
   Eigen::Vector3d backproject(double u, double v, double z) const {
     return {(u - cx) * z / fx, (v - cy) * z / fy, z};

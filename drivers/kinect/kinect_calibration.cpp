@@ -5,27 +5,13 @@
 #include "common/error.h"
 
 namespace kestrel::kinect {
-namespace {
-
-PinholeCamera camera(double fx, double fy, double cx, double cy) {
-  PinholeCamera c;
-  c.width = 640;
-  c.height = 480;
-  c.fx = fx;
-  c.fy = fy;
-  c.cx = cx;
-  c.cy = cy;
-  return c;
-}
-
-}  // namespace
 
 KinectCalibration KinectCalibration::standard() {
   KinectCalibration c;
-  c.rgb = camera(5.2921508098293293e+02, 5.2556393630057437e+02, 3.2894272028759258e+02,
-                 2.6748068171871557e+02);
-  c.ir = camera(5.9421434211923247e+02, 5.9104053696870778e+02, 3.3930780975300314e+02,
-                2.4273913761751615e+02);
+  c.rgb = PinholeCamera::vga(5.2921508098293293e+02, 5.2556393630057437e+02, 3.2894272028759258e+02,
+                                2.6748068171871557e+02);
+  c.ir = PinholeCamera::vga(5.9421434211923247e+02, 5.9104053696870778e+02, 3.3930780975300314e+02,
+                               2.4273913761751615e+02);
   Eigen::Matrix3d R;
   R << 9.9984628826577793e-01, 1.2635359098409581e-03, -1.7487233004436643e-02,
       -1.4779096108364480e-03, 9.9992385683542895e-01, -1.2251380107679535e-02,

@@ -3,20 +3,6 @@
 #include <filesystem>
 
 namespace kestrel::tum {
-namespace {
-
-PinholeCamera make(double fx, double fy, double cx, double cy) {
-  PinholeCamera c;
-  c.width = 640;
-  c.height = 480;
-  c.fx = fx;
-  c.fy = fy;
-  c.cx = cx;
-  c.cy = cy;
-  return c;
-}
-
-}  // namespace
 
 TumCamera detect_camera(const std::string& folder) {
   // "a/b/" has an empty filename(); the folder's own name is what TUM puts the camera in.
@@ -32,15 +18,15 @@ TumCamera detect_camera(const std::string& folder) {
 PinholeCamera camera_intrinsics(TumCamera camera) {
   switch (camera) {
     case TumCamera::kFreiburg1:
-      return make(517.3, 516.5, 318.6, 255.3);
+      return PinholeCamera::vga(517.3, 516.5, 318.6, 255.3);
     case TumCamera::kFreiburg2:
-      return make(520.9, 521.0, 325.1, 249.7);
+      return PinholeCamera::vga(520.9, 521.0, 325.1, 249.7);
     case TumCamera::kFreiburg3:
-      return make(535.4, 539.2, 320.1, 247.6);
+      return PinholeCamera::vga(535.4, 539.2, 320.1, 247.6);
     case TumCamera::kUnknown:
       break;
   }
-  return make(525.0, 525.0, 319.5, 239.5);
+  return PinholeCamera::vga(525.0, 525.0, 319.5, 239.5);
 }
 
 const char* camera_name(TumCamera camera) {
