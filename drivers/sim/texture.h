@@ -57,6 +57,41 @@ class MipTexture {
     return lerp(top, bottom, wy);
   }
 
+  /// Bilinear samples of level `l` along a line: out[i] at (x + i dx, y + i dy), where x, y
+  /// are level-l texel coordinates in 16.16 fixed point, half-texel offset already applied.
+  /// Unsigned arithmetic wraps at 2^16 texels, a multiple of every level's side, so the
+  /// coordinates wrap like the texture. The renderer's inner loop: no float, no branch.
+  void bilinear_span(int l, uint32_t x, uint32_t y, int32_t dx, int32_t dy, int n, uint32_t* out) const {
+    const uint32_t mask = static_cast<uint32_t>((size_ >> l) - 1);
+    const int shift = log2_size_ - l;
+    const uint32_t* d = levels_[l].data();
+    for (int i = 0; i < n; ++i) {
+      const uint32_t ix = (x >> 16) & mask, iy = (y >> 16) & mask;
+      const uint32_t wx = (x >> 8) & 255u, wy = (y >> 8) & 255u;
+      const uint32_t ix1 = (ix + 1) & mask, r0 = iy << shift, r1 = ((iy + 1) & mask) << shift;
+      out[i] = lerp(lerp(d[r0 | ix], d[r0 | ix1], wx), lerp(d[r1 | ix], d[r1 | ix1], wx), wy);
+      x += static_cast<uint32_t>(dx);
+      y += static_cast<uint32_t>(dy);
+    }
+  }
+
+  /// 16.16 fixed-point level-l coordinate (half-texel offset applied) of level-0 coordinate
+  /// `x`, reduced modulo the level's side first so float keeps sub-texel precision.
+  uint32_t fixed_coordinate(int l, float x) const {
+    const float side = static_cast<float>(size_ >> l);
+    float f = x * inverse_scale_[l] - 0.5f;
+    f -= side * floor_fast(f / side);
+    return static_cast<uint32_t>(static_cast<int32_t>(f * 65536.0f));
+  }
+  /// A step of `dx` level-0 texels in level-l 16.16 fixed point, reduced modulo the side
+  /// (which changes no sample, and keeps huge steps at coarse levels from overflowing).
+  int32_t fixed_step(int l, float dx) const {
+    const float side = static_cast<float>(size_ >> l);
+    float f = dx * inverse_scale_[l];
+    f -= side * floor_fast(f / side + 0.5f);
+    return static_cast<int32_t>(f * 65536.0f);
+  }
+
   /// The first channel of a grey texture at (x, y), bilinear in the level nearest `lod`.
   float sample_grey(float x, float y, float lod) const {
     const int l = std::clamp(static_cast<int>(lod + 0.5f), 0, levels() - 1);
