@@ -9,16 +9,23 @@ namespace kestrel::mapper {
 namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-// Inclusive index range [lo, hi] of pixels within one pixel of [a, b], clamped to [0, n).
+// Inclusive index range [lo, hi] of the pixels whose centre (at integer coordinates) lies in
+// [a, b], clamped to [0, n). The corners were grown by the margin, which covers rounding.
 void pixel_range(double a, double b, int n, int& lo, int& hi) {
-  lo = a <= -1e9 ? 0 : static_cast<int>(std::max(std::floor(a) - 1.0, 0.0));
-  hi = b >= 1e9 ? n - 1 : static_cast<int>(std::min(std::ceil(b) + 1.0, n - 1.0));
+  lo = a <= -1e9 ? 0 : static_cast<int>(std::max(std::ceil(a), 0.0));
+  hi = b >= 1e9 ? n - 1 : static_cast<int>(std::min(std::floor(b), n - 1.0));
   if (a > n + 1.0 || b < -1.0) hi = lo - 1;
+}
+
+bool same_camera(const PinholeCamera& a, const PinholeCamera& b) {
+  return a.width == b.width && a.height == b.height && a.fx == b.fx && a.fy == b.fy &&
+         a.cx == b.cx && a.cy == b.cy;
 }
 }  // namespace
 
-FootprintProjector::FootprintProjector(const KeySpace& keys, const Scan& scan)
-    : keys_(keys), cols_(scan.cols), rows_(scan.rows) {
+void FootprintProjector::begin(const Scan& scan) {
+  cols_ = scan.cols;
+  rows_ = scan.rows;
   const PinholeCamera& c = scan.camera;
   Eigen::Matrix3d K;
   K << c.fx, 0.0, c.cx, 0.0, c.fy, c.cy, 0.0, 0.0, 1.0;
@@ -33,17 +40,30 @@ FootprintProjector::FootprintProjector(const KeySpace& keys, const Scan& scan)
   column_dir_.resize(static_cast<size_t>(cols_));
   row_dir_.resize(static_cast<size_t>(rows_));
   const Eigen::Matrix3d R_world_camera = scan.T_world_camera.linear();
+  double max_x2 = 0.0, max_y2 = 0.0;
   for (int u = 0; u < cols_; ++u) {
-    ray_x_[static_cast<size_t>(u)] = (u - c.cx) / c.fx;
-    column_dir_[static_cast<size_t>(u)] = R_world_camera.col(0) * ray_x_[static_cast<size_t>(u)];
+    const double x = (u - c.cx) / c.fx;
+    ray_x_[static_cast<size_t>(u)] = x;
+    column_dir_[static_cast<size_t>(u)] = R_world_camera.col(0) * x;
+    max_x2 = std::max(max_x2, x * x);
   }
   for (int v = 0; v < rows_; ++v) {
-    ray_y_[static_cast<size_t>(v)] = (v - c.cy) / c.fy;
-    row_dir_[static_cast<size_t>(v)] =
-        R_world_camera.col(1) * ray_y_[static_cast<size_t>(v)] + R_world_camera.col(2);
+    const double y = (v - c.cy) / c.fy;
+    ray_y_[static_cast<size_t>(v)] = y;
+    row_dir_[static_cast<size_t>(v)] = R_world_camera.col(1) * y + R_world_camera.col(2);
+    max_y2 = std::max(max_y2, y * y);
   }
+  max_dir_norm_ = std::sqrt(1.0 + max_x2 + max_y2) * (1.0 + 1e-12);
+  if (!have_tiles_ || !same_camera(tile_camera_, c)) make_tiles(c);
+  // Float rounding moves OctoMap's origin and points by about 6e-8 of their coordinates;
+  // 1e-5 m plus 1e-7 of the origin's distance from 0 bounds that with a wide margin.
+  line_error_ = 1e-5 + 1e-7 * static_cast<double>(scan.origin.norm());
+}
+
+void FootprintProjector::make_tiles(const PinholeCamera& c) {
   // Tile cones: the axis through the tile's middle, and the widest angle to a ray through any
-  // of its pixels' corners (a tile is convex in the image, so its corners bound it).
+  // of its pixels' corners (a tile is convex in the image, so its corners bound it). They
+  // depend on the camera model only.
   tiles_x_ = (cols_ + kTilePixels - 1) / kTilePixels;
   const int tiles_y = (rows_ + kTilePixels - 1) / kTilePixels;
   tiles_.resize(static_cast<size_t>(tiles_x_) * tiles_y);
@@ -65,9 +85,32 @@ FootprintProjector::FootprintProjector(const KeySpace& keys, const Scan& scan)
       t.sin_half = std::sqrt(std::max(0.0, 1.0 - cos_half * cos_half));
     }
   }
-  // Float rounding moves OctoMap's origin and points by about 6e-8 of their coordinates;
-  // 1e-5 m plus 1e-7 of the origin's distance from 0 bounds that with a wide margin.
-  line_error_ = 1e-5 + 1e-7 * static_cast<double>(scan.origin.norm());
+  tile_camera_ = c;
+  have_tiles_ = true;
+}
+
+bool FootprintProjector::certainly_clears(const Key& cell, int u, int v, double s_end_lo) const {
+  // Parameter s = camera depth along the pixel's direction d (camera-z component 1), so
+  // distance = s |d|. OctoMap's ray lies within line_error + 1e-6 distance of the pixel's
+  // line (footprint header), and its walk's crossing times are off by far less than that;
+  // in s along axis a that is (line_error + 2e-6 s |d|) / |d_a|.
+  const Eigen::Vector3d d = column_dir_[static_cast<size_t>(u)] + row_dir_[static_cast<size_t>(v)];
+  double in = -kInf, out = kInf, out_outer = kInf, start = 0.0;
+  for (int a = 0; a < 3; ++a) {
+    const double da = d[a];
+    if (!(std::fabs(da) > 1e-6)) return false;  // nearly parallel to a face: leave it to the exact tests
+    const double inv = 1.0 / da;
+    const double t0 = (keys_.lower(cell[a]) - origin_[a]) * inv;
+    const double t1 = (keys_.upper(cell[a]) - origin_[a]) * inv;
+    const double s_in = std::min(t0, t1), s_out = std::max(t0, t1);
+    const double scale = std::fabs(inv);
+    const double tol = (line_error_ + 2e-6 * max_dir_norm_ * std::max(std::fabs(s_in), std::fabs(s_out))) * scale;
+    in = std::max(in, s_in + tol);
+    out = std::min(out, s_out - tol);
+    out_outer = std::min(out_outer, s_out + tol);
+    start = std::max(start, line_error_ * scale);
+  }
+  return std::max(in, start) < out && out_outer < s_end_lo;
 }
 
 bool FootprintProjector::slabs_may_clear(const CellFootprint& f, int u, int v,
@@ -90,14 +133,17 @@ bool FootprintProjector::slabs_may_clear(const CellFootprint& f, int u, int v,
     outer_out = std::min(outer_out, t_out + tol);
     inner_out = std::min(inner_out, t_out - tol);
   }
-  return outer_in <= outer_out && inner_out <= static_cast<double>(reach);
+  // outer_out < 0: the cell lies behind the camera along this line (the walk starts at 0).
+  return outer_in <= outer_out && outer_out >= 0.0 && inner_out <= static_cast<double>(reach);
 }
 
 bool FootprintProjector::centre_pixel(const Key& cell, int& u, int& v) const {
   const Eigen::Vector3d centre(keys_.centre(cell[0]), keys_.centre(cell[1]), keys_.centre(cell[2]));
   const Eigen::Vector3d h = P_.leftCols<3>() * centre + P_.col(3);
   if (!(h.z() > 0.0)) return false;
-  const double ur = std::round(h.x() / h.z()), vr = std::round(h.y() / h.z());
+  // Nearest pixel, rounding halves up (a plain cast truncates, which is floor here; std::round
+  // is a library call on the baseline x86-64 target).
+  const double ur = h.x() / h.z() + 0.5, vr = h.y() / h.z() + 0.5;
   if (!(ur >= 0.0 && vr >= 0.0 && ur < cols_ && vr < rows_)) return false;
   u = static_cast<int>(ur);
   v = static_cast<int>(vr);

@@ -8,6 +8,11 @@
 // Everything here is conservative: the cell is grown by a margin (1e-4 m) far larger than
 // the distance between a ray as OctoMap walks it (float origin, float point) and the exact
 // pixel direction used here (below 1e-6 m), so no ray that could touch the cell is left out.
+// certainly_clears() is the same bound used the other way: the cell shrunk and the ray
+// shortened by those errors, so a ray it accepts clears the cell in OctoMap's walk too.
+//
+// One projector serves every scan of an integrator: begin() redoes the pose-dependent parts
+// and keeps the per-tile cones while the camera model stays the same.
 
 #include <Eigen/Core>
 #include <vector>
@@ -39,12 +44,24 @@ struct CellFootprint {
 
 class FootprintProjector {
  public:
-  FootprintProjector(const KeySpace& keys, const Scan& scan);
+  explicit FootprintProjector(const KeySpace& keys) : keys_(keys) {}
+  void begin(const Scan& scan);
 
   /// The pixel nearest the image of the cell's centre, if the centre is in front of the camera
   /// and projects into the grid.
   bool centre_pixel(const Key& cell, int& u, int& v) const;
   CellFootprint footprint(const Key& cell) const;
+
+  /// True if OctoMap's walk of the ray through pixel (u, v) certainly clears the cell, given
+  /// that the ray's end lies at camera depth >= s_end_lo along the pixel's direction: the
+  /// pixel's line passes through the cell's interior, with room for every rounding error,
+  /// after the start and leaves it before the end. False says nothing (the caller goes on to
+  /// the exact tests). Never true for the origin's cell.
+  bool certainly_clears(const Key& cell, int u, int v, double s_end_lo) const;
+
+  /// Upper bound of the distance between OctoMap's float ray and the exact pixel line,
+  /// apart from the 1e-6 relative error of the direction.
+  double line_error() const { return line_error_; }
 
   /// False if no ray through the pixels of tile (ti, tj) can pass through the sphere around
   /// the cell (the tile's cone of directions and the sphere's cone do not overlap).
@@ -73,16 +90,21 @@ class FootprintProjector {
  private:
   bool slabs_may_clear(const CellFootprint& f, int u, int v, float reach) const;
 
+  void make_tiles(const PinholeCamera& camera);
+
   const KeySpace& keys_;
+  PinholeCamera tile_camera_;             // the camera the tiles were made for
+  bool have_tiles_ = false;
   Eigen::Matrix<double, 3, 4> P_;         // world -> homogeneous pixel (u z, v z, z)
   Eigen::Matrix3d R_camera_world_;
   Eigen::Vector3d t_camera_world_;
-  double origin_[3];
-  double margin_;
-  int cols_, rows_;
+  double origin_[3] = {0.0, 0.0, 0.0};
+  double margin_ = 0.0;
+  int cols_ = 0, rows_ = 0;
   std::vector<double> ray_x_, ray_y_;     // pixel ray direction (x/z, y/z) per column / row
   std::vector<Eigen::Vector3d> column_dir_, row_dir_;  // world-frame parts of the pixel rays
-  double line_error_;                     // distance of OctoMap's ray from the pixel's line
+  double line_error_ = 0.0;               // distance of OctoMap's ray from the pixel's line
+  double max_dir_norm_ = 1.0;             // largest |column_dir_ + row_dir_| over the pixels
   struct Tile {
     Eigen::Vector3d axis;  // unit direction of the tile's central ray, camera frame
     double cos_half, sin_half;  // half-angle of a cone holding every ray of the tile

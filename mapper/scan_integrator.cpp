@@ -18,11 +18,11 @@ constexpr int kNear = 2;  // the (2 kNear + 1)^2 pixels around the centre are tr
 void ScanUpdate::clear() {
   free.clear();
   occupied.clear();
-  rays = cells_tested = rays_traced = ray_tests = 0;
+  rays = cells_tested = cells_witnessed = rays_traced = ray_tests = 0;
 }
 
 ScanIntegrator::ScanIntegrator(double resolution_m, const ScanOptions& options)
-    : keys_(resolution_m), options_(options) {
+    : keys_(resolution_m), options_(options), projector_(keys_) {
   if (!(resolution_m > 0.0)) throw std::invalid_argument("ScanIntegrator: resolution must be > 0");
   options_.validate();
   // The cleared cells of a scan lie within max range of the camera's cell; two cells of margin
@@ -53,39 +53,65 @@ void ScanIntegrator::begin(const Scan& scan) {
                      ": camera centre is outside the map's key range");
   }
   for (int a = 0; a < 3; ++a) base_[a] = key_origin_[a] - side_ / 2;
+  stride_[0] = 1;
+  stride_[1] = side_;
+  stride_[2] = side_ * side_;
   classifier_.emplace(keys_, scan.origin, key_origin_);
   ++epoch_;
-  cells_tested_ = rays_traced_ = ray_tests_ = 0;
+  cells_tested_ = cells_witnessed_ = rays_traced_ = ray_tests_ = 0;
   queue_.clear();
-
-  projector_.emplace(keys_, scan);
+  projector_.begin(scan);
 
   const size_t n = scan.points.size();
   if (rays_.size() < n) rays_.resize(n);
   reach_.assign(n, 0.0f);
+  s_end_lo_.assign(n, 0.0f);
   end_cell_.assign(n, -1);
   const int tiles_x = (scan.cols + kTile - 1) / kTile;
   const int tiles_y = (scan.rows + kTile - 1) / kTile;
   tile_reach_.assign(static_cast<size_t>(tiles_x) * tiles_y, 0.0f);
+  begin_pixels(scan);
+}
 
-  // Occupied cells, and how far each ray can reach (for pruning the cell search).
+void ScanIntegrator::begin_pixels(const Scan& scan) {
+  // Per ray: its hit's cell (occupied), an upper bound of its length (pruning the exact
+  // search) and a lower bound of its end's camera depth (the witness test), all from the
+  // float point and origin exactly as OctoMap's make-ray rule sees them (ray.h).
   const double max_range = options_.max_range_m;
+  const Eigen::Vector3d z_axis = scan.T_world_camera.linear().col(2);
+  const double line = projector_.line_error();
+  // A cut ray's end may leave the key range (and then clears nothing) only for a camera
+  // within max range of the range's edge; there the witness is not used.
+  const double edge = KeySpace::kMaxVal * keys_.resolution() - max_range - 1.0;
+  bool witness_ok = true;
+  for (int a = 0; a < 3; ++a) witness_ok = witness_ok && std::fabs(static_cast<double>(scan.origin(a))) < edge;
+  const int tiles_x = (scan.cols + kTile - 1) / kTile;
   for (int v = 0; v < scan.rows; ++v) {
+    float* tile_row = &tile_reach_[static_cast<size_t>(v / kTile) * tiles_x];
     for (int u = 0; u < scan.cols; ++u) {
       const size_t i = static_cast<size_t>(v) * scan.cols + u;
       if (!scan.valid[i]) continue;
       const octomap::point3d& p = scan.points[i];
-      const double range = (p - scan.origin).norm();
+      const octomap::point3d offset = p - scan.origin;
+      const double range = offset.norm();  // float sum of squares, double root: OctoMap's
+      const double depth = z_axis.x() * static_cast<double>(offset.x()) +
+                           z_axis.y() * static_cast<double>(offset.y()) +
+                           z_axis.z() * static_cast<double>(offset.z());
+      double s_end = 0.0;
       if (range <= max_range) {
         Key k;
-        if (keys_.key(p, k)) {
-          mark(k, kOccupied);
-          end_cell_[i] = index(k);
-        }
+        if (!keys_.key(p, k)) continue;  // OctoMap drops such a point altogether
+        mark(k, kOccupied);
+        end_cell_[i] = index(k);
+        s_end = depth - 4.0 * line - 1e-6 * range;
+      } else if (depth > 0.0) {
+        const double dir_norm = range / depth * (1.0 + 1e-6);
+        s_end = (max_range * (1.0 - 2e-6) - 2.0 * line) / dir_norm;
       }
+      if (witness_ok && s_end > 0.0) s_end_lo_[i] = static_cast<float>(s_end * (1.0 - 1e-6));
       const float reach = static_cast<float>(std::min(range, max_range) * (1.0 + 1e-6) + 1e-6);
       reach_[i] = reach;
-      float& tile = tile_reach_[static_cast<size_t>(v / kTile) * tiles_x + u / kTile];
+      float& tile = tile_row[u / kTile];
       tile = std::max(tile, reach);
     }
   }
@@ -107,7 +133,14 @@ void ScanIntegrator::set_cleared(int idx, const Key& key) {
   if (f & kCleared) return;
   if (f == 0) touched_.emplace_back(idx, key);
   f = static_cast<uint8_t>(f | kCleared | kTested);
-  queue_.push_back(key);
+  queue_.push_back({idx, key});
+}
+
+bool ScanIntegrator::witness_clears(const Key& cell) {
+  int u = 0, v = 0;
+  if (!projector_.centre_pixel(cell, u, v)) return false;
+  const float s_end = s_end_lo_[static_cast<size_t>(v) * scan_->cols + u];
+  return s_end > 0.0f && projector_.certainly_clears(cell, u, v, s_end);
 }
 
 void ScanIntegrator::trace_sample(size_t sample) {
@@ -141,35 +174,53 @@ bool ScanIntegrator::try_ray(size_t sample, const Key& cell, int idx) {
 }
 
 bool ScanIntegrator::cleared_by_some_ray(const Key& cell, int idx) {
-  // Most cells are answered by the ray through the pixel nearest the cell's centre.
-  int u = 0, v = 0;
-  size_t witness = std::numeric_limits<size_t>::max();
-  if (projector_->centre_pixel(cell, u, v)) {
-    witness = static_cast<size_t>(v) * scan_->cols + u;
-    if (reach_[witness] > 0.0f && try_ray(witness, cell, idx)) return true;
-  }
-  // Otherwise every ray whose pixel lies in the cell's image and that reaches far enough,
-  // nearest the centre first (the likeliest to pass through), then the rest tile by tile.
-  const CellFootprint f = projector_->footprint(cell);
+  const CellFootprint f = projector_.footprint(cell);
   if (f.empty()) return false;
   const int cols = scan_->cols;
-  auto candidate = [&](int pu, int pv) {
-    const size_t s = static_cast<size_t>(pv) * cols + pu;
-    return s != witness && reach_[s] >= f.min_reach && reach_[s] > 0.0f && end_cell_[s] != idx &&
-           projector_->may_clear(f, pu, pv, reach_[s]);
-  };
+  const int tiles_x = (cols + kTile - 1) / kTile;
+  const int tj0 = f.j0 / kTile, tj1 = f.j1 / kTile, ti0 = f.i0 / kTile, ti1 = f.i1 / kTile;
+  // No ray in the cell's image reaches the cell's far side: the common case behind surfaces.
+  bool reaches = false;
+  for (int tj = tj0; tj <= tj1 && !reaches; ++tj) {
+    for (int ti = ti0; ti <= ti1; ++ti) {
+      if (tile_reach_[static_cast<size_t>(tj) * tiles_x + ti] >= f.min_reach) {
+        reaches = true;
+        break;
+      }
+    }
+  }
+  if (!reaches) return false;
+  // Rays near the centre that certainly clear it (the witness missed through a hole in the
+  // depth or at the image border); no walk needed.
   const int near_i0 = std::max(f.i0, f.u_centre - kNear), near_i1 = std::min(f.i1, f.u_centre + kNear);
   const int near_j0 = std::max(f.j0, f.v_centre - kNear), near_j1 = std::min(f.j1, f.v_centre + kNear);
+  for (int pv = near_j0; pv <= near_j1; ++pv) {
+    for (int pu = near_i0; pu <= near_i1; ++pu) {
+      const size_t s = static_cast<size_t>(pv) * cols + pu;
+      if (s_end_lo_[s] > 0.0f && reach_[s] >= f.min_reach &&
+          projector_.certainly_clears(cell, pu, pv, s_end_lo_[s])) {
+        ++cells_witnessed_;
+        return true;
+      }
+    }
+  }
+  // Otherwise every ray whose pixel lies in the cell's image and that reaches far enough goes
+  // to the exact test, nearest the centre first (the likeliest to pass through), then the rest
+  // tile by tile.
+  auto candidate = [&](int pu, int pv) {
+    const size_t s = static_cast<size_t>(pv) * cols + pu;
+    return reach_[s] >= f.min_reach && reach_[s] > 0.0f && end_cell_[s] != idx &&
+           projector_.may_clear(f, pu, pv, reach_[s]);
+  };
   for (int pv = near_j0; pv <= near_j1; ++pv) {
     for (int pu = near_i0; pu <= near_i1; ++pu) {
       if (candidate(pu, pv) && try_ray(static_cast<size_t>(pv) * cols + pu, cell, idx)) return true;
     }
   }
-  const int tiles_x = (cols + kTile - 1) / kTile;
-  for (int tj = f.j0 / kTile; tj <= f.j1 / kTile; ++tj) {
-    for (int ti = f.i0 / kTile; ti <= f.i1 / kTile; ++ti) {
+  for (int tj = tj0; tj <= tj1; ++tj) {
+    for (int ti = ti0; ti <= ti1; ++ti) {
       if (tile_reach_[static_cast<size_t>(tj) * tiles_x + ti] < f.min_reach ||
-          !projector_->tile_may_pass(f, ti, tj))
+          !projector_.tile_may_pass(f, ti, tj))
         continue;
       const int pv_end = std::min(f.j1, tj * kTile + kTile - 1);
       const int pu_end = std::min(f.i1, ti * kTile + kTile - 1);
@@ -195,21 +246,27 @@ void ScanIntegrator::grow_from_origin() {
     }
   }
   for (size_t head = 0; head < queue_.size(); ++head) {
-    const Key from = queue_[head];
+    const Pending from = queue_[head];
     for (int n = 0; n < 6; ++n) {
       const int axis = n >> 1;
-      const int k = from[axis] + ((n & 1) ? 1 : -1);
-      if (k < 0 || k > 0xffff) continue;
-      Key cell = from;
-      cell[axis] = static_cast<uint16_t>(k);
-      const int idx = index(cell);
-      if (idx < 0) continue;
+      const int step = (n & 1) ? 1 : -1;
+      const int k = from.key[axis] + step;
+      // Cleared cells lie within max range, two cells inside the grid; this never fails.
+      if (k - base_[axis] < 0 || k - base_[axis] >= side_) continue;
+      const int idx = from.idx + step * stride_[axis];
       uint8_t& f = cells_[static_cast<size_t>(idx)];
       if (f & kTested) continue;
+      Key cell = from.key;
+      cell[axis] = static_cast<uint16_t>(k);
       if (f == 0) touched_.emplace_back(idx, cell);
       f = static_cast<uint8_t>(f | kTested);
       ++cells_tested_;
-      if (cleared_by_some_ray(cell, idx)) set_cleared(idx, cell);
+      if (witness_clears(cell)) {
+        ++cells_witnessed_;
+        set_cleared(idx, cell);
+      } else if (cleared_by_some_ray(cell, idx)) {
+        set_cleared(idx, cell);
+      }
     }
   }
 }
@@ -239,6 +296,7 @@ void ScanIntegrator::compute(const Scan& scan, ScanUpdate& update, Method method
     grow_from_origin();
   }
   update.cells_tested = cells_tested_;
+  update.cells_witnessed = cells_witnessed_;
   update.rays_traced = rays_traced_;
   update.ray_tests = ray_tests_;
   collect(update);

@@ -93,13 +93,14 @@ void BM_Cells(benchmark::State& state, ScanIntegrator::Method method) {
   ScanIntegrator integrator(0.1, o);
   ScanUpdate update;
   size_t i = 0;
-  double rays = 0, free = 0, occupied = 0, tested = 0, traced = 0, tests = 0;
+  double rays = 0, free = 0, occupied = 0, tested = 0, witnessed = 0, traced = 0, tests = 0;
   for (auto _ : state) {
     integrator.compute(s[i++ % s.size()], update, method);
     rays += update.rays;
     free += update.free.size();
     occupied += update.occupied.size();
     tested += update.cells_tested;
+    witnessed += update.cells_witnessed;
     traced += update.rays_traced;
     tests += update.ray_tests;
   }
@@ -108,6 +109,7 @@ void BM_Cells(benchmark::State& state, ScanIntegrator::Method method) {
   state.counters["free"] = free / n;
   state.counters["occ"] = occupied / n;
   state.counters["tested"] = tested / n;
+  state.counters["witnessed"] = witnessed / n;
   state.counters["traced"] = traced / n;
   state.counters["tests"] = tests / n;
 }
