@@ -25,43 +25,58 @@ void make_kinect_depth(const Rasterizer& raster, const std::vector<float>& ir_re
   const float ret_lo = static_cast<float>(o.return_low), ret_hi = static_cast<float>(o.return_high);
   const float k = static_cast<float>(o.noise_k), jump = static_cast<float>(o.edge_jump);
   const float edge_keep = static_cast<float>(1.0 - o.edge_dropout);
-  std::vector<uint8_t> shadow(static_cast<size_t>(w));
+  const bool noise = o.noise;
+  const float k_used = noise ? k : 0.0f;
+  // Without noise every draw is 0.5: the model's mean behaviour.
+  const float draw = noise ? 1.0f : 0.0f, fixed_draw = noise ? 0.0f : 0.5f;
+  // Row buffers, per thread. inv is copied with a zero on each side: a missing neighbour is
+  // never "markedly nearer" (0 - iz > jump iz is false for iz > 0).
+  thread_local std::vector<float> padded;
+  thread_local std::vector<uint8_t> usable;
+  padded.assign(static_cast<size_t>(w) + 2, 0.0f);
+  usable.resize(static_cast<size_t>(w));
+  uint8_t* ok = usable.data();
   for (int v = 0; v < h; ++v) {
     const uint16_t* ids = raster.ids(v);
     const float* inv = raster.inverse_depth(v);
     const float* ir = ir_return.data() + static_cast<size_t>(v) * w;
     uint16_t* out = depth_mm.ptr<uint16_t>(v);
     // Projector shadow: scanning from the right, a point whose projector column lies right
-    // of a nearer point already seen is hidden from the projector.
+    // of a nearer point already seen is hidden from the projector. (Sequential: scalar.)
     float leftmost = std::numeric_limits<float>::infinity();
     for (int u = w - 1; u >= 0; --u) {
-      shadow[static_cast<size_t>(u)] = 0;
-      if (ids[u] == Rasterizer::kNone) continue;
-      const float up = static_cast<float>(u) - shift_px * inv[u];
-      if (up > leftmost + 1e-3f) shadow[static_cast<size_t>(u)] = 1;
-      else leftmost = std::min(leftmost, up);
+      bool seen = ids[u] != Rasterizer::kNone;
+      if (seen) {
+        const float up = static_cast<float>(u) - shift_px * inv[u];
+        if (up > leftmost + 1e-3f) seen = false;
+        else leftmost = std::min(leftmost, up);
+      }
+      ok[u] = seen && inv[u] >= inv_min && inv[u] <= inv_max;
     }
+    std::copy(inv, inv + w, padded.begin() + 1);
+    const float* pad = padded.data() + 1;
+    // Everything else is per pixel and branch-free, so the compiler vectorises it.
+    const uint32_t row_key = static_cast<uint32_t>(v * w);
     for (int u = 0; u < w; ++u) {
-      out[u] = 0;
-      const float iz = inv[u];
-      if (ids[u] == Rasterizer::kNone || shadow[static_cast<size_t>(u)] || iz < inv_min || iz > inv_max) continue;
-      const uint32_t bits = hash32(static_cast<uint32_t>(v * w + u) ^ key);
+      const float iz = pad[u];
+      const uint32_t bits = hash32((row_key + static_cast<uint32_t>(u)) ^ key);
       const float u1 = static_cast<float>(bits & 1023u) * kUnit;          // weak return
       const float u2 = static_cast<float>((bits >> 10) & 1023u) * kUnit;  // discontinuity
       // Weak IR return.
       const float signal = ir[u] * iz * iz;
-      const float p_return = std::clamp((signal - ret_lo) / (ret_hi - ret_lo), 0.0f, 1.0f);
-      if (o.noise ? u1 >= p_return : p_return < 0.5f) continue;
+      const float p_return = std::min(std::max((signal - ret_lo) / (ret_hi - ret_lo), 0.0f), 1.0f);
+      // Draws compared with '>' / '<' alike in both modes, so there is no branch.
+      const bool returned = (draw * u1 + fixed_draw) < p_return;
       // Far side of a discontinuity (a neighbour markedly nearer).
-      const bool edge = (u > 0 && inv[u - 1] - iz > jump * iz) || (u + 1 < w && inv[u + 1] - iz > jump * iz);
-      if (edge && (o.noise ? u2 >= edge_keep : edge_keep < 0.5f)) continue;
-      float z = 1.0f / iz;
-      if (o.noise) z += k * z * z * normal[bits >> 20];
-      if (!(z > 0.0f)) continue;
-      const float quantised = std::nearbyint(1.0f / (z * q)) * q;  // disparity steps
-      if (!(quantised > 0.0f)) continue;
-      const float mm = 1000.0f / quantised;
-      out[u] = mm >= 65535.0f ? 0 : static_cast<uint16_t>(mm + 0.5f);
+      const bool edge = (pad[u - 1] - iz > jump * iz) | (pad[u + 1] - iz > jump * iz);
+      const bool dropped = edge & ((draw * u2 + fixed_draw) > edge_keep);
+      const float z_true = 1.0f / std::max(iz, 1e-6f);
+      const float z = z_true + k_used * z_true * z_true * normal[bits >> 20];
+      // Quantised in disparity steps (round half up; the argument is positive, < 2^31).
+      const float steps = static_cast<float>(static_cast<int32_t>(1.0f / (std::max(z, 1e-3f) * q) + 0.5f));
+      const float mm = 1000.0f / (std::max(steps, 1.0f) * q);
+      const bool good = (ok[u] != 0) & returned & !dropped & (z > 0.0f) & (steps > 0.0f) & (mm < 65535.0f);
+      out[u] = static_cast<uint16_t>(static_cast<int32_t>(good ? mm + 0.5f : 0.0f));
     }
   }
 }
