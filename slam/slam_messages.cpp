@@ -1,5 +1,6 @@
 #include "slam/slam_messages.h"
 
+#include "common/geometry/se3.h"
 #include "common/transport/convert.h"
 
 namespace kestrel::slam {
@@ -49,10 +50,20 @@ kestrel::slam_correction_t correction_message(const Slam& slam, double sigma_tra
   m.utime = kf.utime;
   m.keyframe_id = kf.id;
   m.graph_revision = slam.revision();
-  m.T_world_body = transport::to_message(slam.graph().poses.back() * kf.T_body_camera.inverse());
+  const Eigen::Isometry3d T_world_body = slam.graph().poses.back() * kf.T_body_camera.inverse();
+  m.T_world_body = transport::to_message(T_world_body);
   Matrix6d covariance = Matrix6d::Zero();
-  covariance.diagonal().head<3>().setConstant(sigma_translation_m * sigma_translation_m);
-  covariance.diagonal().tail<3>().setConstant(sigma_rotation_rad * sigma_rotation_rad);
+  if (const auto& marginal = slam.newest_covariance()) {
+    // A right perturbation xi of T_world_camera moves T_world_body by Ad(T_body_camera) xi on
+    // the right; pose_t wants the translation part in the world frame.
+    Matrix6d J = se3::adjoint(kf.T_body_camera);
+    J.topRows<3>() = (T_world_body.linear() * J.topRows<3>()).eval();
+    covariance = J * *marginal * J.transpose();
+    covariance = 0.5 * (covariance + covariance.transpose()).eval();
+  } else {
+    covariance.diagonal().head<3>().setConstant(sigma_translation_m * sigma_translation_m);
+    covariance.diagonal().tail<3>().setConstant(sigma_rotation_rad * sigma_rotation_rad);
+  }
   transport::covariance_to(covariance, m.covariance);
   return m;
 }

@@ -19,8 +19,10 @@ VoMotion motion_from_message(const kestrel::vo_update_t& m, const char* channel)
 
 kestrel::slam_graph_t graph_message(const Slam& slam);
 
-/// The correction for the newest keyframe, with a diagonal covariance of the given standard
-/// deviations (metres, radians); the slam must have a keyframe.
+/// The correction for the newest keyframe; the slam must have a keyframe. Its covariance is
+/// the optimiser's marginal of that keyframe (Slam::newest_covariance) carried to the body
+/// frame in pose_t's convention; when there is none, a diagonal one of the given standard
+/// deviations (metres, radians).
 kestrel::slam_correction_t correction_message(const Slam& slam, double sigma_translation_m,
                                               double sigma_rotation_rad);
 

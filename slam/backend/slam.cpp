@@ -6,6 +6,7 @@
 
 #include "common/error.h"
 #include "common/geometry/se3.h"
+#include "slam/posegraph/marginals.h"
 
 namespace kestrel::slam {
 namespace {
@@ -61,6 +62,7 @@ void Slam::reset() {
   last_utime_ = 0;
   have_frame_ = false;
   gate_by_pose_ = true;
+  newest_covariance_.reset();
 }
 
 bool Slam::wants_keyframe(const Eigen::Isometry3d& T_odom_camera, bool odometry_broken) const {
@@ -147,6 +149,7 @@ SlamStep Slam::close_loop(SlamStep step) {
     step.loop_keyframe_id = earlier.id;
     ++loop_closures_;
     step.optimisation = optimize(graph_, options_.optimizer);
+    newest_covariance_ = marginal_covariance(graph_, static_cast<int>(query.id), options_.optimizer.kernel);
     ++revision_;
     gate_by_pose_ = true;
     break;  // the paper stops at the first success

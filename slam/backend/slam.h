@@ -65,6 +65,10 @@ class Slam {
   const PoseGraph3d& graph() const { return graph_; }
   int64_t revision() const { return revision_; }
   int num_loop_closures() const { return loop_closures_; }
+  /// Marginal covariance of the newest keyframe's optimised T_world_camera after the last
+  /// optimisation (marginals.h: [rho; phi], right perturbation in the camera frame); nullopt
+  /// before any optimisation or when the graph did not determine it.
+  const std::optional<Matrix6d>& newest_covariance() const { return newest_covariance_; }
 
   /// The optimised estimate of a camera seen at T_odom_camera after the newest keyframe: the
   /// newest keyframe's optimised pose composed with the odometry since.
@@ -87,6 +91,7 @@ class Slam {
   int loop_closures_ = 0;
   int64_t last_utime_ = 0;
   bool have_frame_ = false;
+  std::optional<Matrix6d> newest_covariance_;
   bool gate_by_pose_ = true;  ///< off from an odometry break until a loop closure re-anchors
 };
 

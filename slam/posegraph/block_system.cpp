@@ -11,34 +11,50 @@ BlockSystem<D>::BlockSystem(int num_blocks, const std::vector<std::pair<int, int
     : num_blocks_(num_blocks),
       diagonal_(num_blocks),
       slot_of_pair_(pairs.size()),
+      position_(num_blocks, -1),
       diagonal_offset_(num_blocks),
       rhs_(Vector::Zero(static_cast<Eigen::Index>(num_blocks) * D)) {
   if (num_blocks <= 0) throw std::invalid_argument("BlockSystem: no unknowns");
-  // The blocks above the diagonal, by column block then row block, without repeats.
-  std::vector<std::pair<int, int>> upper;  // (col_block, row_block)
+  if (block_order.size() != static_cast<size_t>(num_blocks)) {
+    throw std::invalid_argument("BlockSystem: the order must list every block once");
+  }
+  for (int k = 0; k < num_blocks; ++k) {
+    const int b = block_order[static_cast<size_t>(k)];
+    if (b < 0 || b >= num_blocks || position_[b] >= 0) {
+      throw std::invalid_argument("BlockSystem: the order must list every block once");
+    }
+    position_[b] = k;
+  }
+  // The blocks above the diagonal of the permuted matrix, by column then row, without repeats.
+  std::vector<std::pair<int, int>> upper;  // (col position, row position)
   upper.reserve(pairs.size());
   for (const auto& [a, b] : pairs) {
     if (a == b || a < 0 || b < 0 || a >= num_blocks || b >= num_blocks) {
       throw std::invalid_argument("BlockSystem: bad block pair");
     }
-    upper.emplace_back(std::max(a, b), std::min(a, b));
+    upper.emplace_back(std::max(position_[a], position_[b]), std::min(position_[a], position_[b]));
   }
   std::vector<int> order(pairs.size());
   for (size_t k = 0; k < order.size(); ++k) order[k] = static_cast<int>(k);
   std::sort(order.begin(), order.end(), [&](int x, int y) { return upper[x] < upper[y]; });
 
-  std::vector<int> count(num_blocks, 0);  // off-diagonal blocks per column block
+  std::vector<int> count(num_blocks, 0);  // off-diagonal blocks per column position
   for (size_t r = 0; r < order.size(); ++r) {
     const auto& key = upper[order[r]];
     if (r == 0 || key != upper[order[r - 1]]) {
-      slots_.push_back(Slot{key.second, key.first, count[key.first] * D});
+      const auto& [a, b] = pairs[static_cast<size_t>(order[r])];
+      const int lo = std::min(a, b), hi = std::max(a, b);
+      // The stored block is H(lo, hi); in the permuted upper triangle it lands transposed
+      // when hi is eliminated before lo.
+      slots_.push_back(Slot{lo, hi, key.second, key.first, count[key.first] * D, position_[lo] > position_[hi]});
       ++count[key.first];
     }
     slot_of_pair_[order[r]] = static_cast<int>(slots_.size()) - 1;
   }
   offdiagonal_.resize(slots_.size());
 
-  // Column c*D+k holds the D rows of each block above the diagonal, then rows c*D..c*D+k.
+  // Column c*D+k (c a position) holds the D rows of each block above the diagonal, then rows
+  // c*D..c*D+k.
   const int n = num_blocks * D;
   col_ptr_.assign(n + 1, 0);
   for (int c = 0; c < num_blocks; ++c) {
@@ -50,8 +66,8 @@ BlockSystem<D>::BlockSystem(int num_blocks, const std::vector<std::pair<int, int
   std::vector<int> row_idx(col_ptr_.back());
   for (const Slot& s : slots_) {
     for (int k = 0; k < D; ++k) {
-      int* rows = row_idx.data() + col_ptr_[s.col_block * D + k] + s.offset;
-      for (int a = 0; a < D; ++a) rows[a] = s.row_block * D + a;
+      int* rows = row_idx.data() + col_ptr_[s.col * D + k] + s.offset;
+      for (int a = 0; a < D; ++a) rows[a] = s.row * D + a;
     }
   }
   for (int c = 0; c < num_blocks; ++c) {
@@ -60,7 +76,9 @@ BlockSystem<D>::BlockSystem(int num_blocks, const std::vector<std::pair<int, int
       for (int a = 0; a <= k; ++a) rows[a] = c * D + a;
     }
   }
-  cholesky_ = std::make_unique<SparseCholesky>(n, col_ptr_, std::move(row_idx), D, block_order);
+  // Already in elimination order: CHOLMOD factorises it as it is, without permuting the matrix
+  // at every factorisation (a copy that cost as much as the factorisation on small graphs).
+  cholesky_ = std::make_unique<SparseCholesky>(n, col_ptr_, std::move(row_idx), D, std::vector<int>{});
   set_zero();
 }
 
@@ -78,14 +96,19 @@ bool BlockSystem<D>::factorize(double lambda, double min_diagonal) {
     const Slot& slot = slots_[s];
     const Block& B = offdiagonal_[s];
     for (int k = 0; k < D; ++k) {
-      double* dst = x + col_ptr_[slot.col_block * D + k] + slot.offset;
-      for (int a = 0; a < D; ++a) dst[a] = B(a, k);
+      double* dst = x + col_ptr_[slot.col * D + k] + slot.offset;
+      if (slot.transposed) {
+        for (int a = 0; a < D; ++a) dst[a] = B(k, a);
+      } else {
+        for (int a = 0; a < D; ++a) dst[a] = B(a, k);
+      }
     }
   }
   for (int c = 0; c < num_blocks_; ++c) {
     const Block& B = diagonal_[c];
+    const int p = position_[c];
     for (int k = 0; k < D; ++k) {
-      double* dst = x + col_ptr_[c * D + k] + diagonal_offset_[c];
+      double* dst = x + col_ptr_[p * D + k] + diagonal_offset_[p];
       for (int a = 0; a < k; ++a) dst[a] = B(a, k);
       dst[k] = B(k, k) + lambda * std::max(B(k, k), min_diagonal);
     }
@@ -95,9 +118,7 @@ bool BlockSystem<D>::factorize(double lambda, double min_diagonal) {
 
 template <int D>
 typename BlockSystem<D>::Vector BlockSystem<D>::solve_factored(const Vector& b) const {
-  Vector x = b;
-  cholesky_->solve(x.data(), 1);
-  return x;
+  return solve_factored(Eigen::MatrixXd(b)).col(0);
 }
 
 template <int D>
@@ -105,9 +126,12 @@ Eigen::MatrixXd BlockSystem<D>::solve_factored(const Eigen::MatrixXd& b) const {
   if (b.rows() != static_cast<Eigen::Index>(num_blocks_) * D) {
     throw std::invalid_argument("BlockSystem: right-hand side of the wrong size");
   }
-  Eigen::MatrixXd x = b;
+  Eigen::MatrixXd x(b.rows(), b.cols());
+  for (int c = 0; c < num_blocks_; ++c) x.middleRows<D>(position_[c] * D) = b.middleRows<D>(c * D);
   cholesky_->solve(x.data(), static_cast<int>(x.cols()));
-  return x;
+  Eigen::MatrixXd out(b.rows(), b.cols());
+  for (int c = 0; c < num_blocks_; ++c) out.middleRows<D>(c * D) = x.middleRows<D>(position_[c] * D);
+  return out;
 }
 
 template <int D>
@@ -124,9 +148,8 @@ typename BlockSystem<D>::Vector BlockSystem<D>::multiply(const Vector& x, double
   for (size_t s = 0; s < slots_.size(); ++s) {
     const Slot& slot = slots_[s];
     const Block& B = offdiagonal_[s];
-    y.template segment<D>(slot.row_block * D).noalias() += B * x.template segment<D>(slot.col_block * D);
-    y.template segment<D>(slot.col_block * D).noalias() +=
-        B.transpose() * x.template segment<D>(slot.row_block * D);
+    y.template segment<D>(slot.lo * D).noalias() += B * x.template segment<D>(slot.hi * D);
+    y.template segment<D>(slot.hi * D).noalias() += B.transpose() * x.template segment<D>(slot.lo * D);
   }
   return y;
 }

@@ -4,7 +4,8 @@
 // joined by an edge: assembled block by block, factorised with CHOLMOD.
 //
 // The pattern is fixed at construction (one symbolic analysis); between factorisations only
-// the values change. Blocks are accumulated densely and scattered into the upper triangle in
+// the values change. The matrix handed to CHOLMOD is already permuted into the fill-reducing
+// order, so that a factorisation does not first copy it into that order. Blocks are accumulated densely and scattered into the upper triangle in
 // compressed-column form when factorising, with Levenberg-Marquardt damping added on the way.
 // The last factorisation stays available while new values are accumulated, so that it can
 // precondition later systems (multiply() and solve_factored()).
@@ -60,15 +61,18 @@ class BlockSystem {
 
  private:
   struct Slot {
-    int row_block, col_block;
-    int offset;  ///< position of the block's first row among the entries of each column
+    int lo, hi;       ///< the blocks, lo < hi: the slot holds H(lo, hi)
+    int row, col;     ///< their positions in elimination order, row < col
+    int offset;       ///< position of the block's first row among the entries of each column
+    bool transposed;  ///< H(lo, hi) lands transposed in the permuted upper triangle
   };
   int num_blocks_;
   std::vector<Block, Eigen::aligned_allocator<Block>> diagonal_;
   std::vector<Block, Eigen::aligned_allocator<Block>> offdiagonal_;
   std::vector<Slot> slots_;
   std::vector<int> slot_of_pair_;
-  std::vector<int> diagonal_offset_;  ///< per block: offset of its diagonal block in its columns
+  std::vector<int> position_;         ///< per block: its place in the elimination order
+  std::vector<int> diagonal_offset_;  ///< per position: offset of its diagonal block in its columns
   std::vector<int> col_ptr_;
   Vector rhs_;
   std::unique_ptr<SparseCholesky> cholesky_;

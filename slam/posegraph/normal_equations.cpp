@@ -1,6 +1,9 @@
 #include "slam/posegraph/normal_equations.h"
 
+#include <Eigen/Cholesky>
 #include <algorithm>
+
+#include "common/geometry/se3.h"
 
 namespace kestrel::slam {
 namespace {
@@ -8,14 +11,24 @@ namespace {
 // The prior that holds the gauge vertex, relative to the mean diagonal of its block.
 constexpr double kGaugePrior = 1e-6;
 
+// The local coordinates (spaces.h retractions) of an infinitesimal rigid motion xi of the
+// whole graph applied on the left: d = A xi.
+Se2::Matrix rigid_motion_in_local(const Se2::Pose& X) {
+  Se2::Matrix A = Se2::Matrix::Identity();  // SE(2) retracts in world coordinates
+  A(0, 2) = -X.y();
+  A(1, 2) = X.x();
+  return A;
+}
+Se3::Matrix rigid_motion_in_local(const Se3::Pose& X) { return se3::adjoint(X.inverse()); }
+
 }  // namespace
 
 template <class Space>
 NormalEquations<Space>::NormalEquations(const PoseGraph<Space>& graph, const RobustKernel& kernel,
-                                        const std::vector<int>& vertex_order)
+                                        const std::vector<int>& vertex_order, bool free_gauge)
     : graph_(graph), kernel_(kernel) {
   index_ = unknown_indices(graph, &num_unknowns_);
-  if (num_unknowns_ == graph.num_vertices() - 1) {
+  if (free_gauge && num_unknowns_ == graph.num_vertices() - 1) {
     // One fixed vertex: make it an unknown too (see the header).
     gauge_vertex_ = static_cast<int>(std::find(index_.begin(), index_.end(), -1) - index_.begin());
     num_unknowns_ = 0;
@@ -144,6 +157,28 @@ Eigen::VectorXd NormalEquations<Space>::acceleration_rhs(const Poses& poses,
     if (j >= 0) b.template segment<D>(j * D).noalias() -= Jj.transpose() * Wr;
   }
   return b;
+}
+
+template <class Space>
+void NormalEquations<Space>::remove_rigid_motion(const Poses& poses, Eigen::VectorXd& dx) const {
+  using Mat = typename Space::Matrix;
+  using Vec = typename Space::Vector;
+  if (gauge_vertex_ < 0) return;
+  Mat N = Mat::Zero();
+  Vec r = Vec::Zero();
+  for (size_t v = 0; v < poses.size(); ++v) {
+    const int u = index_[v];
+    if (u < 0) continue;
+    const Mat A = rigid_motion_in_local(poses[v]);
+    N.noalias() += A.transpose() * A;
+    r.noalias() += A.transpose() * dx.template segment<D>(u * D);
+  }
+  const Vec xi = N.ldlt().solve(r);
+  if (!xi.allFinite()) return;
+  for (size_t v = 0; v < poses.size(); ++v) {
+    const int u = index_[v];
+    if (u >= 0) dx.template segment<D>(u * D).noalias() -= rigid_motion_in_local(poses[v]) * xi;
+  }
 }
 
 template <class Space>

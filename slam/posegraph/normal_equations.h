@@ -26,11 +26,15 @@ class NormalEquations {
   using Pose = typename Space::Pose;
   using Poses = std::vector<Pose>;
 
-  /// `vertex_order`: a fill-reducing order of all vertices (order_blocks()).
+  /// `vertex_order`: a fill-reducing order of all vertices (order_blocks()). With
+  /// `free_gauge` false a single fixed vertex stays out of the unknowns (the system is then the
+  /// information of the others given it: what marginal covariances need).
   NormalEquations(const PoseGraph<Space>& graph, const RobustKernel& kernel,
-                  const std::vector<int>& vertex_order);
+                  const std::vector<int>& vertex_order, bool free_gauge = true);
 
   int num_unknowns() const { return num_unknowns_; }
+  /// The unknown index of a vertex, or -1 when it is held fixed.
+  int unknown_of(int vertex) const { return index_[static_cast<size_t>(vertex)]; }
   BlockSystem<D>& system() { return *system_; }
   const BlockSystem<D>& system() const { return *system_; }
 
@@ -44,6 +48,11 @@ class NormalEquations {
   /// finite differences with step h: solving H a = this gives the geodesic acceleration
   /// (Transtrum & Sethna 2012) of the step.
   Eigen::VectorXd acceleration_rhs(const Poses& poses, const Eigen::VectorXd& dx, double h) const;
+  /// Takes out of dx the rigid motion of the whole graph that is closest to it (least squares
+  /// over the unknowns' local coordinates), when the gauge is free. Only the weak prior holds
+  /// that motion, so an inexact (conjugate-gradient) step can carry a large one, which the
+  /// pose-by-pose retraction does not apply rigidly: tens of metres on a 1000-pose helix.
+  void remove_rigid_motion(const Poses& poses, Eigen::VectorXd& dx) const;
   /// The poses moved rigidly so that the single fixed vertex is back where it was held.
   void anchor(Poses& poses) const;
   /// Loop closures whose kernel weight at `poses` is below one half.

@@ -119,6 +119,7 @@ OptimizerSummary optimize(PoseGraph<Space>& graph, const OptimizerOptions& optio
       summary.cg_iterations += cg.iterations;
       log.cg_iterations = cg.iterations;
       solved = cg.converged && dx.allFinite();
+      if (solved) equations.remove_rigid_motion(x, dx);
       cg_failures = solved ? 0 : cg_failures + 1;
     }
     if (!solved) {

@@ -84,7 +84,7 @@ SparseCholesky::SparseCholesky(int n, std::vector<int> col_ptr, std::vector<int>
   if (n <= 0 || block_size <= 0 || n % block_size != 0 ||
       col_ptr.size() != static_cast<size_t>(n) + 1 ||
       row_idx.size() != static_cast<size_t>(col_ptr.back()) ||
-      block_order.size() != static_cast<size_t>(n / block_size)) {
+      (!block_order.empty() && block_order.size() != static_cast<size_t>(n / block_size))) {
     throw std::invalid_argument("SparseCholesky: inconsistent pattern or ordering");
   }
   Impl& m = *impl_;
@@ -96,14 +96,22 @@ SparseCholesky::SparseCholesky(int n, std::vector<int> col_ptr, std::vector<int>
   std::memcpy(m.A->i, row_idx.data(), row_idx.size() * sizeof(int));
   std::fill_n(static_cast<double*>(m.A->x), row_idx.size(), 0.0);
 
-  std::vector<int> perm(n);
-  for (size_t b = 0; b < block_order.size(); ++b) {
-    for (int k = 0; k < block_size; ++k) perm[b * block_size + k] = block_order[b] * block_size + k;
-  }
   c->nmethods = 1;
-  c->method[0].ordering = CHOLMOD_GIVEN;
-  c->postorder = 1;
-  m.L = cholmod_analyze_p(m.A, perm.data(), nullptr, 0, c);
+  if (block_order.empty()) {
+    // The caller ordered the matrix already: no permutation, and no postorder (which would
+    // bring one back).
+    c->method[0].ordering = CHOLMOD_NATURAL;
+    c->postorder = 0;
+    m.L = cholmod_analyze(m.A, c);
+  } else {
+    std::vector<int> perm(n);
+    for (size_t b = 0; b < block_order.size(); ++b) {
+      for (int k = 0; k < block_size; ++k) perm[b * block_size + k] = block_order[b] * block_size + k;
+    }
+    c->method[0].ordering = CHOLMOD_GIVEN;
+    c->postorder = 1;
+    m.L = cholmod_analyze_p(m.A, perm.data(), nullptr, 0, c);
+  }
   if (m.L == nullptr) throw std::runtime_error("CHOLMOD symbolic analysis failed");
   m.flops = c->fl;
   m.nonzeros = c->lnz;

@@ -23,7 +23,8 @@ class SparseCholesky {
  public:
   /// `col_ptr` (n + 1 entries) and `row_idx` describe the upper triangle; every column holds
   /// its diagonal. `block_order` (from order_blocks) orders blocks of `block_size` unknowns;
-  /// n must be a multiple of `block_size`.
+  /// n must be a multiple of `block_size`. An empty `block_order` means the matrix is already
+  /// in elimination order (it is then factorised without any permutation).
   SparseCholesky(int n, std::vector<int> col_ptr, std::vector<int> row_idx, int block_size,
                  const std::vector<int>& block_order);
   ~SparseCholesky();

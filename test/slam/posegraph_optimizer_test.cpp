@@ -75,12 +75,13 @@ TYPED_TEST(OptimizerTest, ReachesTheOptimumOfANoisyGraphFromOdometry) {
   EXPECT_GT(s.final_chi2, dof - 5 * std::sqrt(2 * dof));
   EXPECT_LT(s.final_chi2, s.initial_chi2);
   EXPECT_LT(test::max_translation_error(g, truth), 0.2 * drift);
-  // A second run from the result cannot improve it: it was a minimum.
+  // A second run from the result cannot improve it: it was a minimum. (Its accepted steps
+  // lower the cost; moving the result back onto the anchor is rigid, exact up to rounding.)
   auto again = g;
   OptimizerOptions warm;
   warm.chordal_initialization = false;
   const OptimizerSummary s2 = optimize(again, warm);
-  EXPECT_LE(s2.final_chi2, s.final_chi2);
+  EXPECT_LE(s2.final_chi2, s.final_chi2 * (1.0 + 1e-12)) << s2.final_chi2 - s.final_chi2;
   EXPECT_NEAR(s2.final_chi2, s.final_chi2, 1e-6 * s.final_chi2);
 }
 
