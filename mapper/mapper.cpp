@@ -46,8 +46,8 @@ void Mapper::integrate(const RgbdFrame& decimated, const Eigen::Isometry3d& T_wo
                        int64_t utime, const char* what) {
   ScanOptions at_full = options_.scan;
   at_full.stride = 1;  // already decimated
-  const Scan scan = make_scan(decimated, T_world_camera, at_full, what);
-  integrator_.compute(scan, update_);
+  make_scan(decimated, T_world_camera, at_full, what, scan_);
+  integrator_.compute(scan_, update_);
   map_.integrate(update_, utime);
   ++frames_inserted_;
 }

@@ -25,6 +25,7 @@
 #include "common/rgbd_frame.h"
 #include "mapper/keyframe_store.h"
 #include "mapper/options.h"
+#include "mapper/scan.h"
 #include "mapper/scan_integrator.h"
 #include "mapper/voxel_map.h"
 
@@ -94,6 +95,7 @@ class Mapper {
   VoxelMap map_;
   KeyframeStore keyframes_;
   ScanUpdate update_;
+  Scan scan_;                      // reused: a fresh one per frame cost page faults
   std::deque<RgbdFrame> buffer_;   // decimated, by increasing utime
   bool have_last_keyframe_ = false;
   Eigen::Isometry3d last_keyframe_pose_ = Eigen::Isometry3d::Identity();

@@ -45,5 +45,8 @@ RgbdFrame decimate(const RgbdFrame& frame, int stride);
 /// `what` for a frame without depth, a broken frame or a non-rigid / non-finite pose.
 Scan make_scan(const RgbdFrame& frame, const Eigen::Isometry3d& T_world_camera,
                const ScanOptions& options, const char* what);
+/// The same into `scan`, reusing its storage (no allocation once it has held a frame as big).
+void make_scan(const RgbdFrame& frame, const Eigen::Isometry3d& T_world_camera,
+               const ScanOptions& options, const char* what, Scan& scan);
 
 }  // namespace kestrel::mapper
