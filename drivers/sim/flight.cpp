@@ -65,11 +65,7 @@ MotionState Flight::state(double t) const {
   s.T_world_body.translation() = q.p;
   s.v_world = q.v;
   s.a_world = q.a;
-  constexpr double h = 1e-3;
-  const Eigen::Matrix3d R_dot =
-      (attitude(t - 2 * h) - 8.0 * attitude(t - h) + 8.0 * attitude(t + h) - attitude(t + 2 * h)) / (12.0 * h);
-  const Eigen::Matrix3d omega_hat = s.T_world_body.linear().transpose() * R_dot;
-  s.omega_body = so3::vee(0.5 * (omega_hat - omega_hat.transpose()));
+  s.omega_body = angular_rate(s.T_world_body.linear(), t, [this](double x) { return attitude(x); });
   return s;
 }
 

@@ -58,8 +58,9 @@ class Flight {
   PathPoint point(double t) const;
   /// Body attitude at flight time t (flatness; see the header comment).
   Eigen::Matrix3d attitude(double t) const;
-  /// Everything at flight time t.
-  MotionState state(double t) const;
+  /// Everything at flight time t. Virtual for paths that are smooth only piecewise (the
+  /// closed-loop vehicle), which difference their attitude within one piece.
+  virtual MotionState state(double t) const;
 
   double ramp_s() const { return ramp_s_; }
 
@@ -69,5 +70,21 @@ class Flight {
 
 /// Attitude of a vehicle whose thrust produces acceleration `a` (world) at heading `yaw`.
 Eigen::Matrix3d flat_attitude(const Eigen::Vector3d& a_world, double yaw);
+
+/// The body angular rate at t from the attitude function R(t') near t (five-point central
+/// difference, step 1 ms): R^T dR/dt, made skew.
+template <typename AttitudeAt>
+Eigen::Vector3d angular_rate(const Eigen::Matrix3d& R, double t, AttitudeAt&& attitude_at);
+
+template <typename AttitudeAt>
+Eigen::Vector3d angular_rate(const Eigen::Matrix3d& R, double t, AttitudeAt&& attitude_at) {
+  constexpr double h = 1e-3;
+  const Eigen::Matrix3d R_dot =
+      (attitude_at(t - 2 * h) - 8.0 * attitude_at(t - h) + 8.0 * attitude_at(t + h) - attitude_at(t + 2 * h)) /
+      (12.0 * h);
+  const Eigen::Matrix3d omega_hat = R.transpose() * R_dot;
+  const Eigen::Matrix3d skew = 0.5 * (omega_hat - omega_hat.transpose());
+  return Eigen::Vector3d(skew(2, 1), skew(0, 2), skew(1, 0));
+}
 
 }  // namespace kestrel::sim

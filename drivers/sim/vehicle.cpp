@@ -57,16 +57,21 @@ void VehicleFlight::reset() {
   wind_rng_ = Rng(derive(seed_, tag("wind")));
 }
 
-PathPoint VehicleFlight::evaluate(const Segment& s, double tau) const {
+PathPoint VehicleFlight::evaluate(const Segment& s, double tau, Eigen::Vector3d* jerk) const {
+  // a = a_in + (c0 + c1 x) e^(-x/T): the critically damped response from (a0, j0), and its
+  // integrals in closed form.
   const double x = tau - s.t0;
-  const double T = options_.response_s, Ty = options_.yaw_response_s;
-  const double e = std::exp(-x / T), ey = std::exp(-x / Ty);
-  const Eigen::Vector3d da = s.a0 - s.a_in;
+  const double T = 0.5 * options_.response_s, Ty = options_.yaw_response_s;
+  const double E = std::exp(-x / T), ey = std::exp(-x / Ty);
+  const Eigen::Vector3d c0 = s.a0 - s.a_in, c1 = s.j0 + c0 / T;
+  const double I0 = T * (1.0 - E), I1 = T * T * (1.0 - E) - T * x * E;
+  const double J0 = T * x - T * I0, J1 = T * T * x - T * T * I0 - T * I1;
   PathPoint q;
-  q.a = s.a_in + da * e;
-  q.v = s.v0 + s.a_in * x + da * (T * (1.0 - e));
-  q.p = s.p0 + s.v0 * x + s.a_in * (0.5 * x * x) + da * (T * (x - T * (1.0 - e)));
+  q.a = s.a_in + (c0 + c1 * x) * E;
+  q.v = s.v0 + s.a_in * x + c0 * I0 + c1 * I1;
+  q.p = s.p0 + s.v0 * x + s.a_in * (0.5 * x * x) + c0 * J0 + c1 * J1;
   q.yaw = s.yaw0 + s.r_in * x + (s.r0 - s.r_in) * Ty * (1.0 - ey);
+  if (jerk) *jerk = c1 * E - (c0 + c1 * x) * (E / T);
   return q;
 }
 
@@ -83,18 +88,30 @@ PathPoint VehicleFlight::path(double tau) const {
   return evaluate(history_[std::min(static_cast<size_t>(k), history_.size() - 1)], tau);
 }
 
+MotionState VehicleFlight::state(double t) const {
+  MotionState s = Flight::state(t);
+  if (t < 0.0 || history_.empty()) return s;  // at rest
+  const int64_t k = static_cast<int64_t>(std::floor(t / options_.control_period_s)) - first_step_;
+  const Segment& seg = history_[std::min(static_cast<size_t>(std::max<int64_t>(k, 0)), history_.size() - 1)];
+  s.omega_body = angular_rate(s.T_world_body.linear(), t, [&](double x) {
+    const PathPoint q = evaluate(seg, x);
+    return flat_attitude(q.a, q.yaw);
+  });
+  return s;
+}
+
 void VehicleFlight::step(const ControlOutput& input) {
   const VehicleOptions& o = options_;
   Segment s;
   s.t0 = end_s_;
   if (history_.empty()) {
     s.p0 = start_.head<3>();
-    s.v0 = s.a0 = Eigen::Vector3d::Zero();
+    s.v0 = s.a0 = s.j0 = Eigen::Vector3d::Zero();
     s.yaw0 = start_[3];
     s.r0 = 0.0;
   } else {
     const Segment& last = history_.back();
-    const PathPoint q = evaluate(last, end_s_);
+    const PathPoint q = evaluate(last, end_s_, &s.j0);
     s.p0 = q.p, s.v0 = q.v, s.a0 = q.a, s.yaw0 = q.yaw;
     s.r0 = last.r_in + (last.r0 - last.r_in) * std::exp(-(end_s_ - last.t0) / o.yaw_response_s);
   }

@@ -4,8 +4,10 @@
 // the controller believes the state is (the estimator's STATE, or the truth).
 //
 // Dynamics, exact within each control period h (inputs held constant, ZOH):
-//   a' = (a_cmd + w - a) / response_s      thrust/attitude lag, so a is continuous
-//   p'' = a                                 and the flatness attitude (flight.h) is smooth
+//   a'' = (a_cmd + w - a) / T^2 - 2 a' / T  thrust/attitude lag, critically damped,
+//   p'' = a                                  T = response_s / 2: a and the jerk a' are
+//                                            continuous, so are the flatness attitude
+//                                            (flight.h) and its angular rate (the gyro)
 //   r' = (r_cmd - r) / yaw_response_s       yaw rate r, yaw' = r
 // with w a slow random acceleration (wind, an Ornstein-Uhlenbeck process drawn from the
 // seed), so holding position needs feedback. The solution is closed-form (exponentials), so
@@ -47,7 +49,7 @@ struct VehicleEstimate {
 
 struct VehicleOptions {
   double control_period_s = 0.005;   ///< controller and input update period (200 Hz)
-  double response_s = 0.12;          ///< acceleration lag (attitude loop), s
+  double response_s = 0.12;          ///< acceleration lag (attitude loop, two poles at 2/response_s), s
   double yaw_response_s = 0.1;       ///< yaw-rate lag, s
   double max_speed_m_s = 1.5;
   double max_accel_m_s2 = 3.0;
@@ -75,6 +77,10 @@ class VehicleFlight : public Flight {
 
   std::string name() const override { return "vehicle"; }
   PathPoint path(double tau) const override;
+  /// As Flight::state, but the angular rate differences the attitude of the control period
+  /// that holds t (continued analytically past its ends): across periods the angular
+  /// acceleration jumps, and a stencil straddling a jump would be off by O(h * jump).
+  MotionState state(double t) const override;
 
   /// Commits the next control period under these inputs (the wind is added here).
   void step(const ControlOutput& input);
@@ -87,10 +93,10 @@ class VehicleFlight : public Flight {
  private:
   struct Segment {
     double t0;
-    Eigen::Vector3d p0, v0, a0, a_in;  // a_in: commanded acceleration plus wind
+    Eigen::Vector3d p0, v0, a0, j0, a_in;  // a_in: commanded acceleration plus wind
     double yaw0, r0, r_in;
   };
-  PathPoint evaluate(const Segment& s, double tau) const;
+  PathPoint evaluate(const Segment& s, double tau, Eigen::Vector3d* jerk = nullptr) const;
 
   Eigen::Vector4d start_;
   VehicleOptions options_;

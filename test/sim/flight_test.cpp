@@ -113,55 +113,6 @@ TEST(FlightTest, LoopInCorridorsRevisitsItsStart) {
   EXPECT_GT(farthest, 8.0);
 }
 
-// Integrates gyro and accelerometer with RK4 over pairs of samples (k, k+1, k+2 are the
-// start, middle and end of a step of 2 dt) from the true initial state.
-struct Integrated {
-  Eigen::Quaterniond q;
-  Eigen::Vector3d v, p;
-};
-
-Integrated integrate(const Flight& flight, ImuSimulator& imu, double seconds) {
-  const double dt = 1.0 / imu.options().rate_hz;
-  const MotionState s0 = flight.state(0.0);
-  Integrated x{Eigen::Quaterniond(s0.T_world_body.linear()), s0.v_world, s0.T_world_body.translation()};
-  const Eigen::Vector3d g(0, 0, -kGravity);
-  struct Rate {
-    Eigen::Vector4d dq;
-    Eigen::Vector3d dv, dp;
-  };
-  auto f = [&](const Eigen::Quaterniond& q, const Eigen::Vector3d& v, const ImuSample& m) {
-    const Eigen::Quaterniond w(0, m.gyro.x(), m.gyro.y(), m.gyro.z());
-    const Eigen::Quaterniond qd = q * w;
-    return Rate{0.5 * qd.coeffs(), q.normalized() * m.accel + g, v};
-  };
-  ImuSample a = imu.next();
-  const int steps = static_cast<int>(std::lround(seconds / (2 * dt)));
-  for (int k = 0; k < steps; ++k) {
-    const ImuSample b = imu.next(), c = imu.next();
-    const double h = 2 * dt;
-    auto add = [](const Integrated& s, const Rate& r, double step) {
-      Integrated out;
-      out.q.coeffs() = s.q.coeffs() + step * r.dq;
-      out.v = s.v + step * r.dv;
-      out.p = s.p + step * r.dp;
-      return out;
-    };
-    const Rate k1 = f(x.q, x.v, a);
-    const Integrated x2 = add(x, k1, h / 2);
-    const Rate k2 = f(x2.q, x2.v, b);
-    const Integrated x3 = add(x, k2, h / 2);
-    const Rate k3 = f(x3.q, x3.v, b);
-    const Integrated x4 = add(x, k3, h);
-    const Rate k4 = f(x4.q, x4.v, c);
-    x.q.coeffs() += h / 6 * (k1.dq + 2 * k2.dq + 2 * k3.dq + k4.dq);
-    x.q.normalize();
-    x.v += h / 6 * (k1.dv + 2 * k2.dv + 2 * k3.dv + k4.dv);
-    x.p += h / 6 * (k1.dp + 2 * k2.dp + 2 * k3.dp + k4.dp);
-    a = c;
-  }
-  return x;
-}
-
 class ImuIntegrationTest : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(ImuIntegrationTest, NoiselessSamplesIntegrateBackToTheTruthOverTenSeconds) {
@@ -169,7 +120,7 @@ TEST_P(ImuIntegrationTest, NoiselessSamplesIntegrateBackToTheTruthOverTenSeconds
   ImuOptions options;
   options.noise = false;
   ImuSimulator imu(*flight, options, 1);
-  const Integrated x = integrate(*flight, imu, 10.0);
+  const test::Integrated x = test::integrate(*flight, imu, 10.0);
   const MotionState truth = flight->state(10.0);
   EXPECT_LT((x.p - truth.T_world_body.translation()).norm(), 1e-3);
   EXPECT_LT((x.v - truth.v_world).norm(), 1e-3);

@@ -5,6 +5,8 @@
 #include <Eigen/Geometry>
 
 #include "drivers/sim/camera_options.h"
+#include "drivers/sim/flight.h"
+#include "drivers/sim/imu.h"
 #include "drivers/sim/world.h"
 
 namespace kestrel::sim::test {
@@ -23,5 +25,13 @@ Eigen::Isometry3d look(const Eigen::Vector3d& position, double yaw, double pitch
 
 /// Camera options with every random effect off (depth still quantised).
 CameraOptions exact_camera();
+
+/// The state reached by integrating `imu`'s samples with RK4 (steps of two sample periods)
+/// from the flight's true state at t = 0, after `seconds`.
+struct Integrated {
+  Eigen::Quaterniond q;
+  Eigen::Vector3d v, p;
+};
+Integrated integrate(const Flight& flight, ImuSimulator& imu, double seconds);
 
 }  // namespace kestrel::sim::test
