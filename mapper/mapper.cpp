@@ -34,6 +34,8 @@ void MapperOptions::validate() const {
   non_negative(rebuild_rotation_deg, "rebuild-rotation");
   non_negative(rebuild_interval_s, "rebuild-interval");
   positive(frame_buffer_s, "frame-buffer");
+  if (checkpoint_every < 0) throw std::invalid_argument("checkpoint-every: must be >= 0");
+  non_negative(checkpoint_megabytes, "checkpoint-megabytes");
 }
 
 Mapper::Mapper(const MapperOptions& options)
@@ -52,9 +54,38 @@ void Mapper::integrate(const RgbdFrame& decimated, const Eigen::Isometry3d& T_wo
   ++frames_inserted_;
 }
 
+void Mapper::integrate_keyframe(const StoredKeyframe& kf) {
+  integrate(kf.frame, kf.T_world_camera, kf.utime, "keyframe");
+  if (!map_is_sequence_) return;
+  sequence_.emplace_back(kf.id, kf.T_world_camera);
+  maybe_checkpoint();
+}
+
+void Mapper::maybe_checkpoint() {
+  const size_t every = static_cast<size_t>(options_.checkpoint_every);
+  if (every == 0 || sequence_.size() % every != 0) return;
+  if (!checkpoints_.empty() && checkpoints_.back().keyframes.size() >= sequence_.size()) return;
+  checkpoints_.push_back({sequence_, map_});
+  const double budget = options_.checkpoint_megabytes * 1e6;
+  // Over budget: every other checkpoint goes (the spacing doubles), the newest stays.
+  while (checkpoints_.size() > 1 && static_cast<double>(checkpoint_bytes()) > budget) {
+    std::vector<Checkpoint> kept;
+    for (size_t i = checkpoints_.size() % 2; i < checkpoints_.size(); i += 2) kept.push_back(std::move(checkpoints_[i]));
+    checkpoints_ = std::move(kept);
+  }
+  if (static_cast<double>(checkpoint_bytes()) > budget) checkpoints_.clear();
+}
+
+size_t Mapper::checkpoint_bytes() const {
+  size_t bytes = 0;
+  for (const Checkpoint& c : checkpoints_) bytes += c.map.memory_bytes() + c.keyframes.size() * sizeof(Placed);
+  return bytes;
+}
+
 const ScanUpdate& Mapper::insert(const RgbdFrame& frame, const Eigen::Isometry3d& T_world_camera,
                                  const char* what) {
   frame.validate(what);
+  map_is_sequence_ = false;  // the map now holds a frame no rebuild inserts
   RgbdFrame small = decimate(frame, options_.scan.stride);
   const int64_t utime = frame.depth_utime != 0 ? frame.depth_utime : frame.utime;
   integrate(small, T_world_camera, utime, what);
@@ -124,13 +155,17 @@ GraphResult Mapper::apply_graph(const std::vector<GraphKeyframe>& graph) {
     kf.utime = g.utime;
     kf.T_world_camera = g.T_world_camera;
     kf.frame = *frame;
+    // A keyframe older than a stored one breaks the live map's time order (a rebuild would
+    // insert it earlier), so the live map is no longer a checkpointable sequence.
+    const auto order = keyframes_.in_time_order();
+    if (!order.empty() && order.back()->utime >= kf.utime) map_is_sequence_ = false;
     // Inserted now unless the whole map is about to be rebuilt anyway.
-    if (!(rebuild_pending_ && may_rebuild)) integrate(kf.frame, kf.T_world_camera, kf.utime, "keyframe");
+    if (!(rebuild_pending_ && may_rebuild)) integrate_keyframe(kf);
     keyframes_.add(std::move(kf));
     ++result.inserted;
   }
   if (rebuild_pending_ && may_rebuild) {
-    rebuild();
+    result.reinserted = rebuild();
     last_rebuild_utime_ = newest;
     result.rebuilt = true;
     result.rebuild_keyframes = keyframes_.size();
@@ -138,17 +173,47 @@ GraphResult Mapper::apply_graph(const std::vector<GraphKeyframe>& graph) {
   return result;
 }
 
-void Mapper::rebuild() {
-  map_.clear();
-  for (const StoredKeyframe* kf : keyframes_.in_time_order()) {
-    integrate(kf->frame, kf->T_world_camera, kf->utime, "keyframe");
+size_t Mapper::rebuild() { return rebuild_from(true); }
+
+size_t Mapper::rebuild_from_scratch() { return rebuild_from(false); }
+
+size_t Mapper::rebuild_from(bool use_checkpoints) {
+  const std::vector<const StoredKeyframe*> order = keyframes_.in_time_order();
+  // The newest checkpoint holding exactly the first keyframes of `order` at their current
+  // poses (a pose that moved by less than the rebuild threshold was not updated, so equality
+  // is exact); the ones after it are stale.
+  size_t valid = 0;
+  for (; valid < checkpoints_.size(); ++valid) {
+    const std::vector<Placed>& held = checkpoints_[valid].keyframes;
+    bool same = held.size() <= order.size();
+    for (size_t i = 0; same && i < held.size(); ++i) {
+      same = held[i].first == order[i]->id &&
+             held[i].second.matrix() == order[i]->T_world_camera.matrix();
+    }
+    if (!same) break;
   }
+  checkpoints_.resize(valid);
+  size_t start = 0;
+  if (use_checkpoints && valid > 0) {
+    map_ = checkpoints_.back().map;
+    sequence_ = checkpoints_.back().keyframes;
+    start = sequence_.size();
+  } else {
+    map_.clear();
+    sequence_.clear();
+  }
+  map_is_sequence_ = true;
+  for (size_t i = start; i < order.size(); ++i) integrate_keyframe(*order[i]);
   rebuild_pending_ = false;
   ++rebuilds_;
+  return order.size() - start;
 }
 
 void Mapper::reset() {
   map_.clear();
+  checkpoints_.clear();
+  sequence_.clear();
+  map_is_sequence_ = true;
   keyframes_.clear();
   buffer_.clear();
   have_last_keyframe_ = false;

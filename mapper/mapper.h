@@ -15,7 +15,12 @@
 //    rebuild_interval_s of sensor time (later moves wait for the next allowed rebuild).
 //
 // The log-odds of a frame cannot be taken out of a clamped map, so moved keyframes mean a
-// rebuild rather than an update; at 128x96 a rebuild costs about one insertion per keyframe.
+// rebuild rather than an update. A rebuild inserts the keyframes in time order; copies of the
+// map taken along the way (checkpoints, every checkpoint_every keyframes, within a memory
+// budget) each remember which keyframes at which poses they hold, so the next rebuild starts
+// from the newest checkpoint whose keyframes are unchanged and re-inserts only the rest. When a
+// loop closure moves only the later part of the trajectory, that is the later part only; the
+// result is the same map as a rebuild from scratch (the same insertions in the same order).
 
 #include <Eigen/Geometry>
 #include <cstdint>
@@ -41,6 +46,10 @@ struct MapperOptions {
   double rebuild_rotation_deg = 0.5;
   double rebuild_interval_s = 1.0;       ///< at most one rebuild per this much sensor time
   double frame_buffer_s = 5.0;           ///< frames kept for SLAM keyframes to refer to
+  /// Rebuild checkpoints: a copy of the map after every this many keyframes (in time order),
+  /// so a rebuild starts from the last one whose keyframes did not move (0 = none).
+  int checkpoint_every = 8;
+  double checkpoint_megabytes = 128.0;   ///< budget of the copies; over it every other one goes
   void validate() const;
 };
 
@@ -57,6 +66,7 @@ struct GraphResult {
   size_t missing = 0;    ///< new keyframes whose frame was not (or no longer) buffered
   bool rebuilt = false;  ///< the map was rebuilt from the stored keyframes
   size_t rebuild_keyframes = 0;
+  size_t reinserted = 0;  ///< keyframes the rebuild inserted (the rest came from a checkpoint)
 };
 
 class Mapper {
@@ -73,8 +83,11 @@ class Mapper {
   void buffer_frame(const RgbdFrame& frame, const char* what = "frame");
   /// SLAM mode: one graph revision.
   GraphResult apply_graph(const std::vector<GraphKeyframe>& keyframes);
-  /// Rebuilds the map from the stored keyframes at their current poses.
-  void rebuild();
+  /// Rebuilds the map from the stored keyframes at their current poses; returns how many were
+  /// inserted (the others came from a checkpoint).
+  size_t rebuild();
+  /// Rebuilds from nothing (ignores the checkpoints, keeps them; for comparisons).
+  size_t rebuild_from_scratch();
 
   /// Forgets the map, the keyframes and the buffered frames.
   void reset();
@@ -84,11 +97,21 @@ class Mapper {
   const MapperOptions& options() const { return options_; }
   size_t frames_inserted() const { return frames_inserted_; }
   size_t rebuilds() const { return rebuilds_; }
+  size_t checkpoints() const { return checkpoints_.size(); }
+  size_t checkpoint_bytes() const;
 
  private:
   void integrate(const RgbdFrame& decimated, const Eigen::Isometry3d& T_world_camera, int64_t utime,
                  const char* what);
   const RgbdFrame* buffered(int64_t utime) const;
+  using Placed = std::pair<int64_t, Eigen::Isometry3d>;  // keyframe id, pose it was inserted at
+  struct Checkpoint {
+    std::vector<Placed> keyframes;  // what the map holds, in insertion (time) order
+    VoxelMap map;
+  };
+  void integrate_keyframe(const StoredKeyframe& kf);
+  void maybe_checkpoint();
+  size_t rebuild_from(bool use_checkpoints);
 
   MapperOptions options_;
   ScanIntegrator integrator_;
@@ -104,6 +127,11 @@ class Mapper {
   bool rebuild_pending_ = false;
   size_t frames_inserted_ = 0;
   size_t rebuilds_ = 0;
+  // The live map is exactly sequence_'s keyframes inserted in order (false once insert() put
+  // a non-keyframe frame in, or a keyframe arrived out of time order).
+  bool map_is_sequence_ = true;
+  std::vector<Placed> sequence_;
+  std::vector<Checkpoint> checkpoints_;  // increasing length, each a prefix of the next
 };
 
 }  // namespace kestrel::mapper

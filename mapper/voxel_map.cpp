@@ -67,6 +67,26 @@ void VoxelMap::erase(const Key& key) {
   }
 }
 
+VoxelMap::VoxelMap(const VoxelMap& other)
+    : options_(other.options_),
+      keys_(other.keys_),
+      hit_(other.hit_),
+      miss_(other.miss_),
+      clamp_min_(other.clamp_min_),
+      clamp_max_(other.clamp_max_),
+      threshold_(other.threshold_),
+      num_cells_(other.num_cells_),
+      utime_(other.utime_),
+      decay_utime_(other.decay_utime_) {
+  bricks_.reserve(other.bricks_.size());
+  for (const auto& [id, brick] : other.bricks_) bricks_.emplace(id, std::make_unique<Brick>(*brick));
+}
+
+VoxelMap& VoxelMap::operator=(const VoxelMap& other) {
+  if (this != &other) *this = VoxelMap(other);
+  return *this;
+}
+
 void VoxelMap::clear() {
   bricks_.clear();
   last_id_ = ~0ULL;

@@ -40,6 +40,11 @@ class VoxelMap {
 
   /// Throws std::invalid_argument (naming the field) for bad options.
   explicit VoxelMap(const MapOptions& options = {});
+  /// Deep copies (the rebuild's checkpoints are copies of the map).
+  VoxelMap(const VoxelMap& other);
+  VoxelMap& operator=(const VoxelMap& other);
+  VoxelMap(VoxelMap&&) = default;
+  VoxelMap& operator=(VoxelMap&&) = default;
 
   const MapOptions& options() const { return options_; }
   const KeySpace& keys() const { return keys_; }

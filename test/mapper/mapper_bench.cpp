@@ -7,7 +7,8 @@
 // "Insert" is the whole update (decimated frame -> rays -> cells -> log-odds); "Cells" is the
 // cell computation alone; "Octomap" is the insertPointCloud call alone (its own rays in, its
 // tree updated and pruned), i.e. the comparison favours OctoMap. The rebuild benchmark times
-// Mapper::rebuild() over every stored keyframe (what a loop closure costs).
+// a loop closure (Mapper::apply_graph moving the last quarter of the keyframes), without and
+// with the rebuild's checkpoints.
 //
 // Run: ./kestrel bench mapper   (or build/<dir>/bench/mapper_bench --benchmark_repetitions=5)
 
@@ -127,22 +128,39 @@ void BM_Octomap(benchmark::State& state) {
   state.SetLabel(frames().source);
 }
 
+// A loop closure that moves the last quarter of the keyframes (alternately by +-3 cm, through
+// apply_graph as SLAM would), arg 1: with checkpoints (every 4 keyframes), arg 0: without
+// (every rebuild starts from nothing).
 void BM_Rebuild(benchmark::State& state) {
   MapperOptions o;
   o.keyframe_translation_m = 0.0;  // every frame is a keyframe
   o.keyframe_rotation_deg = 0.0;
+  o.rebuild_interval_s = 0.0;
+  o.checkpoint_every = state.range(0) ? 4 : 0;
   Mapper mapper(o);
   const Frames& f = frames();
   for (size_t i = 0; i < f.frames.size(); ++i) mapper.insert(f.frames[i], f.poses[i]);
-  for (auto _ : state) mapper.rebuild();
-  state.counters["keyframes"] = static_cast<double>(mapper.keyframes().size());
+  std::vector<GraphKeyframe> graph;
+  for (const StoredKeyframe* kf : mapper.keyframes().in_time_order())
+    graph.push_back({kf->id, kf->utime, kf->T_world_camera});
+  mapper.rebuild();  // the first rebuild takes the checkpoints
+  const size_t moved_from = graph.size() - graph.size() / 4;
+  double reinserted = 0, n = 0;
+  for (auto _ : state) {
+    const double dx = static_cast<int>(n) % 2 ? -0.03 : 0.03;
+    for (size_t i = moved_from; i < graph.size(); ++i) graph[i].T_world_camera.translation().x() += dx;
+    reinserted += static_cast<double>(mapper.apply_graph(graph).reinserted);
+    ++n;
+  }
+  state.counters["keyframes"] = static_cast<double>(graph.size());
+  state.counters["reinserted"] = reinserted / n;
 }
 
 BENCHMARK(BM_Insert)->Arg(5)->Arg(1)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_Cells, cell_search, ScanIntegrator::Method::kCellSearch)->Arg(5)->Arg(1)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_Cells, ray_trace, ScanIntegrator::Method::kRayTrace)->Arg(5)->Arg(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Octomap)->Arg(5)->Arg(1)->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_Rebuild)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Rebuild)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

@@ -69,6 +69,51 @@ TEST(Mapper, RebuildAfterLoopClosureEqualsTheMapAtTheCorrectedPoses) {
   expect_same_maps(drifted.map(), direct.map());
 }
 
+TEST(Mapper, RebuildStartsFromTheLastCheckpointBeforeTheFirstMovedKeyframe) {
+  const Scene scene = room();
+  const auto truth = sweep(12);
+  MapperOptions options;
+  options.rebuild_interval_s = 0.0;
+  options.checkpoint_every = 4;
+  Mapper mapper(options), direct(options);
+  std::vector<GraphKeyframe> graph;
+  std::vector<RgbdFrame> frames;
+  for (size_t i = 0; i < truth.size(); ++i) {
+    const int64_t utime = 1000000 + 200000 * static_cast<int64_t>(i);
+    frames.push_back(scene.render(test::kinect_camera(), truth[i], utime));
+    mapper.buffer_frame(frames.back());
+    direct.buffer_frame(frames.back());
+    graph.push_back({static_cast<int64_t>(i), utime, truth[i]});
+    mapper.apply_graph(graph);
+  }
+  EXPECT_EQ(mapper.checkpoints(), 3u);  // after keyframes 4, 8 and 12
+  // A loop closure moves keyframes 9 to 11 (by 5 cm): the checkpoint after keyframe 8 holds.
+  std::vector<GraphKeyframe> corrected = graph;
+  for (size_t i = 9; i < corrected.size(); ++i) corrected[i].T_world_camera.translation().x() += 0.05;
+  const GraphResult r = mapper.apply_graph(corrected);
+  EXPECT_TRUE(r.rebuilt);
+  EXPECT_EQ(r.moved, 3u);
+  EXPECT_EQ(r.reinserted, 4u) << "keyframes 8 to 11 again, 0 to 7 from the checkpoint";
+  EXPECT_EQ(mapper.checkpoints(), 3u) << "the stale third checkpoint is replaced";
+  direct.apply_graph(corrected);
+  ASSERT_GT(direct.map().num_occupied(), 100u);
+  expect_same_maps(mapper.map(), direct.map());
+  // Moving the first keyframe leaves no checkpoint usable.
+  corrected[0].T_world_camera.translation().y() += 0.05;
+  EXPECT_EQ(mapper.apply_graph(corrected).reinserted, truth.size());
+  // The budget: no room for a copy means no checkpoints, and the rebuild still works.
+  MapperOptions tight = options;
+  tight.checkpoint_megabytes = 0.0;
+  Mapper thin(tight);
+  for (size_t i = 0; i < truth.size(); ++i) {
+    thin.buffer_frame(frames[i]);
+    thin.apply_graph(std::vector<GraphKeyframe>(graph.begin(), graph.begin() + static_cast<long>(i) + 1));
+  }
+  EXPECT_EQ(thin.checkpoints(), 0u);
+  EXPECT_EQ(thin.apply_graph(corrected).reinserted, truth.size());
+  expect_same_maps(thin.map(), mapper.map());
+}
+
 TEST(Mapper, RebuildsAreRateLimitedAndMissingFramesCounted) {
   const Scene scene = room();
   const auto truth = sweep(3);
