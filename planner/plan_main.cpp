@@ -1,5 +1,5 @@
-// kestrel-plan: plans offline on a map (the built-in Stata-like floor or a ROS map yaml) with
-// BRM or PRM, prints the waypoints with their predicted tr(Sigma), and optionally draws them.
+// kestrel-plan: plans offline in a world (the sim's `floor`, any .world file) or on a ROS map
+// yaml with BRM or PRM, prints the waypoints with their predicted tr(Sigma), and optionally draws them.
 // See planner/README.md.
 #include <spdlog/spdlog.h>
 
@@ -10,8 +10,9 @@
 #include "common/error.h"
 #include "planner/eval/experiment.h"
 #include "planner/eval/plot.h"
-#include "planner/floor_plan.h"
+#include "drivers/sim/world_catalog.h"
 #include "planner/map_sources.h"
+#include "planner/world_environment.h"
 
 namespace {
 
@@ -30,7 +31,7 @@ int main(int argc, char** argv) {
   int samples = 100;
   uint64_t seed = 1;
   double density = 4.0, laser_range = 5.0, z_max = 3.0, start_trace = 0.4;
-  app.add_option("--map", map, "'floor' (built in) or a ROS map YAML");
+  app.add_option("--map", map, "A sim world ('floor', 'room', 'office' or a .world file) or a ROS map YAML");
   app.add_option("--start", start, "Start x y z yaw (m, rad)")->expected(4);
   app.add_option("--goal", goal, "Goal x y z yaw (m, rad)")->expected(4);
   app.add_option("--planner", planner, "brm or prm")->check(CLI::IsMember({"brm", "prm"}));
@@ -50,8 +51,21 @@ int main(int argc, char** argv) {
   return app.run(argc, argv, [&]() -> int {
     sc.space.z_max_m = sc.space.z_min_m;
     sc.start_covariance = (start_trace / 4.0) * Mat4::Identity();
-    GridEnvironment env(map == "floor" ? stata_like_floor() : read_ros_map(map), 0.0, z_max);
-    env.set_features(env.wall_features(density, 2.0, seed));
+    // Sim worlds through the sim's own loader (features from their textures); maps as grids.
+    const bool is_map = map.size() > 5 && map.substr(map.size() - 5) == ".yaml";
+    std::unique_ptr<sim::World> world;
+    std::unique_ptr<Environment> environment;
+    if (is_map) {
+      auto grid = std::make_unique<GridEnvironment>(read_ros_map(map), 0.0, z_max);
+      grid->set_features(grid->wall_features(density, 2.0, seed));
+      environment = std::move(grid);
+    } else {
+      world = std::make_unique<sim::World>(sim::load_world(map));
+      auto w = std::make_unique<WorldEnvironment>(*world);
+      w->place_features({density, seed});
+      environment = std::move(w);
+    }
+    const Environment& env = *environment;
     sc.env = &env;
     sc.sensor = sensor == "camera" ? FeatureSensorOptions::paper_camera()
                 : sensor == "kinect" ? FeatureSensorOptions::kinect()
@@ -78,7 +92,7 @@ int main(int argc, char** argv) {
                 << covariances[i].trace() << "\n";
     if (!png.empty()) {
       eval::DrawnPath drawn{t.path, covariances, planner == "brm" ? cv::Scalar(200, 0, 0) : cv::Scalar(0, 0, 220)};
-      if (!cv::imwrite(png, eval::draw_plans(env, t.samples, {drawn}))) throw InputError(png + ": cannot write");
+      if (!cv::imwrite(png, eval::draw_plans(env, t.samples, {drawn}, sc.space.z_min_m))) throw InputError(png + ": cannot write");
     }
     return kExitOk;
   });

@@ -1,4 +1,4 @@
-// draw_plans: OpenCV drawing of a grid, samples and paths with covariance ellipses.
+// draw_plans: OpenCV drawing of free space, samples and paths with covariance ellipses.
 #include "planner/eval/plot.h"
 
 #include <Eigen/Eigenvalues>
@@ -6,8 +6,8 @@
 
 namespace kestrel::planner::eval {
 
-cv::Mat draw_plans(const GridEnvironment& env, const std::vector<Config>& samples,
-                   const std::vector<DrawnPath>& paths, double ppm) {
+cv::Mat draw_plans(const Environment& env, const std::vector<Config>& samples, const std::vector<DrawnPath>& paths,
+                   double z_m, double ppm) {
   const Eigen::AlignedBox3d b = env.bounds();
   const int w = static_cast<int>(std::ceil((b.max().x() - b.min().x()) * ppm));
   const int h = static_cast<int>(std::ceil((b.max().y() - b.min().y()) * ppm));
@@ -17,9 +17,8 @@ cv::Mat draw_plans(const GridEnvironment& env, const std::vector<Config>& sample
   };
   for (int r = 0; r < h; ++r)
     for (int c = 0; c < w; ++c) {
-      const Eigen::Vector3d p(b.min().x() + (c + 0.5) / ppm, b.max().y() - (r + 0.5) / ppm, 0.5 * (b.min().z() + b.max().z()));
-      const double clear = env.clearance(p);
-      img.at<cv::Vec3b>(r, c) = clear > 0.0 ? cv::Vec3b(255, 255, 255) : cv::Vec3b(40, 40, 40);
+      const Eigen::Vector3d p(b.min().x() + (c + 0.5) / ppm, b.max().y() - (r + 0.5) / ppm, z_m);
+      img.at<cv::Vec3b>(r, c) = env.is_free(p, 0.5 / ppm) ? cv::Vec3b(255, 255, 255) : cv::Vec3b(40, 40, 40);
     }
   for (const Feature& f : env.features()) cv::circle(img, px(f.position), 1, cv::Scalar(0, 160, 0), cv::FILLED);
   for (const Config& q : samples) cv::circle(img, px(position(q)), 3, cv::Scalar(200, 120, 0), cv::FILLED);

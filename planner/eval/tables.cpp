@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <iomanip>
 #include <numeric>
 #include <sstream>
@@ -36,17 +37,29 @@ struct Summary {
   double mean_trace() const {
     return goal_traces.empty() ? 0.0 : std::accumulate(goal_traces.begin(), goal_traces.end(), 0.0) / goal_traces.size();
   }
+  /// Standard error of mean_trace() (0 with fewer than two successes).
+  double sem_trace() const {
+    const size_t n = goal_traces.size();
+    if (n < 2) return 0.0;
+    const double m = mean_trace();
+    double ss = 0.0;
+    for (double v : goal_traces) ss += (v - m) * (v - m);
+    return std::sqrt(ss / static_cast<double>(n - 1) / static_cast<double>(n));
+  }
   double mean_length() const {
     return lengths.empty() ? 0.0 : std::accumulate(lengths.begin(), lengths.end(), 0.0) / lengths.size();
   }
 };
 
-Summary run_many(const Scenario& sc, const Setting& s, const Pairs& pairs, const ExperimentOptions& o) {
+// `first_pair`: the index of pairs[0] among the experiment's pairs, so that a path gets the same
+// seeds whether it runs alone (Table 4) or with the others (Table 5).
+Summary run_many(const Scenario& sc, const Setting& s, const Pairs& pairs, const ExperimentOptions& o,
+                 size_t first_pair = 0) {
   Summary sum;
   for (size_t p = 0; p < pairs.size(); ++p)
     for (int t = 0; t < o.trials; ++t) {
       // The same seed per (pair, trial) for every setting: samplers differ, not luck.
-      const Trial r = run_trial(sc, s, pairs[p].first, pairs[p].second, o.seed * 1000003ull + p * 1009ull + t);
+      const Trial r = run_trial(sc, s, pairs[p].first, pairs[p].second, o.seed * 1000003ull + (first_pair + p) * 1009ull + t);
       ++sum.trials;
       sum.build_s.push_back(r.build_s);
       sum.search_s.push_back(r.search_s);
@@ -110,11 +123,14 @@ std::string table4_samplers(const Scenario& sc, const Pairs& pairs, const Experi
   for (size_t p = 0; p <= pairs.size(); ++p) out << "---|";
   out << "\n";
   const char* names[] = {"uniform", "su", "gaussian", "bridge", "su-ukf"};
+  std::vector<std::vector<Summary>> all(5);
   for (int k = 0; k < 5; ++k) {
     out << "| " << names[k] << " |";
     for (size_t p = 0; p < pairs.size(); ++p) {
-      const Summary s = run_many(sc, Setting{"brm", names[k], o.samples}, Pairs{pairs[p]}, o);
-      out << " " << fmt("%.1f", s.success_pct()) << " · " << fmt("%.2f", s.mean_trace()) << " |";
+      all[k].push_back(run_many(sc, Setting{"brm", names[k], o.samples}, Pairs{pairs[p]}, o, p));
+      const Summary& s = all[k].back();
+      out << " " << fmt("%.1f", s.success_pct()) << " · " << fmt("%.2f", s.mean_trace()) << " ± "
+          << fmt("%.2f", s.sem_trace()) << " |";
     }
     out << " ";
     if (k < 4)
@@ -123,6 +139,24 @@ std::string table4_samplers(const Scenario& sc, const Pairs& pairs, const Experi
       out << "—";
     out << " |\n";
   }
+  // The target "SU no worse than uniform, Gaussian and bridge on each path": SU (EKF) is worse
+  // than another sampler on a path when its success rate is lower, or its mean goal tr(Sigma)
+  // higher, by more than two standard errors of the difference (binomial for the rates).
+  out << "\nSU (EKF) against the other samplers, per path:";
+  for (size_t p = 0; p < pairs.size(); ++p) {
+    const Summary& su = all[1][p];
+    std::string worse;
+    for (int k : {0, 2, 3}) {
+      const Summary& other = all[k][p];
+      const double se = std::hypot(su.sem_trace(), other.sem_trace());
+      const double p1 = su.success_pct() / 100.0, p2 = other.success_pct() / 100.0;
+      const double se_rate = std::sqrt(p1 * (1 - p1) / su.trials + p2 * (1 - p2) / other.trials);
+      if (p1 < p2 - 2.0 * se_rate - 1e-12 || su.mean_trace() > other.mean_trace() + 2.0 * se)
+        worse += std::string(worse.empty() ? "" : ", ") + names[k];
+    }
+    out << " path " << p + 1 << ": " << (worse.empty() ? "no worse" : "worse than " + worse) << ";";
+  }
+  out << "\n";
   return out.str();
 }
 

@@ -1,29 +1,26 @@
-// Speed of the planner on the built-in floor (Release, one core): roadmap build with 100
-// samples per sampler (BRM: with transfer functions), BRM search, and one edge transfer.
+// Speed of the planner in the sim's `floor` world (Release, one core): roadmap build with 100
+// samples per sampler (BRM: with transfer functions), BRM search, the two sensor-uncertainty
+// weights per candidate (EKF tr(M), UKF I(x)), and one edge transfer.
 #include <benchmark/benchmark.h>
 
 #include "planner/eval/experiment.h"
-#include "planner/floor_plan.h"
+#include "planner/experiment_worlds.h"
 
 namespace {
 
 using namespace kestrel::planner;
 
-struct Floor {
-  GridEnvironment env{stata_like_floor(), 0.0, 3.0};
-  Floor() { env.set_features(env.wall_features(4.0, 2.0, 1)); }
-};
-const Floor& floor_world() {
-  static const Floor f;
-  return f;
+const ExperimentWorld& floor() {
+  static const ExperimentWorld w = floor_experiment_world({4.0, 1}, 0.3);
+  return w;
 }
 
 void BM_BuildBrm(benchmark::State& state, const char* sampler_name) {
-  const auto& env = floor_world().env;
+  const Environment& env = *floor().env;
   const ConfigurationSpace space(env, {});
   const FeatureSensor sensor(env, FeatureSensorOptions::paper_camera());
   const BeliefModel model(MotionOptions{}, [&](const Config& q) { return sensor.information(q); });
-  const auto pair = stata_like_pairs()[0];
+  const auto pair = floor().pairs[0];
   uint64_t seed = 1;
   for (auto _ : state) {
     Rng rng(seed++);
@@ -35,11 +32,11 @@ BENCHMARK_CAPTURE(BM_BuildBrm, su, "su")->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_BuildBrm, uniform, "uniform")->Unit(benchmark::kMillisecond);
 
 void BM_SearchBrm(benchmark::State& state) {
-  const auto& env = floor_world().env;
+  const Environment& env = *floor().env;
   const ConfigurationSpace space(env, {});
   const FeatureSensor sensor(env, FeatureSensorOptions::paper_camera());
   const BeliefModel model(MotionOptions{}, [&](const Config& q) { return sensor.information(q); });
-  const auto pair = stata_like_pairs()[0];
+  const auto pair = floor().pairs[0];
   Rng rng(1);
   auto sampler = eval::make_sampler("su", space, sensor, 0.1 * Mat4::Identity());
   const Roadmap map = build_roadmap(space, *sampler, pair.first, pair.second, {}, &model, rng);
@@ -48,6 +45,27 @@ void BM_SearchBrm(benchmark::State& state) {
   for (auto _ : state) benchmark::DoNotOptimize(belief_search(map, 0, 1, q));
 }
 BENCHMARK(BM_SearchBrm)->Unit(benchmark::kMicrosecond);
+
+// The sampler's weight at valid uniform candidates: tr(M) (EKF) and I(x) (UKF, eq. 27).
+void BM_Weight(benchmark::State& state, bool ukf) {
+  const Environment& env = *floor().env;
+  const ConfigurationSpace space(env, {});
+  const FeatureSensor sensor(env, FeatureSensorOptions::paper_camera());
+  Rng rng(3);
+  std::vector<Config> qs;
+  while (qs.size() < 256) {
+    const Config q = space.uniform(rng);
+    if (space.is_valid(q)) qs.push_back(q);
+  }
+  const Mat4 prior = 0.1 * Mat4::Identity();
+  size_t i = 0;
+  for (auto _ : state) {
+    const Config& q = qs[i++ % qs.size()];
+    benchmark::DoNotOptimize(ukf ? sensor.ukf_information_gain(q, prior) : sensor.information(q).trace());
+  }
+}
+BENCHMARK_CAPTURE(BM_Weight, ekf_trace, false)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_Weight, ukf_gain, true)->Unit(benchmark::kMicrosecond);
 
 void BM_TransferApply(benchmark::State& state) {
   BeliefStep s;
