@@ -200,25 +200,30 @@ CellFootprint FootprintProjector::footprint(const Key& cell) const {
     umax = vmax = kInf;
     any = true;
   } else {
+    // The grown cell's corners: one projected, the others by adding the projected edges.
     Eigen::Vector3d corner[8];
+    const double side = res + 2.0 * margin_;
+    const Eigen::Vector3d edge[3] = {P_.col(0) * side, P_.col(1) * side, P_.col(2) * side};
+    corner[0] = P_.leftCols<3>() * Eigen::Vector3d(lo[0] - margin_, lo[1] - margin_, lo[2] - margin_) + P_.col(3);
+    bool all_in_front = true;
     for (int c = 0; c < 8; ++c) {
-      const Eigen::Vector3d p(c & 1 ? hi[0] + margin_ : lo[0] - margin_,
-                              c & 2 ? hi[1] + margin_ : lo[1] - margin_,
-                              c & 4 ? hi[2] + margin_ : lo[2] - margin_);
-      corner[c] = P_.leftCols<3>() * p + P_.col(3);
+      if (c > 0) corner[c] = corner[c & ~(c & -c)] + edge[__builtin_ctz(static_cast<unsigned>(c))];
       const Eigen::Vector3d& h = corner[c];
       if (h.z() > 0.0) {
-        const double u = h.x() / h.z(), v = h.y() / h.z();
+        const double inv = 1.0 / h.z();
+        const double u = h.x() * inv, v = h.y() * inv;
         umin = std::min(umin, u);
         umax = std::max(umax, u);
         vmin = std::min(vmin, v);
         vmax = std::max(vmax, v);
         any = true;
-      } else if (h.z() == 0.0) {
-        towards_infinity(h.x(), h.y());
+      } else {
+        all_in_front = false;
+        if (h.z() == 0.0) towards_infinity(h.x(), h.y());
       }
     }
-    for (int c = 0; c < 8; ++c) {
+    // Only a cell crossing the camera plane has an image reaching to infinity.
+    for (int c = 0; c < 8 && !all_in_front; ++c) {
       for (int bit = 1; bit < 8; bit <<= 1) {
         if (c & bit) continue;
         const Eigen::Vector3d& a = corner[c];

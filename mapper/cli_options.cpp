@@ -32,6 +32,11 @@ void add_mapper_options(CLI::App& app, MapperOptions& o) {
   opt("--rebuild-translation", o.rebuild_translation_m, "A keyframe moved by more than this triggers a rebuild, m");
   opt("--rebuild-rotation", o.rebuild_rotation_deg, "... or by more than this, deg");
   opt("--rebuild-interval", o.rebuild_interval_s, "At most one rebuild per this much sensor time, s");
+  app.add_option("--checkpoint-every", o.checkpoint_every,
+                 "Rebuild checkpoints: a copy of the map every this many keyframes (0: none)")
+      ->capture_default_str()
+      ->group("Map");
+  opt("--checkpoint-megabytes", o.checkpoint_megabytes, "Memory budget of the rebuild checkpoints, MB");
   opt("--frame-buffer", o.frame_buffer_s, "Frames kept for SLAM keyframes to refer to, s");
 }
 
