@@ -4,9 +4,13 @@
 // Gaussian and decimation). Extra coarse levels, beyond the feature levels, serve the rotation
 // prior, which works on heavily down-sampled images.
 //
+// The filters are kestrel's own integer, separable, single-threaded loops (image_pyramid.cpp),
+// not OpenCV's, whose thread pool would hide work from a one-core measurement.
+//
 // Invariants: level(i) is CV_8UC1 of size ceil(size / 2^i); buffers are reused from one build()
 // to the next when the image size does not change, so a steady stream allocates nothing.
 
+#include <cstdint>
 #include <opencv2/core/mat.hpp>
 #include <vector>
 
@@ -24,9 +28,21 @@ class ImagePyramid {
   void swap(ImagePyramid& other) noexcept;
 
  private:
+  void blur(const cv::Mat& grey, double sigma, cv::Mat& out);
+
   cv::Mat grey_;
   std::vector<cv::Mat> levels_;
+  std::vector<int> kernel_;
+  double kernel_sigma_ = -1.0;  // the sigma kernel_ was made for
+  std::vector<uint16_t> row_, column_;  // filter scratch
 };
+
+/// Integer Gaussian weights of radius max(1, ceil(2 sigma)) summing to 64.
+void gaussian_kernel_64(double sigma, std::vector<int>& weights);
+
+/// Halves `in` like cv::pyrDown (5-tap 1-4-6-4-1 Gaussian, reflect-101 border, size
+/// ceil(size / 2)); `row` is scratch.
+void half_size(const cv::Mat& in, cv::Mat& out, std::vector<uint16_t>& row);
 
 /// Pixel coordinates of level `level` mapped to level 0 (pixel centres, not corners, scale).
 inline float to_level0(float x, int level) {

@@ -115,6 +115,11 @@ MotionEstimate MotionEstimator::estimate(const Frame& ref, const Frame& cur,
   out.T_ref_cur = T;
   out.covariance = ldlt.solve(Matrix6d::Identity());
   out.covariance = 0.5 * (out.covariance + out.covariance.transpose());
+  out.model_covariance = out.covariance;
+  const CovarianceOptions& co = options.covariance;
+  out.covariance *= co.model_scale;
+  out.covariance.diagonal().head<3>().array() += co.translation_floor_m * co.translation_floor_m;
+  out.covariance.diagonal().tail<3>().array() += co.rotation_floor_rad * co.rotation_floor_rad;
   out.status = VoStatus::kOk;
   return out;
 }

@@ -26,7 +26,8 @@ namespace kestrel::vo {
 struct MotionEstimate {
   VoStatus status = VoStatus::kInsufficientMatches;
   Eigen::Isometry3d T_ref_cur = Eigen::Isometry3d::Identity();
-  Matrix6d covariance = Matrix6d::Zero();
+  Matrix6d covariance = Matrix6d::Zero();        ///< reported: model_scale * model + floors
+  Matrix6d model_covariance = Matrix6d::Zero();  ///< the refinement's own (pixel and depth noise)
   int num_matches = 0;
   int num_inliers = 0;                ///< after max-clique / RANSAC
   int num_reprojection_inliers = 0;   ///< after outlier removal

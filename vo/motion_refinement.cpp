@@ -28,14 +28,28 @@ Projection project(const Eigen::Vector3d& X, const PinholeCamera& cam,
   return p;
 }
 
+// The normal equations, upper triangles only. The image and depth residuals are kept apart
+// because their information shares differ (see add()): information = share * H_image + H_depth.
 struct Accumulator {
-  Matrix6d H = Matrix6d::Zero();
-  Matrix6d information = Matrix6d::Zero();  // H with each measurement counted once
+  Matrix6d H_image = Matrix6d::Zero();
+  Matrix6d H_depth = Matrix6d::Zero();
   Vector6d g = Vector6d::Zero();
   double cost = 0.0;         // robust, whitened
   double sq_px = 0.0;        // unwhitened squared pixel error
   int residuals = 0;
 };
+
+// H += w * J^T J on the upper triangle, written out: Eigen's rankUpdate takes its general
+// matrix-product path for these tiny sizes, several times slower.
+template <int Rows>
+void rank_update(Matrix6d& H, const Eigen::Matrix<double, Rows, 6>& J, double w) {
+  for (int r = 0; r < Rows; ++r) {
+    for (int j = 0; j < 6; ++j) {
+      const double a = w * J(r, j);
+      for (int i = 0; i <= j; ++i) H(i, j) += a * J(r, i);
+    }
+  }
+}
 
 // Adds one scalar residual r with Jacobian J and standard deviation sigma.
 void add_scalar(Accumulator& acc, double r, const Eigen::Matrix<double, 1, 6>& J, double sigma,
@@ -48,20 +62,15 @@ void add_scalar(Accumulator& acc, double r, const Eigen::Matrix<double, 1, 6>& J
     rho = 2.0 * o.huber_px * e - o.huber_px * o.huber_px;
   }
   const Eigen::Matrix<double, 1, 6> Jw = J / sigma;
-  acc.H.noalias() += weight * Jw.transpose() * Jw;
-  acc.information.noalias() += weight * Jw.transpose() * Jw;
+  rank_update<1>(acc.H_depth, Jw, weight);
   acc.g.noalias() += weight * Jw.transpose() * rw;
   acc.cost += rho;
 }
 
 // Adds one residual r = pixel(T) - measured with Jacobian J (2x6), whitened by pixel noise
 // sigma and depth noise along g (the image motion per metre of depth of the projected point).
-// `information_share` is the part of its information that is new: a reprojection residual
-// involves two noisy pixels (the measured one and the ray the point lies on), and the two
-// directions of a bidirectional refinement measure the same pair again.
-
 void add(Accumulator& acc, const Eigen::Vector2d& r, const Matrix26d& J, const Eigen::Vector2d& g,
-         double sigma_z, double information_share, const RefinementOptions& o) {
+         double sigma_z, const RefinementOptions& o) {
   const double s = o.pixel_sigma;
   Eigen::Matrix2d W = Eigen::Matrix2d::Identity() / s;  // Sigma^-1/2
   if (o.depth_weighted && sigma_z > 0.0) {
@@ -80,12 +89,23 @@ void add(Accumulator& acc, const Eigen::Vector2d& r, const Matrix26d& J, const E
     weight = o.huber_px / e;
     rho = 2.0 * o.huber_px * e - o.huber_px * o.huber_px;
   }
-  acc.H.noalias() += weight * Jw.transpose() * Jw;
-  acc.information.noalias() += information_share * weight * Jw.transpose() * Jw;
+  rank_update<2>(acc.H_image, Jw, weight);
   acc.g.noalias() += weight * Jw.transpose() * rw;
   acc.cost += rho;
   acc.sq_px += r.squaredNorm();
   ++acc.residuals;
+}
+
+Matrix6d full(const Matrix6d& upper) { return upper.selfadjointView<Eigen::Upper>(); }
+
+Matrix6d hessian(const Accumulator& acc) { return full(acc.H_image + acc.H_depth); }
+
+// Each measurement counted once: a reprojection residual involves two noisy pixels (the measured
+// one and the ray the point lies on), and the two directions of a bidirectional refinement
+// measure the same pair again.
+Matrix6d information(const Accumulator& acc, const RefinementOptions& o) {
+  const double share = o.bidirectional ? 0.25 : 0.5;
+  return full(share * acc.H_image + acc.H_depth);
 }
 
 Accumulator linearise(const std::vector<Correspondence>& cs, const std::vector<int>& use,
@@ -96,7 +116,6 @@ Accumulator linearise(const std::vector<Correspondence>& cs, const std::vector<i
   const Eigen::Matrix3d Rt = R.transpose();
   const Eigen::Vector3d p = T.translation();
   const bool esm = o.solver == Solver::kEsm;
-  const double share = o.bidirectional ? 0.25 : 0.5;
   for (int i : use) {
     const Correspondence& c = cs[static_cast<size_t>(i)];
     // Reference point into the current image: Y = R^T (P - p).
@@ -107,7 +126,7 @@ Accumulator linearise(const std::vector<Correspondence>& cs, const std::vector<i
       J.leftCols<3>() = -pr.J * Rt;
       J.rightCols<3>() = pr.J * so3::hat(Y);
       const Eigen::Vector3d dY_dz = Rt * (c.ref_point / c.ref_point.z());
-      add(acc, pr.pixel - c.cur_pixel, J, pr.J * dY_dz, c.ref_sigma_z, share, o);
+      add(acc, pr.pixel - c.cur_pixel, J, pr.J * dY_dz, c.ref_sigma_z, o);
     }
     // Current point in the reference frame: X = R Q + p.
     const Eigen::Vector3d X = R * c.cur_point + p;
@@ -128,7 +147,7 @@ Accumulator linearise(const std::vector<Correspondence>& cs, const std::vector<i
       J.leftCols<3>() = pr.J;
       J.rightCols<3>() = -pr.J * R * so3::hat(c.cur_point);
       const Eigen::Vector3d dX_dz = R * (c.cur_point / c.cur_point.z());
-      add(acc, pr.pixel - c.ref_pixel, J, pr.J * dX_dz, c.cur_sigma_z, share, o);
+      add(acc, pr.pixel - c.ref_pixel, J, pr.J * dX_dz, c.cur_sigma_z, o);
     }
   }
   return acc;
@@ -157,7 +176,7 @@ RefinementResult refine_motion(const std::vector<Correspondence>& cs, const std:
   double lambda = 0.0;  // Levenberg-Marquardt damping, only once a step fails
   for (int it = 0; it < o.max_iterations && acc.residuals >= 6; ++it) {
     result.iterations = it + 1;
-    Matrix6d A = acc.H;
+    Matrix6d A = hessian(acc);
     A.diagonal() *= 1.0 + lambda;
     const Vector6d delta = A.ldlt().solve(-acc.g);
     if (!delta.allFinite()) break;
@@ -180,11 +199,11 @@ RefinementResult refine_motion(const std::vector<Correspondence>& cs, const std:
   if (!result.converged && acc.residuals >= 6) {
     // Stopped by the iteration limit or a step that no damping could make descend: a local
     // minimum to within what the data resolves.
-    const Vector6d step = acc.H.ldlt().solve(-acc.g);
+    const Vector6d step = hessian(acc).ldlt().solve(-acc.g);
     result.converged = step.allFinite() && step.head<3>().norm() < 1e-4 && step.tail<3>().norm() < 1e-4;
   }
   result.T_ref_cur = T;
-  result.information = acc.information;
+  result.information = information(acc, o);
   result.rms_error_px = acc.residuals > 0 ? std::sqrt(acc.sq_px / acc.residuals) : 0.0;
   return result;
 }

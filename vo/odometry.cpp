@@ -19,14 +19,19 @@ std::string counts(const char* what, int have, int need) {
   return std::string(what) + ": " + std::to_string(have) + " (need " + std::to_string(need) + ")";
 }
 
-void build_coarse(const ImagePyramid& pyramid, int level, cv::Mat& coarse) {
+void build_coarse(const ImagePyramid& pyramid, int level, cv::Mat& coarse, cv::Mat& scratch,
+                  std::vector<uint16_t>& row) {
   const int top = pyramid.levels() - 1;
   if (level <= top) {
     pyramid.level(level).copyTo(coarse);
     return;
   }
-  cv::pyrDown(pyramid.level(top), coarse);
-  for (int l = top + 1; l < level; ++l) cv::pyrDown(coarse, coarse);
+  const cv::Mat* from = &pyramid.level(top);
+  for (int l = top + 1; l <= level; ++l) {
+    cv::Mat& to = (level - l) % 2 == 0 ? coarse : scratch;  // the last one lands in `coarse`
+    half_size(*from, to, row);
+    from = &to;
+  }
 }
 
 }  // namespace
@@ -146,11 +151,15 @@ VoResult VisualOdometry::process(const RgbdFrame& input) {
   threshold_.update(cur.num_detected, input.camera.width * input.camera.height);
   result.num_features = cur.num_detected;
   if (cur.num_detected < options_.min_features) {
+    // A blank view counts as a failure, so that the first frame with features again restarts
+    // the odometry at once if it cannot be matched to the reference from before the gap.
+    ++consecutive_failures_;
     result.status = VoStatus::kInsufficientFeatures;
     result.message = counts("too few features", cur.num_detected, options_.min_features);
     return result;
   }
-  build_coarse(cur.pyramid, options_.rotation_prior.downsample_level, cur.coarse);
+  build_coarse(cur.pyramid, options_.rotation_prior.downsample_level, cur.coarse, coarse_scratch_,
+               coarse_row_);
 
   // The motion since the previous frame, predicted; it also carries depth to RGB time.
   Eigen::Isometry3d T_prev_cur_predicted = Eigen::Isometry3d::Identity();
@@ -168,6 +177,7 @@ VoResult VisualOdometry::process(const RgbdFrame& input) {
   attach_depth(input.depth_mm, lens_, options_.depth, motion, cur);
   result.num_features_with_depth = static_cast<int>(cur.features.size());
   if (result.num_features_with_depth < options_.min_features_with_depth) {
+    ++consecutive_failures_;
     result.status = VoStatus::kInsufficientDepth;
     result.message = counts("too little valid depth: features with depth",
                             result.num_features_with_depth, options_.min_features_with_depth);

@@ -101,6 +101,8 @@ class VisualOdometry {
 
   std::vector<Eigen::Vector2f> predicted_;
   std::vector<Match> matches_;
+  cv::Mat coarse_scratch_;            // the rotation prior's intermediate halvings
+  std::vector<uint16_t> coarse_row_;
 };
 
 }  // namespace kestrel::vo

@@ -50,6 +50,9 @@ void VoOptions::validate() const {
   require(refinement.outlier_threshold_px > 0.0, "refinement.outlier_threshold_px", "must be > 0");
   require(refinement.max_iterations >= 1, "refinement.max_iterations", "must be >= 1");
   require(refinement.min_inliers >= 3, "refinement.min_inliers", "must be >= 3");
+  require(covariance.model_scale > 0.0, "covariance.model_scale", "must be > 0");
+  require(covariance.translation_floor_m >= 0.0, "covariance.translation_floor_m", "must be >= 0");
+  require(covariance.rotation_floor_rad >= 0.0, "covariance.rotation_floor_rad", "must be >= 0");
   require(keyframe.min_inliers_to_keep >= 0, "keyframe.min_inliers_to_keep", "must be >= 0");
   require(min_features >= 0 && min_features_with_depth >= 3 && min_matches >= 3,
           "min_features/min_features_with_depth/min_matches", "must be >= 0 / 3 / 3");

@@ -92,6 +92,16 @@ struct RefinementOptions {
   int min_inliers = 10;           ///< fewer after outlier removal = optimisation failure
 };
 
+/// What the reported covariance adds to the refinement's own (whose noise model only holds
+/// pixel and depth noise): the per-estimate error the model does not contain (colour/depth time
+/// offset and misregistration, rolling shutter), measured as the RMS per axis of the relative-
+/// pose errors against ground truth on fr1_xyz and fr1_rpy (vo/README.md, "Covariance").
+struct CovarianceOptions {
+  double model_scale = 1.0;              ///< multiplies the refinement's covariance
+  double translation_floor_m = 0.0032;   ///< per-axis sigma added in quadrature, metres
+  double rotation_floor_rad = 0.0038;    ///< per-axis sigma added in quadrature, radians
+};
+
 /// Reference (key) frame policy.
 struct KeyframeOptions {
   int min_inliers_to_keep = 300;  ///< below this, the current frame becomes the reference
@@ -107,6 +117,7 @@ struct VoOptions {
   MatchOptions match;
   InlierOptions inliers;
   RefinementOptions refinement;
+  CovarianceOptions covariance;
   KeyframeOptions keyframe;
   int min_features = 30;          ///< fewer detections: "too few features"
   int min_features_with_depth = 20;  ///< fewer with valid depth: "too little valid depth"

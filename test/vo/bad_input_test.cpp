@@ -98,6 +98,27 @@ TEST_F(BadInput, TwoFailuresInARowRestartFromTheCurrentFrame) {
   EXPECT_NEAR(third.T_reference_current.translation().x(), 0.01, 0.002);
 }
 
+TEST_F(BadInput, AfterABlankViewTheFirstUnmatchableFrameRestarts) {
+  // A blank wall (no features) for a few frames, then a place the old reference does not
+  // show: the first frame with features becomes the new reference at once (it does not wait
+  // for a second failure), and the next frame has a motion again.
+  for (int k = 2; k < 6; ++k) {
+    RgbdFrame f = good(k);
+    f.rgb.setTo(cv::Scalar::all(128));
+    ASSERT_EQ(vo.process(f).status, VoStatus::kInsufficientFeatures);
+  }
+  const test::SyntheticScene other(99);
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  const VoResult first = vo.process(other.render(T, test::test_camera(), 2000000));
+  EXPECT_NE(first.status, VoStatus::kOk);
+  EXPECT_TRUE(first.new_reference) << first.message;
+  T.translation().x() = 0.01;
+  const VoResult second = vo.process(other.render(T, test::test_camera(), 2033333));
+  ASSERT_EQ(second.status, VoStatus::kOk) << second.message;
+  EXPECT_EQ(second.reference_utime, 2000000);
+  EXPECT_NEAR(second.T_reference_current.translation().x(), 0.01, 0.002);
+}
+
 TEST(Options, UnusableValuesAreRejectedByName) {
   VoOptions o;
   o.match.window_size = 8;
@@ -131,7 +152,7 @@ TEST(Options, SetByNameAndRejectedByName) {
     }
   }
   EXPECT_EQ(o.fast.threshold, 15) << "a rejected value changes nothing";
-  EXPECT_EQ(describe_options(o).size(), 51u);
+  EXPECT_EQ(describe_options(o).size(), 54u);
 }
 
 }  // namespace
