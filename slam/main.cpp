@@ -14,6 +14,7 @@
 #include "common/error.h"
 #include "common/transport/channels.h"
 #include "common/transport/node.h"
+#include "slam/memory_policy.h"
 #include "slam/slam_adapter.h"
 #if KESTREL_SLAM_OFFLINE
 #include "slam/sequence_run.h"
@@ -127,6 +128,7 @@ int serve(const Options& o, const SlamOptions& options, std::shared_ptr<const Vo
 }  // namespace
 
 int main(int argc, char** argv) {
+  kestrel::slam::keep_freed_memory();
   cli::App app("slam",
                "SLAM: keyframes, loop closure and pose-graph optimisation. CAMERA_RGBD + VO_UPDATE -> "
                "SLAM_GRAPH + SLAM_CORRECTION, or with --tum an offline VO + SLAM run over a TUM folder.");

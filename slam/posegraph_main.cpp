@@ -16,6 +16,7 @@
 
 #include "common/cli.h"
 #include "common/error.h"
+#include "slam/memory_policy.h"
 #include "slam/posegraph/g2o_io.h"
 #include "slam/posegraph/optimizer.h"
 
@@ -53,6 +54,7 @@ void run(PoseGraph<Space>& graph, const OptimizerOptions& options, const std::st
 }  // namespace
 
 int main(int argc, char** argv) {
+  kestrel::slam::keep_freed_memory();
   cli::App app("posegraph",
                "Optimise a pose graph in g2o format (SE2 or SE3) with kestrel's SLAM optimiser");
   std::string input, output;

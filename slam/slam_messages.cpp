@@ -43,6 +43,16 @@ kestrel::slam_graph_t graph_message(const Slam& slam) {
   return m;
 }
 
+Matrix6d body_covariance(const Eigen::Isometry3d& T_world_body, const Eigen::Isometry3d& T_body_camera,
+                         const Matrix6d& camera_covariance) {
+  // A right perturbation xi of T_world_camera moves T_world_body by Ad(T_body_camera) xi on the
+  // right; pose_t wants the translation part in the world frame.
+  Matrix6d J = se3::adjoint(T_body_camera);
+  J.topRows<3>() = (T_world_body.linear() * J.topRows<3>()).eval();
+  const Matrix6d covariance = J * camera_covariance * J.transpose();
+  return 0.5 * (covariance + covariance.transpose());
+}
+
 kestrel::slam_correction_t correction_message(const Slam& slam, double sigma_translation_m,
                                               double sigma_rotation_rad) {
   const Keyframe& kf = slam.keyframes().back();
@@ -54,12 +64,7 @@ kestrel::slam_correction_t correction_message(const Slam& slam, double sigma_tra
   m.T_world_body = transport::to_message(T_world_body);
   Matrix6d covariance = Matrix6d::Zero();
   if (const auto& marginal = slam.newest_covariance()) {
-    // A right perturbation xi of T_world_camera moves T_world_body by Ad(T_body_camera) xi on
-    // the right; pose_t wants the translation part in the world frame.
-    Matrix6d J = se3::adjoint(kf.T_body_camera);
-    J.topRows<3>() = (T_world_body.linear() * J.topRows<3>()).eval();
-    covariance = J * *marginal * J.transpose();
-    covariance = 0.5 * (covariance + covariance.transpose()).eval();
+    covariance = body_covariance(T_world_body, kf.T_body_camera, *marginal);
   } else {
     covariance.diagonal().head<3>().setConstant(sigma_translation_m * sigma_translation_m);
     covariance.diagonal().tail<3>().setConstant(sigma_rotation_rad * sigma_rotation_rad);

@@ -19,6 +19,12 @@ VoMotion motion_from_message(const kestrel::vo_update_t& m, const char* channel)
 
 kestrel::slam_graph_t graph_message(const Slam& slam);
 
+/// The covariance of T_world_body in pose_t's convention ([dp in world; dtheta in body]) from
+/// that of T_world_camera as the optimiser gives it (marginals.h: right perturbation
+/// [rho; phi] in the camera frame), with T_world_body = T_world_camera * T_body_camera^-1.
+Matrix6d body_covariance(const Eigen::Isometry3d& T_world_body, const Eigen::Isometry3d& T_body_camera,
+                         const Matrix6d& camera_covariance);
+
 /// The correction for the newest keyframe; the slam must have a keyframe. Its covariance is
 /// the optimiser's marginal of that keyframe (Slam::newest_covariance) carried to the body
 /// frame in pose_t's convention; when there is none, a diagonal one of the given standard

@@ -125,5 +125,27 @@ TEST_F(AdapterTest, ResetForgetsEverything) {
   EXPECT_TRUE(adapter_.on_vo_update(update(0)).graph);
 }
 
+TEST(CorrectionCovariance, CarriesTheCameraMarginalToTheBody) {
+  // The camera sits 10 cm ahead of the body; its yaw uncertainty swings the body sideways.
+  Eigen::Isometry3d T_body_camera = Eigen::Isometry3d::Identity();
+  T_body_camera.translation() = Eigen::Vector3d(0.1, 0.0, 0.0);
+  const double s2 = 0.01 * 0.01;
+  Matrix6d camera = Matrix6d::Zero();
+  camera(5, 5) = s2;  // yaw about the camera's z
+  const Matrix6d body = body_covariance(Eigen::Isometry3d::Identity(), T_body_camera, camera);
+  Matrix6d expected = Matrix6d::Zero();
+  expected(1, 1) = 0.01 * s2;  // (0.1 m)^2
+  expected(5, 5) = s2;
+  expected(1, 5) = expected(5, 1) = -0.1 * s2;
+  EXPECT_LT((body - expected).cwiseAbs().maxCoeff(), 1e-15) << body;
+  // A body turned by 90 degrees about z in the world: the sideways swing is along world x.
+  Eigen::Isometry3d T_world_body = Eigen::Isometry3d::Identity();
+  T_world_body.linear() = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const Matrix6d turned = body_covariance(T_world_body, T_body_camera, camera);
+  EXPECT_NEAR(turned(0, 0), 0.01 * s2, 1e-15);
+  EXPECT_NEAR(turned(1, 1), 0.0, 1e-15);
+  EXPECT_NEAR(turned(0, 5), 0.1 * s2, 1e-15);
+}
+
 }  // namespace
 }  // namespace kestrel::slam

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 
 #include "common/error.h"
@@ -12,6 +13,7 @@
 #include "common/geometry/se3.h"
 #include "slam/backend/odometry_chain.h"
 #include "slam/backend/slam.h"
+#include "slam/posegraph/marginals.h"
 #include "test/slam/synthetic_room.h"
 
 namespace kestrel::slam {
@@ -50,6 +52,9 @@ struct LoopRun {
   std::vector<Eigen::Isometry3d> truth, odometry, optimised;
   int loop_closures = 0;
   int false_closures = 0;
+  int64_t last_loop_keyframe = -1;           ///< the newest keyframe when the last loop closed
+  std::optional<Matrix6d> loop_covariance;   ///< Slam::newest_covariance() then
+  PoseGraph3d graph;                         ///< at the end
 };
 
 LoopRun run(const SyntheticRoom& room, const std::vector<Eigen::Isometry3d>& truth, double yaw_bias_rad) {
@@ -63,6 +68,8 @@ LoopRun run(const SyntheticRoom& room, const std::vector<Eigen::Isometry3d>& tru
     const SlamStep step = slam.add(frame, r.odometry[k]);
     if (step.loop_closed) {
       ++r.loop_closures;
+      r.last_loop_keyframe = step.keyframe_id;
+      r.loop_covariance = slam.newest_covariance();
       // The closure's relative pose against the truth of the two keyframes' frames.
       const auto& kfs = slam.keyframes();
       const auto frame_of = [&](int64_t id) { return static_cast<size_t>((kfs[static_cast<size_t>(id)].utime - 1'000'000) / 200'000); };
@@ -77,6 +84,7 @@ LoopRun run(const SyntheticRoom& room, const std::vector<Eigen::Isometry3d>& tru
     placed.emplace_back(static_cast<int>(kf.id), kf.T_odom_camera.inverse() * r.odometry[k]);
   }
   for (const auto& [kf, T] : placed) r.optimised.push_back(slam.graph().poses[static_cast<size_t>(kf)] * T);
+  r.graph = slam.graph();
   return r;
 }
 
@@ -89,6 +97,21 @@ TEST(Slam, LoopClosureCutsTheDriftOfAClosedLoop) {
   EXPECT_GE(r.loop_closures, 1);
   EXPECT_EQ(r.false_closures, 0);
   std::cout << "ATE: VO only " << vo << " m, SLAM " << slam << " m, " << r.loop_closures << " loop closures\n";
+
+  // The correction's covariance comes from the graph: the loop closures tie the keyframe back
+  // to the start, so it is far tighter than what the odometry alone would give it.
+  ASSERT_TRUE(r.loop_covariance);
+  EXPECT_GT(r.loop_covariance->ldlt().vectorD().minCoeff(), 0.0);
+  PoseGraph3d odometry_only = r.graph;
+  odometry_only.edges.erase(std::remove_if(odometry_only.edges.begin(), odometry_only.edges.end(),
+                                           [](const auto& e) { return e.kind == EdgeKind::kLoopClosure; }),
+                            odometry_only.edges.end());
+  const auto open = marginal_covariance(odometry_only, static_cast<int>(r.last_loop_keyframe));
+  ASSERT_TRUE(open);
+  const double closed_m = std::sqrt(r.loop_covariance->topLeftCorner<3, 3>().trace());
+  const double open_m = std::sqrt(open->topLeftCorner<3, 3>().trace());
+  EXPECT_LT(closed_m, 0.5 * open_m) << "position sigma with loops " << closed_m << " m, odometry only " << open_m << " m";
+  std::cout << "newest keyframe position sigma: " << closed_m << " m (odometry only: " << open_m << " m)\n";
 }
 
 TEST(Slam, ALoopFreeRunClosesNoLoop) {
