@@ -48,6 +48,7 @@ struct Options {
   int jpeg_quality = 95;
   std::vector<double> intrinsics;
   double tilt_deg = 10.0;
+  double camera_rate_hz = 30.0;
   bool list = false;
 };
 
@@ -81,6 +82,9 @@ void add_options(cli::App& app, Options& o) {
   app.add_option("--camera-tilt", o.tilt_deg, "Camera pitched down from body x, degrees")
       ->check(CLI::Range(-90.0, 90.0))
       ->capture_default_str();
+  app.add_option("--camera-rate", o.camera_rate_hz, "Frames per second (the IMU and ground truth stay at 200 Hz)")
+      ->check(CLI::Range(0.1, 1000.0))
+      ->capture_default_str();
   app.add_flag("--list", o.list, "List the built-in worlds and the flights, then exit");
 }
 
@@ -113,6 +117,7 @@ int run(const Options& o) {
   sim::SimulationOptions so;
   so.seed = o.seed;
   so.camera.rgb.motion_blur_samples = o.motion_blur;
+  so.camera.rate_hz = o.camera_rate_hz;
   so.camera.T_body_camera = sim::CameraOptions::default_T_body_camera(o.tilt_deg);
   if (!o.intrinsics.empty()) {
     PinholeCamera& c = so.camera.camera;
