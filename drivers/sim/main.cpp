@@ -24,6 +24,7 @@
 #include "drivers/sim/messages.h"
 #include "drivers/sim/simulation.h"
 #include "drivers/sim/tum_writer.h"
+#include "drivers/sim/vehicle.h"
 #include "drivers/sim/world_catalog.h"
 
 namespace {
@@ -49,6 +50,7 @@ struct Options {
   std::vector<double> intrinsics;
   double tilt_deg = 10.0;
   double camera_rate_hz = 30.0;
+  std::string feedback = "state";
   bool list = false;
 };
 
@@ -56,7 +58,14 @@ void add_options(cli::App& app, Options& o) {
   app.add_option("--world", o.world, "room, floor, office, stata (needs --map), a .world file or a map .yaml")
       ->capture_default_str();
   app.add_option("--map", o.map, "ROS occupancy map (yaml) for --world stata, e.g. ../shared/data/maps/stata_basement.yaml");
-  app.add_option("--flight", o.flight, "hover, figure8, aggressive, loop, survey")->capture_default_str();
+  app.add_option("--flight", o.flight,
+                 "hover, figure8, aggressive, loop, survey, or vehicle (closed loop: flies VEHICLE_COMMAND)")
+      ->capture_default_str();
+  app.add_option("--vehicle-feedback", o.feedback,
+                 "vehicle: what its position controller uses, the estimator's STATE (the truth until the first "
+                 "usable STATE) or the truth")
+      ->check(CLI::IsMember({"state", "truth"}))
+      ->capture_default_str();
   app.add_option("--duration", o.duration_s, "Seconds of flight to simulate")->check(cli::Positive)->capture_default_str();
   app.add_option("--seed", o.seed, "Sensor noise seed (same seed, same bytes)")->capture_default_str();
   app.add_option("--log", o.log, "Write an LCM log here (no network, full speed)");
@@ -104,13 +113,21 @@ int run(const Options& o) {
     for (const auto& w : sim::builtin_world_names()) std::cout << "world " << w << "\n";
     std::cout << "world stata (--map FILE.yaml)\n";
     for (const auto& f : sim::flight_names()) std::cout << "flight " << f << "\n";
+    std::cout << "flight vehicle (closed loop)\n";
     return kExitOk;
   }
   const auto t0 = Clock::now();
   const sim::World world = sim::load_world(o.world, o.map);
   std::unique_ptr<sim::Flight> flight;
+  sim::VehicleFlight* vehicle = nullptr;
   try {
-    flight = sim::make_flight(o.flight, world);
+    if (o.flight == "vehicle") {
+      auto v = std::make_unique<sim::VehicleFlight>(world.start(), sim::VehicleOptions{}, o.seed);
+      vehicle = v.get();
+      flight = std::move(v);
+    } else {
+      flight = sim::make_flight(o.flight, world);
+    }
   } catch (const std::invalid_argument& e) {
     throw CLI::ValidationError("--flight", e.what());
   }
@@ -131,6 +148,13 @@ int run(const Options& o) {
     so.imu.noise = false;
   }
   sim::Simulation simulation(world, *flight, so);
+  // The closed-loop vehicle is committed one control period ahead of the next event, plus the
+  // IMU's 2 ms difference and half a motion-blurred exposure.
+  std::optional<sim::VehicleLoop> loop;
+  std::optional<sim::VehicleEstimate> estimate;  // the latest usable STATE
+  if (vehicle)
+    loop.emplace(*vehicle, 0.002 + vehicle->options().control_period_s +
+                               (o.motion_blur > 1 ? 0.5 * so.camera.rgb.exposure_time_s : 0.0));
   transport::RgbdEncoding encoding;
   encoding.rgb = o.rgb_encoding == "raw" ? kestrel::rgbd_frame_t::RGB_RGB8 : kestrel::rgbd_frame_t::RGB_JPEG;
   encoding.depth = o.depth_encoding == "raw" ? kestrel::rgbd_frame_t::DEPTH_U16_MM : kestrel::rgbd_frame_t::DEPTH_U16_MM_ZSTD;
@@ -154,6 +178,15 @@ int run(const Options& o) {
       return kExitUnavailable;
     }
     for (const char* c : {channel::kCameraRgbd, channel::kImu, channel::kGroundTruth}) sinks.node->advertise(c);
+    if (vehicle) {
+      sinks.node->subscribe<kestrel::vehicle_command_t>(
+          channel::kVehicleCommand, [&](const kestrel::vehicle_command_t& m) { loop->set_command(sim::vehicle_command(m)); });
+      if (o.feedback == "state")
+        sinks.node->subscribe<kestrel::state_t>(channel::kState, [&](const kestrel::state_t& m) {
+          sim::VehicleEstimate e;
+          if (sim::vehicle_estimate(m, e)) estimate = e;
+        });
+    }
     sinks.node->on_reset([&] { restart = true; });
     sinks.node->set_health(kestrel::process_status_t::STATE_RUNNING, "");
   }
@@ -166,8 +199,26 @@ int run(const Options& o) {
   while (!stopping()) {
     if (restart) {
       simulation.reset();
+      if (vehicle) {
+        vehicle->reset();
+        loop->set_command(sim::VehicleCommand{});  // hold where it starts
+        estimate.reset();
+      }
       wall_start = Clock::now();
       restart = false;
+    }
+    if (loop) {
+      // The controller acts on the latest STATE (or the truth) before the next event.
+      const double t_next = simulation.seconds(simulation.next_utime());
+      const double t_now = std::max(0.0, t_next - vehicle->options().control_period_s);
+      sim::VehicleEstimate now;
+      if (estimate) {
+        now = *estimate;
+      } else {
+        const sim::PathPoint q = vehicle->point(t_now);
+        now = {q.p, q.v, q.yaw};
+      }
+      loop->advance_to(t_next, now);
     }
     sim::SimEvent e = simulation.next();
     if (e.utime > end_utime) break;

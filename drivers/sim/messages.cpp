@@ -1,5 +1,10 @@
 #include "drivers/sim/messages.h"
 
+#include <cmath>
+#include <string>
+
+#include "common/error.h"
+#include "common/transport/channels.h"
 #include "common/transport/convert.h"
 
 namespace kestrel::sim {
@@ -35,6 +40,47 @@ kestrel::ground_truth_t ground_truth_message(int64_t utime, const MotionState& t
     copy3(biases->accel_bias, m.accel_bias);
   }
   return m;
+}
+
+VehicleCommand vehicle_command(const kestrel::vehicle_command_t& m) {
+  auto bad = [](const std::string& what) {
+    return InputError(std::string(channel::kVehicleCommand) + ": " + what);
+  };
+  VehicleCommand c;
+  const Eigen::Vector3d position(m.position[0], m.position[1], m.position[2]);
+  const Eigen::Vector3d velocity(m.velocity[0], m.velocity[1], m.velocity[2]);
+  switch (m.mode) {
+    case kestrel::vehicle_command_t::MODE_HOLD:
+      c.mode = VehicleCommand::kHold;
+      break;
+    case kestrel::vehicle_command_t::MODE_VELOCITY:
+      if (!velocity.allFinite() || !std::isfinite(m.yaw_rate)) throw bad("non-finite velocity or yaw rate");
+      c.mode = VehicleCommand::kVelocity;
+      c.velocity = velocity;
+      c.yaw_rate = m.yaw_rate;
+      break;
+    case kestrel::vehicle_command_t::MODE_POSITION:
+      if (!position.allFinite() || !std::isfinite(m.yaw)) throw bad("non-finite position or yaw");
+      c.mode = VehicleCommand::kPosition;
+      c.position = position;
+      c.yaw = m.yaw;
+      c.velocity = velocity.allFinite() ? velocity : Eigen::Vector3d::Zero();  // feed-forward is optional
+      break;
+    default:
+      throw bad("unknown mode " + std::to_string(static_cast<int>(m.mode)));
+  }
+  return c;
+}
+
+bool vehicle_estimate(const kestrel::state_t& m, VehicleEstimate& out) {
+  if (m.status != kestrel::state_t::STATUS_OK && m.status != kestrel::state_t::STATUS_DEGRADED) return false;
+  const Eigen::Isometry3d T = transport::from_message(m.T_world_body, channel::kState);
+  const Eigen::Vector3d v(m.velocity[0], m.velocity[1], m.velocity[2]);
+  if (!T.matrix().allFinite() || !v.allFinite()) return false;
+  out.p = T.translation();
+  out.v = v;
+  out.yaw = std::atan2(T.linear()(1, 0), T.linear()(0, 0));
+  return true;
 }
 
 }  // namespace kestrel::sim

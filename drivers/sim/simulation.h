@@ -18,6 +18,7 @@
 // sample and a frame share a time stamp the IMU sample comes first. A fixed seed gives the
 // same bytes on every run and machine.
 
+#include <algorithm>
 #include <cstdint>
 
 #include "common/rgbd_frame.h"
@@ -53,6 +54,9 @@ class Simulation {
 
   /// The next event in time order (never ends; the caller decides the duration).
   SimEvent next();
+  /// Time stamp of the event next() returns next (a closed-loop driver commits the vehicle's
+  /// motion up to it first).
+  int64_t next_utime() const { return std::min(frame_utime(next_frame_), imu_utime(next_imu_)); }
   /// Starts again at t = 0; the same events follow.
   void reset();
 

@@ -3,12 +3,17 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <filesystem>
 #include <fstream>
 #include <cmath>
 #include <iterator>
 #include <sstream>
+#include <vector>
 
+#include "common/transport/channels.h"
+#include "common/transport/log_file.h"
+#include "kestrel/vehicle_command_t.hpp"
 #include "test/support/test_support.h"
 
 namespace {
@@ -104,6 +109,54 @@ TEST(SimToolTest, LivePublishingReachesAnLcmLogger) {
   // 201 sent (0 .. 1 s at 200 Hz); UDP may drop a few when the logger falls behind.
   EXPECT_GE(data_lines(dir / "gt.txt"), 180);
   EXPECT_LE(data_lines(dir / "gt.txt"), 201);
+}
+
+// Closed loop over LCM: a VEHICLE_COMMAND (velocity 0.3 m/s along world x, played by the
+// stock lcm-logplayer half a second into the flight) moves the simulated vehicle, as its
+// GROUND_TRUTH recorded by lcm-logger shows; before it the vehicle holds its start.
+TEST(SimToolTest, VehicleFliesAVehicleCommandReceivedOverLcm) {
+  if (!kestrel::test::can_isolate_network()) GTEST_SKIP() << "cannot create a network namespace here";
+  if (!fs::exists(tool("eval"))) GTEST_SKIP() << "kestrel-eval is not built";
+  TempDir dir;
+  const std::string log = (dir / "live.lcmlog").string(), commands = (dir / "command.lcmlog").string();
+  {
+    kestrel::vehicle_command_t c{};
+    c.mode = kestrel::vehicle_command_t::MODE_VELOCITY;
+    c.velocity[0] = 0.3;
+    kestrel::transport::LogWriter writer(commands);
+    writer.write_message(kestrel::channel::kVehicleCommand, 0, c);
+  }
+  const std::string pid = (dir / "pid").string();
+  const std::string script =
+      "ip link set lo up && ip link set lo multicast on && ip route add 224.0.0.0/4 dev lo && "
+      "export LCM_DEFAULT_URL='udpm://239.255.76.67:7667?ttl=0' && "
+      "(lcm-logger -f '" + log + "' >/dev/null 2>&1 & echo $! > '" + pid + "') && sleep 1 && "
+      "('" + tool("sim").string() + "' --world office --flight vehicle --vehicle-feedback truth --duration 4 "
+      "--camera-rate 3 -q & "
+      // Once the flight is on the wire (so the sim has subscribed), half a second later.
+      "while [ $(stat -c %s '" + log + "') -lt 20000 ]; do sleep 0.05; done; sleep 0.5 && "
+      "lcm-logplayer '" + commands + "' >/dev/null 2>&1; wait) && sleep 1 && "
+      "kill $(cat '" + pid + "')";
+  const auto r = run({"unshare", "-n", "sh", "-c", script}, 200.0);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto eval = run({tool("eval").string(), "--est", log + ":GROUND_TRUTH", "--to-tum", (dir / "gt.txt").string()});
+  ASSERT_EQ(eval.exit_code, 0) << eval.err;
+  std::ifstream in(dir / "gt.txt");
+  std::string line;
+  std::vector<std::array<double, 3>> p;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream fields(line);
+    double t, x, y, z;
+    fields >> t >> x >> y >> z;
+    p.push_back({x, y, z});
+  }
+  ASSERT_GE(p.size(), 600u);
+  // Held for the first quarter second (wind only), then carried along x.
+  EXPECT_LT(std::hypot(p[50][0] - p[0][0], p[50][1] - p[0][1]), 0.02);
+  EXPECT_GT(p.back()[0] - p[0][0], 0.2);
+  EXPECT_LT(p.back()[0] - p[0][0], 0.3 * 3.5);
+  EXPECT_LT(std::abs(p.back()[1] - p[0][1]), 0.1);
 }
 
 TEST(SimToolTest, BadInputIsOneLineNamingTheFileWithExitCode3) {
