@@ -101,10 +101,11 @@ int main(int argc, char** argv) {
       const eval::Pairs pairs(w.pairs.begin(), w.pairs.end());
       const Eigen::AlignedBox3d b = w.env->bounds();
       std::ostringstream head;
-      head << "## World " << w.name << "\n\n" << w.world->source() << ", " << b.sizes().x() << " x " << b.sizes().y()
+      head << std::fixed << std::setprecision(1) << "## World " << w.name << "\n\n" << w.world->source() << ", "
+           << b.sizes().x() << " x " << b.sizes().y()
            << " m, " << w.env->features().size() << " wall features (mean " << features.mean_density_per_m2
            << " /m², per-wall share from the textures); pair distances";
-      for (const auto& p : pairs) head << " " << std::fixed << std::setprecision(1) << (p.second - p.first).head<3>().norm();
+      for (const auto& p : pairs) head << " " << (p.second - p.first).head<3>().norm();
       head << " m.\n\n";
       emit(head.str());
       section("table4", "Table 4: BRM success % · final tr(Σ) per sampler and path",

@@ -151,7 +151,9 @@ std::string table4_samplers(const Scenario& sc, const Pairs& pairs, const Experi
       const double se = std::hypot(su.sem_trace(), other.sem_trace());
       const double p1 = su.success_pct() / 100.0, p2 = other.success_pct() / 100.0;
       const double se_rate = std::sqrt(p1 * (1 - p1) / su.trials + p2 * (1 - p2) / other.trials);
-      if (p1 < p2 - 2.0 * se_rate - 1e-12 || su.mean_trace() > other.mean_trace() + 2.0 * se)
+      // Traces are compared only when both have successes (a mean over none is no value).
+      const bool traces = su.successes > 0 && other.successes > 0;
+      if (p1 < p2 - 2.0 * se_rate - 1e-12 || (traces && su.mean_trace() > other.mean_trace() + 2.0 * se))
         worse += std::string(worse.empty() ? "" : ", ") + names[k];
     }
     out << " path " << p + 1 << ": " << (worse.empty() ? "no worse" : "worse than " + worse) << ";";
