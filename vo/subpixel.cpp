@@ -32,6 +32,17 @@ SubpixelResult refine_subpixel(const cv::Mat& ref, const Eigen::Vector2i& ref_px
     for (int x = 0; x < side; ++x) t[static_cast<size_t>(y * side + x)] = row[x];
   }
 
+  // The template's half of the gradients does not change between iterations.
+  Patch tgx{}, tgy{};
+  const size_t sd = static_cast<size_t>(side);
+  for (int y = 1; y <= window; ++y) {
+    for (int x = 1; x <= window; ++x) {
+      const size_t i = static_cast<size_t>(y * side + x);
+      tgx[i] = t[i + 1] - t[i - 1];
+      tgy[i] = t[i + sd] - t[i - sd];
+    }
+  }
+
   Eigen::Vector2f pos = cur_start;
   float bias = 0.0f;
   Patch s{};
@@ -51,12 +62,11 @@ SubpixelResult refine_subpixel(const cv::Mat& ref, const Eigen::Vector2i& ref_px
     // The normal equations of J = (gx, gy, -1) accumulated as scalars: the compiler keeps
     // them in registers, where a generic rank update per pixel would not.
     float hxx = 0, hxy = 0, hyy = 0, sx = 0, sy = 0, ex = 0, ey = 0, se = 0, cost = 0;
-    const size_t sd = static_cast<size_t>(side);
     for (int y = 1; y <= window; ++y) {
       for (int x = 1; x <= window; ++x) {
         const size_t i = static_cast<size_t>(y * side + x);
-        const float gx = 0.25f * (s[i + 1] - s[i - 1] + t[i + 1] - t[i - 1]);
-        const float gy = 0.25f * (s[i + sd] - s[i - sd] + t[i + sd] - t[i - sd]);
+        const float gx = 0.25f * (s[i + 1] - s[i - 1] + tgx[i]);
+        const float gy = 0.25f * (s[i + sd] - s[i - sd] + tgy[i]);
         const float e = s[i] - t[i] - bias;
         hxx += gx * gx;
         hxy += gx * gy;
