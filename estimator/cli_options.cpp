@@ -69,6 +69,10 @@ void add_estimator_options(CLI::App& app, EstimatorOptions& o) {
   app.add_option("--ukf-kappa", o.unscented.kappa, "UKF secondary scaling")->capture_default_str();
   app.add_option("--init-duration", o.init.duration_s, "Still IMU time averaged to start, s")
       ->check(positive)->capture_default_str();
+  app.add_option("--init-moving-after", o.init.moving_start_after_s,
+                 "Without a still IMU window for this long, start on the move with a wide "
+                 "covariance (0 = wait for a still vehicle), s")
+      ->check(non_negative)->capture_default_str();
   app.add_option("--init-yaw", o.init.yaw, "Yaw of the initial attitude (unobservable), rad")
       ->capture_default_str();
   app.add_option_function<std::vector<double>>(

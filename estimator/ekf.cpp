@@ -6,15 +6,20 @@
 
 namespace kestrel::estimator {
 
-void transform_covariance(const Transition& phi, Covariance& P) {
+namespace {
+
+// P <- Phi P Phi^T on any square matrix expression (a fixed-size map or the dynamic one).
+template <typename Mat>
+void transform_blocks(const Transition& phi, Mat& P) {
+  constexpr int N = Mat::RowsAtCompileTime;
   const int n = static_cast<int>(P.rows());
   const double half_dt = 0.5 * phi.dt;
-  using Rows = Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::ColMajor, 3, kMaxDim>;
-  using Cols = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::ColMajor, kMaxDim, 3>;
+  using Rows = Eigen::Matrix<double, 3, N, Eigen::ColMajor, 3, N == Eigen::Dynamic ? kMaxDim : N>;
+  using Cols = Eigen::Matrix<double, N, 3, Eigen::ColMajor, N == Eigen::Dynamic ? kMaxDim : N, 3>;
   {  // Rows: P <- Phi P.
-    const auto th = P.middleRows<3>(idx::kTheta);
-    const auto bg = P.middleRows<3>(idx::kBg);
-    const auto ba = P.middleRows<3>(idx::kBa);
+    const auto th = P.template middleRows<3>(idx::kTheta);
+    const auto bg = P.template middleRows<3>(idx::kBg);
+    const auto ba = P.template middleRows<3>(idx::kBa);
     Rows t(3, n);
     t.noalias() = phi.v_theta * th;
     t.noalias() += phi.v_bg * bg;
@@ -22,14 +27,14 @@ void transform_covariance(const Transition& phi, Covariance& P) {
     Rows new_th(3, n);
     new_th.noalias() = phi.theta_theta * th;
     new_th.noalias() += phi.theta_bg * bg;
-    P.middleRows<3>(idx::kP) += phi.dt * P.middleRows<3>(idx::kV) + half_dt * t;
-    P.middleRows<3>(idx::kV) += t;
-    P.middleRows<3>(idx::kTheta) = new_th;
+    P.template middleRows<3>(idx::kP) += phi.dt * P.template middleRows<3>(idx::kV) + half_dt * t;
+    P.template middleRows<3>(idx::kV) += t;
+    P.template middleRows<3>(idx::kTheta) = new_th;
   }
   {  // Columns: P <- P Phi^T.
-    const auto th = P.middleCols<3>(idx::kTheta);
-    const auto bg = P.middleCols<3>(idx::kBg);
-    const auto ba = P.middleCols<3>(idx::kBa);
+    const auto th = P.template middleCols<3>(idx::kTheta);
+    const auto bg = P.template middleCols<3>(idx::kBg);
+    const auto ba = P.template middleCols<3>(idx::kBa);
     Cols t(n, 3);
     t.noalias() = th * phi.v_theta.transpose();
     t.noalias() += bg * phi.v_bg.transpose();
@@ -37,9 +42,30 @@ void transform_covariance(const Transition& phi, Covariance& P) {
     Cols new_th(n, 3);
     new_th.noalias() = th * phi.theta_theta.transpose();
     new_th.noalias() += bg * phi.theta_bg.transpose();
-    P.middleCols<3>(idx::kP) += phi.dt * P.middleCols<3>(idx::kV) + half_dt * t;
-    P.middleCols<3>(idx::kV) += t;
-    P.middleCols<3>(idx::kTheta) = new_th;
+    P.template middleCols<3>(idx::kP) += phi.dt * P.template middleCols<3>(idx::kV) + half_dt * t;
+    P.template middleCols<3>(idx::kV) += t;
+    P.template middleCols<3>(idx::kTheta) = new_th;
+  }
+}
+
+// The state's dimension is one of four (0 to 3 clones): each gets a fixed-size view of the
+// same storage, so the products above are unrolled and vectorised at IMU rate.
+template <int N>
+void transform_fixed(const Transition& phi, Covariance& P) {
+  Eigen::Map<Eigen::Matrix<double, N, N>> fixed(P.data());
+  transform_blocks(phi, fixed);
+}
+
+}  // namespace
+
+void transform_covariance(const Transition& phi, Covariance& P) {
+  static_assert(kMaxClones == 3, "one fixed size per clone count below");
+  switch (P.rows()) {
+    case idx::kNav: return transform_fixed<idx::kNav>(phi, P);
+    case idx::kNav + 6: return transform_fixed<idx::kNav + 6>(phi, P);
+    case idx::kNav + 12: return transform_fixed<idx::kNav + 12>(phi, P);
+    case idx::kNav + 18: return transform_fixed<idx::kNav + 18>(phi, P);
+    default: transform_blocks(phi, P);
   }
 }
 

@@ -20,17 +20,18 @@ struct Options {
   std::string out;
   LogChannels channels;
   EstimatorOptions estimator;
+  double skip_s = 0.0;
 };
 
 int run(const Options& o) {
-  const LogRunResult r = run_log(o.log, o.estimator, o.channels);
+  const LogRunResult r = run_log(o.log, o.estimator, o.channels, o.skip_s);
   if (!r.skips.damage.empty()) spdlog::warn("{}", r.skips.damage);
   if (r.skips.rejected > 0)
     spdlog::warn("{} messages skipped; the first: {}", r.skips.rejected, r.skips.first_reason);
   if (r.trajectory.empty())
     throw InputError(o.log + ": the filter never initialised (" + std::to_string(r.imu_messages) +
                      " IMU messages; it needs " + std::to_string(o.estimator.init.duration_s) +
-                     " s of a still IMU)");
+                     " s of a still IMU, or --init-moving-after)");
   write_tum_trajectory(o.out, r.trajectory);
   const EstimatorCounters& c = r.counters;
   std::cout << "states written: " << r.trajectory.size() << " to " << o.out << "\n"
@@ -44,7 +45,9 @@ int run(const Options& o) {
             << "SLAM corrections: " << r.correction_messages << " (" << c.corrections_applied
             << " applied, " << c.corrections_too_old << " too old)\n"
             << "messages skipped: " << r.skips.rejected << "\n"
-            << "filter restarts: " << c.filter_failures << "\n";
+            << "filter restarts: " << c.filter_failures << "\n"
+            << "started: " << (c.moving_starts > 0 ? "on the move" : "still") << " at "
+            << r.trajectory.poses().front().utime << "\n";
   return kExitOk;
 }
 
@@ -61,6 +64,9 @@ int main(int argc, char** argv) {
   app.add_option("--vo-channel", o.channels.vo, "VO channel")->capture_default_str();
   app.add_option("--correction-channel", o.channels.correction, "SLAM correction channel")
       ->capture_default_str();
+  app.add_option("--skip", o.skip_s,
+                 "Leave out the log's first seconds: the estimator starts in flight, s")
+      ->check(CLI::Range(0.0, 1e6))->capture_default_str();
   add_estimator_options(app, o.estimator);
   return app.run(argc, argv, [&] { return run(o); });
 }

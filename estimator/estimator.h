@@ -25,6 +25,7 @@
 // back in time are dropped; VO failures only count (the filter keeps predicting and its
 // covariance grows); gaps in the IMU add noise; everything is counted in counters().
 
+#include <cmath>
 #include <cstdint>
 #include <deque>
 #include <map>
@@ -35,27 +36,11 @@
 #include "common/geometry/se3.h"
 #include "estimator/filter.h"
 #include "estimator/initializer.h"
+#include "estimator/inputs.h"
 #include "estimator/options.h"
+#include "estimator/ring.h"
 
 namespace kestrel::estimator {
-
-/// One visual-odometry result (vo_update_t without the diagnostics).
-struct VoUpdate {
-  int64_t utime = 0;
-  int64_t reference_utime = 0;
-  bool ok = false;  ///< status OK: the motion below is an estimate
-  Eigen::Isometry3d T_refcam_curcam = Eigen::Isometry3d::Identity();
-  Matrix6d covariance = Matrix6d::Zero();  ///< [dp (reference camera); dtheta (current camera)]
-  Eigen::Isometry3d T_body_camera = Eigen::Isometry3d::Identity();
-};
-
-/// A SLAM correction: the body pose at a past utime.
-struct PoseCorrection {
-  int64_t utime = 0;
-  int64_t revision = 0;  ///< a newer revision replaces an older one for the same utime
-  Eigen::Isometry3d T_world_body = Eigen::Isometry3d::Identity();
-  Matrix6d covariance = Matrix6d::Zero();  ///< [dp (world); dtheta (body)]; zero = unknown
-};
 
 /// kDegraded: no VO fused for vo_timeout_s, the state runs on the IMU alone. (A diverged filter
 /// is not reported as failed: it starts initialising again, so there is no state to publish.)
@@ -91,6 +76,7 @@ struct EstimatorCounters {
           corrections_too_old = 0, corrections_before_init = 0;
   int64_t corrections_applied = 0, corrections_gated = 0;
   int64_t replays = 0, replayed_steps = 0, resets = 0, filter_failures = 0, init_restarts = 0;
+  int64_t moving_starts = 0;  ///< initialisations on the move (no still window)
 };
 
 class Estimator {
@@ -150,12 +136,15 @@ class Estimator {
   void retire(const Event& event);
   Matrix6d vo_noise(const VoUpdate& update) const;
   int64_t oldest_utime() const { return history_.front().imu.utime; }
+  static int64_t to_utime(double seconds) { return static_cast<int64_t>(std::llround(seconds * 1e6)); }
 
   EstimatorOptions options_;
   std::unique_ptr<Filter> filter_;
-  StaticInitializer initializer_;
-  std::deque<Snapshot> history_;
-  std::vector<Event> events_;  // sorted by (utime, kind, seq)
+  Initializer initializer_;
+  Ring<Snapshot> history_;  // a snapshot per IMU sample, oldest first
+  // Sorted by (utime, kind, seq). A deque: events retire from the front at VO rate, and a
+  // vector would move the whole history of events (tens of kilobytes) each time.
+  std::deque<Event> events_;
   std::map<int64_t, CloneSpec> clone_specs_;  // by VO reference utime
   int64_t next_seq_ = 0;
   int64_t last_imu_utime_ = -1;
@@ -163,11 +152,5 @@ class Estimator {
   int64_t last_retired_vo_applied_ = -1;
   EstimatorCounters counters_;  // inputs, and outcomes of retired events
 };
-
-/// Throws InputError (naming `what`) unless the input is usable: finite values, a proper
-/// rotation, a symmetric positive semi-definite covariance (all zero allowed where noted).
-void validate_imu(const ImuSample& sample, const std::string& what);
-void validate_vo(const VoUpdate& update, bool need_covariance, const std::string& what);
-void validate_correction(const PoseCorrection& correction, const std::string& what);
 
 }  // namespace kestrel::estimator

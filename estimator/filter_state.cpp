@@ -37,10 +37,17 @@ ErrorVector boxminus(const FilterMean& a, const FilterMean& b) {
   return dx;
 }
 
-bool FilterState::is_valid() const {
+bool FilterState::is_valid(bool check_symmetry) const {
   const int n = mean.dim();
-  if (P.rows() != n || P.cols() != n || !P.allFinite() || !mean.nav.all_finite()) return false;
-  if ((P.diagonal().array() < 0.0).any()) return false;
+  if (P.rows() != n || P.cols() != n || !mean.nav.all_finite()) return false;
+  // NaN fails this too; a NaN from an update spreads over its whole row, diagonal included.
+  if (!(P.diagonal().array() >= 0.0).all() || !P.diagonal().allFinite()) return false;
+  if (!check_symmetry) {
+    // A prediction only changes the navigation rows and columns: by symmetry, the leading
+    // columns hold every entry it wrote.
+    return P.leftCols<idx::kNav>().allFinite();
+  }
+  if (!P.allFinite()) return false;
   const double scale = std::max(1e-300, P.cwiseAbs().maxCoeff());
   return (P - P.transpose()).cwiseAbs().maxCoeff() <= 1e-9 * scale;
 }

@@ -58,8 +58,11 @@ struct FilterState {
   /// the estimator) so that re-playing history reproduces it exactly.
   int vo_gated_in_row = 0;
 
-  /// Symmetric, finite, of the right size, with a non-negative diagonal.
-  bool is_valid() const;
+  /// Symmetric, finite, of the right size, with a non-negative diagonal. Without
+  /// check_symmetry, the cheap part of it for every IMU step: the diagonal and the
+  /// navigation columns (a prediction writes only those and keeps P symmetric to rounding;
+  /// updates symmetrise; the full check runs after every re-play).
+  bool is_valid(bool check_symmetry = true) const;
 };
 
 /// Clones the current body pose at mean.utime (P grows by the copied rows and columns). When

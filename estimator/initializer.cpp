@@ -2,7 +2,22 @@
 
 #include <cmath>
 
+#include "common/geometry/so3.h"
+
 namespace kestrel::estimator {
+namespace {
+
+double sq(double v) { return v * v; }
+
+// Tilt about the horizontal body axes, yaw about world z (R^T e_z in the body frame).
+Eigen::Matrix3d attitude_covariance(const Eigen::Matrix3d& R_world_body, double sigma_tilt,
+                                    double sigma_yaw) {
+  const Eigen::Vector3d up_body = R_world_body.transpose() * Eigen::Vector3d::UnitZ();
+  return sq(sigma_tilt) * (Eigen::Matrix3d::Identity() - up_body * up_body.transpose()) +
+         sq(sigma_yaw) * up_body * up_body.transpose();
+}
+
+}  // namespace
 
 Eigen::Matrix3d attitude_from_gravity(const Eigen::Vector3d& f, double yaw) {
   const double roll = std::atan2(f.y(), f.z());
@@ -13,7 +28,27 @@ Eigen::Matrix3d attitude_from_gravity(const Eigen::Vector3d& f, double yaw) {
       .toRotationMatrix();
 }
 
-std::optional<InitialState> StaticInitializer::add(const ImuSample& sample) {
+Eigen::Vector3d mean_specific_force_in_last_frame(const std::vector<ImuSample>& window) {
+  // Walk backwards from the last sample: R maps body-at-k into body-at-last.
+  Eigen::Matrix3d R_last_k = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d sum = window.back().accel;
+  for (size_t k = window.size() - 1; k-- > 0;) {
+    const ImuSample& a = window[k];
+    const ImuSample& b = window[k + 1];
+    const double dt = 1e-6 * static_cast<double>(b.utime - a.utime);
+    R_last_k = R_last_k * so3::exp(-0.5 * (a.gyro + b.gyro) * dt);
+    sum += R_last_k * a.accel;
+  }
+  return sum / static_cast<double>(window.size());
+}
+
+void Initializer::reset() {
+  window_.clear();
+  first_utime_ = -1;
+}
+
+std::optional<InitialState> Initializer::add(const ImuSample& sample) {
+  if (first_utime_ < 0) first_utime_ = sample.utime;
   window_.push_back(sample);
   const double span = 1e-6 * static_cast<double>(window_.back().utime - window_.front().utime);
   if (span < options_.duration_s) return std::nullopt;
@@ -33,14 +68,27 @@ std::optional<InitialState> StaticInitializer::add(const ImuSample& sample) {
   }
   const bool still = std::sqrt(var_w / n) <= options_.max_gyro_std &&
                      std::sqrt(var_a / n) <= options_.max_accel_std &&
+                     mean_w.norm() <= options_.max_gyro_mean &&
                      std::abs(mean_a.norm() - gravity_) < 0.1 * gravity_;
-  if (!still) {
-    // Keep the newest sample: the next window starts from it.
-    window_.erase(window_.begin(), window_.end() - 1);
+  std::optional<InitialState> init;
+  if (still) {
+    init = still_start(mean_w, mean_a);
+  } else {
     ++restarts_;
-    return std::nullopt;
+    const double waited = 1e-6 * static_cast<double>(sample.utime - first_utime_);
+    if (options_.moving_start_after_s > 0.0 && waited >= options_.moving_start_after_s)
+      init = moving_start();
   }
+  if (init) {
+    reset();
+  } else {
+    window_.erase(window_.begin(), window_.end() - 1);  // the next window starts from the newest
+  }
+  return init;
+}
 
+InitialState Initializer::still_start(const Eigen::Vector3d& mean_w,
+                                      const Eigen::Vector3d& mean_a) const {
   InitialState init;
   init.last = window_.back();
   NavState& x = init.nav;
@@ -49,19 +97,33 @@ std::optional<InitialState> StaticInitializer::add(const ImuSample& sample) {
   x.gyro_bias = mean_w;
   // At rest the reading is R^T (0, 0, g) + b_a: only the part along gravity is observable.
   x.accel_bias = (mean_a.norm() - gravity_) * mean_a.normalized();
-  const auto sq = [](double v) { return v * v; };
-  Matrix15d P = Matrix15d::Zero();
+  Matrix15d& P = init.P;
+  P.setZero();
   P.block<3, 3>(idx::kP, idx::kP).diagonal().setConstant(sq(options_.sigma_position));
   P.block<3, 3>(idx::kV, idx::kV).diagonal().setConstant(sq(options_.sigma_velocity));
-  // Roll and pitch about the body axes; yaw about world z, which in the body frame is R^T e_z.
-  const Eigen::Vector3d up_body = x.R_world_body.transpose() * Eigen::Vector3d::UnitZ();
   P.block<3, 3>(idx::kTheta, idx::kTheta) =
-      sq(options_.sigma_tilt) * (Eigen::Matrix3d::Identity() - up_body * up_body.transpose()) +
-      sq(options_.sigma_yaw) * up_body * up_body.transpose();
+      attitude_covariance(x.R_world_body, options_.sigma_tilt, options_.sigma_yaw);
   P.block<3, 3>(idx::kBg, idx::kBg).diagonal().setConstant(sq(options_.sigma_gyro_bias));
   P.block<3, 3>(idx::kBa, idx::kBa).diagonal().setConstant(sq(options_.sigma_accel_bias));
-  init.P = P;
-  window_.clear();
+  return init;
+}
+
+InitialState Initializer::moving_start() const {
+  InitialState init;
+  init.last = window_.back();
+  init.moving = true;
+  NavState& x = init.nav;
+  x.p_world_body = options_.position;
+  x.R_world_body = attitude_from_gravity(mean_specific_force_in_last_frame(window_), options_.yaw);
+  // Velocity and biases zero: unknown, and the covariance below says how unknown.
+  Matrix15d& P = init.P;
+  P.setZero();
+  P.block<3, 3>(idx::kP, idx::kP).diagonal().setConstant(sq(options_.sigma_position));
+  P.block<3, 3>(idx::kV, idx::kV).diagonal().setConstant(sq(options_.moving_sigma_velocity));
+  P.block<3, 3>(idx::kTheta, idx::kTheta) =
+      attitude_covariance(x.R_world_body, options_.moving_sigma_tilt, options_.sigma_yaw);
+  P.block<3, 3>(idx::kBg, idx::kBg).diagonal().setConstant(sq(options_.moving_sigma_gyro_bias));
+  P.block<3, 3>(idx::kBa, idx::kBa).diagonal().setConstant(sq(options_.sigma_accel_bias));
   return init;
 }
 

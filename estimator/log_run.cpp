@@ -27,11 +27,15 @@ bool convert_event(const transport::LogEvent& ev, const Convert& convert, LogSki
 }  // namespace
 
 LogRunResult run_log(const std::string& path, const EstimatorOptions& options,
-                     const LogChannels& channels) {
+                     const LogChannels& channels, double skip_s) {
   transport::LogReader log(path);
   Estimator estimator(options);
   LogRunResult r;
+  int64_t first_timestamp = -1;
+  const auto skip_us = static_cast<int64_t>(skip_s * 1e6);
   while (auto ev = log.next()) {
+    if (first_timestamp < 0) first_timestamp = ev->timestamp;
+    if (ev->timestamp - first_timestamp < skip_us) continue;
     if (ev->channel == channels.imu) {
       ++r.imu_messages;
       convert_event<kestrel::imu_t>(*ev, [&](const kestrel::imu_t& m) {

@@ -38,10 +38,11 @@ struct LogRunResult {
   LogSkips skips;
 };
 
-/// Runs an estimator with `options` over the log at `path`. Throws InputError if the log
+/// Runs an estimator with `options` over the log at `path`. Messages logged in the first
+/// skip_s seconds are left out (an estimator started in flight). Throws InputError if the log
 /// cannot be read or holds no IMU message.
 LogRunResult run_log(const std::string& path, const EstimatorOptions& options,
-                     const LogChannels& channels = {});
+                     const LogChannels& channels = {}, double skip_s = 0.0);
 
 struct VoAndTruth {
   std::vector<VoUpdate> updates;

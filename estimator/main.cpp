@@ -28,7 +28,7 @@ struct Options {
 // Health follows the filter: RUNNING while VO is being fused, DEGRADED on the IMU alone.
 void report_health(transport::Node& node, const std::optional<EstimatorOutput>& out) {
   if (!out) {
-    node.set_health(kestrel::process_status_t::STATE_STARTING, "initialising: waiting for a still IMU");
+    node.set_health(kestrel::process_status_t::STATE_STARTING, "initialising: waiting for a still IMU (or --init-moving-after)");
   } else if (out->status == Status::kDegraded) {
     node.set_health(kestrel::process_status_t::STATE_DEGRADED, "no VO fused recently: IMU only");
   } else {

@@ -23,11 +23,24 @@ struct VoNoiseOptions {
       (Eigen::Matrix<double, 6, 1>() << 0.005, 0.005, 0.008, 0.004, 0.004, 0.003).finished();
 };
 
-/// How the filter starts when no state is given: averaging the IMU over a still period.
+/// How the filter starts when no state is given: averaging the IMU over a still period, or,
+/// when the vehicle is already moving, from the gravity direction with a wide covariance.
 struct InitOptions {
   double duration_s = 0.5;        ///< IMU time averaged for attitude and gyro bias
   double max_accel_std = 0.3;     ///< m/s^2: above this the vehicle is moving; wait
   double max_gyro_std = 0.05;     ///< rad/s
+  /// rad/s: a mean rate above this is motion, not gyro bias (a slow constant turn passes
+  /// the spread tests above, and its rate taken for bias would stay wrong for good).
+  double max_gyro_mean = 0.05;
+  /// Without a still window after this long, start on the move (0 = wait for a still vehicle
+  /// however long it takes). Must be at least duration_s.
+  double moving_start_after_s = 1.0;  ///< s
+  // Prior standard deviations of a start on the move (the rest as for a still start). The
+  // tilt comes from the window's mean specific force, which a mean acceleration of a tilts
+  // by about a / g; the velocity is unknown until the visual odometry has seen motion.
+  double moving_sigma_tilt = 0.15;       ///< rad: a mean acceleration of up to ~1.5 m/s^2
+  double moving_sigma_velocity = 1.5;    ///< m/s
+  double moving_sigma_gyro_bias = 0.02;  ///< rad/s: the bias is not measured at all
   Eigen::Vector3d position = Eigen::Vector3d::Zero();  ///< world frame origin choice, m
   double yaw = 0.0;               ///< rad: yaw is unobservable, so it is given
   // Prior standard deviations of the initial state.

@@ -22,6 +22,13 @@ VoUpdate SyntheticVo::next(int64_t utime, const Eigen::Isometry3d& T_world_body)
   std::uniform_real_distribution<double> uniform(0.0, 1.0);
   u.reference_utime = keyframe_utime_;
   const Eigen::Isometry3d truth = T_world_keycam_.inverse() * T_world_cam;
+  if (options_.blind && options_.blind(utime)) return u;  // not ok, keyframe kept
+  if (truth.translation().norm() > options_.max_match_distance_m ||
+      Eigen::AngleAxisd(truth.linear()).angle() > options_.max_match_angle_rad) {
+    keyframe_utime_ = utime;  // nothing in common with the keyframe: restart from here
+    T_world_keycam_ = T_world_cam;
+    return u;
+  }
   if (uniform(rng_) >= options_.failure_probability) {
     Vector6d noise;
     for (int i = 0; i < 6; ++i) noise[i] = options_.sigma[i] * normal(rng_);

@@ -7,6 +7,7 @@
 
 #include <Eigen/Geometry>
 #include <cstdint>
+#include <functional>
 #include <random>
 
 #include "estimator/estimator.h"
@@ -21,6 +22,13 @@ struct SyntheticVoOptions {
   double keyframe_distance_m = 0.25;
   double keyframe_angle_rad = 10.0 * M_PI / 180.0;
   double failure_probability = 0.0;  ///< per frame: a failed update, as the VO reports it
+  /// Frames for which this returns true see nothing to track (a blank wall): failed updates
+  /// that keep the keyframe, as the real VO keeps it. The first frame that sees again is
+  /// matched against that keyframe if the camera is still within max_match_distance_m and
+  /// max_match_angle_rad of it; otherwise it fails and becomes the new keyframe (a restart).
+  std::function<bool(int64_t utime)> blind;
+  double max_match_distance_m = 1.0;
+  double max_match_angle_rad = 30.0 * M_PI / 180.0;
 };
 
 class SyntheticVo {

@@ -1,0 +1,79 @@
+// How each event changes the filter state: a keyframe clone, a VO update (against its clone,
+// directly or through an anchor), a SLAM correction; and the noise of a VO update.
+
+#include <cmath>
+
+#include "common/geometry/so3.h"
+#include "estimator/estimator.h"
+#include "estimator/measurements.h"
+
+namespace kestrel::estimator {
+namespace {
+
+// Covariance of A^-1 z from those of an anchor A = T_ref_anchor and z = T_ref_cur, treated
+// as independent (conservative: both share the reference frame's errors).
+Matrix6d anchored_covariance(const Eigen::Isometry3d& A, const Matrix6d& cov_A,
+                             const Eigen::Isometry3d& z, const Matrix6d& cov_z) {
+  const Eigen::Isometry3d rel = A.inverse() * z;
+  const Eigen::Matrix3d Rt = A.linear().transpose();
+  Matrix6d Jz = Matrix6d::Zero();
+  Jz.topLeftCorner<3, 3>() = Rt;
+  Jz.bottomRightCorner<3, 3>().setIdentity();
+  Matrix6d JA = Matrix6d::Zero();
+  JA.topLeftCorner<3, 3>() = -Rt;
+  JA.topRightCorner<3, 3>() = so3::hat(rel.translation());
+  JA.bottomRightCorner<3, 3>() = -rel.linear().transpose();
+  return Jz * cov_z * Jz.transpose() + JA * cov_A * JA.transpose();
+}
+
+}  // namespace
+
+Matrix6d Estimator::vo_noise(const VoUpdate& u) const {
+  if (options_.vo_noise.source == VoNoiseOptions::Source::kConstant)
+    return options_.vo_noise.constant_sigma.array().square().matrix().asDiagonal();
+  return options_.vo_noise.reported_scale * u.covariance;
+}
+
+void Estimator::apply(Event& e, FilterState& s) {
+  switch (e.kind) {
+    case EventKind::kClone:
+      add_clone(s);
+      e.outcome = Outcome::kApplied;
+      return;
+    case EventKind::kVo: {
+      const auto spec = clone_specs_.find(e.vo.reference_utime);
+      const int clone = spec == clone_specs_.end() ? -1 : s.mean.find_clone(spec->second.clone_utime);
+      if (clone < 0) {
+        e.outcome = Outcome::kUnreferenced;
+        return;
+      }
+      Eigen::Isometry3d z = e.vo.T_refcam_curcam;
+      Matrix6d Q = vo_noise(e.vo);
+      if (spec->second.anchored) {
+        Q = anchored_covariance(spec->second.anchor, spec->second.anchor_covariance, z, Q);
+        z = spec->second.anchor.inverse() * z;
+      }
+      const RelativePoseMeasurement m(clone, z, Q, e.vo.T_body_camera);
+      const int max_in_row = options_.vo_max_gated_in_row;
+      const bool force = max_in_row > 0 && s.vo_gated_in_row >= max_in_row;
+      const UpdateResult r = filter_->update(s, m, force ? 0.0 : options_.vo_gate_chi2);
+      e.outcome = r.applied ? (force ? Outcome::kForced : Outcome::kApplied) : Outcome::kGated;
+      s.vo_gated_in_row = r.applied ? 0 : s.vo_gated_in_row + 1;
+      return;
+    }
+    case EventKind::kCorrection: {
+      Matrix6d Q = e.correction.covariance;
+      if (Q.isZero(0.0)) {
+        Q.setZero();
+        Q.diagonal() << Eigen::Vector3d::Constant(std::pow(options_.correction_sigma_position, 2)),
+            Eigen::Vector3d::Constant(std::pow(options_.correction_sigma_rotation, 2));
+      }
+      const AbsolutePoseMeasurement m(e.correction.T_world_body, Q);
+      const UpdateResult r = filter_->update(s, m, options_.correction_gate_chi2);
+      e.outcome = r.applied ? Outcome::kApplied : Outcome::kGated;
+      return;
+    }
+  }
+}
+
+}  // namespace kestrel::estimator

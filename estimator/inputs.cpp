@@ -1,0 +1,51 @@
+#include "estimator/inputs.h"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+
+#include "common/error.h"
+#include "common/geometry/se3.h"
+
+namespace kestrel::estimator {
+namespace {
+
+bool finite_pose(const Eigen::Isometry3d& T) { return se3::is_valid(T, 1e-6); }
+
+bool symmetric_psd(const Matrix6d& C, bool allow_zero) {
+  if (!C.allFinite()) return false;
+  if ((C - C.transpose()).cwiseAbs().maxCoeff() > 1e-9 * std::max(1.0, C.cwiseAbs().maxCoeff()))
+    return false;
+  if (C.isZero(0.0)) return allow_zero;
+  const Eigen::SelfAdjointEigenSolver<Matrix6d> eig(C, Eigen::EigenvaluesOnly);
+  return eig.eigenvalues().minCoeff() > 0.0;
+}
+
+}  // namespace
+
+void validate_imu(const ImuSample& s, const std::string& what) {
+  if (!s.gyro.allFinite() || !s.accel.allFinite())
+    throw InputError(what + ": non-finite IMU reading at utime " + std::to_string(s.utime));
+  if (s.utime < 0) throw InputError(what + ": negative utime " + std::to_string(s.utime));
+}
+
+void validate_vo(const VoUpdate& u, bool need_covariance, const std::string& what) {
+  if (!u.ok) return;  // a failure carries nothing to check
+  if (!finite_pose(u.T_refcam_curcam) || !finite_pose(u.T_body_camera))
+    throw InputError(what + ": non-finite or non-rigid pose at utime " + std::to_string(u.utime));
+  if (u.reference_utime >= u.utime)
+    throw InputError(what + ": reference utime " + std::to_string(u.reference_utime) +
+                     " is not before the frame's " + std::to_string(u.utime));
+  if (!symmetric_psd(u.covariance, !need_covariance))
+    throw InputError(what + ": covariance is not symmetric positive definite at utime " +
+                     std::to_string(u.utime));
+}
+
+void validate_correction(const PoseCorrection& c, const std::string& what) {
+  if (!finite_pose(c.T_world_body))
+    throw InputError(what + ": non-finite or non-rigid pose at utime " + std::to_string(c.utime));
+  if (!symmetric_psd(c.covariance, true))
+    throw InputError(what + ": covariance is not symmetric positive definite at utime " +
+                     std::to_string(c.utime));
+}
+
+}  // namespace kestrel::estimator
