@@ -18,6 +18,39 @@ function(kestrel_tool name)
   target_link_libraries(kestrel-${name} PRIVATE ${ARG_DEPS} kestrel_options)
 endfunction()
 
+function(_kestrel_test_definitions target)
+  target_compile_definitions(${target} PRIVATE
+    KESTREL_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
+    KESTREL_BINARY_DIR="${CMAKE_BINARY_DIR}"
+    KESTREL_SHARED_DATA="${KESTREL_SHARED_DATA}")
+endfunction()
+
+# -pthread defines _REENTRANT, which the system headers test; some tests get it from their
+# dependencies (LCM's pkg-config flags), so every test and the header get it, or GCC would
+# refuse the header for some of them.
+set(_KESTREL_PCH_FLAGS -pthread)
+
+# One precompiled header for every test: GoogleTest, Eigen and OpenCV's core are parsed once
+# per build instead of once per test file (they are most of a small test file's compile
+# time). It is built with exactly the flags the tests get, so GCC accepts it for each of them
+# (-Winvalid-pch would say otherwise).
+function(_kestrel_test_pch)
+  if(TARGET kestrel_test_pch)
+    return()
+  endif()
+  set(anchor ${CMAKE_BINARY_DIR}/kestrel_test_pch.cpp)
+  file(CONFIGURE OUTPUT ${anchor} CONTENT "// anchors the tests' precompiled header\n")
+  add_library(kestrel_test_pch OBJECT ${anchor})
+  target_link_libraries(kestrel_test_pch PRIVATE GTest::gtest GTest::gmock Eigen3::Eigen
+                        opencv_core kestrel_options)
+  target_compile_options(kestrel_test_pch PRIVATE ${_KESTREL_PCH_FLAGS})
+  _kestrel_test_definitions(kestrel_test_pch)
+  target_precompile_headers(kestrel_test_pch PRIVATE
+    <gtest/gtest.h> <gmock/gmock.h> <Eigen/Core> <Eigen/Geometry> <opencv2/core.hpp>
+    <algorithm> <cmath> <filesystem> <fstream> <map> <memory> <random> <sstream> <string>
+    <vector>)
+endfunction()
+
 # kestrel_test(name SOURCES ... [DEPS ...] LABELS unit|integration|data [TIMEOUT s])
 # A GoogleTest executable registered with ctest. Label `unit`: fast, in-process, no files
 # outside the repository. `integration`: several processes or tools, in a private network
@@ -30,10 +63,10 @@ function(kestrel_test name)
   add_executable(${name} ${ARG_SOURCES})
   target_link_libraries(${name} PRIVATE ${ARG_DEPS} GTest::gtest GTest::gtest_main GTest::gmock
                         kestrel_options)
-  target_compile_definitions(${name} PRIVATE
-    KESTREL_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
-    KESTREL_BINARY_DIR="${CMAKE_BINARY_DIR}"
-    KESTREL_SHARED_DATA="${KESTREL_SHARED_DATA}")
+  _kestrel_test_definitions(${name})
+  _kestrel_test_pch()
+  target_precompile_headers(${name} REUSE_FROM kestrel_test_pch)
+  target_compile_options(${name} PRIVATE ${_KESTREL_PCH_FLAGS} -Winvalid-pch)
   set_target_properties(${name} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/test)
   gtest_discover_tests(${name}
     PROPERTIES LABELS "${ARG_LABELS}" TIMEOUT ${ARG_TIMEOUT}
