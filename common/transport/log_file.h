@@ -76,4 +76,15 @@ class LogWriter {
   int64_t next_event_number_ = 0;
 };
 
+/// Every message on `channel` in the log at `path`, decoded as Msg, in log order; throws
+/// InputError if the log cannot be read or a message does not decode.
+template <class Msg>
+std::vector<Msg> read_messages(const std::string& path, const std::string& channel) {
+  std::vector<Msg> out;
+  LogReader log(path);
+  while (auto e = log.next())
+    if (e->channel == channel) out.push_back(decode_message<Msg>(e->data.data(), e->data.size(), channel));
+  return out;
+}
+
 }  // namespace kestrel::transport

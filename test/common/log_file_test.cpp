@@ -50,6 +50,25 @@ TEST(LogFile, WriteThenReadBack) {
   EXPECT_EQ(r.damage_report(), "");
 }
 
+TEST(LogFile, ReadMessagesKeepsOneChannelInOrder) {
+  test::TempDir dir;
+  const std::string path = (dir / "two.lcmlog").string();
+  LogWriter w(path);
+  for (int i = 0; i < 6; ++i) {
+    kestrel::imu_t m{};
+    m.utime = 1000 + i;
+    m.seq = i;
+    w.write_message(i % 2 == 0 ? "IMU" : "OTHER", m.utime, m);
+  }
+  w.close();
+  const auto imu = read_messages<kestrel::imu_t>(path, "IMU");
+  ASSERT_EQ(imu.size(), 3u);
+  EXPECT_EQ(imu[0].seq, 0);
+  EXPECT_EQ(imu[1].seq, 2);
+  EXPECT_EQ(imu[2].seq, 4);
+  EXPECT_TRUE(read_messages<kestrel::imu_t>(path, "NONE").empty());
+}
+
 TEST(LogFile, TruncatedTailIsReportedNotFatal) {
   test::TempDir dir;
   write_log(dir / "a.lcmlog");

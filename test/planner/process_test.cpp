@@ -85,12 +85,7 @@ void write_input_log(const std::string& path) {
 }
 
 std::vector<kestrel::plan_t> plans(const std::string& path) {
-  std::vector<kestrel::plan_t> out;
-  transport::LogReader log(path);
-  while (auto e = log.next())
-    if (e->channel == channel::kPlan)
-      out.push_back(transport::decode_message<kestrel::plan_t>(e->data.data(), e->data.size(), e->channel));
-  return out;
+  return transport::read_messages<kestrel::plan_t>(path, channel::kPlan);
 }
 
 // Every point of the polyline keeps `clearance` from the walls; returns the largest y where it
@@ -104,7 +99,9 @@ double check_path(const kestrel::plan_t& p, double clearance) {
       const double y = (1 - t) * p.waypoints[i - 1][1] + t * p.waypoints[i][1];
       for (double dx = -clearance; dx <= clearance; dx += clearance / 4)
         for (double dy = -clearance; dy <= clearance; dy += clearance / 4)
-          if (dx * dx + dy * dy <= clearance * clearance) EXPECT_FALSE(wall_at(x + dx, y + dy)) << x << " " << y;
+          if (dx * dx + dy * dy <= clearance * clearance) {
+            EXPECT_FALSE(wall_at(x + dx, y + dy)) << x << " " << y;
+          }
       if (std::abs(x - 4.0) < 0.05) crossing_y = std::max(crossing_y, y);
     }
   return crossing_y;

@@ -40,12 +40,7 @@ void write_input_log(const std::string& path) {
 }
 
 std::vector<kestrel::vo_update_t> updates(const std::string& path) {
-  std::vector<kestrel::vo_update_t> out;
-  transport::LogReader log(path);
-  while (auto e = log.next())
-    if (e->channel == channel::kVoUpdate)
-      out.push_back(transport::decode_message<kestrel::vo_update_t>(e->data.data(), e->data.size(), e->channel));
-  return out;
+  return transport::read_messages<kestrel::vo_update_t>(path, channel::kVoUpdate);
 }
 
 TEST(VoProcess, LockStepReplayGivesOneUpdatePerFrameAndRepeats) {
