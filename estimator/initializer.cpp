@@ -17,6 +17,19 @@ Eigen::Matrix3d attitude_covariance(const Eigen::Matrix3d& R_world_body, double 
          sq(sigma_yaw) * up_body * up_body.transpose();
 }
 
+// The diagonal prior of a start; still and moving starts differ only in how well they know
+// velocity, tilt and gyro bias.
+Matrix15d start_covariance(const Eigen::Matrix3d& R_world_body, const InitOptions& o,
+                           double sigma_velocity, double sigma_tilt, double sigma_gyro_bias) {
+  Matrix15d P = Matrix15d::Zero();
+  P.block<3, 3>(idx::kP, idx::kP).diagonal().setConstant(sq(o.sigma_position));
+  P.block<3, 3>(idx::kV, idx::kV).diagonal().setConstant(sq(sigma_velocity));
+  P.block<3, 3>(idx::kTheta, idx::kTheta) = attitude_covariance(R_world_body, sigma_tilt, o.sigma_yaw);
+  P.block<3, 3>(idx::kBg, idx::kBg).diagonal().setConstant(sq(sigma_gyro_bias));
+  P.block<3, 3>(idx::kBa, idx::kBa).diagonal().setConstant(sq(o.sigma_accel_bias));
+  return P;
+}
+
 }  // namespace
 
 Eigen::Matrix3d attitude_from_gravity(const Eigen::Vector3d& f, double yaw) {
@@ -97,14 +110,8 @@ InitialState Initializer::still_start(const Eigen::Vector3d& mean_w,
   x.gyro_bias = mean_w;
   // At rest the reading is R^T (0, 0, g) + b_a: only the part along gravity is observable.
   x.accel_bias = (mean_a.norm() - gravity_) * mean_a.normalized();
-  Matrix15d& P = init.P;
-  P.setZero();
-  P.block<3, 3>(idx::kP, idx::kP).diagonal().setConstant(sq(options_.sigma_position));
-  P.block<3, 3>(idx::kV, idx::kV).diagonal().setConstant(sq(options_.sigma_velocity));
-  P.block<3, 3>(idx::kTheta, idx::kTheta) =
-      attitude_covariance(x.R_world_body, options_.sigma_tilt, options_.sigma_yaw);
-  P.block<3, 3>(idx::kBg, idx::kBg).diagonal().setConstant(sq(options_.sigma_gyro_bias));
-  P.block<3, 3>(idx::kBa, idx::kBa).diagonal().setConstant(sq(options_.sigma_accel_bias));
+  init.P = start_covariance(x.R_world_body, options_, options_.sigma_velocity, options_.sigma_tilt,
+                            options_.sigma_gyro_bias);
   return init;
 }
 
@@ -116,14 +123,8 @@ InitialState Initializer::moving_start() const {
   x.p_world_body = options_.position;
   x.R_world_body = attitude_from_gravity(mean_specific_force_in_last_frame(window_), options_.yaw);
   // Velocity and biases zero: unknown, and the covariance below says how unknown.
-  Matrix15d& P = init.P;
-  P.setZero();
-  P.block<3, 3>(idx::kP, idx::kP).diagonal().setConstant(sq(options_.sigma_position));
-  P.block<3, 3>(idx::kV, idx::kV).diagonal().setConstant(sq(options_.moving_sigma_velocity));
-  P.block<3, 3>(idx::kTheta, idx::kTheta) =
-      attitude_covariance(x.R_world_body, options_.moving_sigma_tilt, options_.sigma_yaw);
-  P.block<3, 3>(idx::kBg, idx::kBg).diagonal().setConstant(sq(options_.moving_sigma_gyro_bias));
-  P.block<3, 3>(idx::kBa, idx::kBa).diagonal().setConstant(sq(options_.sigma_accel_bias));
+  init.P = start_covariance(x.R_world_body, options_, options_.moving_sigma_velocity,
+                            options_.moving_sigma_tilt, options_.moving_sigma_gyro_bias);
   return init;
 }
 
