@@ -26,6 +26,7 @@
 #include "drivers/sim/tum_writer.h"
 #include "drivers/sim/vehicle.h"
 #include "drivers/sim/world_catalog.h"
+#include "kestrel/vo_update_t.hpp"
 
 namespace {
 
@@ -51,6 +52,7 @@ struct Options {
   double tilt_deg = 10.0;
   double camera_rate_hz = 30.0;
   std::string feedback = "state";
+  double lockstep_s = 0.0;
   bool list = false;
 };
 
@@ -65,6 +67,12 @@ void add_options(cli::App& app, Options& o) {
                  "vehicle: what its position controller uses, the estimator's STATE (the truth until the first "
                  "usable STATE) or the truth")
       ->check(CLI::IsMember({"state", "truth"}))
+      ->capture_default_str();
+  app.add_option("--lockstep", o.lockstep_s,
+                 "vehicle, live: after each camera frame wait for its VO_UPDATE, after each IMU sample for "
+                 "its STATE (once STATE flows), at most this many wall seconds each, so the closed loop "
+                 "runs at the pace of the VO and the estimator on a loaded machine (with --rate 0); 0 = off")
+      ->check(CLI::Range(0.0, 60.0))
       ->capture_default_str();
   app.add_option("--duration", o.duration_s, "Seconds of flight to simulate")->check(cli::Positive)->capture_default_str();
   app.add_option("--seed", o.seed, "Sensor noise seed (same seed, same bytes)")->capture_default_str();
@@ -163,6 +171,11 @@ int run(const Options& o) {
                world.surfaces().size(), flight->name(), o.duration_s, o.seed,
                std::chrono::duration<double>(Clock::now() - t0).count());
 
+  // Lock-step with the loop's consumers (--lockstep): the newest STATE and VO_UPDATE seen.
+  int64_t last_state_utime = -1, last_vo_utime = -1;
+  int64_t lockstep_timeouts = 0;
+  bool wait_vo = vehicle && o.lockstep_s > 0, wait_state = wait_vo && o.feedback == "state";
+
   Sinks sinks;
   const bool offline = !o.log.empty() || !o.tum.empty();
   if (!o.log.empty()) sinks.log.emplace(o.log);
@@ -183,14 +196,31 @@ int run(const Options& o) {
           channel::kVehicleCommand, [&](const kestrel::vehicle_command_t& m) { loop->set_command(sim::vehicle_command(m)); });
       if (o.feedback == "state")
         sinks.node->subscribe<kestrel::state_t>(channel::kState, [&](const kestrel::state_t& m) {
+          last_state_utime = std::max(last_state_utime, m.utime);
           sim::VehicleEstimate e;
           if (sim::vehicle_estimate(m, e)) estimate = e;
+        });
+      if (o.lockstep_s > 0)
+        sinks.node->subscribe<kestrel::vo_update_t>(channel::kVoUpdate, [&](const kestrel::vo_update_t& m) {
+          last_vo_utime = std::max(last_vo_utime, m.utime);
         });
     }
     sinks.node->on_reset([&] { restart = true; });
     sinks.node->set_health(kestrel::process_status_t::STATE_RUNNING, "");
   }
   auto stopping = [&] { return interrupted() || (sinks.node && sinks.node->stopping()); };
+  // Waits until `seen` reaches `utime`; a consumer that misses the timeout is not waited for
+  // again (it may not run at all), so the simulation never hangs on it.
+  auto wait_for = [&](const int64_t& seen, int64_t utime, bool& waiting, const char* what) {
+    const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                             std::chrono::duration<double>(o.lockstep_s));
+    while (seen < utime && !stopping() && Clock::now() < deadline) sinks.node->spin_once(5);
+    if (seen < utime && !stopping()) {
+      ++lockstep_timeouts;
+      waiting = false;
+      spdlog::warn("--lockstep: no {} for utime {} within {} s; no longer waiting for it", what, utime, o.lockstep_s);
+    }
+  };
 
   const int64_t end_utime = so.start_utime + static_cast<int64_t>(o.duration_s * 1e6);
   int64_t frames = 0, imu_samples = 0;
@@ -203,6 +233,7 @@ int run(const Options& o) {
         vehicle->reset();
         loop->set_command(sim::VehicleCommand{});  // hold where it starts
         estimate.reset();
+        last_state_utime = last_vo_utime = -1;
       }
       wall_start = Clock::now();
       restart = false;
@@ -232,17 +263,25 @@ int run(const Options& o) {
     } else if (sinks.node) {
       sinks.node->spin_once(0);
     }
+    // Behind the clock (or unpaced), the pacing above waits for nothing: the vehicle's
+    // feedback is read here so that it flies on the newest STATE, not a stale one.
+    if (sinks.node && vehicle)
+      while (!stopping() && sinks.node->lcm().handleTimeout(0) > 0) {
+      }
     if (e.kind == sim::SimEvent::kImu) {
       sinks.publish(channel::kImu, e.utime, transport::encode_message(sim::imu_message(e.utime, e.imu)));
       sinks.publish(channel::kGroundTruth, e.utime,
                     transport::encode_message(sim::ground_truth_message(e.utime, e.truth, &e.imu)));
       if (sinks.tum) sinks.tum->add_imu(e.utime, e.imu, e.T_world_camera);
       ++imu_samples;
+      // The estimator publishes STATE only once initialised: until then there is nothing to wait for.
+      if (wait_state && last_state_utime >= 0) wait_for(last_state_utime, e.utime, wait_state, "STATE");
     } else {
       if (sinks.log || sinks.node)
         sinks.publish(channel::kCameraRgbd, e.utime, transport::encode_message(transport::encode_rgbd(e.frame, encoding)));
       if (sinks.tum) sinks.tum->add_frame(e.frame, e.T_world_camera);
       ++frames;
+      if (wait_vo) wait_for(last_vo_utime, e.utime, wait_vo, "VO_UPDATE");
     }
   }
   if (sinks.log) sinks.log->close();
@@ -253,6 +292,7 @@ int run(const Options& o) {
             << "simulated seconds: " << o.duration_s << "\n"
             << "wall seconds: " << seconds << "\n"
             << "times real time: " << (seconds > 0 ? o.duration_s / seconds : 0.0) << "\n";
+  if (o.lockstep_s > 0) std::cout << "lockstep timeouts: " << lockstep_timeouts << "\n";
   return stopping() ? kExitInterrupted : kExitOk;
 }
 
