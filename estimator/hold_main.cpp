@@ -25,6 +25,7 @@ struct Options {
   std::string log;
   double from_s = -1.0;
   bool print_start = false;
+  bool truth_only = false;
 };
 
 TimedPosition timed(int64_t utime, const kestrel::pose3_t& pose, const char* what) {
@@ -67,8 +68,10 @@ int run(const Options& o) {
     if (m.status == kestrel::state_t::STATUS_DEGRADED) ++degraded;
     flown.push_back(timed(m.utime, m.T_world_body, channel::kState));
   }
-  if (flown.empty()) throw InputError(o.log + ": no usable STATE (OK or DEGRADED): the vehicle never flew on the estimator");
-  const double on_state_s = 1e-6 * static_cast<double>(flown.front().utime - start.utime);
+  if (flown.empty() && !o.truth_only)
+    throw InputError(o.log + ": no usable STATE (OK or DEGRADED): the vehicle never flew on the estimator");
+  if (o.truth_only) flown.clear();
+  const double on_state_s = flown.empty() ? 0.0 : 1e-6 * static_cast<double>(flown.front().utime - start.utime);
   const double from_s = o.from_s >= 0 ? o.from_s : std::max(0.0, on_state_s);
   int64_t vo = 0, vo_ok = 0;
   for (const auto& m : transport::read_messages<kestrel::vo_update_t>(o.log, channel::kVoUpdate)) {
@@ -83,17 +86,24 @@ int run(const Options& o) {
   }
   std::printf("target: %.3f %.3f %.3f (the first GROUND_TRUTH), yaw %.3f rad\n", start.p.x(),
               start.p.y(), start.p.z(), start.yaw);
-  std::printf("flying on STATE from %.2f s; scored %.2f to %.2f s (%.1f s)\n", on_state_s,
-              s.scored_from_s, s.scored_to_s, s.scored_to_s - s.scored_from_s);
-  std::printf("STATE: %lld messages, %lld usable, %lld of them DEGRADED; VO_UPDATE: %lld (%lld OK)\n",
-              static_cast<long long>(states), static_cast<long long>(flown.size()),
-              static_cast<long long>(degraded), static_cast<long long>(vo), static_cast<long long>(vo_ok));
+  if (o.truth_only) {
+    std::printf("truth only; scored %.2f to %.2f s (%.1f s)\n", s.scored_from_s, s.scored_to_s,
+                s.scored_to_s - s.scored_from_s);
+  } else {
+    std::printf("flying on STATE from %.2f s; scored %.2f to %.2f s (%.1f s)\n", on_state_s,
+                s.scored_from_s, s.scored_to_s, s.scored_to_s - s.scored_from_s);
+    std::printf("STATE: %lld messages, %lld usable, %lld of them DEGRADED; VO_UPDATE: %lld (%lld OK)\n",
+                static_cast<long long>(states), static_cast<long long>(flown.size()),
+                static_cast<long long>(degraded), static_cast<long long>(vo), static_cast<long long>(vo_ok));
+  }
   std::cout << "hold, truth from target, horizontal: " << cm(s.truth_horizontal) << "\n"
-            << "hold, truth from target, 3D:         " << cm(s.truth_3d) << "\n"
-            << "estimator, truth vs STATE, horizontal: " << cm(s.error_horizontal) << "\n"
-            << "estimator, truth vs STATE, 3D:         " << cm(s.error_3d) << "\n";
-  std::printf("estimator, yaw error: mean %.2f deg, max %.2f deg\n", s.error_yaw.mean * 180 / M_PI,
-              s.error_yaw.max * 180 / M_PI);
+            << "hold, truth from target, 3D:         " << cm(s.truth_3d) << "\n";
+  if (!o.truth_only) {
+    std::cout << "estimator, truth vs STATE, horizontal: " << cm(s.error_horizontal) << "\n"
+              << "estimator, truth vs STATE, 3D:         " << cm(s.error_3d) << "\n";
+    std::printf("estimator, yaw error: mean %.2f deg, max %.2f deg\n", s.error_yaw.mean * 180 / M_PI,
+                s.error_yaw.max * 180 / M_PI);
+  }
   if (s.unmatched_estimates > 0)
     std::printf("STATE without a GROUND_TRUTH within 3 ms: %lld (left out)\n",
                 static_cast<long long>(s.unmatched_estimates));
@@ -112,6 +122,10 @@ int main(int argc, char** argv) {
                  "Score from this many seconds after the first GROUND_TRUTH (default: from the "
                  "first usable STATE, when the vehicle starts flying on the estimator)")
       ->check(CLI::Range(0.0, 1e6));
+  app.add_flag("--truth-only", o.truth_only,
+               "Score the truth against the target only, ignoring STATE: a flight on the truth "
+               "(kestrel-sim --flight vehicle --log ..., or --vehicle-feedback truth), the baseline "
+               "that the wind and the controller alone give (use --from 0.5 to compare)");
   app.add_flag("--print-start", o.print_start,
                "Print the first GROUND_TRUTH pose as --init-position/--init-yaw and exit");
   return app.run(argc, argv, [&] { return run(o); });
