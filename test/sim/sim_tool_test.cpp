@@ -9,6 +9,7 @@
 #include <cmath>
 #include <iterator>
 #include <sstream>
+#include <string>
 #include <vector>
 
 #include "common/transport/channels.h"
@@ -157,6 +158,28 @@ TEST(SimToolTest, VehicleFliesAVehicleCommandReceivedOverLcm) {
   EXPECT_GT(p.back()[0] - p[0][0], 0.2);
   EXPECT_LT(p.back()[0] - p[0][0], 0.3 * 3.5);
   EXPECT_LT(std::abs(p.back()[1] - p[0][1]), 0.1);
+}
+
+// --lockstep with nobody answering (estimator/hold/run relies on this): the first frame
+// waits the whole timeout for its VO_UPDATE, then the sim stops waiting for good and
+// finishes; it never waits for a STATE, since none ever flowed (a STATE wait would be a
+// second timeout).
+TEST(SimToolTest, LockstepWithoutConsumersWaitsOnceThenFinishes) {
+  if (!kestrel::test::can_isolate_network()) GTEST_SKIP() << "cannot create a network namespace here";
+  const std::string script =
+      "ip link set lo up && ip link set lo multicast on && ip route add 224.0.0.0/4 dev lo && "
+      "export LCM_DEFAULT_URL='udpm://239.255.76.67:7667?ttl=0' && '" + tool("sim").string() +
+      "' --world room --flight vehicle --duration 0.5 --rate 0 --lockstep 1.5 -q";
+  const auto r = run({"unshare", "-n", "sh", "-c", script}, 120.0);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("frames: 16\n"), std::string::npos) << r.out;  // 0 .. 0.5 s at 30 Hz
+  EXPECT_NE(r.out.find("imu samples: 101\n"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("lockstep timeouts: 1\n"), std::string::npos) << r.out;
+  const auto at = r.out.find("wall seconds: ");
+  ASSERT_NE(at, std::string::npos) << r.out;
+  const double wall = std::stod(r.out.substr(at + 14));
+  EXPECT_GE(wall, 1.5);   // it did wait for the first frame's VO_UPDATE
+  EXPECT_LT(wall, 12.0);  // and not for every frame (16 x 1.5 s = 24 s)
 }
 
 TEST(SimToolTest, BadInputIsOneLineNamingTheFileWithExitCode3) {
