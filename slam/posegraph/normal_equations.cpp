@@ -182,6 +182,17 @@ void NormalEquations<Space>::remove_rigid_motion(const Poses& poses, Eigen::Vect
 }
 
 template <class Space>
+Eigen::MatrixXd NormalEquations<Space>::rigid_motions(const Poses& poses) const {
+  if (gauge_vertex_ < 0) return Eigen::MatrixXd(num_unknowns_ * D, 0);
+  Eigen::MatrixXd W(num_unknowns_ * D, D);
+  for (size_t v = 0; v < poses.size(); ++v) {
+    const int u = index_[v];
+    if (u >= 0) W.template middleRows<D>(u * D) = rigid_motion_in_local(poses[v]);
+  }
+  return W;
+}
+
+template <class Space>
 void NormalEquations<Space>::anchor(Poses& poses) const {
   if (gauge_vertex_ < 0) return;
   const Pose T = Space::compose(graph_.poses[gauge_vertex_], Space::inverse(poses[gauge_vertex_]));

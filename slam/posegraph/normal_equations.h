@@ -53,6 +53,10 @@ class NormalEquations {
   /// that motion, so an inexact (conjugate-gradient) step can carry a large one, which the
   /// pose-by-pose retraction does not apply rigidly: tens of metres on a 1000-pose helix.
   void remove_rigid_motion(const Poses& poses, Eigen::VectorXd& dx) const;
+  /// The D rigid motions of the whole graph at `poses` in the unknowns' local coordinates (one
+  /// column each), when the gauge is free; no columns otherwise. The preconditioner of the
+  /// inexact steps projects them out (gauge_preconditioner.h).
+  Eigen::MatrixXd rigid_motions(const Poses& poses) const;
   /// The poses moved rigidly so that the single fixed vertex is back where it was held.
   void anchor(Poses& poses) const;
   /// Loop closures whose kernel weight at `poses` is below one half.
