@@ -1,11 +1,20 @@
-// The estimator's tools as a user runs them: kestrel-estimate and kestrel-fit-vo-noise on
-// synthesised logs, their usage errors and exit codes, and kestrel-estimator's --help.
+// The estimator's tools as a user runs them: kestrel-estimate, kestrel-fit-vo-noise and
+// kestrel-hold on synthesised logs, their usage errors and exit codes, and kestrel-estimator's
+// --help.
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
+#include <string>
+#include <vector>
+
 #include "common/error.h"
 #include "common/trajectory.h"
+#include "common/transport/channels.h"
+#include "common/transport/convert.h"
 #include "common/transport/log_file.h"
+#include "kestrel/ground_truth_t.hpp"
+#include "kestrel/state_t.hpp"
 #include "test/estimator/synthetic_log.h"
 #include "test/support/test_support.h"
 
@@ -64,6 +73,72 @@ TEST(FitVoNoiseTool, PrintsTheFittedModelAsEstimatorOptions) {
   const std::string no_truth = (dir / "no_truth.lcmlog").string();
   test::write_log(no_truth, 1.0, false, false);
   EXPECT_EQ(ts::run({ts::tool("fit-vo-noise"), "--log", no_truth}).exit_code, kExitBadInput);
+}
+
+// kestrel-hold on a hand-made log: truth at 0, 0.5 and 1 s (3-4-5 triangles: 5 cm horizontal,
+// then 12 cm up as well, 13 cm 3D), STATE from 0.5 s (one INITIALIZING before it, not usable).
+TEST(HoldTool, ScoresTruthFromTargetAndStateFromTruth) {
+  ts::TempDir dir;
+  const std::string log = (dir / "hold.lcmlog").string(), truth_only = (dir / "truth.lcmlog").string();
+  auto pose = [](double x, double y, double z, double yaw) {
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    T.translation() << x, y, z;
+    T.linear() = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    return transport::to_message(T);
+  };
+  auto truth = [&](int64_t utime, double x, double y, double z) {
+    kestrel::ground_truth_t m{};
+    m.utime = utime;
+    m.frame = kestrel::ground_truth_t::FRAME_BODY;
+    m.T_world_frame = pose(x, y, z, 0.5);
+    return m;
+  };
+  auto state = [&](int64_t utime, int8_t status, double x, double y, double z) {
+    kestrel::state_t m{};
+    m.utime = utime;
+    m.status = status;
+    m.T_world_body = pose(x, y, z, 0.5);
+    return m;
+  };
+  {
+    transport::LogWriter w(log), t(truth_only);
+    const std::vector<kestrel::ground_truth_t> gt{truth(1000000, 1, 2, 3), truth(1500000, 1.03, 2.04, 3),
+                                                  truth(2000000, 1.03, 2.04, 3.12)};
+    for (const auto& m : gt) {
+      w.write_message(channel::kGroundTruth, m.utime, m);
+      t.write_message(channel::kGroundTruth, m.utime, m);
+    }
+    w.write_message(channel::kState, 1200000, state(1200000, kestrel::state_t::STATUS_INITIALIZING, 0, 0, 0));
+    w.write_message(channel::kState, 1500000, state(1500000, kestrel::state_t::STATUS_OK, 1, 2, 3));
+    w.write_message(channel::kState, 2000000, state(2000000, kestrel::state_t::STATUS_DEGRADED, 1.03, 2.04, 3.12));
+    w.close();
+    t.close();
+  }
+  auto r = ts::run({ts::tool("hold"), "--log", log});
+  ASSERT_EQ(r.exit_code, kExitOk) << r.err;
+  for (const char* want : {"flying on STATE from 0.50 s; scored 0.50 to 1.00 s",
+                           "STATE: 3 messages, 2 usable, 1 of them DEGRADED",
+                           "truth from target, horizontal: mean   5.0 cm, max   5.0 cm",
+                           "truth from target, 3D:         mean   9.0 cm, max  13.0 cm",
+                           "truth vs STATE, horizontal: mean   2.5 cm, max   5.0 cm",
+                           "truth vs STATE, 3D:         mean   2.5 cm, max   5.0 cm",
+                           "yaw error: mean 0.00 deg, max 0.00 deg"})
+    EXPECT_NE(r.out.find(want), std::string::npos) << want << "\n" << r.out;
+
+  // --truth-only scores the truth alone, from the first sample unless --from says otherwise.
+  r = ts::run({ts::tool("hold"), "--log", truth_only, "--truth-only"});
+  ASSERT_EQ(r.exit_code, kExitOk) << r.err;
+  EXPECT_NE(r.out.find("horizontal: mean   3.3 cm, max   5.0 cm"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("3D:         mean   6.0 cm, max  13.0 cm"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("STATE"), std::string::npos) << r.out;
+  r = ts::run({ts::tool("hold"), "--log", truth_only, "--truth-only", "--from", "0.5"});
+  EXPECT_NE(r.out.find("3D:         mean   9.0 cm, max  13.0 cm"), std::string::npos) << r.out;
+
+  // Without usable STATE it is bad input, unless --truth-only; --print-start gives the start.
+  EXPECT_EQ(ts::run({ts::tool("hold"), "--log", truth_only}).exit_code, kExitBadInput);
+  r = ts::run({ts::tool("hold"), "--log", log, "--print-start"});
+  ASSERT_EQ(r.exit_code, kExitOk) << r.err;
+  EXPECT_EQ(r.out, "--init-position 1.000000,2.000000,3.000000 --init-yaw 0.500000\n");
 }
 
 }  // namespace
