@@ -1,5 +1,44 @@
 # Small helpers so that every library, process, test and benchmark is declared the same way.
 
+# -pthread defines _REENTRANT, which the system headers test; some targets get it from their
+# dependencies (LCM's pkg-config flags), so every target that uses a precompiled header and the
+# header itself get it, or GCC would refuse the header for some of them.
+set(_KESTREL_PCH_FLAGS -pthread)
+
+# _kestrel_shared_pch(pch_target PIC DEPS ... HEADERS ...): an object library whose only job
+# is to build one precompiled header that other targets take with REUSE_FROM. Headers that
+# most files of a kind include (Eigen, OpenCV's core, CLI11, the standard library) are then
+# parsed once per build instead of once per file: about a second for each library file and
+# five for each tool's main. It is built with the flags its users get (-fPIC for the
+# libraries, not for the executables), so GCC accepts it for each of them; -Winvalid-pch on
+# the users would say otherwise.
+function(_kestrel_shared_pch pch)
+  if(TARGET ${pch})
+    return()
+  endif()
+  cmake_parse_arguments(ARG "PIC" "" "DEPS;HEADERS" ${ARGN})
+  set(anchor ${CMAKE_BINARY_DIR}/${pch}.cpp)
+  file(CONFIGURE OUTPUT ${anchor} CONTENT "// anchors a shared precompiled header\n")
+  add_library(${pch} OBJECT ${anchor})
+  target_link_libraries(${pch} PRIVATE ${ARG_DEPS} kestrel_options)
+  target_compile_options(${pch} PRIVATE ${_KESTREL_PCH_FLAGS})
+  set_target_properties(${pch} PROPERTIES POSITION_INDEPENDENT_CODE ${ARG_PIC})
+  target_precompile_headers(${pch} PRIVATE ${ARG_HEADERS})
+endfunction()
+
+# _kestrel_use_pch(target pch): `target` compiles with `pch` force-included. It links what the
+# header needs, so that the header also compiles (slowly) if GCC ever refused the binary one.
+function(_kestrel_use_pch target pch deps)
+  target_link_libraries(${target} PRIVATE ${deps})
+  target_precompile_headers(${target} REUSE_FROM ${pch})
+  target_compile_options(${target} PRIVATE ${_KESTREL_PCH_FLAGS} -Winvalid-pch)
+endfunction()
+
+set(_KESTREL_STD_HEADERS <algorithm> <cmath> <cstdint> <functional> <limits> <memory> <optional>
+    <stdexcept> <string> <utility> <vector>)
+set(_KESTREL_LIBRARY_PCH_DEPS Eigen3::Eigen opencv_core)
+set(_KESTREL_TOOL_PCH_DEPS Eigen3::Eigen opencv_core CLI11::CLI11 spdlog::spdlog)
+
 # kestrel_library(name SOURCES ... [DEPS ...]) — a component library; headers are included
 # from the repository root ("vo/feature_detector.h").
 function(kestrel_library name)
@@ -8,6 +47,9 @@ function(kestrel_library name)
   target_include_directories(${name} PUBLIC ${PROJECT_SOURCE_DIR})
   target_link_libraries(${name} PUBLIC ${ARG_DEPS} PRIVATE kestrel_options)
   set_target_properties(${name} PROPERTIES POSITION_INDEPENDENT_CODE ON)
+  _kestrel_shared_pch(kestrel_library_pch PIC DEPS ${_KESTREL_LIBRARY_PCH_DEPS}
+    HEADERS <Eigen/Core> <Eigen/Geometry> <opencv2/core.hpp> ${_KESTREL_STD_HEADERS})
+  _kestrel_use_pch(${name} kestrel_library_pch "${_KESTREL_LIBRARY_PCH_DEPS}")
 endfunction()
 
 # kestrel_tool(name SOURCES ... [DEPS ...]) — an executable `kestrel-<name>`, run as
@@ -16,6 +58,11 @@ function(kestrel_tool name)
   cmake_parse_arguments(ARG "" "" "SOURCES;DEPS" ${ARGN})
   add_executable(kestrel-${name} ${ARG_SOURCES})
   target_link_libraries(kestrel-${name} PRIVATE ${ARG_DEPS} kestrel_options)
+  _kestrel_shared_pch(kestrel_tool_pch DEPS ${_KESTREL_TOOL_PCH_DEPS}
+    HEADERS <CLI/CLI.hpp> <spdlog/spdlog.h> <Eigen/Core> <Eigen/Geometry> <opencv2/core.hpp>
+            <chrono> <filesystem> <fstream> <iostream> ${_KESTREL_STD_HEADERS})
+  _kestrel_use_pch(kestrel-${name} kestrel_tool_pch "${_KESTREL_TOOL_PCH_DEPS}")
+  set_property(GLOBAL APPEND PROPERTY KESTREL_TOOLS kestrel-${name})
 endfunction()
 
 function(_kestrel_test_definitions target)
@@ -25,30 +72,17 @@ function(_kestrel_test_definitions target)
     KESTREL_SHARED_DATA="${KESTREL_SHARED_DATA}")
 endfunction()
 
-# -pthread defines _REENTRANT, which the system headers test; some tests get it from their
-# dependencies (LCM's pkg-config flags), so every test and the header get it, or GCC would
-# refuse the header for some of them.
-set(_KESTREL_PCH_FLAGS -pthread)
-
-# One precompiled header for every test: GoogleTest, Eigen and OpenCV's core are parsed once
-# per build instead of once per test file (they are most of a small test file's compile
-# time). It is built with exactly the flags the tests get, so GCC accepts it for each of them
-# (-Winvalid-pch would say otherwise).
+# The tests' precompiled header: GoogleTest, Eigen and OpenCV's core are most of a small test
+# file's compile time.
+set(_KESTREL_TEST_PCH_DEPS GTest::gtest GTest::gmock Eigen3::Eigen opencv_core)
 function(_kestrel_test_pch)
   if(TARGET kestrel_test_pch)
     return()
   endif()
-  set(anchor ${CMAKE_BINARY_DIR}/kestrel_test_pch.cpp)
-  file(CONFIGURE OUTPUT ${anchor} CONTENT "// anchors the tests' precompiled header\n")
-  add_library(kestrel_test_pch OBJECT ${anchor})
-  target_link_libraries(kestrel_test_pch PRIVATE GTest::gtest GTest::gmock Eigen3::Eigen
-                        opencv_core kestrel_options)
-  target_compile_options(kestrel_test_pch PRIVATE ${_KESTREL_PCH_FLAGS})
+  _kestrel_shared_pch(kestrel_test_pch DEPS ${_KESTREL_TEST_PCH_DEPS}
+    HEADERS <gtest/gtest.h> <gmock/gmock.h> <Eigen/Core> <Eigen/Geometry> <opencv2/core.hpp>
+            <filesystem> <fstream> <map> <random> <sstream> ${_KESTREL_STD_HEADERS})
   _kestrel_test_definitions(kestrel_test_pch)
-  target_precompile_headers(kestrel_test_pch PRIVATE
-    <gtest/gtest.h> <gmock/gmock.h> <Eigen/Core> <Eigen/Geometry> <opencv2/core.hpp>
-    <algorithm> <cmath> <filesystem> <fstream> <map> <memory> <random> <sstream> <string>
-    <vector>)
 endfunction()
 
 # kestrel_test(name SOURCES ... [DEPS ...] LABELS unit|integration|data [TIMEOUT s])
@@ -65,8 +99,7 @@ function(kestrel_test name)
                         kestrel_options)
   _kestrel_test_definitions(${name})
   _kestrel_test_pch()
-  target_precompile_headers(${name} REUSE_FROM kestrel_test_pch)
-  target_compile_options(${name} PRIVATE ${_KESTREL_PCH_FLAGS} -Winvalid-pch)
+  _kestrel_use_pch(${name} kestrel_test_pch "${_KESTREL_TEST_PCH_DEPS}")
   set_target_properties(${name} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/test)
   gtest_discover_tests(${name}
     PROPERTIES LABELS "${ARG_LABELS}" TIMEOUT ${ARG_TIMEOUT}
