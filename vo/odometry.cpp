@@ -46,6 +46,7 @@ VisualOdometry::VisualOdometry(const VoOptions& options)
 
 void VisualOdometry::reset() {
   keyframe_ = nullptr;
+  keyframe_first_inliers_ = 0;
   previous_ = nullptr;
   T_key_prev_.setIdentity();
   T_prev_cur_last_.setIdentity();
@@ -187,6 +188,7 @@ VoResult VisualOdometry::process(const RgbdFrame& input) {
 
   if (keyframe_ == nullptr) {
     keyframe_ = previous_ = &cur;
+    keyframe_first_inliers_ = 0;
     T_key_prev_.setIdentity();
     have_velocity_ = false;
     result.status = VoStatus::kNoReference;
@@ -229,6 +231,7 @@ VoResult VisualOdometry::process(const RgbdFrame& input) {
     if (++consecutive_failures_ >= 2) {
       // Lost: start again from this frame rather than wait for a view of the old reference.
       keyframe_ = previous_ = &cur;
+      keyframe_first_inliers_ = 0;
       T_key_prev_.setIdentity();
       have_velocity_ = false;
       consecutive_failures_ = 0;
@@ -246,8 +249,13 @@ VoResult VisualOdometry::process(const RgbdFrame& input) {
   T_prev_cur_last_ = against_previous ? e.T_ref_cur : Eigen::Isometry3d(T_key_prev_.inverse() * e.T_ref_cur);
   last_dt_s_ = dt;
   have_velocity_ = dt > 0.0;
-  if (result.fell_back_to_previous || e.num_reprojection_inliers < options_.keyframe.min_inliers_to_keep) {
+  const bool against_keyframe = attempt.reference == keyframe_;
+  if (against_keyframe && keyframe_first_inliers_ == 0) keyframe_first_inliers_ = e.num_reprojection_inliers;
+  const double relative_floor = options_.keyframe.min_inlier_fraction_to_keep * keyframe_first_inliers_;
+  if (result.fell_back_to_previous || e.num_reprojection_inliers < options_.keyframe.min_inliers_to_keep ||
+      e.num_reprojection_inliers < relative_floor) {
     keyframe_ = &cur;
+    keyframe_first_inliers_ = 0;
     T_key_prev_.setIdentity();
     result.new_reference = true;
   } else {

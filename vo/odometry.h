@@ -97,6 +97,7 @@ class VisualOdometry {
   double last_dt_s_ = 0.0;
   bool have_velocity_ = false;
   int consecutive_failures_ = 0;
+  int keyframe_first_inliers_ = 0;  // the keyframe's reprojection inliers at its first match; 0 = none yet
   int64_t last_utime_ = 0;
 
   std::vector<Eigen::Vector2f> predicted_;

@@ -61,6 +61,7 @@ std::vector<std::pair<std::string, Field>> fields(VoOptions& o) {
       {"covariance.translation_floor_m", &o.covariance.translation_floor_m},
       {"covariance.rotation_floor_rad", &o.covariance.rotation_floor_rad},
       {"keyframe.min_inliers_to_keep", &o.keyframe.min_inliers_to_keep},
+      {"keyframe.min_inlier_fraction_to_keep", &o.keyframe.min_inlier_fraction_to_keep},
       {"keyframe.fall_back_to_previous", &o.keyframe.fall_back_to_previous},
       {"min_features", &o.min_features},
       {"min_features_with_depth", &o.min_features_with_depth},

@@ -54,6 +54,8 @@ void VoOptions::validate() const {
   require(covariance.translation_floor_m >= 0.0, "covariance.translation_floor_m", "must be >= 0");
   require(covariance.rotation_floor_rad >= 0.0, "covariance.rotation_floor_rad", "must be >= 0");
   require(keyframe.min_inliers_to_keep >= 0, "keyframe.min_inliers_to_keep", "must be >= 0");
+  require(keyframe.min_inlier_fraction_to_keep >= 0.0 && keyframe.min_inlier_fraction_to_keep <= 1.0,
+          "keyframe.min_inlier_fraction_to_keep", "must be in [0, 1]");
   require(min_features >= 0 && min_features_with_depth >= 3 && min_matches >= 3,
           "min_features/min_features_with_depth/min_matches", "must be >= 0 / 3 / 3");
 }

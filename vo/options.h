@@ -104,7 +104,11 @@ struct CovarianceOptions {
 
 /// Reference (key) frame policy.
 struct KeyframeOptions {
-  int min_inliers_to_keep = 300;  ///< below this, the current frame becomes the reference
+  /// Absolute floor: below this many reprojection inliers the current frame becomes the reference.
+  int min_inliers_to_keep = 300;
+  /// Relative rule: the current frame also becomes the reference when its inliers fall below this
+  /// fraction of the keyframe's inliers at its first match (0 = off, only the floor applies).
+  double min_inlier_fraction_to_keep = 0.0;
   bool fall_back_to_previous = true;
 };
 

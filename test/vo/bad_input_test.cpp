@@ -152,7 +152,10 @@ TEST(Options, SetByNameAndRejectedByName) {
     }
   }
   EXPECT_EQ(o.fast.threshold, 15) << "a rejected value changes nothing";
-  EXPECT_EQ(describe_options(o).size(), 54u);
+  set_option(o, "keyframe.min_inlier_fraction_to_keep", "0.8");
+  EXPECT_EQ(o.keyframe.min_inlier_fraction_to_keep, 0.8);
+  EXPECT_THROW(set_option(o, "keyframe.min_inlier_fraction_to_keep", "1.5"), std::invalid_argument);
+  EXPECT_EQ(describe_options(o).size(), 55u);
 }
 
 }  // namespace

@@ -75,6 +75,43 @@ TEST(Pipeline, KeepsTheKeyframeWhileItOverlaps) {
   EXPECT_EQ(r2.reference_utime, frames[0].utime) << "frame 2 is matched against the keyframe";
 }
 
+// The relative keyframe rule: a frame becomes the reference exactly when its inliers fall
+// below the fraction of the keyframe's inliers at its first match (floor off); with both
+// rules off the first frame stays the reference over the whole arc.
+TEST(Pipeline, RelativeKeyframeRuleFollowsTheFirstMatchCount) {
+  const auto& frames = rendered().frames;
+  VoOptions off;
+  off.keyframe.min_inliers_to_keep = 0;
+  off.keyframe.min_inlier_fraction_to_keep = 0.0;
+  VisualOdometry never(off);
+  never.process(frames[0]);
+  for (size_t k = 1; k < frames.size(); ++k) {
+    const VoResult r = never.process(frames[k]);
+    ASSERT_EQ(r.status, VoStatus::kOk) << r.message;
+    EXPECT_EQ(r.reference_utime, frames[0].utime) << "frame " << k;
+    EXPECT_FALSE(r.new_reference) << "frame " << k;
+  }
+
+  VoOptions relative = off;
+  relative.keyframe.min_inlier_fraction_to_keep = 0.9;
+  VisualOdometry vo(relative);
+  vo.process(frames[0]);
+  int first = 0;  // the current keyframe's inliers at its first match
+  int new_references = 0;
+  for (size_t k = 1; k < frames.size(); ++k) {
+    const VoResult r = vo.process(frames[k]);
+    ASSERT_EQ(r.status, VoStatus::kOk) << r.message;
+    if (first == 0) first = r.num_reprojection_inliers;
+    const bool expected = r.num_reprojection_inliers < 0.9 * first;
+    EXPECT_EQ(r.new_reference, expected) << "frame " << k << ": " << r.num_reprojection_inliers << " vs " << first;
+    if (r.new_reference) {
+      first = 0;
+      ++new_references;
+    }
+  }
+  EXPECT_GT(new_references, 0) << "the arc loses more than 10 % of the first view's inliers";
+}
+
 TEST(Pipeline, ResetForgetsTheReference) {
   VisualOdometry vo;
   const auto& frames = rendered().frames;
