@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <iostream>
 
 #include "common/cli.h"
@@ -41,7 +42,8 @@ int run(const Options& o) {
   const sim::SequenceStats r = sim::summarise(real), s = sim::summarise(simulated);
   std::printf("%-34s %14s %14s %8s\n", "median per frame", "real", "sim", "sim/real");
   auto row = [](const char* name, double a, double b) {
-    std::printf("%-34s %14.4g %14.4g %8.2f\n", name, a, b, a > 0 ? b / a : NAN);
+    const double ratio = a > 0 ? b / a : std::numeric_limits<double>::quiet_NaN();
+    std::printf("%-34s %14.4g %14.4g %8.2f\n", name, a, b, ratio);
   };
   row("FAST corners (threshold 20)", r.fast_corners_median, s.fast_corners_median);
   row("valid depth fraction", r.valid_depth_median, s.valid_depth_median);
