@@ -27,10 +27,12 @@ MipTexture::MipTexture(const cv::Mat& rgb) {
   while ((1 << log2_size_) < size_) ++log2_size_;
   cv::Mat level = rgb;
   for (int l = 0;; ++l) {
-    std::vector<uint32_t> packed(level.total());
-    for (int r = 0; r < level.rows; ++r) {
-      const cv::Vec3f* row = level.ptr<cv::Vec3f>(r);
-      for (int c = 0; c < level.cols; ++c) packed[static_cast<size_t>(r) * level.cols + c] = pack(row[c]);
+    // Rows and columns 0..side-1, then copies of column 0 and row 0 (the wrap).
+    const size_t side = static_cast<size_t>(level.rows), stride = side + 1;
+    std::vector<uint32_t> packed(stride * stride);
+    for (size_t r = 0; r < stride; ++r) {
+      const cv::Vec3f* row = level.ptr<cv::Vec3f>(static_cast<int>(r % side));
+      for (size_t c = 0; c < stride; ++c) packed[r * stride + c] = pack(row[c % side]);
     }
     levels_.push_back(std::move(packed));
     inverse_scale_.push_back(std::ldexp(1.0f, -l));
@@ -50,6 +52,16 @@ MipTexture::MipTexture(const cv::Mat& rgb) {
     }
     level = next;
   }
+}
+
+std::vector<uint32_t> MipTexture::level(int l) const {
+  const size_t side = static_cast<size_t>(size_ >> l), stride = side + 1;
+  const std::vector<uint32_t>& stored = levels_[static_cast<size_t>(l)];
+  std::vector<uint32_t> out(side * side);
+  for (size_t r = 0; r < side; ++r)
+    std::copy(stored.begin() + static_cast<std::ptrdiff_t>(r * stride),
+              stored.begin() + static_cast<std::ptrdiff_t>(r * stride + side), out.begin() + static_cast<std::ptrdiff_t>(r * side));
+  return out;
 }
 
 }  // namespace kestrel::sim

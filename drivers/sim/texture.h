@@ -5,10 +5,15 @@
 // one texel, each texel the mean of the 2x2 texels below it (box pre-filter), so a lookup at the
 // level matching the pixel footprint does not alias. Texels are packed R | G << 8 | B << 16.
 // Texture coordinates are in level-0 texels and wrap (the texture tiles the plane).
+// Each level is stored with one extra column and row (copies of the first ones), so the 2x2
+// texels of a bilinear lookup are two adjacent pairs of a row and the next row, wrap or not.
 
 #include <Eigen/Core>
 #include <algorithm>
 #include <cstdint>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 #include <opencv2/core/mat.hpp>
 #include <vector>
 
@@ -21,7 +26,8 @@ class MipTexture {
 
   int size() const { return size_; }
   int levels() const { return static_cast<int>(levels_.size()); }
-  const std::vector<uint32_t>& level(int l) const { return levels_[l]; }
+  /// Level `l`'s texels, row-major, (size >> l) squared (without the stored wrap copies).
+  std::vector<uint32_t> level(int l) const;
   /// Mean colour (the last level), R, G, B in [0, 1].
   const Eigen::Vector3f& mean() const { return mean_; }
 
@@ -47,32 +53,55 @@ class MipTexture {
     const float x0 = floor_fast(fx), y0 = floor_fast(fy);
     const uint32_t wx = static_cast<uint32_t>((fx - x0) * 256.0f), wy = static_cast<uint32_t>((fy - y0) * 256.0f);
     const uint32_t mask = static_cast<uint32_t>((size_ >> l) - 1);
-    const int shift = log2_size_ - l;
+    const size_t stride = static_cast<size_t>(mask) + 2;
     const uint32_t ix = static_cast<uint32_t>(static_cast<int64_t>(x0)) & mask;
     const uint32_t iy = static_cast<uint32_t>(static_cast<int64_t>(y0)) & mask;
-    const uint32_t ix1 = (ix + 1) & mask, iy1 = (iy + 1) & mask;
-    const uint32_t* d = levels_[l].data();
-    const uint32_t top = lerp(d[(iy << shift) | ix], d[(iy << shift) | ix1], wx);
-    const uint32_t bottom = lerp(d[(iy1 << shift) | ix], d[(iy1 << shift) | ix1], wx);
-    return lerp(top, bottom, wy);
+    const uint32_t* d = levels_[l].data() + iy * stride + ix;
+    return lerp(lerp(d[0], d[1], wx), lerp(d[stride], d[stride + 1], wx), wy);
   }
 
   /// Bilinear samples of level `l` along a line: out[i] at (x + i dx, y + i dy), where x, y
   /// are level-l texel coordinates in 16.16 fixed point, half-texel offset already applied.
   /// Unsigned arithmetic wraps at 2^16 texels, a multiple of every level's side, so the
   /// coordinates wrap like the texture. The renderer's inner loop: no float, no branch.
+  /// With SSE2, one pixel's four texels are two 64-bit loads widened to 16 bits per channel,
+  /// and the same integer lerps as lerp() (bit-identical to the scalar path).
   void bilinear_span(int l, uint32_t x, uint32_t y, int32_t dx, int32_t dy, int n, uint32_t* out) const {
     const uint32_t mask = static_cast<uint32_t>((size_ >> l) - 1);
-    const int shift = log2_size_ - l;
+    const size_t stride = static_cast<size_t>(mask) + 2;
     const uint32_t* d = levels_[l].data();
+#if defined(__SSE2__)
+    const __m128i zero = _mm_setzero_si128();
+    // Per-lane weights: 256 - w in the low four 16-bit lanes, w in the high four.
+    const __m128i base = _mm_set_epi16(0, 0, 0, 0, 256, 256, 256, 256);
+    const __m128i sign = _mm_set_epi16(1, 1, 1, 1, -1, -1, -1, -1);
     for (int i = 0; i < n; ++i) {
       const uint32_t ix = (x >> 16) & mask, iy = (y >> 16) & mask;
-      const uint32_t wx = (x >> 8) & 255u, wy = (y >> 8) & 255u;
-      const uint32_t ix1 = (ix + 1) & mask, r0 = iy << shift, r1 = ((iy + 1) & mask) << shift;
-      out[i] = lerp(lerp(d[r0 | ix], d[r0 | ix1], wx), lerp(d[r1 | ix], d[r1 | ix1], wx), wy);
+      const uint32_t* p = d + iy * stride + ix;
+      const __m128i top = _mm_loadl_epi64(reinterpret_cast<const __m128i*>(p));
+      const __m128i bottom = _mm_loadl_epi64(reinterpret_cast<const __m128i*>(p + stride));
+      const __m128i wx = _mm_add_epi16(base, _mm_mullo_epi16(sign, _mm_set1_epi16(static_cast<short>((x >> 8) & 255u))));
+      const __m128i wy = _mm_add_epi16(base, _mm_mullo_epi16(sign, _mm_set1_epi16(static_cast<short>((y >> 8) & 255u))));
+      // Products stay below 2^16 (255 * 256), so 16-bit lanes hold them exactly.
+      const __m128i t = _mm_mullo_epi16(_mm_unpacklo_epi8(top, zero), wx);     // t00 (256-wx) | t01 wx
+      const __m128i b = _mm_mullo_epi16(_mm_unpacklo_epi8(bottom, zero), wx);  // t10 (256-wx) | t11 wx
+      const __m128i h = _mm_srli_epi16(_mm_add_epi16(_mm_unpacklo_epi64(t, b), _mm_unpackhi_epi64(t, b)), 8);
+      const __m128i v = _mm_mullo_epi16(h, wy);                                // top (256-wy) | bottom wy
+      const __m128i sum = _mm_srli_epi16(_mm_add_epi16(v, _mm_srli_si128(v, 8)), 8);
+      out[i] = static_cast<uint32_t>(_mm_cvtsi128_si32(_mm_packus_epi16(sum, zero)));
       x += static_cast<uint32_t>(dx);
       y += static_cast<uint32_t>(dy);
     }
+#else
+    for (int i = 0; i < n; ++i) {
+      const uint32_t ix = (x >> 16) & mask, iy = (y >> 16) & mask;
+      const uint32_t wx = (x >> 8) & 255u, wy = (y >> 8) & 255u;
+      const uint32_t* p = d + iy * stride + ix;
+      out[i] = lerp(lerp(p[0], p[1], wx), lerp(p[stride], p[stride + 1], wx), wy);
+      x += static_cast<uint32_t>(dx);
+      y += static_cast<uint32_t>(dy);
+    }
+#endif
   }
 
   /// 16.16 fixed-point level-l coordinate (half-texel offset applied) of level-0 coordinate
