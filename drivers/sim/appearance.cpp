@@ -30,7 +30,9 @@ std::shared_ptr<const MipTexture> make_wear_texture(uint64_t seed) {
       out[c] = cv::Vec3f(g, g, g);
     }
   }
-  return std::make_shared<const MipTexture>(rgb);
+  auto wear = std::make_shared<MipTexture>(rgb);
+  wear->add_grey_levels();  // the renderer reads it with grey_span
+  return wear;
 }
 
 std::vector<SurfaceLook> make_looks(const std::vector<Surface>& surfaces,

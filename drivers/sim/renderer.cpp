@@ -121,6 +121,7 @@ void Renderer::shade(bool ir) {
     std::copy(look.wear_offset, look.wear_offset + 2, s.wear_o);
   }
   const MipTexture& wear = world_.wear_texture();
+  if (!wear.has_grey_levels()) throw std::logic_error("Renderer: the wear texture needs its grey levels");
   const int w = cam.width;
   const int wear_top = wear.levels() - 1;
   uint32_t texels[kChunk], texels_next[kChunk], greys[kChunk];
@@ -186,7 +187,7 @@ void Renderer::shade(bool ir) {
         const float wdx = (s.wear_m[0] * (s1 - s0) + s.wear_m[1] * (t1 - t0)) * step;
         const float wdy = (s.wear_m[2] * (s1 - s0) + s.wear_m[3] * (t1 - t0)) * step;
         const int wl = std::clamp(static_cast<int>(lz + s.wear_lod_c + 0.5f), 0, wear_top);
-        wear.bilinear_span(wl, wear.fixed_coordinate(wl, wx0), wear.fixed_coordinate(wl, wy0),
+        wear.grey_span(wl, wear.fixed_coordinate(wl, wx0), wear.fixed_coordinate(wl, wy0),
                            wear.fixed_step(wl, wdx), wear.fixed_step(wl, wdy), n, greys);
         const float light0 = s.shade->at(s0, t0) * exposure;
         const float dlight = (s.shade->at(s1, t1) * exposure - light0) * step;

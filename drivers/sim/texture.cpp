@@ -54,6 +54,15 @@ MipTexture::MipTexture(const cv::Mat& rgb) {
   }
 }
 
+void MipTexture::add_grey_levels() {
+  grey_levels_.clear();
+  for (const auto& level : levels_) {
+    std::vector<uint8_t> grey(level.size());
+    for (size_t i = 0; i < level.size(); ++i) grey[i] = static_cast<uint8_t>(level[i] & 255u);
+    grey_levels_.push_back(std::move(grey));
+  }
+}
+
 std::vector<uint32_t> MipTexture::level(int l) const {
   const size_t side = static_cast<size_t>(size_ >> l), stride = side + 1;
   const std::vector<uint32_t>& stored = levels_[static_cast<size_t>(l)];

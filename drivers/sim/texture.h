@@ -104,6 +104,29 @@ class MipTexture {
 #endif
   }
 
+  /// Keeps an 8-bit copy of the first channel of every level, for grey_span (a grey texture's
+  /// lookups then touch a quarter of the memory).
+  void add_grey_levels();
+  bool has_grey_levels() const { return !grey_levels_.empty(); }
+
+  /// bilinear_span's first channel, from the grey copy (add_grey_levels); the same integer
+  /// lerps, so out[i] == bilinear_span's out[i] & 255 exactly.
+  void grey_span(int l, uint32_t x, uint32_t y, int32_t dx, int32_t dy, int n, uint32_t* out) const {
+    const uint32_t mask = static_cast<uint32_t>((size_ >> l) - 1);
+    const size_t stride = static_cast<size_t>(mask) + 2;
+    const uint8_t* d = grey_levels_[static_cast<size_t>(l)].data();
+    for (int i = 0; i < n; ++i) {
+      const uint32_t ix = (x >> 16) & mask, iy = (y >> 16) & mask;
+      const uint32_t wx = (x >> 8) & 255u, wy = (y >> 8) & 255u;
+      const uint8_t* p = d + iy * stride + ix;
+      const uint32_t top = (p[0] * (256u - wx) + p[1] * wx) >> 8;
+      const uint32_t bottom = (p[stride] * (256u - wx) + p[stride + 1] * wx) >> 8;
+      out[i] = (top * (256u - wy) + bottom * wy) >> 8;
+      x += static_cast<uint32_t>(dx);
+      y += static_cast<uint32_t>(dy);
+    }
+  }
+
   /// 16.16 fixed-point level-l coordinate (half-texel offset applied) of level-0 coordinate
   /// `x`, reduced modulo the level's side first so float keeps sub-texel precision.
   uint32_t fixed_coordinate(int l, float x) const {
@@ -144,6 +167,7 @@ class MipTexture {
   int size_ = 0;
   int log2_size_ = 0;
   std::vector<std::vector<uint32_t>> levels_;
+  std::vector<std::vector<uint8_t>> grey_levels_;  // same layout, first channel only
   std::vector<float> inverse_scale_;
   Eigen::Vector3f mean_ = Eigen::Vector3f::Zero();
 };
