@@ -35,24 +35,32 @@ void make_kinect_depth(const Rasterizer& raster, const std::vector<float>& ir_re
   thread_local std::vector<uint8_t> usable;
   padded.assign(static_cast<size_t>(w) + 2, 0.0f);
   usable.resize(static_cast<size_t>(w));
+  thread_local std::vector<float> columns;
+  thread_local std::vector<uint8_t> lits;
+  columns.resize(static_cast<size_t>(w));
+  lits.resize(static_cast<size_t>(w));
   uint8_t* ok = usable.data();
+  float* column = columns.data();
+  uint8_t* lit = lits.data();
   for (int v = 0; v < h; ++v) {
     const uint16_t* ids = raster.ids(v);
     const float* inv = raster.inverse_depth(v);
     const float* ir = ir_return.data() + static_cast<size_t>(v) * w;
     uint16_t* out = depth_mm.ptr<uint16_t>(v);
     // Projector shadow: scanning from the right, a point whose projector column lies right
-    // of a nearer point already seen is hidden from the projector. (Sequential: scalar.)
-    float leftmost = std::numeric_limits<float>::infinity();
+    // of a nearer point already seen is hidden from the projector. The projector columns
+    // (+inf where nothing is seen) are a vectorised loop; the scan is a branch-free running
+    // minimum (a hidden point's column is right of the minimum, so min() leaves it as it is).
+    const float inf = std::numeric_limits<float>::infinity();
+    for (int u = 0; u < w; ++u) column[u] = ids[u] != Rasterizer::kNone ? static_cast<float>(u) - shift_px * inv[u] : inf;
+    float leftmost = inf;
     for (int u = w - 1; u >= 0; --u) {
-      bool seen = ids[u] != Rasterizer::kNone;
-      if (seen) {
-        const float up = static_cast<float>(u) - shift_px * inv[u];
-        if (up > leftmost + 1e-3f) seen = false;
-        else leftmost = std::min(leftmost, up);
-      }
-      ok[u] = seen && inv[u] >= inv_min && inv[u] <= inv_max;
+      const float up = column[u];
+      lit[u] = !(up > leftmost + 1e-3f);
+      leftmost = std::min(leftmost, up);
     }
+    for (int u = 0; u < w; ++u)
+      ok[u] = (ids[u] != Rasterizer::kNone) & (lit[u] != 0) & (inv[u] >= inv_min) & (inv[u] <= inv_max);
     std::copy(inv, inv + w, padded.begin() + 1);
     const float* pad = padded.data() + 1;
     // Everything else is per pixel and branch-free, so the compiler vectorises it.

@@ -8,23 +8,18 @@
 namespace kestrel::sim {
 namespace {
 
-// In-place [1 2 1] / 4 blur along each row, edges clamped (the vertical pass is done on the
-// fly in expose_rgb, from three of these rows).
-void blur_rows(std::vector<float>& plane, std::vector<float>& row, int w, int h) {
-  row.resize(static_cast<size_t>(w));
-  for (int v = 0; v < h; ++v) {
-    float* p = plane.data() + static_cast<size_t>(v) * w;
-    std::copy(p, p + w, row.begin());
-    const float* in = row.data();
-    p[0] = 0.75f * in[0] + 0.25f * in[std::min(1, w - 1)];
-    for (int u = 1; u + 1 < w; ++u) p[u] = 0.25f * (in[u - 1] + in[u + 1]) + 0.5f * in[u];
-    if (w > 1) p[w - 1] = 0.75f * in[w - 1] + 0.25f * in[w - 2];
-  }
+// [1 2 1] / 4 blur of one row, edges clamped (the vertical pass is done on the fly in
+// expose_rgb, from three of these rows).
+void blur_row(const float* in, float* p, int w) {
+  p[0] = 0.75f * in[0] + 0.25f * in[std::min(1, w - 1)];
+  for (int u = 1; u + 1 < w; ++u) p[u] = 0.25f * (in[u - 1] + in[u + 1]) + 0.5f * in[u];
+  if (w > 1) p[w - 1] = 0.75f * in[w - 1] + 0.25f * in[w - 2];
 }
 
 // Row buffers, per thread so that concurrent renderers never share them.
 struct RowBuffers {
-  std::vector<float> row, fall_u, value, normal;
+  std::vector<float> blurred;  // 3 channels x 3 rows (a ring over v - 1, v, v + 1)
+  std::vector<float> fall_u, value, normal;
   std::vector<uint32_t> bits;
 };
 
@@ -35,11 +30,15 @@ void expose_rgb(std::vector<float> (&planes)[3], const PinholeCamera& cam, const
   const int w = cam.width, h = cam.height;
   thread_local RowBuffers buf;
   const size_t n = static_cast<size_t>(w);
-  if (o.optics_blur)
-    for (auto& p : planes) blur_rows(p, buf.row, w, h);
+  // Horizontally blurred rows, computed once each as the vertical pass first needs them.
+  buf.blurred.resize(9 * n);
+  auto blurred = [&](int c, int r) { return buf.blurred.data() + (static_cast<size_t>(c) * 3 + static_cast<size_t>(r % 3)) * n; };
+  auto blur_into_ring = [&](int r) {
+    for (int c = 0; c < 3; ++c) blur_row(planes[c].data() + static_cast<size_t>(r) * n, blurred(c, r), w);
+  };
   // Vignetting 1 - a (x^2 + y^2) / 2 with x, y = -1..1 across the image: 1 - a at the corners.
   buf.fall_u.resize(n);
-  buf.value.resize(n);
+  buf.value.resize(3 * n);
   buf.normal.resize(n);
   buf.bits.resize(n);
   const float a = static_cast<float>(o.vignetting) * 0.5f;
@@ -52,24 +51,29 @@ void expose_rgb(std::vector<float> (&planes)[3], const PinholeCamera& cam, const
   const float shot = static_cast<float>(o.shot_noise_dn);
   rgb.create(h, w, CV_8UC3);
   // Separate simple loops over a row, so the compiler vectorises all but the table lookup.
-  float* value = buf.value.data();
   float* noise = buf.normal.data();
   uint32_t* bits = buf.bits.data();
   const float* fall_u = buf.fall_u.data();
+  if (o.optics_blur) {
+    blur_into_ring(0);
+    if (h > 1) blur_into_ring(1);
+  }
   for (int v = 0; v < h; ++v) {
     const float y = static_cast<float>((v - cam.cy) / (0.5 * h));
     const float gain_v = 1.0f - a * y * y;
     const uint32_t row_key = static_cast<uint32_t>(v * w);
+    if (o.optics_blur && v > 0 && v + 1 < h) blur_into_ring(v + 1);
     if (o.noise)
       for (int u = 0; u < w; ++u) bits[u] = hash32((row_key + static_cast<uint32_t>(u)) ^ key);
-    uchar* out = rgb.ptr<uchar>(v);
     for (int c = 0; c < 3; ++c) {
-      const float* mid = planes[c].data() + static_cast<size_t>(v) * w;
+      float* value = buf.value.data() + static_cast<size_t>(c) * n;
       if (o.optics_blur) {
-        const float* up = planes[c].data() + static_cast<size_t>(std::max(v - 1, 0)) * w;
-        const float* down = planes[c].data() + static_cast<size_t>(std::min(v + 1, h - 1)) * w;
+        const float* up = blurred(c, std::max(v - 1, 0));
+        const float* mid = blurred(c, v);
+        const float* down = blurred(c, std::min(v + 1, h - 1));
         for (int u = 0; u < w; ++u) value[u] = (0.25f * (up[u] + down[u]) + 0.5f * mid[u]) * (gain_v - fall_u[u]);
       } else {
+        const float* mid = planes[c].data() + static_cast<size_t>(v) * w;
         for (int u = 0; u < w; ++u) value[u] = mid[u] * (gain_v - fall_u[u]);
       }
       if (o.noise) {
@@ -77,7 +81,16 @@ void expose_rgb(std::vector<float> (&planes)[3], const PinholeCamera& cam, const
         for (int u = 0; u < w; ++u) noise[u] = normal[bits[u] >> shift];
         for (int u = 0; u < w; ++u) value[u] += std::sqrt(read_var + shot * std::max(value[u], 0.0f)) * noise[u];
       }
-      for (int u = 0; u < w; ++u) out[3 * u + c] = static_cast<uchar>(std::min(std::max(value[u] + 0.5f, 0.0f), 255.0f));
+      for (int u = 0; u < w; ++u) value[u] = std::min(std::max(value[u] + 0.5f, 0.0f), 255.0f);
+    }
+    const float* r = buf.value.data();
+    const float* g = r + n;
+    const float* b = g + n;
+    uchar* out = rgb.ptr<uchar>(v);
+    for (int u = 0; u < w; ++u) {
+      out[3 * u] = static_cast<uchar>(r[u]);
+      out[3 * u + 1] = static_cast<uchar>(g[u]);
+      out[3 * u + 2] = static_cast<uchar>(b[u]);
     }
   }
 }

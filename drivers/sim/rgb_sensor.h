@@ -13,7 +13,7 @@
 
 namespace kestrel::sim {
 
-/// `planes` holds R, G, B radiance per pixel (row-major, camera size); they are modified.
+/// `planes` holds R, G, B radiance per pixel (row-major, camera size); they are not modified.
 /// Writes rgb (CV_8UC3, R, G, B). Noise draws are keyed by `key` and the pixel index.
 void expose_rgb(std::vector<float> (&planes)[3], const PinholeCamera& camera, const RgbOptions& options,
                 uint32_t key, cv::Mat& rgb);
