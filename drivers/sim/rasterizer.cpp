@@ -115,12 +115,12 @@ void Rasterizer::scan(const std::vector<Eigen::Vector2d>& poly, const ViewSurfac
     float* depth = inverse_depth_.data() + static_cast<size_t>(v) * w;
     uint16_t* ids = ids_.data() + static_cast<size_t>(v) * w;
     const float row = vs.inv_b * static_cast<float>(v) + vs.inv_c;
+    // Branch-free, so the compiler vectorises the depth test.
     for (int u = u0; u <= u1; ++u) {
       const float inv = vs.inv_a * static_cast<float>(u) + row;
-      if (inv > depth[u]) {
-        depth[u] = inv;
-        ids[u] = id;
-      }
+      const bool nearer = inv > depth[u];
+      depth[u] = nearer ? inv : depth[u];
+      ids[u] = nearer ? id : ids[u];
     }
   }
 }

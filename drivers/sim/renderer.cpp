@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstring>
 #include <stdexcept>
+#include <type_traits>
 
 #include "drivers/sim/kinect_depth.h"
 #include "drivers/sim/random.h"
@@ -65,16 +66,19 @@ RgbdFrame Renderer::render(const Eigen::Isometry3d& T_world_camera, int64_t utim
 
 RgbdFrame Renderer::render(const std::vector<Eigen::Isometry3d>& exposure, int64_t utime, int64_t seq) {
   if (exposure.empty()) throw std::invalid_argument("Renderer::render: no pose");
-  for (auto& p : planes_) std::fill(p.begin(), p.end(), 0.0f);
   const size_t middle = exposure.size() / 2;
+  // With one pose the planes are written, not accumulated (no clearing pass).
+  const bool accumulate = exposure.size() > 1;
+  if (accumulate)
+    for (auto& p : planes_) std::fill(p.begin(), p.end(), 0.0f);
   // The middle pose last, so the rasteriser's buffers hold it for the depth image.
   for (size_t i = 0; i < exposure.size(); ++i) {
     if (i == middle) continue;
     raster_.draw(world_.surfaces(), exposure[i]);
-    shade(false);
+    shade(false, true);
   }
   raster_.draw(world_.surfaces(), exposure[middle]);
-  shade(true);
+  shade(true, accumulate);
   if (exposure.size() > 1) {
     const float scale = 1.0f / static_cast<float>(exposure.size());
     for (auto& p : planes_)
@@ -92,7 +96,7 @@ RgbdFrame Renderer::render(const std::vector<Eigen::Isometry3d>& exposure, int64
   return frame;
 }
 
-void Renderer::shade(bool ir) {
+void Renderer::shade(bool ir, bool accumulate) {
   const PinholeCamera& cam = options_.camera;
   const auto& visible = raster_.visible();
   const float f = static_cast<float>(0.5 * (cam.fx + cam.fy));
@@ -141,6 +145,11 @@ void Renderer::shade(bool ir) {
       while (end < w && ids[end] == id) ++end;
       if (id == Rasterizer::kNone) {
         if (ir) std::fill(irow + u, irow + end, 0.0f);
+        if (!accumulate) {
+          std::fill(R + u, R + end, 0.0f);
+          std::fill(G + u, G + end, 0.0f);
+          std::fill(B + u, B + end, 0.0f);
+        }
         u = end;
         continue;
       }
@@ -194,14 +203,24 @@ void Renderer::shade(bool ir) {
         float* r = R + u;
         float* g = G + u;
         float* b = B + u;
-        for (int i = 0; i < n; ++i) {
-          const uint32_t texel = texels[i];
-          const float wear_factor = 1.0f + s.wear_k * (static_cast<float>(greys[i] & 255u) - 127.5f);
-          const float light = (light0 + dlight * static_cast<float>(i)) * wear_factor;
-          r[i] += (s.base[0] + s.detail * static_cast<float>(texel & 255u)) * light;
-          g[i] += (s.base[1] + s.detail * static_cast<float>((texel >> 8) & 255u)) * light;
-          b[i] += (s.base[2] + s.detail * static_cast<float>((texel >> 16) & 255u)) * light;
-        }
+        // Written, or added to what earlier poses left (the same values when that is 0).
+        auto radiance = [&](auto add) {
+          for (int i = 0; i < n; ++i) {
+            const uint32_t texel = texels[i];
+            const float wear_factor = 1.0f + s.wear_k * (static_cast<float>(greys[i] & 255u) - 127.5f);
+            const float light = (light0 + dlight * static_cast<float>(i)) * wear_factor;
+            const float vr = (s.base[0] + s.detail * static_cast<float>(texel & 255u)) * light;
+            const float vg = (s.base[1] + s.detail * static_cast<float>((texel >> 8) & 255u)) * light;
+            const float vb = (s.base[2] + s.detail * static_cast<float>((texel >> 16) & 255u)) * light;
+            if constexpr (decltype(add)::value) {
+              r[i] += vr, g[i] += vg, b[i] += vb;
+            } else {
+              r[i] = vr, g[i] = vg, b[i] = vb;
+            }
+          }
+        };
+        if (accumulate) radiance(std::true_type{});
+        else radiance(std::false_type{});
         if (ir) {
           const float* iz = inv + u;
           const float* rn = rin + u;

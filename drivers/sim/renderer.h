@@ -42,8 +42,9 @@ class Renderer {
 
  private:
   // Adds the radiance seen from the rasterised view to the colour planes; with `ir`, also
-  // fills the IR return (albedo * cos(incidence)) for the depth model.
-  void shade(bool ir);
+  // fills the IR return (albedo * cos(incidence)) for the depth model. Without `accumulate`
+  // the planes are overwritten (background 0) instead of added to.
+  void shade(bool ir, bool accumulate);
 
   const World& world_;
   CameraOptions options_;
