@@ -65,6 +65,9 @@ void add_options(cli::App& app, Options& o, SlamOptions& s) {
   app.add_option("--lcm-url", o.lcm_url, "LCM URL (default: $LCM_DEFAULT_URL or kestrel's)");
   app.add_option("--camera-channel", o.adapter.camera_channel, "Channel of rgbd_frame_t")->capture_default_str();
   app.add_option("--vo-channel", o.adapter.vo_channel, "Channel of vo_update_t")->capture_default_str();
+  app.add_option("--state-channel", o.adapter.state_channel,
+                 "Channel of the estimator's state_t: its world frame becomes the map's (SLAM_GRAPH, SLAM_CORRECTION)")
+      ->capture_default_str();
   app.add_option("--graph-channel", o.graph_channel, "Channel of slam_graph_t")->capture_default_str();
   app.add_option("--correction-channel", o.correction_channel, "Channel of slam_correction_t")
       ->capture_default_str();
@@ -106,6 +109,7 @@ int serve(const Options& o, const SlamOptions& options, std::shared_ptr<const Vo
   node->advertise(o.correction_channel);
   node->on_reset([&] { adapter.reset(); });
   auto publish = [&](const AdapterOutputs& out) {
+    if (out.anchored) spdlog::info("map anchored in the estimator's world at keyframe {}", adapter.slam().keyframes().back().id);
     if (out.graph) node->publish(o.graph_channel, *out.graph);
     if (out.correction) node->publish(o.correction_channel, *out.correction);
     if (out.step && out.step->loop_closed) {
@@ -116,6 +120,7 @@ int serve(const Options& o, const SlamOptions& options, std::shared_ptr<const Vo
   };
   node->subscribe<rgbd_frame_t>(o.adapter.camera_channel, [&](const rgbd_frame_t& m) { publish(adapter.on_frame(m)); });
   node->subscribe<vo_update_t>(o.adapter.vo_channel, [&](const vo_update_t& m) { publish(adapter.on_vo_update(m)); });
+  node->subscribe<state_t>(o.adapter.state_channel, [&](const state_t& m) { publish(adapter.on_state(m)); });
   node->set_health(process_status_t::STATE_RUNNING, "");
   spdlog::info("{}: {} + {} -> {}, {}", o.name, o.adapter.camera_channel, o.adapter.vo_channel,
                o.graph_channel, o.correction_channel);

@@ -1,6 +1,8 @@
 #include "slam/slam_adapter.h"
 
 #include "common/error.h"
+#include "common/geometry/se3.h"
+#include "common/transport/convert.h"
 #include "common/transport/rgbd_codec.h"
 
 namespace kestrel::slam {
@@ -18,6 +20,8 @@ void SlamAdapter::reset() {
   poses_.clear();
   last_processed_utime_ = 0;
   lost_break_ = false;
+  anchored_ = false;
+  states_.clear();
 }
 
 void SlamAdapter::trim_frames() {
@@ -66,6 +70,45 @@ AdapterOutputs SlamAdapter::on_vo_update(const kestrel::vo_update_t& update) {
   return process(message, *pose);
 }
 
+AdapterOutputs SlamAdapter::on_state(const kestrel::state_t& state) {
+  AdapterOutputs out;
+  if (anchored_) return out;
+  if (!states_.empty() && state.utime <= states_.back().first) {
+    throw InputError(options_.state_channel + ": state " + std::to_string(state.utime) +
+                     " is not newer than the previous one");
+  }
+  if (state.status != kestrel::state_t::STATUS_OK) return out;  // no trusted pose now
+  const Eigen::Isometry3d T_world_body = transport::from_message(state.T_world_body, options_.state_channel.c_str());
+  states_.emplace_back(state.utime, T_world_body);
+  // Keyframes come at most a few seconds apart; older states can no longer bracket one.
+  const int64_t keep_us = 10'000'000;
+  while (states_.front().first < state.utime - keep_us) states_.pop_front();
+  try_anchor(out);
+  return out;
+}
+
+void SlamAdapter::try_anchor(AdapterOutputs& out) {
+  if (anchored_ || states_.empty() || slam_.keyframes().empty()) return;
+  const Keyframe& kf = slam_.keyframes().back();
+  const auto after = std::lower_bound(states_.begin(), states_.end(), kf.utime,
+                                      [](const auto& s, int64_t t) { return s.first < t; });
+  if (after == states_.end()) return;  // the estimator has not reached it yet
+  const bool exact = after->first == kf.utime;
+  if (!exact && after == states_.begin()) return;  // the estimator started after it
+  const auto before = exact ? after : std::prev(after);
+  const double gap_s = 1e-6 * static_cast<double>(after->first - before->first);
+  if (gap_s > options_.max_state_gap_s) return;
+  const double fraction = exact ? 0.0 : 1e-6 * static_cast<double>(kf.utime - before->first) / gap_s;
+  const Eigen::Isometry3d T_world_body = se3::interpolate(before->second, after->second, fraction);
+  const Eigen::Isometry3d T_world_camera = T_world_body * kf.T_body_camera;
+  const Eigen::Isometry3d& T_slam_camera = slam_.graph().poses[static_cast<size_t>(kf.id)];
+  slam_.change_world(T_world_camera * T_slam_camera.inverse());
+  anchored_ = true;
+  states_.clear();
+  out.anchored = true;
+  out.graph = graph_message(slam_);
+}
+
 AdapterOutputs SlamAdapter::process(const kestrel::rgbd_frame_t& message, const OdometryPose& pose) {
   AdapterOutputs out;
   last_processed_utime_ = message.utime;
@@ -80,6 +123,7 @@ AdapterOutputs SlamAdapter::process(const kestrel::rgbd_frame_t& message, const 
     out.correction = correction_message(slam_, options_.correction_sigma_m, options_.correction_sigma_rad);
   }
   out.step = step;
+  try_anchor(out);
   return out;
 }
 

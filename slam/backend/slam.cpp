@@ -65,6 +65,12 @@ void Slam::reset() {
   newest_covariance_.reset();
 }
 
+void Slam::change_world(const Eigen::Isometry3d& T_new_world) {
+  if (!se3::is_valid(T_new_world, 1e-6)) throw std::invalid_argument("slam: change_world needs a rigid transform");
+  for (auto& T : graph_.poses) T = T_new_world * T;
+  ++revision_;
+}
+
 bool Slam::wants_keyframe(const Eigen::Isometry3d& T_odom_camera, bool odometry_broken) const {
   if (!T_odom_camera.matrix().allFinite()) return false;
   if (keyframes_.empty() || odometry_broken) return true;

@@ -11,9 +11,11 @@
 // that passes adds a loop-closure edge and the graph is optimised.
 //
 // Frames: "world" is the odometry frame of the first keyframe, so before any loop closure the
-// optimised poses equal the odometry poses. Invariants: keyframe k is vertex k of graph();
-// vertex 0 is fixed; edge k - 1 -> k is odometry; revision() grows by one with every change of
-// the optimised poses other than appending a keyframe.
+// optimised poses equal the odometry poses, until change_world() moves the whole graph into
+// another frame (the process puts it in the state estimator's world, slam_adapter.h).
+// Invariants: keyframe k is vertex k of graph(); vertex 0 is fixed; edge k - 1 -> k is
+// odometry; revision() grows by one with every change of the optimised poses other than
+// appending a keyframe.
 
 #include <Eigen/Geometry>
 #include <memory>
@@ -73,6 +75,12 @@ class Slam {
   /// The optimised estimate of a camera seen at T_odom_camera after the newest keyframe: the
   /// newest keyframe's optimised pose composed with the odometry since.
   Eigen::Isometry3d world_pose(const Eigen::Isometry3d& T_odom_camera) const;
+
+  /// Re-expresses the map in another world frame: every optimised pose T_world_camera becomes
+  /// T_new_world * T_world_camera. A change of gauge only: edges, loop closures, covariances
+  /// (right perturbations in the camera frame) and what later frames will do are unchanged;
+  /// the revision grows by one. Throws std::invalid_argument for a non-rigid transform.
+  void change_world(const Eigen::Isometry3d& T_new_world);
 
   /// Forgets everything (as after construction).
   void reset();

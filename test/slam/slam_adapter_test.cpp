@@ -1,8 +1,11 @@
 // The message side of kestrel-slam (slam_adapter.h): frames and VO updates paired by utime in
-// either order, SLAM_GRAPH after each keyframe with the odometry poses, and bad messages
-// refused with the channel named and no change of state.
+// either order, SLAM_GRAPH after each keyframe with the odometry poses, the graph moved into
+// the estimator's world once its STATE covers a keyframe, and bad messages refused with the
+// channel named and no change of state.
 
 #include <gtest/gtest.h>
+
+#include <cmath>
 
 #include "common/error.h"
 #include "common/transport/convert.h"
@@ -39,9 +42,90 @@ class AdapterTest : public ::testing::Test {
     return T;
   }
 
+  // The estimator's state at frame time k (fractional k between frames): its world is X away
+  // from the odometry frame, and the body is the camera (T_body_camera = I in update()).
+  static kestrel::state_t state(double k, const Eigen::Isometry3d& X,
+                                int8_t status = kestrel::state_t::STATUS_OK) {
+    kestrel::state_t m{};
+    m.utime = 1'000'000 + static_cast<int64_t>(std::llround(100'000 * k));
+    m.status = status;
+    Eigen::Isometry3d T = pose(0);
+    T.translation().x() += 0.1 * k;
+    m.T_world_body = transport::to_message(X * pose(0).inverse() * T);
+    m.cov_dim = 0;
+    return m;
+  }
+  static Eigen::Isometry3d estimator_world() {
+    Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+    X.linear() = Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitZ()).toRotationMatrix() *
+                 Eigen::AngleAxisd(0.05, Eigen::Vector3d::UnitX()).toRotationMatrix();
+    X.translation() = Eigen::Vector3d(1.0, -2.0, 0.5);
+    return X;
+  }
+  static Eigen::Isometry3d keyframe_pose(const kestrel::slam_graph_t& g, int i) {
+    return transport::from_message(g.keyframes[static_cast<size_t>(i)].T_world_camera, "test");
+  }
+
   test::SyntheticRoom room_;
   SlamAdapter adapter_;
 };
+
+TEST_F(AdapterTest, AnchorsTheGraphInTheEstimatorsWorldAtTheFirstKeyframeItsStatesBracket) {
+  const Eigen::Isometry3d X = estimator_world();
+  adapter_.on_frame(frame(0));
+  ASSERT_TRUE(adapter_.on_vo_update(update(0)).graph);
+  // Initialising states carry no pose; a state after the keyframe alone brackets nothing.
+  EXPECT_FALSE(adapter_.on_state(state(-0.5, X, kestrel::state_t::STATUS_INITIALIZING)).anchored);
+  EXPECT_FALSE(adapter_.on_state(state(0.4, X)).anchored) << "no state before keyframe 0 yet";
+  EXPECT_FALSE(adapter_.anchored());
+  // Keyframe 3 (0.3 m) is bracketed by states at 2.95 and 3.05: anchored there, by interpolation.
+  for (int k = 1; k <= 3; ++k) {
+    adapter_.on_frame(frame(k));
+    adapter_.on_vo_update(update(k));
+  }
+  EXPECT_FALSE(adapter_.on_state(state(2.95, X)).anchored) << "the estimator is not past keyframe 3";
+  const AdapterOutputs out = adapter_.on_state(state(3.05, X));
+  ASSERT_TRUE(out.anchored);
+  ASSERT_TRUE(out.graph);
+  EXPECT_TRUE(adapter_.anchored());
+  ASSERT_EQ(out.graph->num_keyframes, 2);
+  // Every keyframe, the earlier one included, is now where the estimator's world has it.
+  for (int i = 0; i < 2; ++i) {
+    const Eigen::Isometry3d expected = X * pose(0).inverse() * pose(3 * i);
+    EXPECT_LT((keyframe_pose(*out.graph, i).matrix() - expected.matrix()).norm(), 1e-9) << "keyframe " << i;
+  }
+  // Later keyframes follow the odometry in the new world; later states change nothing.
+  for (int k = 4; k <= 6; ++k) {
+    adapter_.on_frame(frame(k));
+    const AdapterOutputs later = adapter_.on_vo_update(update(k));
+    if (k == 6) {
+      ASSERT_TRUE(later.graph);
+      const Eigen::Isometry3d expected = X * pose(0).inverse() * pose(6);
+      EXPECT_LT((keyframe_pose(*later.graph, 2).matrix() - expected.matrix()).norm(), 1e-9);
+    }
+  }
+  EXPECT_FALSE(adapter_.on_state(state(6.5, Eigen::Isometry3d::Identity())).graph);
+}
+
+TEST_F(AdapterTest, StatesGoingBackOrNotRigidAreRefusedNamingTheChannel) {
+  const Eigen::Isometry3d X = estimator_world();
+  adapter_.on_state(state(1.0, X));
+  try {
+    adapter_.on_state(state(0.5, X));
+    ADD_FAILURE() << "a state going back in time was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("STATE"), std::string::npos) << e.what();
+  }
+  kestrel::state_t bad = state(2.0, X);
+  bad.T_world_body.orientation[0] = std::nan("");
+  EXPECT_THROW(adapter_.on_state(bad), InputError);
+  // Without states (offline runs) the world stays the odometry frame.
+  adapter_.reset();
+  adapter_.on_frame(frame(0));
+  const AdapterOutputs out = adapter_.on_vo_update(update(0));
+  ASSERT_TRUE(out.graph);
+  EXPECT_LT((keyframe_pose(*out.graph, 0).matrix() - Eigen::Matrix4d::Identity()).norm(), 1e-12);
+}
 
 TEST_F(AdapterTest, PairsFramesAndUpdatesInEitherOrderAndPublishesTheGraph) {
   std::vector<kestrel::slam_graph_t> graphs;

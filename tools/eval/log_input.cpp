@@ -14,6 +14,7 @@
 #include "common/transport/log_file.h"
 #include "common/transport/message.h"
 #include "kestrel/ground_truth_t.hpp"
+#include "kestrel/slam_graph_t.hpp"
 #include "kestrel/state_t.hpp"
 #include "kestrel/vo_update_t.hpp"
 #include "tools/eval/vo_chain.h"
@@ -24,7 +25,7 @@ namespace {
 // The first four bytes of every LCM log event (lcm-logger's format).
 constexpr uint8_t kLogSync[4] = {0xED, 0xA1, 0xDA, 0x01};
 
-enum class Kind { kUnknown, kGroundTruth, kState, kVo };
+enum class Kind { kUnknown, kGroundTruth, kState, kVo, kSlamGraph };
 
 const char* type_name(Kind kind) {
   switch (kind) {
@@ -34,6 +35,8 @@ const char* type_name(Kind kind) {
       return kestrel::state_t::getTypeName();
     case Kind::kVo:
       return kestrel::vo_update_t::getTypeName();
+    case Kind::kSlamGraph:
+      return kestrel::slam_graph_t::getTypeName();
     case Kind::kUnknown:
       break;
   }
@@ -44,6 +47,7 @@ Kind kind_of_channel(const std::string& channel) {
   if (channel == channel::kGroundTruth) return Kind::kGroundTruth;
   if (channel == channel::kState) return Kind::kState;
   if (channel == channel::kVoUpdate) return Kind::kVo;
+  if (channel == channel::kSlamGraph) return Kind::kSlamGraph;
   return Kind::kUnknown;
 }
 
@@ -56,6 +60,7 @@ Kind kind_of_message(const std::vector<uint8_t>& data) {
   if (h == kestrel::ground_truth_t::getHash()) return Kind::kGroundTruth;
   if (h == kestrel::state_t::getHash()) return Kind::kState;
   if (h == kestrel::vo_update_t::getHash()) return Kind::kVo;
+  if (h == kestrel::slam_graph_t::getHash()) return Kind::kSlamGraph;
   return Kind::kUnknown;
 }
 
@@ -108,6 +113,9 @@ class ChannelReader {
       case Kind::kVo:
         if (const auto m = decode<kestrel::vo_update_t>(data)) add_vo(*m);
         break;
+      case Kind::kSlamGraph:
+        if (auto m = decode<kestrel::slam_graph_t>(data)) add_graph(std::move(*m));
+        break;
       case Kind::kUnknown:
         break;
     }
@@ -121,6 +129,7 @@ class ChannelReader {
       out_.diagnostics.no_pose = chain_.without_estimate();
       out_.frame = PoseFrame::kCamera;
     }
+    if (kind_ == Kind::kSlamGraph && graph_) add_keyframes(*graph_);
     out_.format = std::string("LCM log, ") + type_name(kind_);
   }
 
@@ -201,9 +210,33 @@ class ChannelReader {
     chain_.add(step);
   }
 
+  // Only the newest revision counts: every graph supersedes the ones before it.
+  void add_graph(kestrel::slam_graph_t m) {
+    if (graph_ && m.revision < graph_->revision) {
+      ++out_.diagnostics.out_of_order;
+      return;
+    }
+    graph_ = std::move(m);
+  }
+
+  // The keyframes of the final graph, in time order: SLAM's optimised camera trajectory.
+  void add_keyframes(const kestrel::slam_graph_t& g) {
+    std::vector<const kestrel::slam_keyframe_t*> keyframes;
+    for (const auto& k : g.keyframes) keyframes.push_back(&k);
+    std::stable_sort(keyframes.begin(), keyframes.end(),
+                     [](const auto* a, const auto* b) { return a->utime < b->utime; });
+    out_.frame = PoseFrame::kCamera;
+    for (const auto* k : keyframes) {
+      if (!in_order(k->utime)) continue;
+      out_.frame_utimes.push_back(k->utime);
+      if (const auto T = pose(k->T_world_camera)) out_.trajectory.push_back(k->utime, *T);
+    }
+  }
+
   std::string channel_;
   TrajectoryInput& out_;
   Kind kind_;
+  std::optional<kestrel::slam_graph_t> graph_;
   std::optional<int64_t> last_utime_;
   VoChain chain_;
 };

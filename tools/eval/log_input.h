@@ -2,14 +2,17 @@
 // Trajectories from LCM logs: the LCM side of the evaluation (library kestrel_eval_log; the
 // metrics in kestrel_eval know nothing of LCM).
 //
-// A channel holds one of three message types, each giving a trajectory:
+// A channel holds one of four message types, each giving a trajectory:
 //  * ground_truth_t (GROUND_TRUTH): T_world_frame, of the body or the camera as the message
 //    says (every message on the channel must say the same);
 //  * state_t (STATE): T_world_body; frames with status INITIALIZING or FAILED have no estimate;
 //  * vo_update_t (VO_UPDATE): motions chained into T_world_camera by VoChain (vo_chain.h);
-//    the camera mounting T_body_camera is taken from the first such message.
+//    the camera mounting T_body_camera is taken from the first such message;
+//  * slam_graph_t (SLAM_GRAPH): the keyframes' optimised T_world_camera in the graph of the
+//    highest revision (the final map), one pose per keyframe; a graph of a lower revision
+//    after a higher one is counted as out of order.
 // The standard channel names fix the type; any other channel takes the type of its first
-// message of one of the three. Time is the messages' utime, not the log's time stamps.
+// message of one of the four. Time is the messages' utime, not the log's time stamps.
 //
 // Bad input is counted, not fatal, wherever the rest can still be used: a damaged log is read
 // up to and around the damage (LogReader), a message of another type, a corrupt message, a

@@ -84,7 +84,7 @@ int main(int argc, char** argv) {
   app.add_option("--est", est_spec, "Estimate, FILE[:CHANNEL] (TUM file or LCM log)")->required();
   app.add_option("--gt-channel", gt_channel, "Ground-truth channel of a log (ground_truth_t)");
   app.add_option("--est-channel", est_channel,
-                 "Estimate channel of a log (state_t, vo_update_t or ground_truth_t); auto = "
+                 "Estimate channel of a log (state_t, vo_update_t, slam_graph_t or ground_truth_t); auto = "
                  "STATE if the log has it, else VO_UPDATE");
   app.add_option("--frames", frames_path,
                  "Reference frame list (TUM list such as rgb.txt; default: the estimate's "
