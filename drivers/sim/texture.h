@@ -11,6 +11,7 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <cstdint>
+#include <cstring>
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
@@ -115,7 +116,43 @@ class MipTexture {
     const uint32_t mask = static_cast<uint32_t>((size_ >> l) - 1);
     const size_t stride = static_cast<size_t>(mask) + 2;
     const uint8_t* d = grey_levels_[static_cast<size_t>(l)].data();
-    for (int i = 0; i < n; ++i) {
+    int i = 0;
+#if defined(__SSE2__)
+    // Eight pixels at a time: each pixel's two texel pairs are two 16-bit loads into 16-bit
+    // lanes, the weights come from the coordinates in 32-bit lanes, and the lerps are the
+    // scalar ones (products below 2^16).
+    const __m128i low = _mm_set1_epi16(255), c256 = _mm_set1_epi16(256), zero = _mm_setzero_si128();
+    const __m128i steps_x = _mm_set_epi32(static_cast<int>(3u * static_cast<uint32_t>(dx)), static_cast<int>(2u * static_cast<uint32_t>(dx)), dx, 0);
+    const __m128i steps_y = _mm_set_epi32(static_cast<int>(3u * static_cast<uint32_t>(dy)), static_cast<int>(2u * static_cast<uint32_t>(dy)), dy, 0);
+    const __m128i four_x = _mm_set1_epi32(static_cast<int>(4u * static_cast<uint32_t>(dx)));
+    const __m128i four_y = _mm_set1_epi32(static_cast<int>(4u * static_cast<uint32_t>(dy)));
+    for (; i + 8 <= n; i += 8) {
+      const __m128i x0 = _mm_add_epi32(_mm_set1_epi32(static_cast<int>(x)), steps_x), x1 = _mm_add_epi32(x0, four_x);
+      const __m128i y0 = _mm_add_epi32(_mm_set1_epi32(static_cast<int>(y)), steps_y), y1 = _mm_add_epi32(y0, four_y);
+      const __m128i wx = _mm_packs_epi32(_mm_and_si128(_mm_srli_epi32(x0, 8), _mm_set1_epi32(255)),
+                                         _mm_and_si128(_mm_srli_epi32(x1, 8), _mm_set1_epi32(255)));
+      const __m128i wy = _mm_packs_epi32(_mm_and_si128(_mm_srli_epi32(y0, 8), _mm_set1_epi32(255)),
+                                         _mm_and_si128(_mm_srli_epi32(y1, 8), _mm_set1_epi32(255)));
+      __m128i t = zero, b = zero;
+      grey_lane<0>(d, stride, mask, x, y, dx, dy, t, b);
+      grey_lane<1>(d, stride, mask, x, y, dx, dy, t, b);
+      grey_lane<2>(d, stride, mask, x, y, dx, dy, t, b);
+      grey_lane<3>(d, stride, mask, x, y, dx, dy, t, b);
+      grey_lane<4>(d, stride, mask, x, y, dx, dy, t, b);
+      grey_lane<5>(d, stride, mask, x, y, dx, dy, t, b);
+      grey_lane<6>(d, stride, mask, x, y, dx, dy, t, b);
+      grey_lane<7>(d, stride, mask, x, y, dx, dy, t, b);
+      const __m128i iwx = _mm_sub_epi16(c256, wx), iwy = _mm_sub_epi16(c256, wy);
+      const __m128i top = _mm_srli_epi16(
+          _mm_add_epi16(_mm_mullo_epi16(_mm_and_si128(t, low), iwx), _mm_mullo_epi16(_mm_srli_epi16(t, 8), wx)), 8);
+      const __m128i bottom = _mm_srli_epi16(
+          _mm_add_epi16(_mm_mullo_epi16(_mm_and_si128(b, low), iwx), _mm_mullo_epi16(_mm_srli_epi16(b, 8), wx)), 8);
+      const __m128i v = _mm_srli_epi16(_mm_add_epi16(_mm_mullo_epi16(top, iwy), _mm_mullo_epi16(bottom, wy)), 8);
+      _mm_storeu_si128(reinterpret_cast<__m128i*>(out + i), _mm_unpacklo_epi16(v, zero));
+      _mm_storeu_si128(reinterpret_cast<__m128i*>(out + i + 4), _mm_unpackhi_epi16(v, zero));
+    }
+#endif
+    for (; i < n; ++i) {
       const uint32_t ix = (x >> 16) & mask, iy = (y >> 16) & mask;
       const uint32_t wx = (x >> 8) & 255u, wy = (y >> 8) & 255u;
       const uint8_t* p = d + iy * stride + ix;
@@ -159,6 +196,22 @@ class MipTexture {
   }
 
  private:
+#if defined(__SSE2__)
+  // One pixel of grey_span's SIMD loop: its texel pairs (ix, ix + 1) of rows iy and iy + 1
+  // into 16-bit lane k of t and b; advances (x, y).
+  template <int k>
+  static void grey_lane(const uint8_t* d, size_t stride, uint32_t mask, uint32_t& x, uint32_t& y, int32_t dx,
+                        int32_t dy, __m128i& t, __m128i& b) {
+    const uint8_t* p = d + ((y >> 16) & mask) * stride + ((x >> 16) & mask);
+    uint16_t top, bottom;
+    std::memcpy(&top, p, sizeof top);
+    std::memcpy(&bottom, p + stride, sizeof bottom);
+    t = _mm_insert_epi16(t, top, k);
+    b = _mm_insert_epi16(b, bottom, k);
+    x += static_cast<uint32_t>(dx);
+    y += static_cast<uint32_t>(dy);
+  }
+#endif
   static float floor_fast(float v) {
     const float t = static_cast<float>(static_cast<int64_t>(v));
     return t > v ? t - 1.0f : t;
