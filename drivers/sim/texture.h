@@ -73,10 +73,47 @@ class MipTexture {
     const uint32_t* d = levels_[l].data();
 #if defined(__SSE2__)
     const __m128i zero = _mm_setzero_si128();
+    int i = 0;
+    {
+      // Four pixels per iteration, as two pairs: a pair's texels (ix) in one register of
+      // 16-bit lanes, its texels (ix + 1) in another, the weights from the coordinates in
+      // 32-bit lanes broadcast to each pixel's four channels.
+      const __m128i c256 = _mm_set1_epi16(256), m255 = _mm_set1_epi32(255);
+      const uint32_t ux = static_cast<uint32_t>(dx), uy = static_cast<uint32_t>(dy);
+      const __m128i steps_x = _mm_set_epi32(static_cast<int>(3u * ux), static_cast<int>(2u * ux), static_cast<int>(ux), 0);
+      const __m128i steps_y = _mm_set_epi32(static_cast<int>(3u * uy), static_cast<int>(2u * uy), static_cast<int>(uy), 0);
+      auto pair = [&](const uint32_t* a, const uint32_t* b, __m128i wx, __m128i wy, uint32_t* o) {
+        const __m128i top = _mm_unpacklo_epi32(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(a)),
+                                               _mm_loadl_epi64(reinterpret_cast<const __m128i*>(b)));
+        const __m128i bottom = _mm_unpacklo_epi32(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(a + stride)),
+                                                  _mm_loadl_epi64(reinterpret_cast<const __m128i*>(b + stride)));
+        const __m128i iwx = _mm_sub_epi16(c256, wx), iwy = _mm_sub_epi16(c256, wy);
+        const __m128i t = _mm_srli_epi16(_mm_add_epi16(_mm_mullo_epi16(_mm_unpacklo_epi8(top, zero), iwx),
+                                                       _mm_mullo_epi16(_mm_unpackhi_epi8(top, zero), wx)), 8);
+        const __m128i u = _mm_srli_epi16(_mm_add_epi16(_mm_mullo_epi16(_mm_unpacklo_epi8(bottom, zero), iwx),
+                                                       _mm_mullo_epi16(_mm_unpackhi_epi8(bottom, zero), wx)), 8);
+        const __m128i v = _mm_srli_epi16(_mm_add_epi16(_mm_mullo_epi16(t, iwy), _mm_mullo_epi16(u, wy)), 8);
+        _mm_storel_epi64(reinterpret_cast<__m128i*>(o), _mm_packus_epi16(v, zero));
+      };
+      // [w0 w0 w0 w0 w1 w1 w1 w1] (16-bit) from 32-bit lanes [w0 w1 ...] twice over.
+      auto spread = [](__m128i w2) { return _mm_shufflehi_epi16(_mm_shufflelo_epi16(w2, 0), 0); };
+      for (; i + 4 <= n; i += 4) {
+        const __m128i wx = _mm_and_si128(_mm_srli_epi32(_mm_add_epi32(_mm_set1_epi32(static_cast<int>(x)), steps_x), 8), m255);
+        const __m128i wy = _mm_and_si128(_mm_srli_epi32(_mm_add_epi32(_mm_set1_epi32(static_cast<int>(y)), steps_y), 8), m255);
+        const uint32_t* p[4];
+        for (auto& q : p) {
+          q = d + ((y >> 16) & mask) * stride + ((x >> 16) & mask);
+          x += ux;
+          y += uy;
+        }
+        pair(p[0], p[1], spread(_mm_unpacklo_epi32(wx, wx)), spread(_mm_unpacklo_epi32(wy, wy)), out + i);
+        pair(p[2], p[3], spread(_mm_unpackhi_epi32(wx, wx)), spread(_mm_unpackhi_epi32(wy, wy)), out + i + 2);
+      }
+    }
     // Per-lane weights: 256 - w in the low four 16-bit lanes, w in the high four.
     const __m128i base = _mm_set_epi16(0, 0, 0, 0, 256, 256, 256, 256);
     const __m128i sign = _mm_set_epi16(1, 1, 1, 1, -1, -1, -1, -1);
-    for (int i = 0; i < n; ++i) {
+    for (; i < n; ++i) {
       const uint32_t ix = (x >> 16) & mask, iy = (y >> 16) & mask;
       const uint32_t* p = d + iy * stride + ix;
       const __m128i top = _mm_loadl_epi64(reinterpret_cast<const __m128i*>(p));
