@@ -43,7 +43,6 @@ void make_kinect_depth(const Rasterizer& raster, const std::vector<float>& ir_re
   float* column = columns.data();
   uint8_t* lit = lits.data();
   for (int v = 0; v < h; ++v) {
-    const uint16_t* ids = raster.ids(v);
     const float* inv = raster.inverse_depth(v);
     const float* ir = ir_return.data() + static_cast<size_t>(v) * w;
     uint16_t* out = depth_mm.ptr<uint16_t>(v);
@@ -52,7 +51,11 @@ void make_kinect_depth(const Rasterizer& raster, const std::vector<float>& ir_re
     // (+inf where nothing is seen) are a vectorised loop; the scan is a branch-free running
     // minimum (a hidden point's column is right of the minimum, so min() leaves it as it is).
     const float inf = std::numeric_limits<float>::infinity();
-    for (int u = 0; u < w; ++u) column[u] = ids[u] != Rasterizer::kNone ? static_cast<float>(u) - shift_px * inv[u] : inf;
+    // (inv > 0 exactly where a surface is seen: the rasteriser's depth test starts from 0.)
+    for (int u = 0; u < w; ++u) {
+      const float up = static_cast<float>(u) - shift_px * inv[u];
+      column[u] = inv[u] > 0.0f ? up : inf;
+    }
     float leftmost = inf;
     for (int u = w - 1; u >= 0; --u) {
       const float up = column[u];
@@ -60,7 +63,7 @@ void make_kinect_depth(const Rasterizer& raster, const std::vector<float>& ir_re
       leftmost = std::min(leftmost, up);
     }
     for (int u = 0; u < w; ++u)
-      ok[u] = (ids[u] != Rasterizer::kNone) & (lit[u] != 0) & (inv[u] >= inv_min) & (inv[u] <= inv_max);
+      ok[u] = static_cast<uint8_t>((inv[u] > 0.0f) & (lit[u] != 0) & (inv[u] >= inv_min) & (inv[u] <= inv_max));
     std::copy(inv, inv + w, padded.begin() + 1);
     const float* pad = padded.data() + 1;
     // Everything else is per pixel and branch-free, so the compiler vectorises it.

@@ -36,6 +36,7 @@ MipTexture::MipTexture(const cv::Mat& rgb) {
     }
     levels_.push_back(std::move(packed));
     inverse_scale_.push_back(std::ldexp(1.0f, -l));
+    inverse_side_.push_back(1.0f / static_cast<float>(level.rows));
     if (level.rows == 1) {
       const cv::Vec3f m = level.at<cv::Vec3f>(0, 0);
       mean_ = Eigen::Vector3f(m[0], m[1], m[2]).cwiseMax(0.0f).cwiseMin(1.0f);

@@ -206,7 +206,7 @@ class MipTexture {
   uint32_t fixed_coordinate(int l, float x) const {
     const float side = static_cast<float>(size_ >> l);
     float f = x * inverse_scale_[l] - 0.5f;
-    f -= side * floor_fast(f / side);
+    f -= side * floor_fast(f * inverse_side_[l]);  // == f / side: a power of two
     return static_cast<uint32_t>(static_cast<int32_t>(f * 65536.0f));
   }
   /// A step of `dx` level-0 texels in level-l 16.16 fixed point, reduced modulo the side
@@ -214,7 +214,7 @@ class MipTexture {
   int32_t fixed_step(int l, float dx) const {
     const float side = static_cast<float>(size_ >> l);
     float f = dx * inverse_scale_[l];
-    f -= side * floor_fast(f / side + 0.5f);
+    f -= side * floor_fast(f * inverse_side_[l] + 0.5f);
     return static_cast<int32_t>(f * 65536.0f);
   }
 
@@ -259,6 +259,7 @@ class MipTexture {
   std::vector<std::vector<uint32_t>> levels_;
   std::vector<std::vector<uint8_t>> grey_levels_;  // same layout, first channel only
   std::vector<float> inverse_scale_;
+  std::vector<float> inverse_side_;  // 1 / (size >> l), exact
   Eigen::Vector3f mean_ = Eigen::Vector3f::Zero();
 };
 
