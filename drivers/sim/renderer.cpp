@@ -164,8 +164,10 @@ void Renderer::shade(bool ir, bool accumulate) {
       // Chunks of up to kChunk pixels: exact (perspective) surface coordinates and light at
       // the first and last pixel, linear in between (the perspective error over 16 px is a
       // small fraction of a texel at these depths); one mip level (or one blend) per chunk.
-      for (; u < end; u += kChunk) {
-        const int n = std::min(kChunk, end - u);
+      // A chunk's work; full chunks (the common case) with a compile-time count, so their
+      // loops need no remainder handling.
+      auto chunk = [&](auto count) {
+        const int n = count;
         float s0, t0, s1, t1;
         surface_point(u, s0, t0);
         surface_point(u + n - 1, s1, t1);
@@ -234,6 +236,10 @@ void Renderer::shade(bool ir, bool accumulate) {
             out[i] = grey * wear_factor * (1.0f / 255.0f) * iz[i] * s.abs_d * rn[i];
           }
         }
+      };
+      for (; u < end; u += kChunk) {
+        if (end - u >= kChunk) chunk(std::integral_constant<int, kChunk>{});
+        else chunk(end - u);
       }
       u = end;
     }

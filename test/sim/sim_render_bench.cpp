@@ -60,6 +60,9 @@ void BM_SimulateSecond(benchmark::State& state, const std::string& name) {
 BENCHMARK_CAPTURE(BM_RenderLoop, room, std::string("room"))->Unit(benchmark::kMillisecond)->MinTime(2.0);
 BENCHMARK_CAPTURE(BM_RenderLoop, floor, std::string("floor"))->Unit(benchmark::kMillisecond)->MinTime(2.0);
 BENCHMARK_CAPTURE(BM_RenderLoop, stata, std::string("stata"))->Unit(benchmark::kMillisecond)->MinTime(2.0);
+// The first 30 frames of room's loop, exactly: for instruction counts that repeat
+// (valgrind --tool=callgrind --toggle-collect='kestrel::sim::Renderer::render*' ... --benchmark_filter=frames30).
+BENCHMARK_CAPTURE(BM_RenderLoop, room_frames30, std::string("room"))->Unit(benchmark::kMillisecond)->Iterations(30);
 BENCHMARK_CAPTURE(BM_SimulateSecond, stata, std::string("stata"))->Unit(benchmark::kMillisecond)->MinTime(3.0);
 BENCHMARK_CAPTURE(BM_SimulateSecond, floor, std::string("floor"))->Unit(benchmark::kMillisecond)->MinTime(3.0);
 
