@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 #include "drivers/sim/random.h"
 
@@ -20,7 +21,7 @@ void blur_row(const float* in, float* p, int w) {
 struct RowBuffers {
   std::vector<float> blurred;  // 3 channels x 3 rows (a ring over v - 1, v, v + 1)
   std::vector<float> fall_u, value, normal;
-  std::vector<uint32_t> bits;
+  std::vector<uint32_t> bits, packed;
 };
 
 }  // namespace
@@ -39,7 +40,8 @@ void expose_rgb(std::vector<float> (&planes)[3], const PinholeCamera& cam, const
   // Vignetting 1 - a (x^2 + y^2) / 2 with x, y = -1..1 across the image: 1 - a at the corners.
   buf.fall_u.resize(n);
   buf.value.resize(3 * n);
-  buf.normal.resize(n);
+  buf.normal.resize(3 * n);
+  buf.packed.resize(n);
   buf.bits.resize(n);
   const float a = static_cast<float>(o.vignetting) * 0.5f;
   for (int u = 0; u < w; ++u) {
@@ -63,8 +65,19 @@ void expose_rgb(std::vector<float> (&planes)[3], const PinholeCamera& cam, const
     const float gain_v = 1.0f - a * y * y;
     const uint32_t row_key = static_cast<uint32_t>(v * w);
     if (o.optics_blur && v > 0 && v + 1 < h) blur_into_ring(v + 1);
-    if (o.noise)
+    if (o.noise) {
       for (int u = 0; u < w; ++u) bits[u] = hash32((row_key + static_cast<uint32_t>(u)) ^ key);
+      // The table lookups (not vectorisable) for all three channels in one pass.
+      float* n0 = noise;
+      float* n1 = noise + n;
+      float* n2 = noise + 2 * n;
+      for (int u = 0; u < w; ++u) {
+        const uint32_t b = bits[u];
+        n0[u] = normal[b];
+        n1[u] = normal[b >> 10];
+        n2[u] = normal[b >> 20];
+      }
+    }
     for (int c = 0; c < 3; ++c) {
       float* value = buf.value.data() + static_cast<size_t>(c) * n;
       if (o.optics_blur) {
@@ -77,9 +90,8 @@ void expose_rgb(std::vector<float> (&planes)[3], const PinholeCamera& cam, const
         for (int u = 0; u < w; ++u) value[u] = mid[u] * (gain_v - fall_u[u]);
       }
       if (o.noise) {
-        const int shift = 10 * c;
-        for (int u = 0; u < w; ++u) noise[u] = normal[bits[u] >> shift];
-        for (int u = 0; u < w; ++u) value[u] += std::sqrt(read_var + shot * std::max(value[u], 0.0f)) * noise[u];
+        const float* nc = noise + static_cast<size_t>(c) * n;
+        for (int u = 0; u < w; ++u) value[u] += std::sqrt(read_var + shot * std::max(value[u], 0.0f)) * nc[u];
       }
       for (int u = 0; u < w; ++u) value[u] = std::min(std::max(value[u] + 0.5f, 0.0f), 255.0f);
     }
@@ -87,11 +99,19 @@ void expose_rgb(std::vector<float> (&planes)[3], const PinholeCamera& cam, const
     const float* g = r + n;
     const float* b = g + n;
     uchar* out = rgb.ptr<uchar>(v);
-    for (int u = 0; u < w; ++u) {
-      out[3 * u] = static_cast<uchar>(r[u]);
-      out[3 * u + 1] = static_cast<uchar>(g[u]);
-      out[3 * u + 2] = static_cast<uchar>(b[u]);
-    }
+    // R | G << 8 | B << 16 per pixel (vectorised), then one overlapping 4-byte store per
+    // pixel (the next pixel's store overwrites the spare byte; the last pixel stores 3).
+    uint32_t* packed = buf.packed.data();
+    for (int u = 0; u < w; ++u)
+      packed[u] = static_cast<uint32_t>(static_cast<int32_t>(r[u])) | static_cast<uint32_t>(static_cast<int32_t>(g[u])) << 8 |
+                  static_cast<uint32_t>(static_cast<int32_t>(b[u])) << 16;
+#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+    for (int u = 0; u + 1 < w; ++u) std::memcpy(out + 3 * u, packed + u, 4);
+    if (w > 0) std::memcpy(out + 3 * (w - 1), packed + (w - 1), 3);
+#else
+    for (int u = 0; u < w; ++u)
+      for (int c = 0; c < 3; ++c) out[3 * u + c] = static_cast<uchar>(packed[u] >> (8 * c));
+#endif
   }
 }
 
