@@ -7,6 +7,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <cmath>
 #include <iostream>
 #include <memory>
 
@@ -15,10 +16,12 @@
 #include "common/transport/channels.h"
 #include "common/transport/node.h"
 #include "slam/memory_policy.h"
+#include "slam/place/builtin_vocabulary.h"
 #include "slam/slam_adapter.h"
 #if KESTREL_SLAM_OFFLINE
 #include "slam/sequence_run.h"
-#include "vo/sequence_run.h"
+#include "drivers/tum/tum_sequence.h"
+#include "vo/options.h"
 #endif
 
 namespace {
@@ -27,7 +30,7 @@ using namespace kestrel;
 using namespace kestrel::slam;
 
 struct Options {
-  std::string vocabulary;
+  std::string vocabulary = "builtin";
   std::string kernel = "dcs";
   // Offline.
   std::string tum, out, vo_out;
@@ -40,7 +43,10 @@ struct Options {
 };
 
 void add_options(cli::App& app, Options& o, SlamOptions& s) {
-  app.add_option("--vocabulary", o.vocabulary, "Vocabulary file (Vocabulary::save format); default: built online from the keyframes");
+  app.add_option("--vocabulary", o.vocabulary,
+                 "Place-recognition vocabulary: builtin (trained on the simulator's worlds, see slam/README.md), "
+                 "online (built from the keyframes as they come) or a file (kestrel-slam-vocabulary's output)")
+      ->capture_default_str();
   app.add_option("--keyframe-distance", s.keyframes.min_translation_m, "New keyframe after this motion, m")
       ->check(CLI::NonNegativeNumber)->capture_default_str();
   app.add_option("--keyframe-angle", s.keyframes.min_rotation_rad, "New keyframe after this rotation, rad")
@@ -79,17 +85,32 @@ int run_offline(const Options& o, const SlamOptions& options, std::shared_ptr<co
   (void)vocabulary;
   throw CLI::ValidationError("--tum", "this build has no visual odometry (vo/ was absent)");
 #else
-  const vo::LoadedSequence sequence = vo::load_tum_sequence(o.tum);
-  const SlamRun run = run_slam_sequence(sequence.frames, vo::VoOptions{}, options, std::move(vocabulary));
+  // Frames are decoded one at a time: a long sequence (e.g. a sim flight) need not fit in memory.
+  const tum::TumSequence sequence(o.tum);
+  const SlamRun run = run_slam_sequence(
+      sequence.size(), [&sequence](size_t i) { return sequence.frame(i); }, vo::VoOptions{}, options,
+      std::move(vocabulary));
   write_tum_trajectory(o.out, run.slam);
   if (!o.vo_out.empty()) write_tum_trajectory(o.vo_out, run.vo);
   std::vector<double> ms = run.keyframe_ms;
   std::sort(ms.begin(), ms.end());
-  std::cout << "frames: " << sequence.frames.size() << ", with a pose: " << run.slam.size() << "\n"
+  std::cout << "frames: " << sequence.size() << ", with a pose: " << run.slam.size() << "\n"
             << "keyframes: " << run.keyframes << ", loop closures: " << run.loop_closures
             << " (" << run.candidates_verified << " candidates verified)\n";
   if (!ms.empty()) {
-    std::cout << "ms per keyframe: median " << ms[ms.size() / 2] << ", p95 " << ms[ms.size() * 95 / 100] << "\n";
+    std::cout << "ms per keyframe: median " << ms[ms.size() / 2] << ", p95 " << ms[ms.size() * 95 / 100]
+              << ", max " << ms.back() << "\n";
+  }
+  // Each loop closure against the ground truth, when the folder has one.
+  if (sequence.has_ground_truth()) {
+    for (const LoopError& e : loop_errors(run, sequence.ground_truth())) {
+      std::cout << "loop " << e.edge.from_utime << " -> " << e.edge.to_utime << ": ";
+      if (e.has_truth) {
+        std::cout << "error " << e.translation_m << " m, " << e.rotation_rad * 180.0 / M_PI << " deg\n";
+      } else {
+        std::cout << "no ground truth\n";
+      }
+    }
   }
   return kExitOk;
 #endif
@@ -143,7 +164,11 @@ int main(int argc, char** argv) {
   return app.run(argc, argv, [&] {
     options.optimizer.kernel.type = parse_kernel_type(o.kernel);
     std::shared_ptr<const Vocabulary> vocabulary;
-    if (!o.vocabulary.empty()) vocabulary = std::make_shared<const Vocabulary>(Vocabulary::load(o.vocabulary));
+    if (o.vocabulary == "builtin") {
+      vocabulary = builtin_vocabulary();
+    } else if (o.vocabulary != "online") {
+      vocabulary = std::make_shared<const Vocabulary>(Vocabulary::load(o.vocabulary));
+    }
     return o.tum.empty() ? serve(o, options, vocabulary) : run_offline(o, options, vocabulary);
   });
 }

@@ -9,6 +9,13 @@ namespace kestrel::slam {
 
 SlamRun run_slam_sequence(const std::vector<RgbdFrame>& frames, const vo::VoOptions& vo_options,
                           const SlamOptions& options, std::shared_ptr<const Vocabulary> vocabulary) {
+  return run_slam_sequence(
+      frames.size(), [&frames](size_t i) { return frames[i]; }, vo_options, options, std::move(vocabulary));
+}
+
+SlamRun run_slam_sequence(size_t count, const std::function<RgbdFrame(size_t)>& frame_at,
+                          const vo::VoOptions& vo_options, const SlamOptions& options,
+                          std::shared_ptr<const Vocabulary> vocabulary) {
   vo::VisualOdometry odometry(vo_options);
   OdometryChain chain;
   Slam slam(options, std::move(vocabulary));
@@ -19,7 +26,8 @@ SlamRun run_slam_sequence(const std::vector<RgbdFrame>& frames, const vo::VoOpti
     Eigen::Isometry3d T_keyframe_camera;  // odometry since that keyframe
   };
   std::vector<Placed> placed;
-  for (const RgbdFrame& frame : frames) {
+  for (size_t i = 0; i < count; ++i) {
+    const RgbdFrame frame = frame_at(i);
     const vo::VoResult r = odometry.process(frame);
     VoMotion m;
     m.utime = r.utime;
@@ -44,9 +52,33 @@ SlamRun run_slam_sequence(const std::vector<RgbdFrame>& frames, const vo::VoOpti
   for (const Placed& p : placed) {
     run.slam.push_back(p.utime, slam.graph().poses[static_cast<size_t>(p.keyframe)] * p.T_keyframe_camera);
   }
+  for (const auto& e : slam.graph().edges) {
+    if (e.kind != EdgeKind::kLoopClosure) continue;
+    run.loops.push_back({slam.keyframes()[static_cast<size_t>(e.from)].utime,
+                         slam.keyframes()[static_cast<size_t>(e.to)].utime, e.measurement});
+  }
   run.keyframes = static_cast<int>(slam.keyframes().size());
   run.loop_closures = slam.num_loop_closures();
   return run;
+}
+
+std::vector<LoopError> loop_errors(const SlamRun& run, const Trajectory& ground_truth) {
+  constexpr int64_t kMaxGapUs = 100000;
+  std::vector<LoopError> out;
+  for (const LoopEdge& edge : run.loops) {
+    LoopError e;
+    e.edge = edge;
+    const auto from = ground_truth.at(edge.from_utime, kMaxGapUs);
+    const auto to = ground_truth.at(edge.to_utime, kMaxGapUs);
+    if (from && to) {
+      const Eigen::Isometry3d E = (from->inverse() * *to).inverse() * edge.T_from_to;
+      e.has_truth = true;
+      e.translation_m = E.translation().norm();
+      e.rotation_rad = Eigen::AngleAxisd(E.linear()).angle();
+    }
+    out.push_back(e);
+  }
+  return out;
 }
 
 }  // namespace kestrel::slam

@@ -3,6 +3,7 @@
 // tests): each frame through the visual odometry, the chained odometry pose to SLAM, and at
 // the end every frame's pose both as the odometry had it and as the optimised graph puts it.
 
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -12,6 +13,14 @@
 
 namespace kestrel::slam {
 
+/// An accepted loop closure: the graph edge between two keyframes, by their utimes, with its
+/// measured relative pose T_from_to (camera frames).
+struct LoopEdge {
+  int64_t from_utime = 0;
+  int64_t to_utime = 0;
+  Eigen::Isometry3d T_from_to = Eigen::Isometry3d::Identity();
+};
+
 struct SlamRun {
   Trajectory vo;                   ///< T_world_camera by chained odometry alone
   Trajectory slam;                 ///< the same frames placed by the optimised keyframe graph
@@ -19,9 +28,28 @@ struct SlamRun {
   int loop_closures = 0;
   int candidates_verified = 0;
   std::vector<double> keyframe_ms; ///< SLAM time per keyframe (features, loop search, optimisation)
+  std::vector<LoopEdge> loops;     ///< every accepted loop closure, in the order found
 };
+
+/// A loop closure's error against the ground truth: E = (T_from_to true)^-1 T_from_to measured.
+struct LoopError {
+  LoopEdge edge;
+  bool has_truth = false;  ///< the ground truth covers both keyframes' times
+  double translation_m = 0.0;
+  double rotation_rad = 0.0;
+};
+
+/// The error of each of `run`'s loop closures against `ground_truth` (T_world_camera, as
+/// TUM's groundtruth.txt; interpolated within 0.1 s).
+std::vector<LoopError> loop_errors(const SlamRun& run, const Trajectory& ground_truth);
 
 SlamRun run_slam_sequence(const std::vector<RgbdFrame>& frames, const vo::VoOptions& vo_options,
                           const SlamOptions& options, std::shared_ptr<const Vocabulary> vocabulary);
+
+/// The same over `count` frames decoded one at a time by `frame_at(i)` (a long sequence need
+/// not fit in memory: 1.5 MB a VGA frame).
+SlamRun run_slam_sequence(size_t count, const std::function<RgbdFrame(size_t)>& frame_at,
+                          const vo::VoOptions& vo_options, const SlamOptions& options,
+                          std::shared_ptr<const Vocabulary> vocabulary);
 
 }  // namespace kestrel::slam

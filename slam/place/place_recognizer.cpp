@@ -1,8 +1,9 @@
 #include "slam/place/place_recognizer.h"
 
+#include "slam/place/vocabulary_training.h"
+
 #include <algorithm>
 #include <cmath>
-#include <numeric>
 #include <random>
 
 namespace kestrel::slam {
@@ -37,25 +38,14 @@ int PlaceRecognizer::add(const cv::Mat& descriptors) {
 
 void PlaceRecognizer::retrain() {
   // Training set: every descriptor, or a random subset of them when there are too many.
-  std::vector<cv::Mat> images = descriptors_;
   size_t total = 0;
-  for (const auto& d : images) total += static_cast<size_t>(d.rows);
+  for (const auto& d : descriptors_) total += static_cast<size_t>(d.rows);
   if (total == 0) return;  // nothing to learn words from yet (keyframes without texture)
   std::mt19937_64 rng(options_.seed + static_cast<uint64_t>(trainings_));
-  if (total > static_cast<size_t>(options_.online_max_training)) {
-    const double keep = static_cast<double>(options_.online_max_training) / static_cast<double>(total);
-    for (auto& d : images) {
-      std::vector<int> rows(static_cast<size_t>(d.rows));
-      std::iota(rows.begin(), rows.end(), 0);
-      std::shuffle(rows.begin(), rows.end(), rng);
-      rows.resize(static_cast<size_t>(std::ceil(keep * d.rows)));
-      cv::Mat subset(static_cast<int>(rows.size()), d.cols, d.type());
-      for (size_t r = 0; r < rows.size(); ++r) d.row(rows[r]).copyTo(subset.row(static_cast<int>(r)));
-      d = subset;
-    }
-    total = 0;
-    for (const auto& d : images) total += static_cast<size_t>(d.rows);
-  }
+  const std::vector<cv::Mat> images =
+      subsample_rows(descriptors_, static_cast<size_t>(options_.online_max_training), rng);
+  total = 0;
+  for (const auto& d : images) total += static_cast<size_t>(d.rows);
   VocabularyOptions vo = options_.online_vocabulary;
   // About ten descriptors per word: k^L ~ total / 10.
   const double levels = std::log(std::max(static_cast<double>(total) / 10.0, 2.0)) / std::log(vo.branching);

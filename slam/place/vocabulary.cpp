@@ -5,6 +5,7 @@
 #include <fstream>
 #include <limits>
 #include <map>
+#include <sstream>
 #include <stdexcept>
 
 #include "common/error.h"
@@ -232,6 +233,15 @@ void Vocabulary::save(const std::string& path) const {
 Vocabulary Vocabulary::load(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path + ": cannot open");
+  return read(in, path);
+}
+
+Vocabulary Vocabulary::load_from_memory(const void* data, size_t size, const std::string& name) {
+  std::istringstream in(std::string(static_cast<const char*>(data), size), std::ios::binary);
+  return read(in, name);
+}
+
+Vocabulary Vocabulary::read(std::istream& in, const std::string& path) {
   auto corrupt = [&path](const std::string& what) { return InputError(path + ": not a vocabulary file (" + what + ")"); };
   char magic[sizeof(kMagic) - 1];
   if (!in.read(magic, sizeof(magic)) || std::string(magic, sizeof(magic)) != std::string(kMagic, sizeof(kMagic) - 1)) {

@@ -7,7 +7,9 @@
 // word with an id in [0, num_words()); a word's idf weight is >= 0. transform() gives a vector
 // sorted by word id with weights summing to 1 (or empty).
 
+#include <cstddef>
 #include <cstdint>
+#include <iosfwd>
 #include <random>
 #include <string>
 #include <utility>
@@ -58,8 +60,11 @@ class Vocabulary {
   /// written, or read back (missing, truncated, corrupt).
   void save(const std::string& path) const;
   static Vocabulary load(const std::string& path);
+  /// The same format from memory (e.g. a file built into the program); errors name `name`.
+  static Vocabulary load_from_memory(const void* data, size_t size, const std::string& name);
 
  private:
+  static Vocabulary read(std::istream& in, const std::string& name);
   struct Node {
     Descriptor centre{};
     int first_child = -1;  ///< children are consecutive nodes

@@ -39,6 +39,13 @@ TEST(SlamTool, ACorruptVocabularyIsExitCode3NamingTheFile) {
   EXPECT_NE(r.err.find("words.voc: not a vocabulary file"), std::string::npos) << r.err;
 }
 
+TEST(SlamTool, AMissingVocabularyFileIsExitCode3) {
+  TempDir dir;
+  const auto r = run({tool("slam"), "--vocabulary", (dir / "none.voc").string()});
+  EXPECT_EQ(r.exit_code, kExitBadInput);
+  EXPECT_NE(r.err.find("none.voc: cannot open"), std::string::npos) << r.err;
+}
+
 #if KESTREL_SLAM_OFFLINE
 TEST(SlamTool, AMissingTumFolderIsExitCode3) {
   TempDir dir;
