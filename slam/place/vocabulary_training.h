@@ -17,7 +17,7 @@
 namespace kestrel::slam {
 
 struct VocabularyTrainingOptions {
-  VocabularyOptions tree{10, 4, 10};  ///< k, L, k-majority iterations
+  VocabularyOptions tree{8, 4, 10};   ///< k, L, k-majority iterations (the shipped file's)
   FeatureOptions features;            ///< as the keyframes' (SlamOptions::features)
   int max_descriptors = 200000;       ///< clustered at most (a random subset of the images' rows)
   uint64_t seed = 1;
