@@ -22,6 +22,7 @@ void SlamAdapter::reset() {
   lost_break_ = false;
   anchored_ = false;
   states_.clear();
+  recent_.clear();
 }
 
 void SlamAdapter::trim_frames() {
@@ -87,37 +88,55 @@ AdapterOutputs SlamAdapter::on_state(const kestrel::state_t& state) {
   return out;
 }
 
+void SlamAdapter::remember(const kestrel::rgbd_frame_t& message, const OdometryPose& pose, bool keyframe) {
+  if (anchored_) return;
+  if (keyframe) recent_.clear();  // world_pose() composes from the newest keyframe on
+  recent_.push_back({message.utime, pose.T_odom_camera,
+                     transport::from_message(message.camera.T_body_camera, options_.camera_channel.c_str())});
+  while (static_cast<int>(recent_.size()) > options_.buffer_frames) recent_.pop_front();
+}
+
 void SlamAdapter::try_anchor(AdapterOutputs& out) {
   if (anchored_ || states_.empty() || slam_.keyframes().empty()) return;
-  const Keyframe& kf = slam_.keyframes().back();
-  const auto after = std::lower_bound(states_.begin(), states_.end(), kf.utime,
-                                      [](const auto& s, int64_t t) { return s.first < t; });
-  if (after == states_.end()) return;  // the estimator has not reached it yet
-  const bool exact = after->first == kf.utime;
-  if (!exact && after == states_.begin()) return;  // the estimator started after it
-  const auto before = exact ? after : std::prev(after);
-  const double gap_s = 1e-6 * static_cast<double>(after->first - before->first);
-  if (gap_s > options_.max_state_gap_s) return;
-  const double fraction = exact ? 0.0 : 1e-6 * static_cast<double>(kf.utime - before->first) / gap_s;
-  const Eigen::Isometry3d T_world_body = se3::interpolate(before->second, after->second, fraction);
-  const Eigen::Isometry3d T_world_camera = T_world_body * kf.T_body_camera;
-  const Eigen::Isometry3d& T_slam_camera = slam_.graph().poses[static_cast<size_t>(kf.id)];
-  slam_.change_world(T_world_camera * T_slam_camera.inverse());
-  anchored_ = true;
-  states_.clear();
-  out.anchored = true;
-  out.graph = graph_message(slam_);
+  // The newest frame since the newest keyframe that two states bracket.
+  for (auto f = recent_.rbegin(); f != recent_.rend(); ++f) {
+    const auto after = std::lower_bound(states_.begin(), states_.end(), f->utime,
+                                        [](const auto& s, int64_t t) { return s.first < t; });
+    if (after == states_.end()) continue;  // the estimator has not reached it yet
+    const bool exact = after->first == f->utime;
+    if (!exact && after == states_.begin()) break;  // the estimator started after it (and older ones)
+    const auto before = exact ? after : std::prev(after);
+    const double gap_s = 1e-6 * static_cast<double>(after->first - before->first);
+    if (gap_s > options_.max_state_gap_s) continue;
+    const double fraction = exact ? 0.0 : 1e-6 * static_cast<double>(f->utime - before->first) / gap_s;
+    const Eigen::Isometry3d T_world_camera = se3::interpolate(before->second, after->second, fraction) * f->T_body_camera;
+    slam_.change_world(T_world_camera * slam_.world_pose(f->T_odom_camera).inverse());
+    anchored_ = true;
+    states_.clear();
+    recent_.clear();
+    out.anchored = true;
+    out.graph = graph_message(slam_);
+    return;
+  }
 }
 
 AdapterOutputs SlamAdapter::process(const kestrel::rgbd_frame_t& message, const OdometryPose& pose) {
   AdapterOutputs out;
   last_processed_utime_ = message.utime;
   const bool broken = pose.broken || lost_break_;
-  if (!slam_.wants_keyframe(pose.T_odom_camera, broken)) return out;
+  if (!slam_.wants_keyframe(pose.T_odom_camera, broken)) {
+    remember(message, pose, false);
+    try_anchor(out);
+    return out;
+  }
   const RgbdFrame frame = transport::decode_rgbd(message, options_.camera_channel.c_str());
   const SlamStep step = slam_.add(frame, pose.T_odom_camera, broken);
   lost_break_ = false;
-  if (!step.keyframe) return out;
+  remember(message, pose, step.keyframe);
+  if (!step.keyframe) {
+    try_anchor(out);
+    return out;
+  }
   out.graph = graph_message(slam_);
   if (step.optimisation) {
     out.correction = correction_message(slam_, options_.correction_sigma_m, options_.correction_sigma_rad);

@@ -7,10 +7,11 @@
 // estimator's world (that one is gravity-aligned and fixed when the filter starts, maybe
 // seconds after the first frame). SLAM_CORRECTION poses are applied by the estimator as poses
 // in its own world, and the mapper's map must be in the frame the vehicle flies in, so the
-// first keyframe that the estimator's STATE covers (an OK state on each side of its utime,
-// at most max_state_gap_s apart) anchors the graph: the graph is moved rigidly so that this
-// keyframe's pose is the estimator's pose then. Without STATE (offline runs) the world stays
-// the odometry frame.
+// first frame since the newest keyframe that the estimator's STATE covers (an OK state on
+// each side of its utime, at most max_state_gap_s apart) anchors the graph: the graph is moved
+// rigidly so that this frame's pose (the newest keyframe's composed with the odometry since)
+// is the estimator's pose then. A hovering vehicle makes no keyframe after the first, so any
+// frame must do. Without STATE (offline runs) the world stays the odometry frame.
 //
 // A frame and its VO update are paired by utime. Frames wait (encoded) in a bounded buffer and
 // are decoded only when their pose makes them a keyframe; an update whose frame has not come
@@ -70,7 +71,9 @@ class SlamAdapter {
   void trim_frames();
   /// Drops waiting poses [begin, end), remembering an odometry break among them.
   void drop_poses(std::map<int64_t, OdometryPose>::iterator end);
-  /// Anchors the graph at the newest keyframe when STATE brackets its utime; fills `out`.
+  /// Keeps a processed frame's poses for anchoring (frames since the newest keyframe).
+  void remember(const kestrel::rgbd_frame_t& message, const OdometryPose& pose, bool keyframe);
+  /// Anchors the graph at the newest remembered frame that STATE brackets; fills `out`.
   void try_anchor(AdapterOutputs& out);
 
   AdapterOptions options_;
@@ -82,6 +85,11 @@ class SlamAdapter {
   bool lost_break_ = false;  ///< a pose flagged broken was dropped: flag the next one
   bool anchored_ = false;
   std::deque<std::pair<int64_t, Eigen::Isometry3d>> states_;  ///< recent OK states, until anchored
+  struct RecentFrame {
+    int64_t utime;
+    Eigen::Isometry3d T_odom_camera, T_body_camera;
+  };
+  std::deque<RecentFrame> recent_;  ///< frames since the newest keyframe, until anchored
 };
 
 }  // namespace kestrel::slam

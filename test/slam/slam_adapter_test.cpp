@@ -107,6 +107,22 @@ TEST_F(AdapterTest, AnchorsTheGraphInTheEstimatorsWorldAtTheFirstKeyframeItsStat
   EXPECT_FALSE(adapter_.on_state(state(6.5, Eigen::Isometry3d::Identity())).graph);
 }
 
+TEST_F(AdapterTest, AHoveringVehicleIsAnchoredAtAFrameThatIsNoKeyframe) {
+  // Keyframe 0 comes before the estimator starts; frame 1 (10 cm on, no keyframe) is the
+  // first the states bracket: the anchor composes keyframe 0 with the odometry since.
+  const Eigen::Isometry3d X = estimator_world();
+  adapter_.on_frame(frame(0));
+  adapter_.on_vo_update(update(0));
+  adapter_.on_frame(frame(1));
+  EXPECT_FALSE(adapter_.on_vo_update(update(1)).graph) << "frame 1 is no keyframe";
+  EXPECT_FALSE(adapter_.on_state(state(0.9, X)).anchored);
+  const AdapterOutputs out = adapter_.on_state(state(1.1, X));
+  ASSERT_TRUE(out.anchored);
+  ASSERT_TRUE(out.graph);
+  ASSERT_EQ(out.graph->num_keyframes, 1);
+  EXPECT_LT((keyframe_pose(*out.graph, 0).matrix() - X.matrix()).norm(), 1e-9);
+}
+
 TEST_F(AdapterTest, StatesGoingBackOrNotRigidAreRefusedNamingTheChannel) {
   const Eigen::Isometry3d X = estimator_world();
   adapter_.on_state(state(1.0, X));
