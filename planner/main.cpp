@@ -62,6 +62,10 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"uniform", "su", "gaussian", "bridge"}));
   app.add_option("--sensor", sensor, "kinect or camera (the paper's)")->check(CLI::IsMember({"kinect", "camera"}));
   app.add_option("--feature-density", o.feature_density_per_m2, "Features assumed per m^2 of wall")->check(cli::Positive);
+  app.add_option("--start-unknown-free", o.start_unknown_free_m,
+                 "Unknown map cells within this of the vehicle count as free when planning from STATE (m): the "
+                 "camera cannot see the space around the vehicle")
+      ->check(CLI::NonNegativeNumber)->capture_default_str();
   return app.run(argc, argv, [&]() -> int {
     o.space.z_min_m = o.space.z_max_m = height;
     o.sensor = sensor == "kinect" ? FeatureSensorOptions::kinect() : FeatureSensorOptions::paper_camera();

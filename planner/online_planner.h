@@ -2,7 +2,10 @@
 // The planner behind the `kestrel-planner` process, free of LCM and clocks: it keeps the
 // latest map (as a grid with wall features) and the latest state, and answers requests with
 // BRM or PRM. Roadmaps are built per request from a seed derived from the request id, so the
-// same inputs always give the same plan (lock-step replay).
+// same inputs always give the same plan (lock-step replay). Start and goal must be in known
+// free space, except that a request starting from the state takes the unknown cells within
+// start_unknown_free_m of it as free: the vehicle is there, and its camera never sees the space
+// around it (behind it, beside it, inside its minimum range).
 
 #include <limits>
 #include <memory>
@@ -24,6 +27,11 @@ struct OnlinePlannerOptions {
   double map_z_min_m = 0.3, map_z_max_m = 2.0;  ///< band of the map that matters for collisions
   double feature_density_per_m2 = 4.0;          ///< features assumed on the map's walls
   std::string sampler = "su";                   ///< uniform | su | gaussian | bridge
+  /// Unknown cells within this of a start from STATE count as free (at least the vehicle's
+  /// radius plus a cell): the vehicle fills part of that space and its camera cannot see the
+  /// rest (behind and beside it, and nothing nearer than the Kinect's 0.5 m). An obstacle in
+  /// that blind ring goes unnoticed: the price of being able to leave a hover at all.
+  double start_unknown_free_m = 0.8;
 };
 
 struct PlanQuery {
@@ -56,6 +64,9 @@ class OnlinePlanner {
   bool has_map() const { return env_ != nullptr; }
 
  private:
+  /// The map with the unknown cells the vehicle at q fills made free; null when there are none.
+  std::unique_ptr<GridEnvironment> with_vehicle_space(const Config& q) const;
+
   OnlinePlannerOptions options_;
   std::unique_ptr<GridEnvironment> env_;
   std::optional<std::pair<Config, Mat4>> state_;

@@ -10,8 +10,14 @@ namespace kestrel::planner {
 bool RunningThreshold::accept(double w, Rng& rng) {
   bool ok = true;
   if (count_ >= 2) {
-    std::normal_distribution<double> threshold(mean_, std::sqrt(variance()));
-    ok = w > threshold(rng);
+    // mean + sd * z is how libstdc++ draws N(mean, sd), so the stream is unchanged; written out
+    // because sd may be 0 (every weight so far equal, e.g. no feature seen anywhere), which
+    // std::normal_distribution does not allow. Then nothing tells the candidates apart and a
+    // weight equal to the rest is accepted: the sampler falls back to uniform.
+    std::normal_distribution<double> z(0.0, 1.0);
+    const double sd = std::sqrt(variance());
+    const double threshold = mean_ + sd * z(rng);
+    ok = w > threshold || (sd == 0.0 && w >= mean_);
   }
   ++count_;
   const double delta = w - mean_;

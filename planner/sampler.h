@@ -40,7 +40,8 @@ class Sampler {
 class RunningThreshold {
  public:
   /// Records w and returns whether it beats a threshold drawn from N(mean, var) of the weights
-  /// recorded before it (the first two are always accepted).
+  /// recorded before it (the first two are always accepted; while every weight so far is the
+  /// same, one no smaller is accepted).
   bool accept(double w, Rng& rng);
   double mean() const { return mean_; }
   double variance() const { return count_ > 1 ? m2_ / (count_ - 1) : 0.0; }

@@ -55,5 +55,43 @@ TEST(OnlinePlanner, PlansReproduciblyAndPredictsCovariances) {
   EXPECT_GE(a.length_m, (q.goal - *q.start).head<3>().norm());
 }
 
+// A 6 x 3 m free room whose cells around the vehicle at (1, 1.5) the camera never saw (all
+// within 0.8 m of it, the default start_unknown_free_m).
+OccupancyGrid room_with_unseen_vehicle_space() {
+  OccupancyGrid g = make_grid(60, 30, 0.1, 0.05, 0.05);
+  fill_rect(g, 0.5, 1.0, 1.5, 2.0, OccupancyGrid::kUnknown);
+  return g;
+}
+
+TEST(OnlinePlanner, FromTheStateTheSpaceTheVehicleFillsIsFreeButNotFromAGivenStart) {
+  OnlinePlannerOptions o;
+  o.map_z_min_m = 0.0;
+  o.map_z_max_m = 3.0;
+  OnlinePlanner p(o);
+  p.set_map(room_with_unseen_vehicle_space());
+  p.set_state(Config(1.0, 1.5, 1.0, 0.0), 0.01 * Mat4::Identity());
+  PlanQuery q;
+  q.request_id = 3;
+  q.goal = Config(5.0, 1.5, 1.0, 0.0);
+  const PlanAnswer from_state = p.plan(q);
+  ASSERT_EQ(from_state.status, PlanAnswer::kOk) << from_state.message;
+  EXPECT_TRUE(from_state.waypoints.front().head<2>().isApprox(Eigen::Vector2d(1.0, 1.5)));
+  // The same place given as the start: unknown, so refused (nobody says a vehicle is there).
+  q.start = Config(1.0, 1.5, 1.0, 0.0);
+  q.start_trace = 0.04;
+  EXPECT_EQ(p.plan(q).status, PlanAnswer::kStartInCollision);
+  // The map may end at the camera, in front of the vehicle: the grid grows to hold it.
+  OccupancyGrid ahead = make_grid(60, 30, 0.1, 1.25, 0.05);  // x from 1.2 m on
+  p.set_map(ahead);
+  q.start.reset();
+  const PlanAnswer behind = p.plan(q);
+  ASSERT_EQ(behind.status, PlanAnswer::kOk) << behind.message;
+  // A wall seen 0.2 m from the vehicle stays a wall.
+  OccupancyGrid walled = room_with_unseen_vehicle_space();
+  fill_rect(walled, 1.15, 1.0, 1.25, 2.0, OccupancyGrid::kOccupied);
+  p.set_map(walled);
+  EXPECT_EQ(p.plan(q).status, PlanAnswer::kStartInCollision);
+}
+
 }  // namespace
 }  // namespace kestrel::planner

@@ -112,6 +112,20 @@ TEST(RunningThreshold, AcceptsWithTheNormalProbabilityOfItsRunningStatistics) {
   }
 }
 
+TEST(RunningThreshold, WhileEveryWeightIsTheSameItAcceptsAsUniformWould) {
+  // No feature anywhere: every weight 0. Nothing tells the candidates apart, so all are
+  // accepted (a strict "exceeds" would accept none after the first two); a larger weight is
+  // accepted too, a smaller one never.
+  RunningThreshold threshold;
+  Rng rng(3);
+  for (int i = 0; i < 50; ++i) EXPECT_TRUE(threshold.accept(0.0, rng)) << "candidate " << i;
+  EXPECT_EQ(threshold.variance(), 0.0);
+  EXPECT_TRUE(threshold.accept(0.5, rng));
+  RunningThreshold ones;
+  for (int i = 0; i < 5; ++i) ones.accept(1.0, rng);
+  EXPECT_FALSE(ones.accept(0.5, rng));
+}
+
 TEST(SensorSampler, FavoursInformativeConfigurationsAsAlgorithm2Defines) {
   // Weight = x on free space 0 < x < 10: normalised weights are U(0, 1), so accepted x has
   // density proportional to Phi((x / 10 - 1/2) / sqrt(1/12)).
