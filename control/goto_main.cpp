@@ -1,0 +1,137 @@
+// kestrel-goto: sends the vehicle somewhere. Asks the planner for a path from the vehicle's
+// current STATE to --goal (PLAN_REQUEST), prints the answer and, with --wait, follows STATE
+// until the vehicle is within --arrive-radius of the goal (kestrel-follow flies the PLAN).
+// A "no path" answer (no map yet, start or goal not in known free space, no way) is asked again
+// every second for --retry-for seconds: at start-up the map changes fast. Exit 0: planned (and arrived); 1: no path, or no answer / no arrival within
+// --timeout.
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+#include <cmath>
+#include <iostream>
+#include <optional>
+
+#include "common/cli.h"
+#include "common/error.h"
+#include "common/transport/channels.h"
+#include "common/transport/node.h"
+#include "kestrel/plan_request_t.hpp"
+#include "kestrel/plan_t.hpp"
+#include "kestrel/state_t.hpp"
+
+namespace {
+
+using namespace kestrel;
+
+struct Options {
+  std::string lcm_url;
+  std::vector<double> goal;
+  std::string planner = "brm";
+  double max_trace = 0.0;
+  bool wait = false;
+  double arrive_radius_m = 0.15;
+  double timeout_s = 60.0;
+  double retry_s = 5.0;
+};
+
+int run(const Options& o) {
+  transport::Node node("goto", o.lcm_url);
+  node.advertise(channel::kPlanRequest);
+  const auto start = std::chrono::steady_clock::now();
+  const auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
+  const int64_t request_id = std::chrono::duration_cast<std::chrono::microseconds>(
+                                 std::chrono::system_clock::now().time_since_epoch()).count();
+  std::optional<kestrel::state_t> state;
+  std::optional<kestrel::plan_t> plan;
+  bool sent = false;
+  double sent_at = 0.0;
+  node.subscribe<kestrel::state_t>(channel::kState, [&](const kestrel::state_t& m) {
+    if (m.status == kestrel::state_t::STATUS_OK || m.status == kestrel::state_t::STATUS_DEGRADED) state = m;
+  });
+  node.subscribe<kestrel::plan_t>(channel::kPlan, [&](const kestrel::plan_t& m) {
+    if (m.request_id == request_id) plan = m;
+  });
+  while (elapsed() < o.timeout_s && node.spin_once(100)) {
+    // No map yet, or no way on it yet: at start-up the map changes fast (the first keyframes,
+    // SLAM moving it into the estimator's world), so ask again each second for --retry-for.
+    if (plan && plan->status != kestrel::plan_t::STATUS_OK && plan->status != kestrel::plan_t::STATUS_BAD_REQUEST &&
+        elapsed() - sent_at >= 1.0 && elapsed() < o.retry_s) {
+      spdlog::info("no path yet ({}); asking again", plan->message);
+      plan.reset();
+      sent = false;
+    }
+    if (!sent && state) {
+      kestrel::plan_request_t r{};
+      r.utime = state->utime;
+      r.request_id = request_id;
+      r.start_mode = kestrel::plan_request_t::START_FROM_STATE;
+      for (int i = 0; i < 4; ++i) r.goal[i] = o.goal[static_cast<size_t>(i)];
+      r.planner = o.planner == "prm" ? kestrel::plan_request_t::PLANNER_PRM : kestrel::plan_request_t::PLANNER_BRM;
+      r.objective = o.max_trace > 0.0 ? kestrel::plan_request_t::OBJECTIVE_SHORTEST_BOUNDED
+                                      : kestrel::plan_request_t::OBJECTIVE_MIN_GOAL_UNCERTAINTY;
+      r.max_covariance_trace = o.max_trace;
+      node.publish(channel::kPlanRequest, r);
+      sent = true;
+      sent_at = elapsed();
+      spdlog::info("asked for a path from ({:.2f}, {:.2f}, {:.2f}) to ({:.2f}, {:.2f}, {:.2f})",
+                   state->T_world_body.position[0], state->T_world_body.position[1],
+                   state->T_world_body.position[2], o.goal[0], o.goal[1], o.goal[2]);
+    }
+    const bool retrying = plan && plan->status != kestrel::plan_t::STATUS_OK &&
+                          plan->status != kestrel::plan_t::STATUS_BAD_REQUEST && elapsed() < o.retry_s;
+    if (retrying) continue;
+    if (plan && (plan->status != kestrel::plan_t::STATUS_OK || !o.wait)) break;
+    if (plan && state) {
+      const auto& p = state->T_world_body.position;
+      const double d = std::hypot(p[0] - o.goal[0], p[1] - o.goal[1], p[2] - o.goal[2]);
+      if (d <= o.arrive_radius_m) {
+        std::cout << "arrived: " << d << " m from the goal after " << elapsed() << " s\n";
+        return kExitOk;
+      }
+    }
+  }
+  if (!sent) {
+    std::cerr << "kestrel-goto: error: no STATE within " << o.timeout_s << " s (is the estimator running?)\n";
+    return kExitFailure;
+  }
+  if (!plan) {
+    std::cerr << "kestrel-goto: error: no PLAN within " << o.timeout_s << " s (is the planner running?)\n";
+    return kExitFailure;
+  }
+  if (plan->status != kestrel::plan_t::STATUS_OK) {
+    std::cerr << "kestrel-goto: no path: " << plan->message << "\n";
+    return kExitFailure;
+  }
+  std::cout << "# x y z yaw tr(Sigma)   length " << plan->length << " m, planned in " << plan->planning_ms << " ms\n";
+  for (int i = 0; i < plan->num_waypoints; ++i) {
+    const auto& w = plan->waypoints[static_cast<size_t>(i)];
+    std::cout << w[0] << " " << w[1] << " " << w[2] << " " << w[3] << " " << plan->covariance_trace[static_cast<size_t>(i)] << "\n";
+  }
+  if (o.wait) {
+    std::cerr << "kestrel-goto: error: not within " << o.arrive_radius_m << " m of the goal after " << o.timeout_s << " s\n";
+    return kExitFailure;
+  }
+  return kExitOk;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  cli::App app("goto", "Plan from the vehicle's STATE to a goal (PLAN_REQUEST -> PLAN) and, with --wait, wait for arrival");
+  Options o;
+  app.add_option("--lcm-url", o.lcm_url, "LCM URL (default: $LCM_DEFAULT_URL or kestrel's)");
+  app.add_option("--goal", o.goal, "Goal x y z yaw (world frame: the estimator's, m and rad)")->expected(4)->required();
+  app.add_option("--planner", o.planner, "brm or prm")->check(CLI::IsMember({"brm", "prm"}))->capture_default_str();
+  app.add_option("--max-trace", o.max_trace, "Shortest path with tr(Sigma) below this (0: least uncertain goal)")
+      ->check(CLI::NonNegativeNumber)->capture_default_str();
+  app.add_flag("--wait", o.wait, "Wait until the vehicle is at the goal");
+  app.add_option("--arrive-radius", o.arrive_radius_m, "Arrived within this of the goal (m)")->check(cli::Positive)->capture_default_str();
+  app.add_option("--timeout", o.timeout_s, "Give up after this many wall seconds")->check(cli::Positive)->capture_default_str();
+  app.add_option("--retry-for", o.retry_s, "Ask again each second while the answer is no path, for this many wall seconds")
+      ->check(CLI::NonNegativeNumber)->capture_default_str();
+  return app.run(argc, argv, [&] {
+    for (double v : o.goal)
+      if (!std::isfinite(v)) throw CLI::ValidationError("--goal: not a finite number");
+    return run(o);
+  });
+}
