@@ -1,7 +1,7 @@
 // The renderer against geometry known in closed form: depth of a plane and of a box equals
 // the analytic depth within the Kinect's disparity quantisation; every pixel back-projects
 // onto the surface it shows; textured walls give FAST corners at several pyramid levels and
-// the blank wall few.
+// the blank wall few; the texture span loops equal per-texel lookups in the unpadded levels.
 
 #include <gtest/gtest.h>
 
@@ -10,7 +10,9 @@
 #include <opencv2/imgproc.hpp>
 
 #include "drivers/sim/kinect_depth.h"
+#include "drivers/sim/random.h"
 #include "drivers/sim/renderer.h"
+#include "drivers/sim/texture.h"
 #include "sim_fixture.h"
 
 namespace kestrel::sim {
@@ -135,6 +137,48 @@ TEST(RenderTest, TexturedWallsHaveCornersAtSeveralScalesAndTheBlankWallFew) {
     SCOPED_TRACE("pyramid level " + std::to_string(level));
     EXPECT_GT(textured[level], minimum[level]);
     EXPECT_LT(blank[level] * 5, textured[level]);
+  }
+}
+
+// The spans (SIMD groups of 4 and 8 pixels plus scalar tails, stored wrap copies) against
+// bilinear lookups written out on the unpadded level with explicit wrapping.
+TEST(RenderTest, TextureSpansEqualPerTexelBilinearLookups) {
+  Rng rng(7);
+  cv::Mat image(64, 64, CV_32FC3);
+  for (int r = 0; r < 64; ++r)
+    for (int c = 0; c < 64; ++c)
+      image.at<cv::Vec3f>(r, c) = cv::Vec3f(static_cast<float>(rng.uniform()), static_cast<float>(rng.uniform()),
+                                            static_cast<float>(rng.uniform()));
+  MipTexture tex(image);
+  tex.add_grey_levels();
+  for (int l = 0; l < tex.levels(); ++l) {
+    const std::vector<uint32_t> level = tex.level(l);
+    const uint32_t side = static_cast<uint32_t>(tex.size() >> l), mask = side - 1;
+    ASSERT_EQ(level.size(), static_cast<size_t>(side) * side);
+    for (int trial = 0; trial < 40; ++trial) {
+      const int n = 1 + trial;  // every remainder of the groups of 4 and 8
+      uint32_t x = static_cast<uint32_t>(rng.next()), y = static_cast<uint32_t>(rng.next());
+      const int32_t dx = static_cast<int32_t>(rng.below(1 << 18)) - (1 << 17);
+      const int32_t dy = static_cast<int32_t>(rng.below(1 << 18)) - (1 << 17);
+      std::vector<uint32_t> span(static_cast<size_t>(n)), grey(static_cast<size_t>(n));
+      tex.bilinear_span(l, x, y, dx, dy, n, span.data());
+      tex.grey_span(l, x, y, dx, dy, n, grey.data());
+      for (int i = 0; i < n; ++i) {
+        const uint32_t ix = (x >> 16) & mask, iy = (y >> 16) & mask, wx = (x >> 8) & 255u, wy = (y >> 8) & 255u;
+        const uint32_t ix1 = (ix + 1) & mask, iy1 = (iy + 1) & mask;
+        uint32_t expected = 0;
+        for (int ch = 0; ch < 3; ++ch) {
+          auto t = [&](uint32_t r, uint32_t c) { return (level[r * side + c] >> (8 * ch)) & 255u; };
+          const uint32_t top = (t(iy, ix) * (256u - wx) + t(iy, ix1) * wx) >> 8;
+          const uint32_t bottom = (t(iy1, ix) * (256u - wx) + t(iy1, ix1) * wx) >> 8;
+          expected |= ((top * (256u - wy) + bottom * wy) >> 8) << (8 * ch);
+        }
+        ASSERT_EQ(span[static_cast<size_t>(i)], expected) << "level " << l << " n " << n << " pixel " << i;
+        ASSERT_EQ(grey[static_cast<size_t>(i)], expected & 255u) << "level " << l << " n " << n << " pixel " << i;
+        x += static_cast<uint32_t>(dx);
+        y += static_cast<uint32_t>(dy);
+      }
+    }
   }
 }
 
