@@ -37,7 +37,13 @@ void make_kinect_depth(const Rasterizer& raster, const std::vector<float>& ir_re
   usable.resize(static_cast<size_t>(w));
   thread_local std::vector<float> columns;
   thread_local std::vector<uint8_t> lits;
+  thread_local std::vector<float> pixel_u;  // 0, 1, ..., w - 1 as floats (keeps the loop vectorisable)
   columns.resize(static_cast<size_t>(w));
+  if (pixel_u.size() != static_cast<size_t>(w)) {
+    pixel_u.resize(static_cast<size_t>(w));
+    for (int u = 0; u < w; ++u) pixel_u[static_cast<size_t>(u)] = static_cast<float>(u);
+  }
+  const float* fu = pixel_u.data();
   lits.resize(static_cast<size_t>(w));
   uint8_t* ok = usable.data();
   float* column = columns.data();
@@ -53,7 +59,7 @@ void make_kinect_depth(const Rasterizer& raster, const std::vector<float>& ir_re
     const float inf = std::numeric_limits<float>::infinity();
     // (inv > 0 exactly where a surface is seen: the rasteriser's depth test starts from 0.)
     for (int u = 0; u < w; ++u) {
-      const float up = static_cast<float>(u) - shift_px * inv[u];
+      const float up = fu[u] - shift_px * inv[u];
       column[u] = inv[u] > 0.0f ? up : inf;
     }
     float leftmost = inf;
