@@ -60,6 +60,9 @@ void add_options(cli::App& app, Options& o, SlamOptions& s) {
       ->check(CLI::NonNegativeNumber)->capture_default_str();
   app.add_option("--candidates", s.loops.max_candidates, "Loop candidates verified at most, best first")
       ->check(CLI::PositiveNumber)->capture_default_str();
+  app.add_option("--loop-odometry-sigmas", s.loop_consistency.sigmas,
+                 "A verified loop must agree with the odometry between its keyframes within this many sigmas (0: no check)")
+      ->check(CLI::NonNegativeNumber)->capture_default_str();
   app.add_option("--min-inliers", s.verification.min_inliers, "Inliers a loop closure needs")
       ->check(CLI::PositiveNumber)->capture_default_str();
   app.add_option("--kernel", o.kernel, "Robust kernel on loop closures: none, huber, cauchy or dcs")
@@ -96,7 +99,8 @@ int run_offline(const Options& o, const SlamOptions& options, std::shared_ptr<co
   std::sort(ms.begin(), ms.end());
   std::cout << "frames: " << sequence.size() << ", with a pose: " << run.slam.size() << "\n"
             << "keyframes: " << run.keyframes << ", loop closures: " << run.loop_closures
-            << " (" << run.candidates_verified << " candidates verified)\n";
+            << " (" << run.candidates_verified << " candidates verified, " << run.inconsistent_loops
+            << " verified but refused by the odometry check)\n";
   if (!ms.empty()) {
     std::cout << "ms per keyframe: median " << ms[ms.size() / 2] << ", p95 " << ms[ms.size() * 95 / 100]
               << ", max " << ms.back() << "\n";

@@ -27,6 +27,7 @@ struct SlamRun {
   int keyframes = 0;
   int loop_closures = 0;
   int candidates_verified = 0;
+  int inconsistent_loops = 0;      ///< verified loops refused as disagreeing with the odometry
   std::vector<double> keyframe_ms; ///< SLAM time per keyframe (features, loop search, optimisation)
   std::vector<LoopEdge> loops;     ///< every accepted loop closure, in the order found
 };

@@ -59,6 +59,7 @@ void Slam::reset() {
   graph_ = PoseGraph3d{};
   revision_ = 0;
   loop_closures_ = 0;
+  inconsistent_loops_ = 0;
   last_utime_ = 0;
   have_frame_ = false;
   gate_by_pose_ = true;
@@ -149,6 +150,14 @@ SlamStep Slam::close_loop(SlamStep step) {
     const uint64_t seed = static_cast<uint64_t>(earlier.id) * 1000003u + static_cast<uint64_t>(query.id);
     step.loop = verify_loop(query.features, earlier.features, options_.verification, seed);
     if (!step.loop.accepted) continue;
+    if (gate && !check_loop_against_odometry(graph_, static_cast<int>(earlier.id), static_cast<int>(query.id),
+                                             step.loop.T_candidate_query, options_.loop_consistency)
+                     .consistent) {
+      step.loop.accepted = false;
+      ++step.inconsistent;
+      ++inconsistent_loops_;
+      continue;
+    }
     graph_.add_edge(static_cast<int>(earlier.id), static_cast<int>(query.id), step.loop.T_candidate_query,
                     step.loop.information, EdgeKind::kLoopClosure);
     step.loop_closed = true;

@@ -41,6 +41,7 @@ struct SlamStep {
   bool keyframe = false;          ///< the frame became a keyframe
   int64_t keyframe_id = -1;
   int candidates = 0;             ///< loop candidates verified
+  int inconsistent = 0;           ///< of them, verified but refused as disagreeing with the odometry
   bool loop_closed = false;
   int64_t loop_keyframe_id = -1;  ///< the earlier keyframe it closed with
   LoopConstraint loop;            ///< the accepted constraint, or the last rejection
@@ -67,6 +68,8 @@ class Slam {
   const PoseGraph3d& graph() const { return graph_; }
   int64_t revision() const { return revision_; }
   int num_loop_closures() const { return loop_closures_; }
+  /// Verified loops refused because they disagreed with the odometry (loop_consistency.h).
+  int num_inconsistent_loops() const { return inconsistent_loops_; }
   /// Marginal covariance of the newest keyframe's optimised T_world_camera after the last
   /// optimisation (marginals.h: [rho; phi], right perturbation in the camera frame); nullopt
   /// before any optimisation or when the graph did not determine it.
@@ -97,6 +100,7 @@ class Slam {
   PoseGraph3d graph_;
   int64_t revision_ = 0;
   int loop_closures_ = 0;
+  int inconsistent_loops_ = 0;
   int64_t last_utime_ = 0;
   bool have_frame_ = false;
   std::optional<Matrix6d> newest_covariance_;

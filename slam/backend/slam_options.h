@@ -5,6 +5,7 @@
 
 #include <cmath>
 
+#include "slam/backend/loop_consistency.h"
 #include "slam/place/frame_features.h"
 #include "slam/place/loop_verifier.h"
 #include "slam/place/place_recognizer.h"
@@ -43,6 +44,9 @@ struct OdometryNoise {
 struct SlamOptions {
   KeyframeOptions keyframes;
   LoopSearchOptions loops;
+  /// A verified loop must agree with the odometry between its keyframes (when the estimate is
+  /// trustworthy): rejects perceptual aliasing (loop_consistency.h).
+  LoopConsistencyOptions loop_consistency;
   OdometryNoise odometry;
   FeatureOptions features;
   PlaceOptions place;
