@@ -150,8 +150,9 @@ int serve(const Options& o, const SlamOptions& options, std::shared_ptr<const Vo
   spdlog::info("{}: {} + {} -> {}, {}", o.name, o.adapter.camera_channel, o.adapter.vo_channel,
                o.graph_channel, o.correction_channel);
   const int status = node->spin();
-  spdlog::info("{} keyframes, {} loop closures, {} messages rejected", adapter.slam().keyframes().size(),
-               adapter.slam().num_loop_closures(), node->counters().messages_rejected);
+  spdlog::info("{} keyframes, {} loop closures, {} VO restarts bridged by the estimator, {} messages rejected",
+               adapter.slam().keyframes().size(), adapter.slam().num_loop_closures(), adapter.bridges(),
+               node->counters().messages_rejected);
   return status;
 }
 

@@ -38,9 +38,10 @@ SlamRun run_slam_sequence(size_t count, const std::function<RgbdFrame(size_t)>& 
     m.T_body_camera = frame.T_body_camera;
     const std::optional<OdometryPose> pose = chain.add(m);
     if (!pose) continue;
-    if (slam.wants_keyframe(pose->T_odom_camera, pose->broken)) {
+    const OdometryLink link = pose->broken ? OdometryLink::kBroken : OdometryLink::kContinuous;
+    if (slam.wants_keyframe(pose->T_odom_camera, link)) {
       const auto t0 = std::chrono::steady_clock::now();
-      const SlamStep step = slam.add(frame, pose->T_odom_camera, pose->broken);
+      const SlamStep step = slam.add(frame, pose->T_odom_camera, link);
       run.keyframe_ms.push_back(
           std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
       run.candidates_verified += step.candidates;

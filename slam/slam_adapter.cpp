@@ -1,5 +1,8 @@
 #include "slam/slam_adapter.h"
 
+#include <algorithm>
+#include <cmath>
+
 #include "common/error.h"
 #include "common/geometry/se3.h"
 #include "common/transport/convert.h"
@@ -23,6 +26,9 @@ void SlamAdapter::reset() {
   anchored_ = false;
   states_.clear();
   recent_.clear();
+  odometry_fix_ = Eigen::Isometry3d::Identity();
+  last_pose_.reset();
+  bridges_ = 0;
 }
 
 void SlamAdapter::trim_frames() {
@@ -73,19 +79,68 @@ AdapterOutputs SlamAdapter::on_vo_update(const kestrel::vo_update_t& update) {
 
 AdapterOutputs SlamAdapter::on_state(const kestrel::state_t& state) {
   AdapterOutputs out;
-  if (anchored_) return out;
-  if (!states_.empty() && state.utime <= states_.back().first) {
+  if (!states_.empty() && state.utime <= states_.back().utime) {
     throw InputError(options_.state_channel + ": state " + std::to_string(state.utime) +
                      " is not newer than the previous one");
   }
-  if (state.status != kestrel::state_t::STATUS_OK) return out;  // no trusted pose now
-  const Eigen::Isometry3d T_world_body = transport::from_message(state.T_world_body, options_.state_channel.c_str());
-  states_.emplace_back(state.utime, T_world_body);
-  // Keyframes come at most a few seconds apart; older states can no longer bracket one.
-  const int64_t keep_us = 10'000'000;
-  while (states_.front().first < state.utime - keep_us) states_.pop_front();
+  // DEGRADED is the IMU alone through a VO outage: what a bridge needs; anchoring wants OK.
+  const bool ok = state.status == kestrel::state_t::STATUS_OK;
+  if (!ok && state.status != kestrel::state_t::STATUS_DEGRADED) return out;
+  StateSample sample;
+  sample.utime = state.utime;
+  // The map's world is fixed once: only by a state whose tilt is settled (a filter that started
+  // on the move knows its roll and pitch to a few degrees at first, and a map anchored then
+  // stays tilted against the filter's later world).
+  double tilt_variance = 0.0;
+  if (state.cov_dim >= 9 && static_cast<int>(state.covariance.size()) >= 9)
+    tilt_variance = std::max(state.covariance[6][6], state.covariance[7][7]);
+  sample.ok = ok && std::isfinite(tilt_variance) &&
+              tilt_variance <= options_.anchor_max_tilt_sigma_rad * options_.anchor_max_tilt_sigma_rad;
+  sample.T_world_body = transport::from_message(state.T_world_body, options_.state_channel.c_str());
+  for (int i = 0; i < 3; ++i) {
+    sample.velocity[i] = state.velocity[i];
+    sample.angular_velocity[i] = state.angular_velocity[i];
+  }
+  if (!sample.velocity.allFinite() || !sample.angular_velocity.allFinite()) {
+    throw InputError(options_.state_channel + ": state " + std::to_string(state.utime) + " has a non-finite velocity");
+  }
+  states_.push_back(sample);
+  // A bridge spans a VO outage of a few seconds; older states are of no use.
+  const auto keep_us = static_cast<int64_t>(std::llround(options_.max_bridge_s * 1e6)) + 1'000'000;
+  while (states_.front().utime < state.utime - keep_us) states_.pop_front();
   try_anchor(out);
   return out;
+}
+
+std::optional<Eigen::Isometry3d> SlamAdapter::state_at(int64_t utime, bool ok_only) const {
+  const auto after = std::lower_bound(states_.begin(), states_.end(), utime,
+                                      [](const StateSample& s, int64_t t) { return s.utime < t; });
+  if (after == states_.end()) {
+    // Not reached yet (the IMU sample after a frame may come after it): carry the newest
+    // state on by its velocities over at most a few IMU periods.
+    if (states_.empty()) return std::nullopt;
+    const StateSample& last = states_.back();
+    const double dt = 1e-6 * static_cast<double>(utime - last.utime);
+    if (dt > options_.max_state_extrapolation_s || (ok_only && !last.ok)) return std::nullopt;
+    Eigen::Isometry3d T = last.T_world_body;
+    T.translation() += dt * last.velocity;
+    T.linear() = T.linear() * Eigen::AngleAxisd(dt * last.angular_velocity.norm(),
+                                                last.angular_velocity.norm() > 0.0 ? last.angular_velocity.normalized()
+                                                                                   : Eigen::Vector3d::UnitZ())
+                                  .toRotationMatrix();
+    return T;
+  }
+  if (after->utime == utime) {
+    if (ok_only && !after->ok) return std::nullopt;
+    return after->T_world_body;
+  }
+  if (after == states_.begin()) return std::nullopt;  // the estimator started after it
+  const auto before = std::prev(after);
+  if (ok_only && !(before->ok && after->ok)) return std::nullopt;
+  const double gap_s = 1e-6 * static_cast<double>(after->utime - before->utime);
+  if (gap_s > options_.max_state_gap_s) return std::nullopt;
+  const double fraction = 1e-6 * static_cast<double>(utime - before->utime) / gap_s;
+  return se3::interpolate(before->T_world_body, after->T_world_body, fraction);
 }
 
 void SlamAdapter::remember(const kestrel::rgbd_frame_t& message, const OdometryPose& pose, bool keyframe) {
@@ -98,21 +153,12 @@ void SlamAdapter::remember(const kestrel::rgbd_frame_t& message, const OdometryP
 
 void SlamAdapter::try_anchor(AdapterOutputs& out) {
   if (anchored_ || states_.empty() || slam_.keyframes().empty()) return;
-  // The newest frame since the newest keyframe that two states bracket.
+  // The newest frame since the newest keyframe at which the estimator has an OK pose.
   for (auto f = recent_.rbegin(); f != recent_.rend(); ++f) {
-    const auto after = std::lower_bound(states_.begin(), states_.end(), f->utime,
-                                        [](const auto& s, int64_t t) { return s.first < t; });
-    if (after == states_.end()) continue;  // the estimator has not reached it yet
-    const bool exact = after->first == f->utime;
-    if (!exact && after == states_.begin()) break;  // the estimator started after it (and older ones)
-    const auto before = exact ? after : std::prev(after);
-    const double gap_s = 1e-6 * static_cast<double>(after->first - before->first);
-    if (gap_s > options_.max_state_gap_s) continue;
-    const double fraction = exact ? 0.0 : 1e-6 * static_cast<double>(f->utime - before->first) / gap_s;
-    const Eigen::Isometry3d T_world_camera = se3::interpolate(before->second, after->second, fraction) * f->T_body_camera;
-    slam_.change_world(T_world_camera * slam_.world_pose(f->T_odom_camera).inverse());
+    const auto T_world_body = state_at(f->utime, true);
+    if (!T_world_body) continue;
+    slam_.change_world(*T_world_body * f->T_body_camera * slam_.world_pose(f->T_odom_camera).inverse());
     anchored_ = true;
-    states_.clear();
     recent_.clear();
     out.anchored = true;
     out.graph = graph_message(slam_);
@@ -120,17 +166,38 @@ void SlamAdapter::try_anchor(AdapterOutputs& out) {
   }
 }
 
-AdapterOutputs SlamAdapter::process(const kestrel::rgbd_frame_t& message, const OdometryPose& pose) {
+AdapterOutputs SlamAdapter::process(const kestrel::rgbd_frame_t& message, const OdometryPose& chained) {
   AdapterOutputs out;
   last_processed_utime_ = message.utime;
-  const bool broken = pose.broken || lost_break_;
-  if (!slam_.wants_keyframe(pose.T_odom_camera, broken)) {
+  const Eigen::Isometry3d T_body_camera =
+      transport::from_message(message.camera.T_body_camera, options_.camera_channel.c_str());
+  // The chain's poses, carried into SLAM's odometry frame past the bridged restarts.
+  OdometryPose pose = chained;
+  pose.T_odom_camera = odometry_fix_ * chained.T_odom_camera;
+  OdometryLink link = OdometryLink::kContinuous;
+  if (chained.broken || lost_break_) {
+    link = OdometryLink::kBroken;
+    // The VO restarted: the estimator's motion from the last frame with a pose to this one
+    // (IMU through the outage) relates the new segment to the old one.
+    if (last_pose_ && 1e-6 * static_cast<double>(message.utime - last_pose_->utime) <= options_.max_bridge_s) {
+      const auto before = state_at(last_pose_->utime, false), now = state_at(message.utime, false);
+      if (before && now) {
+        const Eigen::Isometry3d T_before_now = (*before * last_pose_->T_body_camera).inverse() * (*now * T_body_camera);
+        pose.T_odom_camera = last_pose_->T_odom_camera * T_before_now;
+        odometry_fix_ = pose.T_odom_camera * chained.T_odom_camera.inverse();
+        link = OdometryLink::kBridged;
+        ++bridges_;
+      }
+    }
+  }
+  last_pose_ = LastPose{message.utime, pose.T_odom_camera, T_body_camera};
+  if (!slam_.wants_keyframe(pose.T_odom_camera, link)) {
     remember(message, pose, false);
     try_anchor(out);
     return out;
   }
   const RgbdFrame frame = transport::decode_rgbd(message, options_.camera_channel.c_str());
-  const SlamStep step = slam_.add(frame, pose.T_odom_camera, broken);
+  const SlamStep step = slam_.add(frame, pose.T_odom_camera, link);
   lost_break_ = false;
   remember(message, pose, step.keyframe);
   if (!step.keyframe) {

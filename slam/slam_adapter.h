@@ -7,11 +7,20 @@
 // estimator's world (that one is gravity-aligned and fixed when the filter starts, maybe
 // seconds after the first frame). SLAM_CORRECTION poses are applied by the estimator as poses
 // in its own world, and the mapper's map must be in the frame the vehicle flies in, so the
-// first frame since the newest keyframe that the estimator's STATE covers (an OK state on
-// each side of its utime, at most max_state_gap_s apart) anchors the graph: the graph is moved
+// first frame since the newest keyframe that the estimator's STATE covers (an OK state with
+// its roll and pitch settled on each side of its utime, at most max_state_gap_s apart, or the
+// newest carried on by its velocities for up to max_state_extrapolation_s) anchors the graph: the graph is moved
 // rigidly so that this frame's pose (the newest keyframe's composed with the odometry since)
 // is the estimator's pose then. A hovering vehicle makes no keyframe after the first, so any
 // frame must do. Without STATE (offline runs) the world stays the odometry frame.
+//
+// VO restarts: when the visual odometry loses its reference (a blank wall, a fast turn) its
+// new segment is unrelated to the old one, and the heading turned in the gap would be lost for
+// good. The estimator carries on through the gap on the IMU, so its motion from the last frame
+// that had a pose to the first frame of the new segment (STATE interpolated, OK or DEGRADED,
+// at most max_bridge_s apart) bridges it: later poses are carried on from there and the
+// keyframe's odometry edge gets the bridge's uncertainty (OdometryLink::kBridged). Without
+// states around both frames the restart stays a break, as before.
 //
 // A frame and its VO update are paired by utime. Frames wait (encoded) in a bounded buffer and
 // are decoded only when their pose makes them a keyframe; an update whose frame has not come
@@ -37,7 +46,10 @@ struct AdapterOptions {
   std::string camera_channel = "CAMERA_RGBD";  ///< named in error messages
   std::string vo_channel = "VO_UPDATE";
   std::string state_channel = "STATE";
-  double max_state_gap_s = 0.1;           ///< STATE samples bracketing the anchoring keyframe
+  double max_state_gap_s = 0.1;           ///< STATE samples bracketing a frame at most this far apart
+  double anchor_max_tilt_sigma_rad = 0.01;  ///< anchor only on a STATE whose roll/pitch sigma is below this
+  double max_state_extrapolation_s = 0.02;  ///< a frame after the newest STATE: carried on by its velocities
+  double max_bridge_s = 10.0;             ///< longest VO outage the estimator's motion may bridge
 };
 
 struct AdapterOutputs {
@@ -63,11 +75,16 @@ class SlamAdapter {
 
   /// True once the graph is in the estimator's world.
   bool anchored() const { return anchored_; }
+  /// VO restarts bridged by the estimator's motion so far.
+  int bridges() const { return bridges_; }
 
   const Slam& slam() const { return slam_; }
 
  private:
-  AdapterOutputs process(const kestrel::rgbd_frame_t& frame, const OdometryPose& pose);
+  AdapterOutputs process(const kestrel::rgbd_frame_t& frame, const OdometryPose& chained);
+  /// The estimator's T_world_body at utime: interpolated between two states, or carried on
+  /// from the newest by its velocities; nothing when the states do not cover it.
+  std::optional<Eigen::Isometry3d> state_at(int64_t utime, bool ok_only) const;
   void trim_frames();
   /// Drops waiting poses [begin, end), remembering an odometry break among them.
   void drop_poses(std::map<int64_t, OdometryPose>::iterator end);
@@ -84,7 +101,21 @@ class SlamAdapter {
   int64_t last_processed_utime_ = 0;
   bool lost_break_ = false;  ///< a pose flagged broken was dropped: flag the next one
   bool anchored_ = false;
-  std::deque<std::pair<int64_t, Eigen::Isometry3d>> states_;  ///< recent OK states, until anchored
+  struct StateSample {
+    int64_t utime = 0;
+    bool ok = false;  ///< status OK and the tilt settled: fit to anchor on (else only to bridge)
+    Eigen::Isometry3d T_world_body = Eigen::Isometry3d::Identity();
+    Eigen::Vector3d velocity = Eigen::Vector3d::Zero();          ///< world
+    Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();  ///< body
+  };
+  std::deque<StateSample> states_;  ///< the last max_bridge_s (+1 s) of states
+  struct LastPose {
+    int64_t utime;
+    Eigen::Isometry3d T_odom_camera, T_body_camera;
+  };
+  std::optional<LastPose> last_pose_;  ///< the last processed frame, in SLAM's odometry frame
+  Eigen::Isometry3d odometry_fix_ = Eigen::Isometry3d::Identity();  ///< chain -> SLAM's odometry frame
+  int bridges_ = 0;
   struct RecentFrame {
     int64_t utime;
     Eigen::Isometry3d T_odom_camera, T_body_camera;

@@ -24,20 +24,23 @@ void check_options(const SlamOptions& o) {
   require(n.translation_per_m >= 0.0 && n.rotation_per_rad >= 0.0 && n.rotation_per_m >= 0.0,
           "odometry noise rates must be >= 0");
   require(n.break_translation_m > 0.0 && n.break_rotation_rad > 0.0, "odometry break noise must be > 0");
+  require(n.bridge_translation_m > 0.0 && n.bridge_rotation_rad > 0.0, "odometry bridge noise must be > 0");
 }
 
 // Information of an odometry edge in the pose graph's error convention (spaces.h): the
 // rotational part of the error is vec(q) ~ phi / 2, hence the factor 4.
-Matrix6d odometry_information(const Eigen::Isometry3d& T_prev_cur, const OdometryNoise& n, bool broken) {
+Matrix6d odometry_information(const Eigen::Isometry3d& T_prev_cur, const OdometryNoise& n, OdometryLink link) {
   double sigma_t, sigma_r;
-  if (broken) {
+  if (link == OdometryLink::kBroken) {
     sigma_t = n.break_translation_m;
     sigma_r = n.break_rotation_rad;
   } else {
     const double distance = T_prev_cur.translation().norm();
     const double angle = so3::angle(T_prev_cur.linear());
-    sigma_t = n.translation_floor_m + n.translation_per_m * distance;
-    sigma_r = n.rotation_floor_rad + n.rotation_per_rad * angle + n.rotation_per_m * distance;
+    const bool bridged = link == OdometryLink::kBridged;
+    sigma_t = (bridged ? n.bridge_translation_m : n.translation_floor_m) + n.translation_per_m * distance;
+    sigma_r = (bridged ? n.bridge_rotation_rad : n.rotation_floor_rad) + n.rotation_per_rad * angle +
+              n.rotation_per_m * distance;
   }
   Matrix6d info = Matrix6d::Zero();
   info.diagonal().head<3>().setConstant(1.0 / (sigma_t * sigma_t));
@@ -72,9 +75,10 @@ void Slam::change_world(const Eigen::Isometry3d& T_new_world) {
   ++revision_;
 }
 
-bool Slam::wants_keyframe(const Eigen::Isometry3d& T_odom_camera, bool odometry_broken) const {
+bool Slam::wants_keyframe(const Eigen::Isometry3d& T_odom_camera, OdometryLink link) const {
   if (!T_odom_camera.matrix().allFinite()) return false;
-  if (keyframes_.empty() || odometry_broken) return true;
+  // After a restart the earlier keyframe's odometry ends: the edge must span only the gap.
+  if (keyframes_.empty() || link != OdometryLink::kContinuous) return true;
   const Eigen::Isometry3d T_last_cur = keyframes_.back().T_odom_camera.inverse() * T_odom_camera;
   return T_last_cur.translation().norm() >= options_.keyframes.min_translation_m ||
          so3::angle(T_last_cur.linear()) >= options_.keyframes.min_rotation_rad;
@@ -85,15 +89,17 @@ Eigen::Isometry3d Slam::world_pose(const Eigen::Isometry3d& T_odom_camera) const
   return graph_.poses.back() * keyframes_.back().T_odom_camera.inverse() * T_odom_camera;
 }
 
-void Slam::add_odometry_edge(const Keyframe& previous, const Keyframe& current, bool broken) {
+void Slam::add_odometry_edge(const Keyframe& previous, const Keyframe& current, OdometryLink link) {
   // After a break the odometry poses of the two are unrelated: assume no motion, weakly.
-  const Eigen::Isometry3d T_prev_cur =
-      broken ? Eigen::Isometry3d::Identity() : previous.T_odom_camera.inverse() * current.T_odom_camera;
+  const Eigen::Isometry3d T_prev_cur = link == OdometryLink::kBroken
+                                           ? Eigen::Isometry3d::Identity()
+                                           : previous.T_odom_camera.inverse() * current.T_odom_camera;
   graph_.add_edge(static_cast<int>(previous.id), static_cast<int>(current.id), T_prev_cur,
-                  odometry_information(T_prev_cur, options_.odometry, broken), EdgeKind::kOdometry);
+                  odometry_information(T_prev_cur, options_.odometry, link), EdgeKind::kOdometry);
 }
 
-SlamStep Slam::add(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera, bool odometry_broken) {
+SlamStep Slam::add(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera, OdometryLink link) {
+  const bool odometry_broken = link == OdometryLink::kBroken;
   if (have_frame_ && frame.utime <= last_utime_) {
     throw InputError("slam: frame utime " + std::to_string(frame.utime) + " does not follow " +
                      std::to_string(last_utime_));
@@ -105,7 +111,7 @@ SlamStep Slam::add(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camer
   last_utime_ = frame.utime;
   if (odometry_broken) gate_by_pose_ = false;
   SlamStep step;
-  if (!wants_keyframe(T_odom_camera, odometry_broken)) return step;
+  if (!wants_keyframe(T_odom_camera, link)) return step;
 
   Keyframe kf;
   kf.id = static_cast<int64_t>(keyframes_.size());
@@ -117,7 +123,7 @@ SlamStep Slam::add(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camer
       keyframes_.empty() ? T_odom_camera
                          : (odometry_broken ? graph_.poses.back() : world_pose(T_odom_camera));
   graph_.add_vertex(kf.id, T_world_camera, keyframes_.empty());
-  if (!keyframes_.empty()) add_odometry_edge(keyframes_.back(), kf, odometry_broken);
+  if (!keyframes_.empty()) add_odometry_edge(keyframes_.back(), kf, link);
   keyframes_.push_back(std::move(kf));
   step.keyframe = true;
   step.keyframe_id = keyframes_.back().id;

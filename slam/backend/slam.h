@@ -36,6 +36,13 @@ struct Keyframe {
   FrameFeatures features;
 };
 
+/// How a frame's odometry pose relates to the previous frame's.
+enum class OdometryLink {
+  kContinuous,  ///< the visual odometry carried on: the pose follows from the previous one
+  kBridged,     ///< the VO restarted and the state estimator (IMU) bridged the gap: related, less certain
+  kBroken,      ///< the VO restarted and nothing relates the poses
+};
+
 /// What one call of Slam::add did.
 struct SlamStep {
   bool keyframe = false;          ///< the frame became a keyframe
@@ -55,13 +62,15 @@ class Slam {
   explicit Slam(const SlamOptions& options = {}, std::shared_ptr<const Vocabulary> vocabulary = nullptr);
 
   /// Would a frame at this odometry pose become a keyframe? (false for a frame whose pose is
-  /// not finite).
-  bool wants_keyframe(const Eigen::Isometry3d& T_odom_camera, bool odometry_broken = false) const;
+  /// not finite; true after a restart of the odometry, bridged or not).
+  bool wants_keyframe(const Eigen::Isometry3d& T_odom_camera, OdometryLink link = OdometryLink::kContinuous) const;
 
-  /// Adds a frame seen at T_odom_camera. `odometry_broken` says the odometry restarted since the
-  /// last frame, so its pose is not related to the earlier ones. Throws InputError when the
-  /// frame's utime does not increase or the pose is not a finite rigid transform.
-  SlamStep add(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera, bool odometry_broken = false);
+  /// Adds a frame seen at T_odom_camera; `link` says how that pose relates to the previous
+  /// frame's (a bridged restart gives an odometry edge with the bridge's larger uncertainty, a
+  /// broken one a weak edge of no motion). Throws InputError when the frame's utime does not
+  /// increase or the pose is not a finite rigid transform.
+  SlamStep add(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera,
+               OdometryLink link = OdometryLink::kContinuous);
 
   const std::vector<Keyframe>& keyframes() const { return keyframes_; }
   /// Vertices are keyframes (poses T_world_camera); edges odometry and loop closures.
@@ -89,7 +98,7 @@ class Slam {
   void reset();
 
  private:
-  void add_odometry_edge(const Keyframe& previous, const Keyframe& current, bool broken);
+  void add_odometry_edge(const Keyframe& previous, const Keyframe& current, OdometryLink link);
   SlamStep close_loop(SlamStep step);
 
   SlamOptions options_;

@@ -36,9 +36,13 @@ struct OdometryNoise {
   double rotation_floor_rad = 0.005;
   double rotation_per_rad = 0.05;        ///< rad of error per rad turned
   double rotation_per_m = 0.02;          ///< rad of error per m travelled
-  /// When the odometry broke (VO restarted), the edge that bridges the gap.
+  /// When the odometry broke (VO restarted) and nothing bridged the gap: a weak edge.
   double break_translation_m = 1.0;
   double break_rotation_rad = 0.5;
+  /// When the state estimator bridged the gap (IMU through the VO's outage): these floors
+  /// instead of translation_floor_m and rotation_floor_rad (a few seconds on the IMU alone).
+  double bridge_translation_m = 0.05;
+  double bridge_rotation_rad = 0.02;
 };
 
 struct SlamOptions {

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 
 #include "common/error.h"
@@ -52,6 +53,8 @@ class AdapterTest : public ::testing::Test {
     Eigen::Isometry3d T = pose(0);
     T.translation().x() += 0.1 * k;
     m.T_world_body = transport::to_message(X * pose(0).inverse() * T);
+    const Eigen::Vector3d v = X.linear() * Eigen::Vector3d(1.0, 0.0, 0.0);  // 0.1 m per 0.1 s along x
+    for (int i = 0; i < 3; ++i) m.velocity[i] = v[i];
     m.cov_dim = 0;
     return m;
   }
@@ -78,12 +81,12 @@ TEST_F(AdapterTest, AnchorsTheGraphInTheEstimatorsWorldAtTheFirstKeyframeItsStat
   EXPECT_FALSE(adapter_.on_state(state(-0.5, X, kestrel::state_t::STATUS_INITIALIZING)).anchored);
   EXPECT_FALSE(adapter_.on_state(state(0.4, X)).anchored) << "no state before keyframe 0 yet";
   EXPECT_FALSE(adapter_.anchored());
-  // Keyframe 3 (0.3 m) is bracketed by states at 2.95 and 3.05: anchored there, by interpolation.
+  // Keyframe 3 (0.3 m) is bracketed by states at 2.5 and 3.05: anchored there, by interpolation.
   for (int k = 1; k <= 3; ++k) {
     adapter_.on_frame(frame(k));
     adapter_.on_vo_update(update(k));
   }
-  EXPECT_FALSE(adapter_.on_state(state(2.95, X)).anchored) << "the estimator is not past keyframe 3";
+  EXPECT_FALSE(adapter_.on_state(state(2.5, X)).anchored) << "50 ms short of keyframe 3: too far to carry on";
   const AdapterOutputs out = adapter_.on_state(state(3.05, X));
   ASSERT_TRUE(out.anchored);
   ASSERT_TRUE(out.graph);
@@ -115,12 +118,58 @@ TEST_F(AdapterTest, AHoveringVehicleIsAnchoredAtAFrameThatIsNoKeyframe) {
   adapter_.on_vo_update(update(0));
   adapter_.on_frame(frame(1));
   EXPECT_FALSE(adapter_.on_vo_update(update(1)).graph) << "frame 1 is no keyframe";
-  EXPECT_FALSE(adapter_.on_state(state(0.9, X)).anchored);
+  EXPECT_FALSE(adapter_.on_state(state(0.5, X)).anchored);
   const AdapterOutputs out = adapter_.on_state(state(1.1, X));
   ASSERT_TRUE(out.anchored);
   ASSERT_TRUE(out.graph);
   ASSERT_EQ(out.graph->num_keyframes, 1);
   EXPECT_LT((keyframe_pose(*out.graph, 0).matrix() - X.matrix()).norm(), 1e-9);
+}
+
+TEST_F(AdapterTest, TheEstimatorsMotionBridgesAVoRestart) {
+  // Frames 0-7 move 10 cm each; at frame 4 the VO restarts (no reference). Keyframes 0, 3, 4
+  // (a restart always makes one), 7.
+  const Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+  auto run = [&](bool with_states) {
+    SlamAdapter adapter(SlamOptions{}, nullptr);
+    std::optional<kestrel::slam_graph_t> last;
+    for (int k = 0; k <= 7; ++k) {
+      if (with_states) {
+        adapter.on_state(state(k - 0.05, X, k == 4 ? kestrel::state_t::STATUS_DEGRADED : kestrel::state_t::STATUS_OK));
+        adapter.on_state(state(k + 0.05, X));
+      }
+      kestrel::vo_update_t u = update(k);
+      if (k == 4) {
+        u.status = kestrel::vo_update_t::STATUS_NO_REFERENCE;
+        u.T_reference_current = transport::to_message(Eigen::Isometry3d::Identity());
+      }
+      adapter.on_frame(frame(k));
+      const AdapterOutputs out = adapter.on_vo_update(u);
+      if (out.graph) last = out.graph;
+    }
+    EXPECT_EQ(adapter.bridges(), with_states ? 1 : 0);
+    return *last;
+  };
+  const kestrel::slam_graph_t bridged = run(true);
+  ASSERT_EQ(bridged.num_keyframes, 4);
+  // Across the restart the map keeps the true motion: every keyframe where the estimator was.
+  for (int i = 0; i < 4; ++i) {
+    const int k = std::array<int, 4>{0, 3, 4, 7}[static_cast<size_t>(i)];
+    const Eigen::Isometry3d expected = pose(0).inverse() * pose(k);
+    EXPECT_LT((keyframe_pose(bridged, i).matrix() - expected.matrix()).norm(), 1e-9) << "keyframe at frame " << k;
+  }
+  // The edge across the restart measures the 10 cm the estimator saw.
+  const kestrel::slam_edge_t& edge = bridged.edges[1];
+  ASSERT_EQ(edge.from_id, 1);
+  ASSERT_EQ(edge.to_id, 2);
+  EXPECT_EQ(edge.kind, kestrel::slam_edge_t::KIND_ODOMETRY);
+  EXPECT_NEAR(transport::from_message(edge.T_from_to, "test").translation().norm(), 0.1, 1e-9);
+  // Without states the restart is a break: keyframe 4 stays where keyframe 3 was, and the new
+  // segment carries on from there (10 cm short from then on).
+  const kestrel::slam_graph_t broken = run(false);
+  ASSERT_EQ(broken.num_keyframes, 4);
+  EXPECT_LT((keyframe_pose(broken, 2).matrix() - keyframe_pose(broken, 1).matrix()).norm(), 1e-9);
+  EXPECT_NEAR(keyframe_pose(broken, 3).translation().z(), 0.6, 1e-9);
 }
 
 TEST_F(AdapterTest, StatesGoingBackOrNotRigidAreRefusedNamingTheChannel) {
