@@ -66,6 +66,9 @@ int App::run(int argc, char** argv, const std::function<int()>& body) {
   } catch (const InputError& e) {
     std::cerr << tool << ": error: " << e.what() << "\n";
     return kExitBadInput;
+  } catch (const UnavailableError& e) {
+    std::cerr << tool << ": error: " << e.what() << "\n";
+    return kExitUnavailable;
   } catch (const CLI::ParseError& e) {  // validation done inside the body
     std::cerr << tool << ": error: " << e.what() << "\n";
     return kExitUsage;

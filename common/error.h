@@ -16,6 +16,13 @@ class InputError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// A device, the network or a service is not there (LCM cannot start, no Kinect): the tool's
+/// main turns it into one line on stderr and exit code kExitUnavailable.
+class UnavailableError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
 /// "path:line: what" — the form every parser uses.
 std::string at_line(const std::string& path, int line, const std::string& what);
 

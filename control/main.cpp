@@ -3,9 +3,6 @@
 // real one). A thin adapter around FollowerNode (follower_node.h); lock-step replay resets it.
 #include <spdlog/spdlog.h>
 
-#include <iostream>
-#include <optional>
-
 #include "common/cli.h"
 #include "common/error.h"
 #include "common/transport/channels.h"
@@ -31,26 +28,20 @@ int run(const Options& o) {
     given = read_waypoints(o.waypoints);  // InputError: exit 3, naming the file and line
     follower.set_path(given);
   }
-  std::optional<transport::Node> node;
-  try {
-    node.emplace("follow", o.lcm_url);
-  } catch (const std::runtime_error& e) {
-    std::cerr << "kestrel-follow: error: " << e.what() << "\n";
-    return kExitUnavailable;
-  }
-  node->advertise(o.command_channel);
-  node->on_reset([&] {
+  transport::Node node("follow", o.lcm_url);  // UnavailableError: exit 4
+  node.advertise(o.command_channel);
+  node.on_reset([&] {
     follower.reset();
     if (!given.empty()) follower.set_path(given);
   });
   auto health = [&] {
     const FollowStatus s = follower.follower().status();
-    node->set_health(s == FollowStatus::kOffPath ? kestrel::process_status_t::STATE_DEGRADED
+    node.set_health(s == FollowStatus::kOffPath ? kestrel::process_status_t::STATE_DEGRADED
                                                  : kestrel::process_status_t::STATE_RUNNING,
                      to_string(s));
   };
   health();
-  node->subscribe<kestrel::plan_t>(o.node.plan_channel, [&](const kestrel::plan_t& m) {
+  node.subscribe<kestrel::plan_t>(o.node.plan_channel, [&](const kestrel::plan_t& m) {
     follower.on_plan(m);  // throws: Node counts and logs, and the vehicle holds
     if (m.status == kestrel::plan_t::STATUS_OK && m.num_waypoints > 0) {
       spdlog::info("plan {}: {} waypoints, {:.2f} m", m.request_id, m.num_waypoints, follower.follower().length_m());
@@ -60,8 +51,8 @@ int run(const Options& o) {
     health();
   });
   FollowStatus last = follower.follower().status();
-  node->subscribe<kestrel::state_t>(o.node.state_channel, [&](const kestrel::state_t& m) {
-    if (const auto command = follower.on_state(m)) node->publish(o.command_channel, *command);
+  node.subscribe<kestrel::state_t>(o.node.state_channel, [&](const kestrel::state_t& m) {
+    if (const auto command = follower.on_state(m)) node.publish(o.command_channel, *command);
     const FollowStatus now = follower.follower().status();
     if (now != last) {
       spdlog::info("{} at {:.2f} of {:.2f} m (deviation {:.2f} m)", to_string(now), follower.follower().progress_m(),
@@ -70,7 +61,7 @@ int run(const Options& o) {
       health();
     }
   }, 400);
-  return node->spin();
+  return node.spin();
 }
 
 }  // namespace

@@ -49,7 +49,7 @@ Node::Node(std::string name, const std::string& lcm_url, double heartbeat_period
       lcm_(url_),
       heartbeat_period_(std::chrono::duration_cast<std::chrono::steady_clock::duration>(
           std::chrono::duration<double>(heartbeat_period_s))) {
-  if (!lcm_.good()) throw std::runtime_error("cannot start LCM on '" + url_ + "'");
+  if (!lcm_.good()) throw UnavailableError("cannot start LCM on '" + url_ + "'");
   install_signal_handlers();
   add_subscription(
       channel::kReplayControl,

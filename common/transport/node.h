@@ -41,8 +41,8 @@ struct NodeCounters {
 
 class Node {
  public:
-  /// Connects to `lcm_url` (resolved by resolve_lcm_url); throws std::runtime_error naming
-  /// the URL if LCM cannot start.
+  /// Connects to `lcm_url` (resolved by resolve_lcm_url); throws UnavailableError naming
+  /// the URL if LCM cannot start (cli::App::run turns it into exit code 4).
   Node(std::string name, const std::string& lcm_url, double heartbeat_period_s = 1.0);
   ~Node();
   Node(const Node&) = delete;

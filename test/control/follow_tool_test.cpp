@@ -85,6 +85,16 @@ TEST(FollowTool, TurnsAPlanAndStatesIntoCommandsUnderLockStepReplay) {
   EXPECT_EQ(hold, 1) << "one hold after the plan without a path, then silence";
 }
 
+TEST(FollowTool, WithoutLcmFollowAndGotoExit4NamingTheUrl) {
+  for (const char* tool : {"follow", "goto"}) {
+    std::vector<std::string> argv = {test::tool(tool).string(), "--lcm-url", "nosuchprovider://"};
+    if (std::string(tool) == "goto") argv.insert(argv.end(), {"--goal", "1", "2", "1", "0"});
+    const auto r = test::run(argv);
+    EXPECT_EQ(r.exit_code, 4) << tool << ": " << r.err;
+    EXPECT_NE(r.err.find("nosuchprovider://"), std::string::npos) << r.err;
+  }
+}
+
 TEST(FollowTool, AWaypointFileWithABadLineExits3NamingTheLine) {
   test::TempDir dir;
   const std::string path = (dir / "w.txt").string();
