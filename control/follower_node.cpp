@@ -91,6 +91,9 @@ void FollowerNode::on_plan(const kestrel::plan_t& plan) {
 
 std::optional<kestrel::vehicle_command_t> FollowerNode::on_state(const kestrel::state_t& state) {
   if (!active_ && !hold_pending_) return std::nullopt;
+  const bool due = !commanded_ || hold_pending_ ||
+                   state.utime - last_command_utime_ >= std::llround(options_.command_period_s * 1e6);
+  if (!due) return std::nullopt;
   const bool usable = state.status == kestrel::state_t::STATUS_OK || state.status == kestrel::state_t::STATUS_DEGRADED;
   VehicleState s;
   if (usable) {
@@ -98,9 +101,6 @@ std::optional<kestrel::vehicle_command_t> FollowerNode::on_state(const kestrel::
     s.position = T.translation();
     s.yaw = std::atan2(T.linear()(1, 0), T.linear()(0, 0));
   }
-  const bool due = !commanded_ || hold_pending_ ||
-                   state.utime - last_command_utime_ >= std::llround(options_.command_period_s * 1e6);
-  if (!due) return std::nullopt;
   FollowerCommand c;  // kHold unless the follower says otherwise: the vehicle stops where it is
   c.position = s.position;
   c.yaw = s.yaw;

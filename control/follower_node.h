@@ -40,8 +40,8 @@ class FollowerNode {
   void on_plan(const kestrel::plan_t& plan);
   /// Starts following waypoints given directly (the tool's --waypoints).
   void set_path(const std::vector<Waypoint>& waypoints);
-  /// The command for this state, if one is due. Throws InputError naming the channel for a
-  /// pose that is not a finite rigid transform.
+  /// The command for this state, if one is due (only then is the state decoded). Throws
+  /// InputError naming the channel for a pose that is not a finite rigid transform.
   std::optional<kestrel::vehicle_command_t> on_state(const kestrel::state_t& state);
   void reset();
 

@@ -66,20 +66,24 @@ size_t PathFollower::segment_at(double s) const {
   return std::min(i, path_.size() - 2);
 }
 
-Eigen::Vector3d PathFollower::point_at(double s) const {
-  if (path_.size() < 2) return path_.front().position;
+PathFollower::Place PathFollower::locate(double s) const {
   const size_t i = segment_at(s);
   const double len = cumulative_[i + 1] - cumulative_[i];
-  const double t = len > 0.0 ? std::clamp((s - cumulative_[i]) / len, 0.0, 1.0) : 0.0;
-  return path_[i].position + t * (path_[i + 1].position - path_[i].position);
+  // A zero-length segment (a turn on the spot) is at its end: its end's yaw.
+  return {i, len > 0.0 ? std::clamp((s - cumulative_[i]) / len, 0.0, 1.0) : 1.0};
+}
+
+Eigen::Vector3d PathFollower::point_at(double s) const {
+  if (path_.size() < 2) return path_.front().position;
+  const Place at = locate(s);
+  return path_[at.segment].position + at.t * (path_[at.segment + 1].position - path_[at.segment].position);
 }
 
 double PathFollower::yaw_at(double s) const {
   if (path_.size() < 2) return path_.front().yaw;
-  const size_t i = segment_at(s);
-  const double len = cumulative_[i + 1] - cumulative_[i];
-  const double t = len > 0.0 ? std::clamp((s - cumulative_[i]) / len, 0.0, 1.0) : 1.0;
-  return wrap_angle(path_[i].yaw + t * wrap_angle(path_[i + 1].yaw - path_[i].yaw));
+  const Place at = locate(s);
+  const double from = path_[at.segment].yaw;
+  return wrap_angle(from + at.t * wrap_angle(path_[at.segment + 1].yaw - from));
 }
 
 double PathFollower::nearest(const Eigen::Vector3d& p, double from, double to) const {

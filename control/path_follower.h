@@ -81,6 +81,12 @@ class PathFollower {
   Eigen::Vector3d point_at(double s) const;
   double yaw_at(double s) const;
   size_t segment_at(double s) const;
+  struct Place {
+    size_t segment;  ///< from waypoint `segment` to the next
+    double t;        ///< fraction along it, [0, 1]
+  };
+  /// Where s metres of path fall (at least two waypoints).
+  Place locate(double s) const;
   /// The path's point nearest p within [from, to] metres of path.
   double nearest(const Eigen::Vector3d& p, double from, double to) const;
 

@@ -5,6 +5,7 @@
 
 #include "common/error.h"
 #include "common/geometry/se3.h"
+#include "common/geometry/so3.h"
 #include "common/transport/convert.h"
 #include "common/transport/rgbd_codec.h"
 
@@ -124,10 +125,7 @@ std::optional<Eigen::Isometry3d> SlamAdapter::state_at(int64_t utime, bool ok_on
     if (dt > options_.max_state_extrapolation_s || (ok_only && !last.ok)) return std::nullopt;
     Eigen::Isometry3d T = last.T_world_body;
     T.translation() += dt * last.velocity;
-    T.linear() = T.linear() * Eigen::AngleAxisd(dt * last.angular_velocity.norm(),
-                                                last.angular_velocity.norm() > 0.0 ? last.angular_velocity.normalized()
-                                                                                   : Eigen::Vector3d::UnitZ())
-                                  .toRotationMatrix();
+    T.linear() = T.linear() * so3::exp(dt * last.angular_velocity);
     return T;
   }
   if (after->utime == utime) {
@@ -143,11 +141,10 @@ std::optional<Eigen::Isometry3d> SlamAdapter::state_at(int64_t utime, bool ok_on
   return se3::interpolate(before->T_world_body, after->T_world_body, fraction);
 }
 
-void SlamAdapter::remember(const kestrel::rgbd_frame_t& message, const OdometryPose& pose, bool keyframe) {
+void SlamAdapter::remember(const FramePose& frame, bool keyframe) {
   if (anchored_) return;
   if (keyframe) recent_.clear();  // world_pose() composes from the newest keyframe on
-  recent_.push_back({message.utime, pose.T_odom_camera,
-                     transport::from_message(message.camera.T_body_camera, options_.camera_channel.c_str())});
+  recent_.push_back(frame);
   while (static_cast<int>(recent_.size()) > options_.buffer_frames) recent_.pop_front();
 }
 
@@ -190,16 +187,16 @@ AdapterOutputs SlamAdapter::process(const kestrel::rgbd_frame_t& message, const 
       }
     }
   }
-  last_pose_ = LastPose{message.utime, pose.T_odom_camera, T_body_camera};
+  last_pose_ = FramePose{message.utime, pose.T_odom_camera, T_body_camera};
   if (!slam_.wants_keyframe(pose.T_odom_camera, link)) {
-    remember(message, pose, false);
+    remember(*last_pose_, false);
     try_anchor(out);
     return out;
   }
   const RgbdFrame frame = transport::decode_rgbd(message, options_.camera_channel.c_str());
   const SlamStep step = slam_.add(frame, pose.T_odom_camera, link);
   lost_break_ = false;
-  remember(message, pose, step.keyframe);
+  remember(*last_pose_, step.keyframe);
   if (!step.keyframe) {
     try_anchor(out);
     return out;

@@ -81,6 +81,10 @@ class SlamAdapter {
   const Slam& slam() const { return slam_; }
 
  private:
+  struct FramePose {  ///< a processed frame in SLAM's odometry frame, and its camera mounting
+    int64_t utime;
+    Eigen::Isometry3d T_odom_camera, T_body_camera;
+  };
   AdapterOutputs process(const kestrel::rgbd_frame_t& frame, const OdometryPose& chained);
   /// The estimator's T_world_body at utime: interpolated between two states, or carried on
   /// from the newest by its velocities; nothing when the states do not cover it.
@@ -88,8 +92,8 @@ class SlamAdapter {
   void trim_frames();
   /// Drops waiting poses [begin, end), remembering an odometry break among them.
   void drop_poses(std::map<int64_t, OdometryPose>::iterator end);
-  /// Keeps a processed frame's poses for anchoring (frames since the newest keyframe).
-  void remember(const kestrel::rgbd_frame_t& message, const OdometryPose& pose, bool keyframe);
+  /// Keeps a processed frame for anchoring (frames since the newest keyframe).
+  void remember(const FramePose& frame, bool keyframe);
   /// Anchors the graph at the newest remembered frame that STATE brackets; fills `out`.
   void try_anchor(AdapterOutputs& out);
 
@@ -109,18 +113,10 @@ class SlamAdapter {
     Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();  ///< body
   };
   std::deque<StateSample> states_;  ///< the last max_bridge_s (+1 s) of states
-  struct LastPose {
-    int64_t utime;
-    Eigen::Isometry3d T_odom_camera, T_body_camera;
-  };
-  std::optional<LastPose> last_pose_;  ///< the last processed frame, in SLAM's odometry frame
+  std::optional<FramePose> last_pose_;  ///< the last processed frame
   Eigen::Isometry3d odometry_fix_ = Eigen::Isometry3d::Identity();  ///< chain -> SLAM's odometry frame
   int bridges_ = 0;
-  struct RecentFrame {
-    int64_t utime;
-    Eigen::Isometry3d T_odom_camera, T_body_camera;
-  };
-  std::deque<RecentFrame> recent_;  ///< frames since the newest keyframe, until anchored
+  std::deque<FramePose> recent_;  ///< frames since the newest keyframe, until anchored
 };
 
 }  // namespace kestrel::slam

@@ -15,11 +15,13 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <map>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "common/geometry/align.h"
 #include "common/transport/channels.h"
 #include "common/transport/convert.h"
 #include "common/transport/log_file.h"
@@ -75,16 +77,16 @@ std::map<int64_t, Eigen::Vector3d> read_truth(const std::string& path) {
   return truth;
 }
 
-// RMS position error after the best rigid alignment (Horn/Umeyama without scale).
+// RMS position error after the best rigid alignment (the ATE).
 double aligned_rmse(const std::vector<Eigen::Vector3d>& est, const std::vector<Eigen::Vector3d>& gt) {
   Eigen::Matrix3Xd a(3, est.size()), b(3, gt.size());
   for (size_t i = 0; i < est.size(); ++i) {
     a.col(static_cast<Eigen::Index>(i)) = est[i];
     b.col(static_cast<Eigen::Index>(i)) = gt[i];
   }
-  const Eigen::Matrix4d T = Eigen::umeyama(a, b, false);
-  const Eigen::Matrix3Xd moved = (T.topLeftCorner<3, 3>() * a).colwise() + T.topRightCorner<3, 1>();
-  return std::sqrt((moved - b).colwise().squaredNorm().mean());
+  const std::optional<Eigen::Isometry3d> T = align_rigid(a, b);
+  if (!T) return std::numeric_limits<double>::infinity();
+  return std::sqrt(((*T * a) - b).colwise().squaredNorm().mean());
 }
 
 TEST(System, SlamKeyframesAndCorrectionsAreInTheEstimatorsWorld) {
