@@ -33,6 +33,8 @@ std::filesystem::path tool(const std::string& name) {
   return std::filesystem::path(KESTREL_BINARY_DIR) / "bin" / ("kestrel-" + name);
 }
 
+std::filesystem::path source_dir() { return std::filesystem::path(KESTREL_SOURCE_DIR); }
+
 TempDir::TempDir() {
   std::random_device rd;
   const auto base = std::filesystem::temp_directory_path();

@@ -17,6 +17,8 @@ std::filesystem::path tum_sequence(const std::string& name);
 
 /// <build>/bin/kestrel-<tool>.
 std::filesystem::path tool(const std::string& name);
+/// The repository's root (for its scripts, e.g. tools/demo/fly_to_goal).
+std::filesystem::path source_dir();
 
 /// A fresh folder removed at destruction.
 class TempDir {

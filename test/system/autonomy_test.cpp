@@ -1,8 +1,9 @@
-// The whole system flies itself: in the synthetic room, the closed-loop vehicle hovers on the
-// estimator's STATE (VO + IMU), SLAM and the mapper build the map from its camera, and
-// `kestrel goto` asks the planner for a path 1.5 m ahead, which kestrel-follow flies. All the
-// processes run live in a private network, the simulator in lock-step with the VO and the
-// estimator. The vehicle must really get there (ground truth) and the estimator stay right.
+// The whole system flies itself (tools/demo/fly_to_goal, the demo's scenario): in the synthetic
+// room, the closed-loop vehicle hovers on the estimator's STATE (VO + IMU), SLAM and the mapper
+// build the map from its camera, and `kestrel goto` asks the planner for a path 1.5 m ahead,
+// which kestrel-follow flies. All the processes run live in a private network, the simulator
+// in lock-step with the VO and the estimator. The vehicle must really get there (ground truth)
+// and the estimator stay right.
 //
 // This is what found that a hovering vehicle could not plan at all: SLAM anchored its map only
 // at a keyframe (a hover makes one), and the planner required the start in known free space
@@ -40,21 +41,10 @@ TEST(System, TheVehicleFliesToAGoalOnItsOwnMap) {
   if (!test::can_isolate_network()) GTEST_SKIP() << "no network namespace available";
   if (!std::filesystem::exists("/usr/bin/lcm-logger")) GTEST_SKIP() << "lcm-logger is not installed";
   test::TempDir dir;
-  const auto bin = [](const char* name) { return test::tool(name).string(); };
-  const std::string d = dir.path().string();
-  // The sim world's take-off pose is (8, 3.5, 1.3), yaw 0: the estimator is told so, so its
-  // world (and the map's) is the room's; the goal is 1.5 m ahead, in front of the camera.
-  const std::string script =
-      "cd " + d + "; lcm-logger -q -c 'GROUND_TRUTH|STATE|PLAN' " + d + "/run.lcmlog & L=$!; " +
-      bin("vo") + " -q & V=$!; " + bin("estimator") + " -q --init-position 8,3.5,1.3 & E=$!; " + bin("slam") +
-      " -q & S=$!; " + bin("mapper") + " -q --publish-period 1 & M=$!; " + bin("planner") +
-      " --height 1.3 --sensor kinect > planner.txt 2>&1 & P=$!; " + bin("follow") + " > follow.txt 2>&1 & F=$!; " +
-      "sleep 1; " + bin("sim") +
-      " -q --world room --flight vehicle --rate 0 --lockstep 5 --duration 24 > sim.txt 2>&1 & X=$!; " +
-      bin("goto") + " --goal 9.5 3.5 1.3 0 --wait --arrive-radius 0.1 --timeout 90 > goto.txt 2>&1 & G=$!; " +
-      "wait $X; SIM=$?; sleep 1; kill $G 2>/dev/null; wait $G; GOTO=$?; kill -INT $V $E $S $M $P $F $L; wait; " +
-      "echo \"$SIM $GOTO\" > status.txt";
-  const auto r = test::run({bin("isolated"), "--", "sh", "-c", script}, 300.0);
+  // The scenario the demo flies (tools/demo/fly_to_goal): goal 1.5 m ahead of the take-off pose.
+  const auto r = test::run({"bash", (test::source_dir() / "tools/demo/fly_to_goal").string(),
+                            test::tool("sim").parent_path().string(), dir.path().string(), "9.5", "3.5", "1.3", "0"},
+                           300.0);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const std::string status = read_text(dir / "status.txt");
   const std::string go = read_text(dir / "goto.txt");
@@ -66,7 +56,7 @@ TEST(System, TheVehicleFliesToAGoalOnItsOwnMap) {
   std::map<int64_t, Eigen::Vector3d> true_at;
   double worst_estimate = 0.0;
   int plans = 0;
-  transport::LogReader log((dir / "run.lcmlog").string());
+  transport::LogReader log((dir / "flight.lcmlog").string());
   while (auto e = log.next()) {
     const auto& data = e->data;
     if (e->channel == channel::kGroundTruth) {
