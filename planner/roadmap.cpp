@@ -13,13 +13,15 @@ std::vector<BeliefStep> BeliefModel::steps(const Config& a, const Config& b) con
   const Eigen::Vector3d d = position(b) - position(a);
   const double len = d.norm();
   if (!(len > 0.0)) return out;
-  const int n = std::max(1, static_cast<int>(std::ceil(len / motion_.step_m)));
-  const double yaw = d.head<2>().norm() > 1e-9 ? std::atan2(d.y(), d.x()) : b[3];
+  const double turn = wrap_angle(b[3] - a[3]);
+  const int n = std::max({1, static_cast<int>(std::ceil(len / motion_.step_m)),
+                          static_cast<int>(std::ceil(std::abs(turn) / motion_.step_rad))});
   const Eigen::Vector4d variances = motion_.variance_per_m * (len / n);
   out.reserve(n);
   for (int k = 1; k <= n; ++k) {
+    const double f = static_cast<double>(k) / n;
     Config q;
-    q << position(a) + d * (static_cast<double>(k) / n), yaw;
+    q << position(a) + d * f, wrap_angle(a[3] + f * turn);
     BeliefStep s;
     s.G = Mat4::Identity();
     s.R = estimator::process_noise_diagonal(Mat4::Identity(), variances);

@@ -3,8 +3,10 @@
 // edges between nodes closer than a radius, and for BRM each directed edge's transfer
 // function, computed once when the graph is built.
 //
-// Along an edge the vehicle moves in steps of at most `step_m`, facing its direction of
-// travel (so a forward-looking sensor looks where it flies); each step adds process noise
+// An edge is the straight line in C = R^3 x S^1, flown as the follower (control/) flies a
+// plan: the position moves linearly and the yaw turns from one node's yaw to the other's the
+// shortest way round, so a node's sampled yaw is where its sensor looks. The line is cut
+// into steps of at most `step_m` and `step_rad`; each step adds process noise
 // R = V W V^T with W proportional to the distance flown (estimator/information.h), G = I for
 // the holonomic model, and gathers the sensor's information at the step's end.
 
@@ -19,6 +21,7 @@ namespace kestrel::planner {
 
 struct MotionOptions {
   double step_m = 0.25;
+  double step_rad = 0.25;  ///< yaw turned per step at most (under the paper camera's 30 deg field of view)
   /// Variance added per metre flown, per coordinate (x, y, z: m^2/m; yaw: rad^2/m).
   Eigen::Vector4d variance_per_m = Eigen::Vector4d(0.5, 0.5, 0.1, 0.05);
 };
