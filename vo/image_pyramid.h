@@ -37,6 +37,11 @@ class ImagePyramid {
   std::vector<uint16_t> row_, column_;  // filter scratch
 };
 
+/// R,G,B (CV_8UC3) -> grey (CV_8UC1), (77 R + 150 G + 29 B + 128) >> 8; SSE2 where available.
+void rgb_to_grey(const cv::Mat& rgb, cv::Mat& grey);
+/// The same with the portable scalar loop only (the reference the SSE2 path is tested against).
+void rgb_to_grey_scalar(const cv::Mat& rgb, cv::Mat& grey);
+
 /// Integer Gaussian weights of radius max(1, ceil(2 sigma)) summing to 64.
 void gaussian_kernel_64(double sigma, std::vector<int>& weights);
 

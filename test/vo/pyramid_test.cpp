@@ -42,6 +42,34 @@ TEST(Pyramid, MatchesOpenCvGreyBlurAndHalvings) {
   }
 }
 
+TEST(Pyramid, GreyConversionEqualsTheScalarFormulaOnRandomImagesOfAnyWidth) {
+  cv::RNG rng(11);
+  // Widths below, at and around the 32-pixel SIMD block, odd ones, and VGA; a region of
+  // interest so that rows are not contiguous.
+  for (int w : {1, 7, 31, 32, 33, 63, 64, 65, 97, 641}) {
+    cv::Mat big(5, w + 3, CV_8UC3);
+    rng.fill(big, cv::RNG::UNIFORM, 0, 256);
+    big.at<cv::Vec3b>(0, 0) = cv::Vec3b(255, 255, 255);  // the largest sum, 65408
+    const cv::Mat rgb = big(cv::Rect(1, 0, w, 5));
+    cv::Mat fast, scalar;
+    rgb_to_grey(rgb, fast);
+    rgb_to_grey_scalar(rgb, scalar);
+    ASSERT_EQ(fast.size(), rgb.size());
+    ASSERT_EQ(fast.type(), CV_8UC1);
+    EXPECT_EQ(cv::countNonZero(fast != scalar), 0) << "width " << w;
+    for (int y = 0; y < rgb.rows; ++y) {
+      for (int x = 0; x < w; ++x) {
+        const cv::Vec3b p = rgb.at<cv::Vec3b>(y, x);
+        ASSERT_EQ(int(fast.at<uint8_t>(y, x)), (77 * p[0] + 150 * p[1] + 29 * p[2] + 128) >> 8)
+            << "width " << w << " at " << x << "," << y;
+      }
+    }
+  }
+  cv::Mat white(1, 40, CV_8UC3, cv::Scalar(255, 255, 255)), grey;
+  rgb_to_grey(white, grey);
+  EXPECT_EQ(cv::countNonZero(grey != 255), 0);
+}
+
 TEST(Pyramid, KernelSumsTo64AndIsSymmetric) {
   std::vector<int> k;
   gaussian_kernel_64(0.85, k);
