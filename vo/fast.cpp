@@ -68,6 +68,20 @@ int detect_row_scalar(const uint8_t* row, int width, int stride, int threshold,
 }
 
 #if defined(__SSE2__)
+// Per byte lane: the largest, over the 16 arcs of 9 contiguous circle pixels, of the arc's
+// minimum of x_k (sliding minima over 2, 4, 8, then 9; the circle wraps).
+inline __m128i best_arc9(const __m128i (&x)[16]) {
+  __m128i m2[16], m4[16];
+  for (int k = 0; k < 16; ++k) m2[k] = _mm_min_epu8(x[k], x[(k + 1) & 15]);
+  for (int k = 0; k < 16; ++k) m4[k] = _mm_min_epu8(m2[k], m2[(k + 2) & 15]);
+  __m128i best = _mm_setzero_si128();
+  for (int k = 0; k < 16; ++k) {
+    const __m128i m8 = _mm_min_epu8(m4[k], m4[(k + 4) & 15]);
+    best = _mm_max_epu8(best, _mm_min_epu8(m8, x[(k + 8) & 15]));
+  }
+  return best;
+}
+
 int detect_row_sse2(const uint8_t* row, int width, int stride, int threshold,
                     const std::array<int, 16>& off, int16_t* columns, uint8_t* scores) {
   // The bounds centre +- t are formed with unsigned saturation (nothing is brighter than 255
@@ -75,7 +89,7 @@ int detect_row_sse2(const uint8_t* row, int width, int stride, int threshold,
   // signed after flipping the top bit, SSE2 having no unsigned byte comparison.
   const __m128i flip = _mm_set1_epi8(static_cast<char>(0x80));
   const __m128i t = _mm_set1_epi8(static_cast<char>(static_cast<uint8_t>(threshold)));
-  const __m128i eight = _mm_set1_epi8(8);
+  const __m128i one = _mm_set1_epi8(1);
   int n = 0;
   int x = 3;
   for (; x + 16 <= width - 3; x += 16) {
@@ -99,23 +113,28 @@ int detect_row_sse2(const uint8_t* row, int width, int stride, int threshold,
                                      _mm_or_si128(_mm_and_si128(d8, d12), _mm_and_si128(d12, d0))));
     if (_mm_movemask_epi8(m) == 0) continue;
 
-    // Longest run of brighter / darker pixels around the circle (25 = 16 + 8 to wrap).
-    __m128i run_b = _mm_setzero_si128(), run_d = _mm_setzero_si128();
-    __m128i max_run = _mm_setzero_si128();
-    for (int k = 0; k < 25; ++k) {
-      const __m128i v = load(k & 15);
-      const __m128i mb = _mm_cmpgt_epi8(v, hi);
-      const __m128i md = _mm_cmpgt_epi8(lo, v);
-      run_b = _mm_and_si128(_mm_sub_epi8(run_b, mb), mb);  // +1 where brighter, else 0
-      run_d = _mm_and_si128(_mm_sub_epi8(run_d, md), md);
-      max_run = _mm_max_epu8(max_run, _mm_max_epu8(run_b, run_d));
-    }
-    int bits = _mm_movemask_epi8(_mm_cmpgt_epi8(max_run, eight));
+    // The score of all 16 pixels at once, in unsigned bytes: with b_k = max(circle_k - c, 0)
+    // and d_k = max(c - circle_k, 0) (saturating subtractions), the best arc's
+    // max(min b, min d) is fast9_score() + 1, and the pixel is a corner exactly when that
+    // exceeds the threshold (circle_k > c + t with c + t saturated at 255 is circle_k - c > t).
+    __m128i v[16];
+    for (int k = 0; k < 16; ++k)
+      v[k] = _mm_loadu_si128(reinterpret_cast<const __m128i*>(p + off[static_cast<size_t>(k)]));
+    __m128i side[16];
+    for (int k = 0; k < 16; ++k) side[k] = _mm_subs_epu8(v[k], c);
+    const __m128i best_b = best_arc9(side);
+    for (int k = 0; k < 16; ++k) side[k] = _mm_subs_epu8(c, v[k]);
+    const __m128i best = _mm_max_epu8(best_b, best_arc9(side));
+    const __m128i not_corner = _mm_cmpeq_epi8(_mm_subs_epu8(best, t), _mm_setzero_si128());
+    int bits = ~_mm_movemask_epi8(not_corner) & 0xFFFF;
+    if (bits == 0) continue;
+    // Scores (best - 1) of the corners, 0 elsewhere, as the non-maximum suppression expects.
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(scores + x),
+                     _mm_andnot_si128(not_corner, _mm_sub_epi8(best, one)));
     while (bits != 0) {
       const int i = __builtin_ctz(static_cast<unsigned>(bits));
       bits &= bits - 1;
       columns[n++] = static_cast<int16_t>(x + i);
-      scores[x + i] = static_cast<uint8_t>(fast9_score(p + i, stride));
     }
   }
   for (; x < width - 3; ++x) {

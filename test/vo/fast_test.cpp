@@ -70,6 +70,36 @@ TEST(Fast, MatchesOpenCvOnNoiseOfOddWidth) {
   for (int t : {5, 15, 30}) expect_same_as_opencv(image, t, true);
 }
 
+TEST(Fast, SimdCornersAndScoresEqualTheScalarOnesAtAnyThreshold) {
+  // The SSE2 path scores 16 pixels at once in saturating bytes; the scalar one calls
+  // fast9_score() per corner. Raw (unblurred) noise of full contrast has corners up to the
+  // highest thresholds; an odd width and a region of interest (row stride != width) too.
+  cv::Mat raw(61, 150, CV_8UC1);
+  cv::RNG(3).fill(raw, cv::RNG::UNIFORM, 0, 256);
+  raw.at<uint8_t>(30, 40) = 255;
+  raw.at<uint8_t>(30, 60) = 0;
+  const cv::Mat roi = raw(cv::Rect(2, 1, 133, 59));
+  for (int t : {1, 2, 17, 60, 128, 200, 254}) {
+    for (bool nonmax : {false, true}) {
+      std::vector<FastCorner> simd, scalar;
+      FastScratch scratch;
+      detect_fast9(roi, t, nonmax, simd, scratch);
+      detect_fast9_scalar(roi, t, nonmax, scalar, scratch);
+      ASSERT_EQ(simd.size(), scalar.size()) << "threshold " << t << " nonmax " << nonmax;
+      for (size_t i = 0; i < simd.size(); ++i) {
+        ASSERT_EQ(simd[i].x, scalar[i].x) << t << " " << i;
+        ASSERT_EQ(simd[i].y, scalar[i].y) << t << " " << i;
+        ASSERT_EQ(simd[i].score, scalar[i].score) << t << " " << i;
+        ASSERT_EQ(simd[i].score, fast9_score(roi.ptr<uint8_t>(simd[i].y) + simd[i].x, int(roi.step[0])));
+        ASSERT_GE(simd[i].score, t);
+      }
+      if (t <= 60) {
+        EXPECT_GT(simd.size(), 10u) << "threshold " << t;
+      }
+    }
+  }
+}
+
 TEST(Fast, ExtremeIntensitiesSaturateLikeTheScalarTest) {
   // A white dot on black and a black dot on white are corners at any threshold below 255.
   cv::Mat image(32, 48, CV_8UC1, cv::Scalar(0));
