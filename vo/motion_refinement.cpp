@@ -39,14 +39,19 @@ struct Accumulator {
   int residuals = 0;
 };
 
-// H += w * J^T J on the upper triangle, written out: Eigen's rankUpdate takes its general
-// matrix-product path for these tiny sizes, several times slower.
+// H += w * J^T J, written out: Eigen's rankUpdate takes its general matrix-product path for
+// these tiny sizes, several times slower. Only the upper triangle is read (full()); the whole
+// matrix is updated because fixed-length columns vectorise and a triangle's ragged loops did
+// not, and each upper entry still sees exactly the same operations in the same order.
 template <int Rows>
 void rank_update(Matrix6d& H, const Eigen::Matrix<double, Rows, 6>& J, double w) {
+  double* h = H.data();  // column-major
   for (int r = 0; r < Rows; ++r) {
+    double col[6];
+    for (int i = 0; i < 6; ++i) col[i] = J(r, i);
     for (int j = 0; j < 6; ++j) {
       const double a = w * J(r, j);
-      for (int i = 0; i <= j; ++i) H(i, j) += a * J(r, i);
+      for (int i = 0; i < 6; ++i) h[6 * j + i] += a * col[i];
     }
   }
 }

@@ -25,4 +25,10 @@ SubpixelResult refine_subpixel(const cv::Mat& ref, const Eigen::Vector2i& ref_px
                                const Eigen::Vector2f& cur_start, int window, float max_shift,
                                int max_iterations = 6);
 
+/// The same with the portable scalar sums only (refine_subpixel's SSE2 sums equal them bit for
+/// bit; tests hold it to that).
+SubpixelResult refine_subpixel_scalar(const cv::Mat& ref, const Eigen::Vector2i& ref_px, const cv::Mat& cur,
+                                      const Eigen::Vector2f& cur_start, int window, float max_shift,
+                                      int max_iterations = 6);
+
 }  // namespace kestrel::vo

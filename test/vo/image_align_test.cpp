@@ -94,6 +94,42 @@ TEST(Subpixel, FindsAKnownShiftToFiveHundredthsOfAPixel) {
   EXPECT_GE(within, tested * 9 / 10) << within << " of " << tested << " within 0.05 px";
 }
 
+TEST(Subpixel, SimdSumsEqualTheScalarOnesBitForBit) {
+  // refine_subpixel's SSE2 path (rows converted once, sums four pixels at a time) must give
+  // exactly the scalar reference's answer, for every window size and on textures from smooth
+  // to raw noise, including starts that converge, wander off or leave the image.
+  const PinholeCamera cam = test::test_camera();
+  const cv::Mat smooth_ref = blob_image(cam, Eigen::Matrix3d::Identity(), {0, 0});
+  const cv::Mat smooth_cur = blob_image(cam, Eigen::Matrix3d::Identity(), {0.37, -0.21});
+  cv::Mat noise_ref(120, 161, CV_8UC1), noise_cur;
+  cv::RNG(5).fill(noise_ref, cv::RNG::UNIFORM, 0, 256);
+  cv::GaussianBlur(noise_ref, noise_cur, cv::Size(3, 3), 0.6);
+  const std::vector<std::pair<cv::Mat, cv::Mat>> pairs{{smooth_ref, smooth_cur}, {noise_ref, noise_cur}};
+  std::mt19937 rng(9);
+  int compared = 0, converged = 0;
+  for (const auto& [ref, cur] : pairs) {
+    std::uniform_int_distribution<int> px(0, ref.cols - 1), py(0, ref.rows - 1);
+    std::uniform_real_distribution<float> jitter(-1.2f, 1.2f);
+    for (int window = 3; window <= 15; window += 2) {
+      for (int k = 0; k < 150; ++k) {
+        const Eigen::Vector2i at(px(rng), py(rng));
+        const Eigen::Vector2f start(float(at.x()) + jitter(rng), float(at.y()) + jitter(rng));
+        const SubpixelResult a = refine_subpixel(ref, at, cur, start, window, 1.5f);
+        const SubpixelResult b = refine_subpixel_scalar(ref, at, cur, start, window, 1.5f);
+        ASSERT_EQ(a.ok, b.ok) << window << " " << at.transpose();
+        ASSERT_EQ(a.iterations, b.iterations) << window << " " << at.transpose();
+        ASSERT_EQ(a.position.x(), b.position.x()) << window << " " << at.transpose();
+        ASSERT_EQ(a.position.y(), b.position.y()) << window << " " << at.transpose();
+        ASSERT_EQ(a.rms_error, b.rms_error) << window << " " << at.transpose();
+        ++compared;
+        converged += a.ok;
+      }
+    }
+  }
+  EXPECT_GT(converged, compared / 4) << "too few refinements succeeded to compare";
+  EXPECT_LT(converged, compared) << "some should fail (image border, shift limit)";
+}
+
 TEST(Subpixel, FailsWithoutMovingWhenThePatchLeavesTheImage) {
   const cv::Mat image(40, 40, CV_8UC1, cv::Scalar(100));
   const SubpixelResult r = refine_subpixel(image, Eigen::Vector2i(2, 2), image, Eigen::Vector2f(2, 2), 9, 1.5f);
