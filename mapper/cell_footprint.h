@@ -62,6 +62,8 @@ class FootprintProjector {
   /// Upper bound of the distance between OctoMap's float ray and the exact pixel line,
   /// apart from the 1e-6 relative error of the direction.
   double line_error() const { return line_error_; }
+  /// How far the cell is grown on each side for the footprint (covers every rounding).
+  double margin() const { return margin_; }
 
   /// False if no ray through the pixels of tile (ti, tj) can pass through the sphere around
   /// the cell (the tile's cone of directions and the sphere's cone do not overlap).

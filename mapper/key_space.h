@@ -30,10 +30,15 @@ class KeySpace {
 
   /// The key along one axis; false outside the tree (or for a non-finite coordinate).
   bool key(double coordinate, uint16_t& k) const {
-    const double scaled = std::floor(factor_ * coordinate);
-    // The negated comparison also rejects NaN before the cast, which would be undefined.
+    const double scaled = factor_ * coordinate;
+    // floor(s) >= -kMaxVal iff s >= -kMaxVal, and floor(s) < kMaxVal iff s < kMaxVal, so the
+    // range is checked before flooring; the negated comparison also rejects NaN before the
+    // cast, which would be undefined. Then floor is the truncation, minus one for a negative
+    // non-integer (std::floor is a long instruction sequence on the baseline x86-64 target).
     if (!(scaled >= -kMaxVal && scaled < kMaxVal)) return false;
-    k = static_cast<uint16_t>(static_cast<int>(scaled) + kMaxVal);
+    int floored = static_cast<int>(scaled);
+    floored -= static_cast<int>(scaled < static_cast<double>(floored));
+    k = static_cast<uint16_t>(floored + kMaxVal);
     return true;
   }
   bool key(const octomap::point3d& p, Key& k) const {

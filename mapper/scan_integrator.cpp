@@ -12,6 +12,8 @@ namespace kestrel::mapper {
 
 namespace {
 constexpr int kTile = kTilePixels;
+constexpr int kTileLevel = 2;  // the reach pyramid's level of kTile-pixel squares
+static_assert(kTile == 1 << kTileLevel);
 constexpr int kNear = 2;  // the (2 kNear + 1)^2 pixels around the centre are tried first
 }  // namespace
 
@@ -32,14 +34,13 @@ ScanIntegrator::ScanIntegrator(double resolution_m, const ScanOptions& options)
   cells_.assign(static_cast<size_t>(side_) * side_ * side_, 0);
 }
 
-int ScanIntegrator::index(const Key& key) const {
+inline int ScanIntegrator::index(const Key& key) const {
   const int x = key[0] - base_[0], y = key[1] - base_[1], z = key[2] - base_[2];
   if (x < 0 || y < 0 || z < 0 || x >= side_ || y >= side_ || z >= side_) return -1;
   return x + side_ * (y + side_ * z);
 }
 
-void ScanIntegrator::mark(const Key& key, uint8_t flags) {
-  const int idx = index(key);
+inline void ScanIntegrator::mark(int idx, const Key& key, uint8_t flags) {
   if (idx < 0) return;  // cannot happen: every marked cell is within max range
   uint8_t& f = cells_[static_cast<size_t>(idx)];
   if (f == 0) touched_.emplace_back(idx, key);
@@ -67,10 +68,38 @@ void ScanIntegrator::begin(const Scan& scan) {
   reach_.assign(n, 0.0f);
   s_end_lo_.assign(n, 0.0f);
   end_cell_.assign(n, -1);
-  const int tiles_x = (scan.cols + kTile - 1) / kTile;
-  const int tiles_y = (scan.rows + kTile - 1) / kTile;
-  tile_reach_.assign(static_cast<size_t>(tiles_x) * tiles_y, 0.0f);
   begin_pixels(scan);
+  reach_max_.build(reach_.data(), scan.cols, scan.rows);
+  begin_axis_parts(scan);
+}
+
+void ScanIntegrator::begin_axis_parts(const Scan& scan) {
+  const Eigen::Matrix3d R_camera_world = scan.T_world_camera.linear().transpose();
+  const Eigen::Vector3d t_camera_world = -R_camera_world * scan.T_world_camera.translation();
+  const double origin[3] = {static_cast<double>(scan.origin.x()), static_cast<double>(scan.origin.y()),
+                            static_cast<double>(scan.origin.z())};
+  quick_margin_ = projector_.margin();
+  box_half_ = R_camera_world.cwiseAbs().rowwise().sum() *
+              ((0.5 * keys_.resolution() + quick_margin_) * (1.0 + 1e-9));
+  for (int a = 0; a < 3; ++a) {
+    std::vector<AxisPart>& parts = axis_part_[a];
+    parts.resize(static_cast<size_t>(side_));
+    for (int g = 0; g < side_; ++g) {
+      const uint16_t k = static_cast<uint16_t>(base_[a] + g);
+      AxisPart& part = parts[static_cast<size_t>(g)];
+      const Eigen::Vector3d c = R_camera_world.col(a) * keys_.centre(k) + (a == 0 ? t_camera_world : Eigen::Vector3d::Zero());
+      for (int r = 0; r < 3; ++r) part.camera[r] = c[r];
+      // As FootprintProjector::footprint()'s min_reach, regrouped: exit2 = sum of gap2 + min over
+      // the axes of (exit2 along the axis - its gap2).
+      const double lo = keys_.lower(k), hi = keys_.upper(k);
+      const double gap = std::max({lo - origin[a], origin[a] - hi, 0.0});
+      double exit2 = std::numeric_limits<double>::infinity();
+      if (origin[a] < hi) exit2 = std::min(exit2, (hi - origin[a]) * (hi - origin[a]));
+      if (origin[a] > lo) exit2 = std::min(exit2, (origin[a] - lo) * (origin[a] - lo));
+      part.gap2 = gap * gap;
+      part.exit_minus_gap2 = exit2 - part.gap2;
+    }
+  }
 }
 
 void ScanIntegrator::begin_pixels(const Scan& scan) {
@@ -85,9 +114,8 @@ void ScanIntegrator::begin_pixels(const Scan& scan) {
   const double edge = KeySpace::kMaxVal * keys_.resolution() - max_range - 1.0;
   bool witness_ok = true;
   for (int a = 0; a < 3; ++a) witness_ok = witness_ok && std::fabs(static_cast<double>(scan.origin(a))) < edge;
-  const int tiles_x = (scan.cols + kTile - 1) / kTile;
+  int last_hit = -1;
   for (int v = 0; v < scan.rows; ++v) {
-    float* tile_row = &tile_reach_[static_cast<size_t>(v / kTile) * tiles_x];
     for (int u = 0; u < scan.cols; ++u) {
       const size_t i = static_cast<size_t>(v) * scan.cols + u;
       if (!scan.valid[i]) continue;
@@ -101,8 +129,13 @@ void ScanIntegrator::begin_pixels(const Scan& scan) {
       if (range <= max_range) {
         Key k;
         if (!keys_.key(p, k)) continue;  // OctoMap drops such a point altogether
-        mark(k, kOccupied);
-        end_cell_[i] = index(k);
+        // Neighbouring pixels mostly hit the same cell: mark it once.
+        const int idx = index(k);
+        if (idx != last_hit) {
+          mark(idx, k, kOccupied);
+          last_hit = idx;
+        }
+        end_cell_[i] = idx;
         s_end = depth - 4.0 * line - 1e-6 * range;
       } else if (depth > 0.0) {
         const double dir_norm = range / depth * (1.0 + 1e-6);
@@ -111,13 +144,11 @@ void ScanIntegrator::begin_pixels(const Scan& scan) {
       if (witness_ok && s_end > 0.0) s_end_lo_[i] = static_cast<float>(s_end * (1.0 - 1e-6));
       const float reach = static_cast<float>(std::min(range, max_range) * (1.0 + 1e-6) + 1e-6);
       reach_[i] = reach;
-      float& tile = tile_row[u / kTile];
-      tile = std::max(tile, reach);
     }
   }
 }
 
-ScanIntegrator::RayCache& ScanIntegrator::ray(size_t sample) {
+inline ScanIntegrator::RayCache& ScanIntegrator::ray(size_t sample) {
   RayCache& r = rays_[sample];
   if (r.epoch != epoch_) {
     r.ray = make_ray(keys_, scan_->origin, key_origin_, scan_->points[sample], options_.max_range_m);
@@ -128,7 +159,7 @@ ScanIntegrator::RayCache& ScanIntegrator::ray(size_t sample) {
   return r;
 }
 
-void ScanIntegrator::set_cleared(int idx, const Key& key) {
+inline void ScanIntegrator::set_cleared(int idx, const Key& key) {
   uint8_t& f = cells_[static_cast<size_t>(idx)];
   if (f & kCleared) return;
   if (f == 0) touched_.emplace_back(idx, key);
@@ -136,14 +167,14 @@ void ScanIntegrator::set_cleared(int idx, const Key& key) {
   queue_.push_back({idx, key});
 }
 
-bool ScanIntegrator::witness_clears(const Key& cell) {
+inline bool ScanIntegrator::witness_clears(const Key& cell) {
   int u = 0, v = 0;
   if (!projector_.centre_pixel(cell, u, v)) return false;
   const float s_end = s_end_lo_[static_cast<size_t>(v) * scan_->cols + u];
   return s_end > 0.0f && projector_.certainly_clears(cell, u, v, s_end);
 }
 
-void ScanIntegrator::trace_sample(size_t sample) {
+inline void ScanIntegrator::trace_sample(size_t sample) {
   RayCache& r = ray(sample);
   if (r.traced) return;
   r.traced = true;
@@ -154,7 +185,7 @@ void ScanIntegrator::trace_sample(size_t sample) {
   });
 }
 
-bool ScanIntegrator::try_ray(size_t sample, const Key& cell, int idx) {
+inline bool ScanIntegrator::try_ray(size_t sample, const Key& cell, int idx) {
   RayCache& r = ray(sample);
   if (r.traced) return false;  // its cells are marked already
   ++ray_tests_;
@@ -173,23 +204,56 @@ bool ScanIntegrator::try_ray(size_t sample, const Key& cell, int idx) {
   return false;
 }
 
+inline bool ScanIntegrator::some_ray_may_reach(const Key& cell) const {
+  // No pixel in (a rectangle around) the cell's image has a ray reaching the cell's exit: the
+  // common case behind surfaces and beside the image. Then cleared_by_some_ray() is false too
+  // (every ray it accepts has a pixel in footprint(cell) and reach >= min_reach); this test
+  // costs a tenth of a footprint.
+  const AxisPart& x = axis_part_[0][static_cast<size_t>(cell[0] - base_[0])];
+  const AxisPart& y = axis_part_[1][static_cast<size_t>(cell[1] - base_[1])];
+  const AxisPart& z = axis_part_[2][static_cast<size_t>(cell[2] - base_[2])];
+  // The cell's centre in the camera frame, and the camera-frame box around the grown cell.
+  const double cx = x.camera[0] + y.camera[0] + z.camera[0];
+  const double cy = x.camera[1] + y.camera[1] + z.camera[1];
+  const double cz = x.camera[2] + y.camera[2] + z.camera[2];
+  const double z_near = cz - box_half_.z(), z_far = cz + box_half_.z();
+  // A camera within 2 margins of the cell makes footprint() give the whole image; such a cell
+  // reaches nearer than 2 sqrt(3) margins in depth, so it never passes this.
+  if (!(z_near > 4.0 * quick_margin_)) return true;
+  const PinholeCamera& cam = scan_->camera;
+  // x / z over the box: the smallest with the smallest x (over the far depth if x >= 0), the
+  // largest with the largest x (over the near depth if x >= 0); 1e-6 pixel on each side covers
+  // the rounding against footprint()'s corner projections. Clamped to just outside the image,
+  // then floored by truncating a positive number (the rectangle may gain a column or row).
+  const double inv_near = 1.0 / z_near, inv_far = 1.0 / z_far;
+  const double x_lo = cx - box_half_.x(), x_hi = cx + box_half_.x();
+  const double y_lo = cy - box_half_.y(), y_hi = cy + box_half_.y();
+  const double cols = scan_->cols, rows = scan_->rows;
+  const double u_lo = std::max(cam.fx * x_lo * (x_lo >= 0.0 ? inv_far : inv_near) + cam.cx - 1e-6, -2.0);
+  const double u_hi = std::min(cam.fx * x_hi * (x_hi >= 0.0 ? inv_near : inv_far) + cam.cx + 1e-6, cols + 1.0);
+  const double v_lo = std::max(cam.fy * y_lo * (y_lo >= 0.0 ? inv_far : inv_near) + cam.cy - 1e-6, -2.0);
+  const double v_hi = std::min(cam.fy * y_hi * (y_hi >= 0.0 ? inv_near : inv_far) + cam.cy + 1e-6, rows + 1.0);
+  if (!(u_lo <= u_hi && v_lo <= v_hi)) return false;
+  const int i0 = std::max(static_cast<int>(u_lo + 3.0) - 3, 0);
+  const int i1 = std::min(static_cast<int>(u_hi + 3.0) - 3, scan_->cols - 1);
+  const int j0 = std::max(static_cast<int>(v_lo + 3.0) - 3, 0);
+  const int j1 = std::min(static_cast<int>(v_hi + 3.0) - 3, scan_->rows - 1);
+  if (i0 > i1 || j0 > j1) return false;
+  // A lower bound of footprint(cell).min_reach (regrouped sums round differently: 1e-7 m
+  // below covers that, and float rounding is monotonic).
+  const double exit2 = x.gap2 + y.gap2 + z.gap2 +
+                       std::min({x.exit_minus_gap2, y.exit_minus_gap2, z.exit_minus_gap2});
+  const float min_reach = static_cast<float>(std::sqrt(exit2) - quick_margin_ - 1e-7);
+  return reach_max_.any_at_least(i0, i1, j0, j1, min_reach);
+}
+
 bool ScanIntegrator::cleared_by_some_ray(const Key& cell, int idx) {
   const CellFootprint f = projector_.footprint(cell);
   if (f.empty()) return false;
   const int cols = scan_->cols;
-  const int tiles_x = (cols + kTile - 1) / kTile;
   const int tj0 = f.j0 / kTile, tj1 = f.j1 / kTile, ti0 = f.i0 / kTile, ti1 = f.i1 / kTile;
-  // No ray in the cell's image reaches the cell's far side: the common case behind surfaces.
-  bool reaches = false;
-  for (int tj = tj0; tj <= tj1 && !reaches; ++tj) {
-    for (int ti = ti0; ti <= ti1; ++ti) {
-      if (tile_reach_[static_cast<size_t>(tj) * tiles_x + ti] >= f.min_reach) {
-        reaches = true;
-        break;
-      }
-    }
-  }
-  if (!reaches) return false;
+  // No ray in the cell's image reaches the cell's far side.
+  if (!reach_max_.any_at_least(f.i0, f.i1, f.j0, f.j1, f.min_reach)) return false;
   // Rays near the centre that certainly clear it (the witness missed through a hole in the
   // depth or at the image border); no walk needed.
   const int near_i0 = std::max(f.i0, f.u_centre - kNear), near_i1 = std::min(f.i1, f.u_centre + kNear);
@@ -219,7 +283,7 @@ bool ScanIntegrator::cleared_by_some_ray(const Key& cell, int idx) {
   }
   for (int tj = tj0; tj <= tj1; ++tj) {
     for (int ti = ti0; ti <= ti1; ++ti) {
-      if (tile_reach_[static_cast<size_t>(tj) * tiles_x + ti] < f.min_reach ||
+      if (reach_max_.square(kTileLevel, ti * kTile, tj * kTile) < f.min_reach ||
           !projector_.tile_may_pass(f, ti, tj))
         continue;
       const int pv_end = std::min(f.j1, tj * kTile + kTile - 1);
@@ -261,6 +325,7 @@ void ScanIntegrator::grow_from_origin() {
       if (f == 0) touched_.emplace_back(idx, cell);
       f = static_cast<uint8_t>(f | kTested);
       ++cells_tested_;
+      if (!some_ray_may_reach(cell)) continue;
       if (witness_clears(cell)) {
         ++cells_witnessed_;
         set_cleared(idx, cell);

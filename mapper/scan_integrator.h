@@ -33,6 +33,7 @@
 #include "mapper/cell_footprint.h"
 #include "mapper/key_space.h"
 #include "mapper/options.h"
+#include "mapper/reach_pyramid.h"
 #include "mapper/ray.h"
 #include "mapper/ray_cell_classifier.h"
 #include "mapper/scan.h"
@@ -82,12 +83,14 @@ class ScanIntegrator {
 
   void begin(const Scan& scan);
   void begin_pixels(const Scan& scan);
-  void mark(const Key& key, uint8_t flags);
+  void begin_axis_parts(const Scan& scan);
+  void mark(int idx, const Key& key, uint8_t flags);
   int index(const Key& key) const;
   RayCache& ray(size_t sample);
   void trace_sample(size_t sample);
   void set_cleared(int idx, const Key& key);
   bool witness_clears(const Key& cell);
+  bool some_ray_may_reach(const Key& cell) const;
   bool cleared_by_some_ray(const Key& cell, int idx);
   bool try_ray(size_t sample, const Key& cell, int idx);
   void grow_from_origin();
@@ -116,7 +119,17 @@ class ScanIntegrator {
   std::vector<Pending> queue_;
   std::vector<float> reach_;               // upper bound of each ray's length (0: no ray)
   std::vector<float> s_end_lo_;            // lower bound of its end's camera depth (0: clears nothing)
-  std::vector<float> tile_reach_;          // max of reach_ over 8x8 tiles
+  ReachPyramid reach_max_;                 // max of reach_ over any pixel rectangle
+  // Per axis and grid coordinate (key - base_): the camera-frame part of the cell centre, and
+  // the squared gap to / exit along that axis from the origin (for a cheap min_reach bound).
+  struct AxisPart {
+    double camera[3];
+    double gap2;
+    double exit_minus_gap2;
+  };
+  std::vector<AxisPart> axis_part_[3];
+  Eigen::Vector3d box_half_;               // camera-frame half extents of a grown cell
+  double quick_margin_ = 0.0;
   std::vector<int> end_cell_;              // grid index of each hit's cell (-1: none)
   std::vector<RayCache> rays_;
 };

@@ -1,0 +1,49 @@
+#pragma once
+// The largest value over any pixel rectangle of an image, in a few lookups: for the cell
+// search (scan_integrator.h), "does any ray in this cell's image reach past the cell?" is
+// answered before any pixel or ray is looked at.
+//
+// Level L holds, for every pixel (u, v), the maximum over the square [u, u + 2^L) x
+// [v, v + 2^L) clipped to the image (level 0 is the image). A rectangle whose shorter side is
+// at least 2^L is covered exactly by overlapping level-L squares, about (w / 2^L) (h / 2^L) of
+// them; the squares never reach outside the rectangle, so the answer is the exact maximum,
+// not a bound. Building costs two vectorisable max passes per level over the image.
+//
+// Level kTileLevel at (4 ti, 4 tj) is the maximum over the 4x4 tile (ti, tj).
+
+#include <cstddef>
+#include <vector>
+
+namespace kestrel::mapper {
+
+class ReachPyramid {
+ public:
+  static constexpr int kLevels = 5;  ///< squares of 1, 2, 4, 8, 16 pixels
+
+  /// Rebuilds from `values` (cols * rows, row-major); storage is reused between calls.
+  void build(const float* values, int cols, int rows);
+
+  int cols() const { return cols_; }
+  int rows() const { return rows_; }
+
+  /// Maximum over the square of side 2^level whose top-left pixel is (u, v), clipped.
+  float square(int level, int u, int v) const {
+    return levels_[static_cast<size_t>(level)][static_cast<size_t>(v) * cols_ + u];
+  }
+
+  /// True if some pixel in the inclusive rectangle [i0, i1] x [j0, j1] (non-empty, inside
+  /// the image) holds a value >= threshold; stops at the first square that does.
+  bool any_at_least(int i0, int i1, int j0, int j1, float threshold) const;
+
+  /// The maximum over the rectangle (non-empty, inside the image).
+  float max_over(int i0, int i1, int j0, int j1) const;
+
+ private:
+  int level_for(int w, int h) const;
+
+  int cols_ = 0, rows_ = 0;
+  std::vector<float> levels_[kLevels];
+  std::vector<float> scratch_;
+};
+
+}  // namespace kestrel::mapper

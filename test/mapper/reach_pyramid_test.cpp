@@ -1,0 +1,106 @@
+// The reach pyramid's answers equal a brute-force scan of the rectangle (exact maximum, never a
+// bound below it), and KeySpace::key equals OctoMap's floor-based rule at cell edges, signs and
+// the ends of the key range.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <random>
+#include <vector>
+
+#include "mapper/key_space.h"
+#include "mapper/reach_pyramid.h"
+
+namespace kestrel::mapper {
+namespace {
+
+float brute_max(const std::vector<float>& image, int cols, int i0, int i1, int j0, int j1) {
+  float best = -std::numeric_limits<float>::infinity();
+  for (int v = j0; v <= j1; ++v)
+    for (int u = i0; u <= i1; ++u) best = std::max(best, image[static_cast<size_t>(v) * cols + u]);
+  return best;
+}
+
+TEST(ReachPyramid, KnownSmallImage) {
+  // 5 x 3, one large value at (3, 1).
+  const std::vector<float> image = {1, 2, 3, 4, 5,  //
+                                    6, 7, 8, 30, 9,  //
+                                    0, 0, 0, 0, 0};
+  ReachPyramid p;
+  p.build(image.data(), 5, 3);
+  EXPECT_EQ(p.max_over(0, 4, 0, 2), 30.0f);
+  EXPECT_EQ(p.max_over(0, 2, 0, 2), 8.0f);
+  EXPECT_EQ(p.max_over(4, 4, 0, 2), 9.0f);
+  EXPECT_EQ(p.max_over(0, 4, 2, 2), 0.0f);
+  EXPECT_EQ(p.square(1, 2, 0), 30.0f);  // [2, 4) x [0, 2)
+  EXPECT_EQ(p.square(1, 4, 1), 9.0f);   // clipped at the right and bottom edges
+  EXPECT_EQ(p.square(2, 0, 0), 30.0f);  // [0, 4) x [0, 3)
+  EXPECT_TRUE(p.any_at_least(3, 3, 1, 1, 30.0f));
+  EXPECT_FALSE(p.any_at_least(0, 2, 0, 2, 8.5f));
+  EXPECT_TRUE(p.any_at_least(0, 2, 0, 2, 8.0f));
+}
+
+TEST(ReachPyramid, EqualsBruteForceOnRandomRectangles) {
+  std::mt19937 rng(3);
+  for (const auto& [cols, rows] : {std::pair{128, 96}, std::pair{37, 23}, std::pair{1, 1}, std::pair{640, 480}}) {
+    std::vector<float> image(static_cast<size_t>(cols) * rows);
+    std::uniform_real_distribution<float> value(0.0f, 4.0f);
+    std::bernoulli_distribution hole(0.3);
+    for (float& x : image) x = hole(rng) ? 0.0f : value(rng);
+    ReachPyramid p;
+    p.build(image.data(), cols, rows);
+    // Every square of every level is the exact clipped maximum.
+    for (int level = 0; level < ReachPyramid::kLevels; ++level) {
+      const int side = 1 << level;
+      for (int k = 0; k < 200; ++k) {
+        const int u = std::uniform_int_distribution<int>(0, cols - 1)(rng);
+        const int v = std::uniform_int_distribution<int>(0, rows - 1)(rng);
+        ASSERT_EQ(p.square(level, u, v),
+                  brute_max(image, cols, u, std::min(u + side, cols) - 1, v, std::min(v + side, rows) - 1));
+      }
+    }
+    for (int k = 0; k < 2000; ++k) {
+      std::uniform_int_distribution<int> cu(0, cols - 1), cv(0, rows - 1);
+      int i0 = cu(rng), i1 = cu(rng), j0 = cv(rng), j1 = cv(rng);
+      if (k % 3 == 0) i1 = std::min(cols - 1, i0 + k % 7);  // thin ones too
+      if (i0 > i1) std::swap(i0, i1);
+      if (j0 > j1) std::swap(j0, j1);
+      const float truth = brute_max(image, cols, i0, i1, j0, j1);
+      ASSERT_EQ(p.max_over(i0, i1, j0, j1), truth) << cols << "x" << rows << " [" << i0 << "," << i1 << "]x[" << j0 << "," << j1 << "]";
+      ASSERT_TRUE(p.any_at_least(i0, i1, j0, j1, truth));
+      ASSERT_FALSE(p.any_at_least(i0, i1, j0, j1, std::nextafter(truth, 1e9f)));
+    }
+  }
+}
+
+TEST(KeySpace, KeyIsOctomapsFloorRule) {
+  const KeySpace keys(0.1);
+  auto reference = [&](double c, uint16_t& k) {  // OcTreeBaseImpl::coordToKeyChecked
+    const int scaled = static_cast<int>(std::floor(10.0 * c)) + 32768;
+    if (scaled < 0 || scaled >= 65536) return false;
+    k = static_cast<uint16_t>(scaled);
+    return true;
+  };
+  std::vector<double> coords = {0.0, -0.0, 0.05, -0.05, 0.1, -0.1, 1.0, -1.0, 0.3, -0.3, 1e-300, -1e-300,
+                                -3276.8, -3276.8 - 1e-9, 3276.7, 3276.8 - 1e-9, 3276.8, 1e6, -1e6};
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> any(-4000.0, 4000.0);
+  for (int i = 0; i < 20000; ++i) coords.push_back(i % 2 ? any(rng) : static_cast<double>(static_cast<float>(any(rng) * 1e-3)));
+  for (const double c : coords) {
+    uint16_t mine = 0, theirs = 0;
+    const bool ok = keys.key(c, mine);
+    ASSERT_EQ(ok, reference(c, theirs)) << c;
+    if (ok) {
+      ASSERT_EQ(mine, theirs) << c;
+    }
+  }
+  uint16_t k = 0;
+  EXPECT_FALSE(keys.key(std::numeric_limits<double>::quiet_NaN(), k));
+  EXPECT_FALSE(keys.key(std::numeric_limits<double>::infinity(), k));
+  EXPECT_TRUE(keys.key(-0.05, k));
+  EXPECT_EQ(k, 32767);
+}
+
+}  // namespace
+}  // namespace kestrel::mapper
