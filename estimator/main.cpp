@@ -38,12 +38,7 @@ void report_health(transport::Node& node, const std::optional<EstimatorOutput>& 
 
 int run(const Options& o) {
   std::optional<transport::Node> node;
-  try {
-    node.emplace("estimator", o.lcm_url);
-  } catch (const std::runtime_error& e) {
-    std::cerr << "kestrel-estimator: error: " << e.what() << "\n";
-    return kExitUnavailable;
-  }
+  node.emplace("estimator", o.lcm_url);  // UnavailableError: exit 4
   Estimator estimator(o.estimator);
   int64_t seq = 0;
   node->advertise(channel::kState);

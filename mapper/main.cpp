@@ -38,12 +38,7 @@ int serve(Options& o) {
   mapper::MapNode map(o.node);
 
   std::unique_ptr<transport::Node> node;
-  try {
-    node = std::make_unique<transport::Node>(o.name, o.lcm_url);
-  } catch (const std::runtime_error& e) {
-    spdlog::error("{}", e.what());
-    return kExitUnavailable;
-  }
+  node = std::make_unique<transport::Node>(o.name, o.lcm_url);  // UnavailableError: exit 4
   node->advertise(channel::kMapOctomap);
   node->on_reset([&] { map.reset(); });
   auto publish = [&](const std::optional<octomap_t>& msg) {

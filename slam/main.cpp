@@ -124,12 +124,7 @@ int serve(const Options& o, const SlamOptions& options, std::shared_ptr<const Vo
   if (!o.out.empty() || !o.vo_out.empty()) throw CLI::ValidationError("--out/--vo-out", "only with --tum");
   SlamAdapter adapter(options, std::move(vocabulary), o.adapter);
   std::unique_ptr<transport::Node> node;
-  try {
-    node = std::make_unique<transport::Node>(o.name, o.lcm_url);
-  } catch (const std::runtime_error& e) {
-    spdlog::error("{}", e.what());
-    return kExitUnavailable;
-  }
+  node = std::make_unique<transport::Node>(o.name, o.lcm_url);  // UnavailableError: exit 4
   node->advertise(o.graph_channel);
   node->advertise(o.correction_channel);
   node->on_reset([&] { adapter.reset(); });

@@ -71,12 +71,7 @@ int serve(const Options& o, const vo::VoOptions& options) {
   if (!o.out.empty() || !o.stats.empty()) throw CLI::ValidationError("--out/--stats", "only with --tum");
   vo::VisualOdometry odometry(options);
   std::unique_ptr<transport::Node> node;
-  try {
-    node = std::make_unique<transport::Node>(o.name, o.lcm_url);
-  } catch (const std::runtime_error& e) {
-    spdlog::error("{}", e.what());
-    return kExitUnavailable;
-  }
+  node = std::make_unique<transport::Node>(o.name, o.lcm_url);  // UnavailableError: exit 4
   node->advertise(o.out_channel);
   node->on_reset([&] { odometry.reset(); });
   int64_t frames = 0, ok = 0;

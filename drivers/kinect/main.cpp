@@ -115,12 +115,7 @@ int run(const Options& o) {
     log.close();
   } else {
     std::optional<transport::Node> node;
-    try {
-      node.emplace("kinect", o.lcm_url);
-    } catch (const std::runtime_error& e) {
-      std::cerr << "kestrel-kinect: error: " << e.what() << "\n";
-      return kExitUnavailable;
-    }
+    node.emplace("kinect", o.lcm_url);  // UnavailableError: exit 4
     node->advertise(channel::kCameraRgbd);
     node->advertise(channel::kImu);
     node->set_health(kestrel::process_status_t::STATE_RUNNING, "");

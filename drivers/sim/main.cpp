@@ -184,12 +184,7 @@ int run(const Options& o) {
   if (offline) {
     catch_interrupts();
   } else {
-    try {
-      sinks.node.emplace("sim", o.lcm_url);
-    } catch (const std::runtime_error& e) {
-      std::cerr << "kestrel-sim: error: " << e.what() << "\n";
-      return kExitUnavailable;
-    }
+    sinks.node.emplace("sim", o.lcm_url);  // UnavailableError: exit 4
     for (const char* c : {channel::kCameraRgbd, channel::kImu, channel::kGroundTruth}) sinks.node->advertise(c);
     if (vehicle) {
       sinks.node->subscribe<kestrel::vehicle_command_t>(

@@ -129,12 +129,7 @@ int run(const Options& o) {
     log.close();
   } else {
     std::optional<transport::Node> node;
-    try {
-      node.emplace("tum-play", o.lcm_url);
-    } catch (const std::runtime_error& e) {
-      std::cerr << "kestrel-tum-play: error: " << e.what() << "\n";
-      return kExitUnavailable;
-    }
+    node.emplace("tum-play", o.lcm_url);  // UnavailableError: exit 4
     for (const char* c : {channel::kCameraRgbd, channel::kImu, channel::kGroundTruth}) node->advertise(c);
     node->set_health(kestrel::process_status_t::STATE_RUNNING, "");
     po.rate = o.rate;

@@ -40,12 +40,7 @@ int serve(const Options& o) {
   encoding.zstd_level = o.zstd_level;
   kestrel::codec::RgbdTranscoder transcoder(encoding);
   std::unique_ptr<kestrel::transport::Node> node;
-  try {
-    node = std::make_unique<kestrel::transport::Node>(o.name, o.lcm_url);
-  } catch (const std::runtime_error& e) {
-    spdlog::error("{}", e.what());
-    return kestrel::kExitUnavailable;
-  }
+  node = std::make_unique<kestrel::transport::Node>(o.name, o.lcm_url);  // UnavailableError: exit 4
   node->advertise(o.out_channel);
   node->on_reset([&] { transcoder.reset(); });
   node->subscribe<rgbd_frame_t>(o.in_channel, [&](const rgbd_frame_t& frame) {
