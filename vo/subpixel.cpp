@@ -159,10 +159,8 @@ SubpixelResult refine(const cv::Mat& ref, const Eigen::Vector2i& ref_px, const c
   // No zero-initialisation of the patches (4.6 KB per call): every element read is written
   // first (t and s whole, the gradients on the interior 1..window, the only part read).
   Patch t;
-  for (int y = 0; y < side; ++y) {
-    const uint8_t* row = ref.ptr<uint8_t>(ref_px.y() - half + y) + (ref_px.x() - half);
-    for (int x = 0; x < side; ++x) t[static_cast<size_t>(y * side + x)] = row[x];
-  }
+  for (int y = 0; y < side; ++y)
+    to_float_row<side>(ref.ptr<uint8_t>(ref_px.y() - half + y) + (ref_px.x() - half), t.data() + y * side);
 
   // The template's half of the gradients does not change between iterations.
   Patch tgx, tgy;
