@@ -20,6 +20,7 @@
 #include "common/transport/log_file.h"
 #include "common/transport/node.h"
 #include "common/transport/rgbd_codec.h"
+#include "drivers/sim/contact_watch.h"
 #include "drivers/sim/flights.h"
 #include "drivers/sim/messages.h"
 #include "drivers/sim/simulation.h"
@@ -53,6 +54,7 @@ struct Options {
   double camera_rate_hz = 30.0;
   std::string feedback = "state";
   double lockstep_s = 0.0;
+  double body_radius_m = 0.25;
   bool list = false;
 };
 
@@ -101,6 +103,10 @@ void add_options(cli::App& app, Options& o) {
       ->capture_default_str();
   app.add_option("--camera-rate", o.camera_rate_hz, "Frames per second (the IMU and ground truth stay at 200 Hz)")
       ->check(CLI::Range(0.1, 1000.0))
+      ->capture_default_str();
+  app.add_option("--body-radius", o.body_radius_m,
+                 "Radius of the vehicle's sphere: each time it starts touching the world is reported (m)")
+      ->check(cli::Positive)
       ->capture_default_str();
   app.add_flag("--list", o.list, "List the built-in worlds and the flights, then exit");
 }
@@ -217,6 +223,8 @@ int run(const Options& o) {
     }
   };
 
+  // The simulated vehicle passes through walls: every contact is reported instead.
+  sim::ContactWatch contact(world, o.body_radius_m);
   const int64_t end_utime = so.start_utime + static_cast<int64_t>(o.duration_s * 1e6);
   int64_t frames = 0, imu_samples = 0;
   const auto start = Clock::now();
@@ -224,6 +232,7 @@ int run(const Options& o) {
   while (!stopping()) {
     if (restart) {
       simulation.reset();
+      contact.reset();
       if (vehicle) {
         vehicle->reset();
         loop->set_command(sim::VehicleCommand{});  // hold where it starts
@@ -264,6 +273,10 @@ int run(const Options& o) {
       while (!stopping() && sinks.node->lcm().handleTimeout(0) > 0) {
       }
     if (e.kind == sim::SimEvent::kImu) {
+      const Eigen::Vector3d p = e.truth.T_world_body.translation();
+      if (contact.observe(simulation.seconds(e.utime), p))
+        spdlog::warn("the vehicle touches the world at t = {:.3f} s, ({:.2f}, {:.2f}, {:.2f}) (body radius {} m)",
+                     simulation.seconds(e.utime), p.x(), p.y(), p.z(), o.body_radius_m);
       sinks.publish(channel::kImu, e.utime, transport::encode_message(sim::imu_message(e.utime, e.imu)));
       sinks.publish(channel::kGroundTruth, e.utime,
                     transport::encode_message(sim::ground_truth_message(e.utime, e.truth, &e.imu)));
@@ -288,6 +301,8 @@ int run(const Options& o) {
             << "wall seconds: " << seconds << "\n"
             << "times real time: " << (seconds > 0 ? o.duration_s / seconds : 0.0) << "\n";
   if (o.lockstep_s > 0) std::cout << "lockstep timeouts: " << lockstep_timeouts << "\n";
+  std::cout << "contacts: " << contact.contacts() << "\n"
+            << "min clearance: " << contact.min_clearance_m() << " m\n";
   return stopping() ? kExitInterrupted : kExitOk;
 }
 
