@@ -172,32 +172,73 @@ void ImagePyramid::blur(const cv::Mat& grey, double sigma, cv::Mat& out) {
   if (r == 3) blur_rows<3>(grey, kernel_.data(), out, row_, column_);
 }
 
-void half_size(const cv::Mat& in, cv::Mat& out, std::vector<uint16_t>& row) {
+namespace {
+
+// One row of the halving: the vertical 1-4-6-4-1 into v[0 .. w - 1] (with v[-2], v[-1], v[w],
+// v[w + 1] reflected), then the horizontal one at every other column. From column `from` on
+// the horizontal pass is scalar (all of it in the reference).
+void half_row(const uint8_t* const r[5], int w, uint16_t* v, uint8_t* o, int from) {
+  for (int x = 0; x < w; ++x)
+    v[x] = static_cast<uint16_t>(r[0][x] + r[4][x] + 4 * (r[1][x] + r[3][x]) + 6 * r[2][x]);
+  v[-2] = v[reflect101(-2, w)];
+  v[-1] = v[reflect101(-1, w)];
+  v[w] = v[reflect101(w, w)];
+  v[w + 1] = v[reflect101(w + 1, w)];
+  const int ow = (w + 1) / 2;
+  for (int x = from; x < ow; ++x) {
+    const int c = 2 * x;
+    const unsigned s = v[c - 2] + v[c + 2] + 4u * (v[c - 1] + v[c + 1]) + 6u * v[c];
+    o[x] = static_cast<uint8_t>((s + 128u) >> 8);
+  }
+}
+
+void half_size_impl(const cv::Mat& in, cv::Mat& out, std::vector<uint16_t>& row, bool simd) {
   // 1-4-6-4-1 in both directions, then every other pixel (what cv::pyrDown computes).
   const int w = in.cols, h = in.rows;
   const int ow = (w + 1) / 2, oh = (h + 1) / 2;
   out.create(oh, ow, CV_8UC1);
   row.resize(static_cast<size_t>(w + 4));
+  uint16_t* v = row.data() + 2;  // v[-2 .. w + 1]
+  // Blocks of 8 outputs x0 .. x0 + 7 read v up to 2 x0 + 17 <= w + 1.
+  const int blocks = simd && w >= 16 ? (w - 16) / 16 + 1 : 0;
   for (int y = 0; y < oh; ++y) {
-    const uint8_t* r0 = in.ptr<uint8_t>(reflect101(2 * y - 2, h));
-    const uint8_t* r1 = in.ptr<uint8_t>(reflect101(2 * y - 1, h));
-    const uint8_t* r2 = in.ptr<uint8_t>(reflect101(2 * y, h));
-    const uint8_t* r3 = in.ptr<uint8_t>(reflect101(2 * y + 1, h));
-    const uint8_t* r4 = in.ptr<uint8_t>(reflect101(2 * y + 2, h));
-    uint16_t* v = row.data() + 2;  // v[-2 .. w + 1]
-    for (int x = 0; x < w; ++x)
-      v[x] = static_cast<uint16_t>(r0[x] + r4[x] + 4 * (r1[x] + r3[x]) + 6 * r2[x]);
-    v[-2] = v[reflect101(-2, w)];
-    v[-1] = v[reflect101(-1, w)];
-    v[w] = v[reflect101(w, w)];
-    v[w + 1] = v[reflect101(w + 1, w)];
+    const uint8_t* r[5];
+    for (int i = 0; i < 5; ++i) r[i] = in.ptr<uint8_t>(reflect101(2 * y - 2 + i, h));
     uint8_t* o = out.ptr<uint8_t>(y);
-    for (int x = 0; x < ow; ++x) {
-      const int c = 2 * x;
-      const unsigned s = v[c - 2] + v[c + 2] + 4u * (v[c - 1] + v[c + 1]) + 6u * v[c];
-      o[x] = static_cast<uint8_t>((s + 128u) >> 8);
+#if defined(__SSE2__)
+    half_row(r, w, v, o, 8 * blocks);
+    // The same sums in 16-bit lanes (at most 16 * 4080 + 128 = 65408): E(j) = v[2j] and
+    // O(j) = v[2j + 1] taken apart by packing the low / high halves of 32-bit lanes, then
+    // o[x] = (E(x - 1) + E(x + 1) + 4 (O(x - 1) + O(x)) + 6 E(x) + 128) >> 8.
+    const __m128i low = _mm_set1_epi32(0xFFFF), half = _mm_set1_epi16(128);
+    auto at = [&](int i) { return _mm_loadu_si128(reinterpret_cast<const __m128i*>(v + i)); };
+    auto evens = [&](__m128i a, __m128i b) { return _mm_packs_epi32(_mm_and_si128(a, low), _mm_and_si128(b, low)); };
+    auto odds = [&](__m128i a, __m128i b) { return _mm_packs_epi32(_mm_srli_epi32(a, 16), _mm_srli_epi32(b, 16)); };
+    for (int k = 0; k < blocks; ++k) {
+      const int c = 16 * k;  // 2 x0
+      const __m128i m0 = at(c - 2), m1 = at(c + 6), z0 = at(c), z1 = at(c + 8), p0 = at(c + 2), p1 = at(c + 10);
+      const __m128i em = evens(m0, m1), om = odds(m0, m1), e0 = evens(z0, z1), o0 = odds(z0, z1), ep = evens(p0, p1);
+      const __m128i six_e0 = _mm_add_epi16(_mm_slli_epi16(e0, 2), _mm_slli_epi16(e0, 1));
+      __m128i sum = _mm_add_epi16(_mm_add_epi16(em, ep), _mm_slli_epi16(_mm_add_epi16(om, o0), 2));
+      sum = _mm_add_epi16(_mm_add_epi16(sum, six_e0), half);
+      const __m128i bytes = _mm_packus_epi16(_mm_srli_epi16(sum, 8), _mm_setzero_si128());
+      _mm_storel_epi64(reinterpret_cast<__m128i*>(o + 8 * k), bytes);
     }
+#else
+    (void)blocks;
+    half_row(r, w, v, o, 0);
+#endif
   }
+}
+
+}  // namespace
+
+void half_size(const cv::Mat& in, cv::Mat& out, std::vector<uint16_t>& row) {
+  half_size_impl(in, out, row, true);
+}
+
+void half_size_scalar(const cv::Mat& in, cv::Mat& out, std::vector<uint16_t>& row) {
+  half_size_impl(in, out, row, false);
 }
 
 void ImagePyramid::build(const cv::Mat& image, int levels, double blur_sigma) {

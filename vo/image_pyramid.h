@@ -48,6 +48,8 @@ void gaussian_kernel_64(double sigma, std::vector<int>& weights);
 /// Halves `in` like cv::pyrDown (5-tap 1-4-6-4-1 Gaussian, reflect-101 border, size
 /// ceil(size / 2)); `row` is scratch.
 void half_size(const cv::Mat& in, cv::Mat& out, std::vector<uint16_t>& row);
+/// The same with the portable scalar loops only (half_size's SSE2 path equals it exactly).
+void half_size_scalar(const cv::Mat& in, cv::Mat& out, std::vector<uint16_t>& row);
 
 /// Pixel coordinates of level `level` mapped to level 0 (pixel centres, not corners, scale).
 inline float to_level0(float x, int level) {

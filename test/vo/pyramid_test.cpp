@@ -70,6 +70,31 @@ TEST(Pyramid, GreyConversionEqualsTheScalarFormulaOnRandomImagesOfAnyWidth) {
   EXPECT_EQ(cv::countNonZero(grey != 255), 0);
 }
 
+TEST(Pyramid, HalvingEqualsTheScalarLoopsForAnySize) {
+  // half_size's SSE2 blocks of 8 outputs and its scalar tail against the scalar reference,
+  // for widths around the block edges (16 + 16 k), odd and tiny sizes, and extreme values.
+  cv::RNG rng(13);
+  std::vector<uint16_t> row;
+  for (int w : {1, 2, 3, 15, 16, 17, 18, 31, 32, 33, 34, 47, 48, 49, 50, 81, 640, 641}) {
+    for (int h : {1, 2, 5, 8}) {
+      cv::Mat in(h, w, CV_8UC1);
+      rng.fill(in, cv::RNG::UNIFORM, 0, 256);
+      if (w > 4) in.row(0).colRange(0, w / 2).setTo(255);  // the largest sums
+      cv::Mat fast, scalar;
+      half_size(in, fast, row);
+      half_size_scalar(in, scalar, row);
+      ASSERT_EQ(fast.size(), cv::Size((w + 1) / 2, (h + 1) / 2));
+      ASSERT_EQ(scalar.size(), fast.size());
+      EXPECT_EQ(cv::countNonZero(fast != scalar), 0) << w << "x" << h;
+      if (w >= 5 && h >= 5) {
+        cv::Mat reference;
+        cv::pyrDown(in, reference);
+        EXPECT_EQ(cv::countNonZero(reference != fast), 0) << w << "x" << h << " against cv::pyrDown";
+      }
+    }
+  }
+}
+
 TEST(Pyramid, KernelSumsTo64AndIsSymmetric) {
   std::vector<int> k;
   gaussian_kernel_64(0.85, k);
