@@ -14,7 +14,7 @@ namespace {
 constexpr int kTile = kTilePixels;
 constexpr int kTileLevel = 2;  // the reach pyramid's level of kTile-pixel squares
 static_assert(kTile == 1 << kTileLevel);
-constexpr int kNear = 2;  // the (2 kNear + 1)^2 pixels around the centre are tried first
+constexpr int kNear = 1;  // the (2 kNear + 1)^2 pixels around the centre are tried first
 }  // namespace
 
 void ScanUpdate::clear() {
@@ -58,13 +58,20 @@ void ScanIntegrator::begin(const Scan& scan) {
   stride_[1] = side_;
   stride_[2] = side_ * side_;
   classifier_.emplace(keys_, scan.origin, key_origin_);
-  ++epoch_;
+  built_ += 2;
+  if (built_ < 2) {  // wrapped around (after 2^31 scans): forget every state
+    std::fill(ray_state_.begin(), ray_state_.end(), 0u);
+    built_ = 2;
+  }
   cells_tested_ = cells_witnessed_ = rays_traced_ = ray_tests_ = 0;
   queue_.clear();
   projector_.begin(scan);
 
   const size_t n = scan.points.size();
-  if (rays_.size() < n) rays_.resize(n);
+  if (rays_.size() < n) {
+    rays_.resize(n);
+    ray_state_.resize(n, 0u);
+  }
   reach_.assign(n, 0.0f);
   s_end_lo_.assign(n, 0.0f);
   end_cell_.assign(n, -1);
@@ -150,11 +157,10 @@ void ScanIntegrator::begin_pixels(const Scan& scan) {
 
 inline ScanIntegrator::RayCache& ScanIntegrator::ray(size_t sample) {
   RayCache& r = rays_[sample];
-  if (r.epoch != epoch_) {
+  if (ray_state_[sample] < built_) {
     r.ray = make_ray(keys_, scan_->origin, key_origin_, scan_->points[sample], options_.max_range_m);
     r.bounds = classifier_->bounds(r.ray);
-    r.epoch = epoch_;
-    r.traced = false;
+    ray_state_[sample] = built_;
   }
   return r;
 }
@@ -167,17 +173,34 @@ inline void ScanIntegrator::set_cleared(int idx, const Key& key) {
   queue_.push_back({idx, key});
 }
 
-inline bool ScanIntegrator::witness_clears(const Key& cell) {
+inline bool ScanIntegrator::witness_clears(const Key& cell, float min_reach, bool& tried) {
+  // The ray through the pixel nearest the cell's centre, then the others of the
+  // (2 kNear + 1)^2 around it (the centre's may end in a hole of the depth or before the cell).
+  tried = false;
   int u = 0, v = 0;
   if (!projector_.centre_pixel(cell, u, v)) return false;
-  const float s_end = s_end_lo_[static_cast<size_t>(v) * scan_->cols + u];
-  return s_end > 0.0f && projector_.certainly_clears(cell, u, v, s_end);
+  tried = true;
+  const int cols = scan_->cols;
+  auto clears = [&](int pu, int pv) {
+    const size_t s = static_cast<size_t>(pv) * cols + pu;
+    return s_end_lo_[s] > 0.0f && reach_[s] >= min_reach &&
+           projector_.certainly_clears(cell, pu, pv, s_end_lo_[s]);
+  };
+  if (clears(u, v)) return true;
+  const int i0 = std::max(0, u - kNear), i1 = std::min(cols - 1, u + kNear);
+  const int j0 = std::max(0, v - kNear), j1 = std::min(scan_->rows - 1, v + kNear);
+  for (int pv = j0; pv <= j1; ++pv) {
+    for (int pu = i0; pu <= i1; ++pu) {
+      if ((pu != u || pv != v) && clears(pu, pv)) return true;
+    }
+  }
+  return false;
 }
 
 inline void ScanIntegrator::trace_sample(size_t sample) {
+  if (traced(sample)) return;
   RayCache& r = ray(sample);
-  if (r.traced) return;
-  r.traced = true;
+  ray_state_[sample] = built_ + 1;
   ++rays_traced_;
   trace(keys_, scan_->origin, key_origin_, r.ray, [&](const Key& k) {
     const int idx = index(k);
@@ -186,8 +209,8 @@ inline void ScanIntegrator::trace_sample(size_t sample) {
 }
 
 inline bool ScanIntegrator::try_ray(size_t sample, const Key& cell, int idx) {
+  if (traced(sample)) return false;  // its cells are marked already
   RayCache& r = ray(sample);
-  if (r.traced) return false;  // its cells are marked already
   ++ray_tests_;
   switch (classifier_->classify(r.ray, r.bounds, cell)) {
     case Verdict::kMisses:
@@ -204,7 +227,7 @@ inline bool ScanIntegrator::try_ray(size_t sample, const Key& cell, int idx) {
   return false;
 }
 
-inline bool ScanIntegrator::some_ray_may_reach(const Key& cell) const {
+inline bool ScanIntegrator::some_ray_may_reach(const Key& cell, float& min_reach) const {
   // No pixel in (a rectangle around) the cell's image has a ray reaching the cell's exit: the
   // common case behind surfaces and beside the image. Then cleared_by_some_ray() is false too
   // (every ray it accepts has a pixel in footprint(cell) and reach >= min_reach); this test
@@ -219,6 +242,7 @@ inline bool ScanIntegrator::some_ray_may_reach(const Key& cell) const {
   const double z_near = cz - box_half_.z(), z_far = cz + box_half_.z();
   // A camera within 2 margins of the cell makes footprint() give the whole image; such a cell
   // reaches nearer than 2 sqrt(3) margins in depth, so it never passes this.
+  min_reach = 0.0f;
   if (!(z_near > 4.0 * quick_margin_)) return true;
   const PinholeCamera& cam = scan_->camera;
   // x / z over the box: the smallest with the smallest x (over the far depth if x >= 0), the
@@ -243,22 +267,22 @@ inline bool ScanIntegrator::some_ray_may_reach(const Key& cell) const {
   // below covers that, and float rounding is monotonic).
   const double exit2 = x.gap2 + y.gap2 + z.gap2 +
                        std::min({x.exit_minus_gap2, y.exit_minus_gap2, z.exit_minus_gap2});
-  const float min_reach = static_cast<float>(std::sqrt(exit2) - quick_margin_ - 1e-7);
+  min_reach = static_cast<float>(std::sqrt(exit2) - quick_margin_ - 1e-7);
   return reach_max_.any_at_least(i0, i1, j0, j1, min_reach);
 }
 
-bool ScanIntegrator::cleared_by_some_ray(const Key& cell, int idx) {
+bool ScanIntegrator::cleared_by_some_ray(const Key& cell, int idx, bool witnesses_tried) {
   const CellFootprint f = projector_.footprint(cell);
   if (f.empty()) return false;
   const int cols = scan_->cols;
   const int tj0 = f.j0 / kTile, tj1 = f.j1 / kTile, ti0 = f.i0 / kTile, ti1 = f.i1 / kTile;
   // No ray in the cell's image reaches the cell's far side.
   if (!reach_max_.any_at_least(f.i0, f.i1, f.j0, f.j1, f.min_reach)) return false;
-  // Rays near the centre that certainly clear it (the witness missed through a hole in the
-  // depth or at the image border); no walk needed.
+  // Rays near the centre that certainly clear it, when witness_clears() could not look (the
+  // centre projects outside the image); no walk needed.
   const int near_i0 = std::max(f.i0, f.u_centre - kNear), near_i1 = std::min(f.i1, f.u_centre + kNear);
   const int near_j0 = std::max(f.j0, f.v_centre - kNear), near_j1 = std::min(f.j1, f.v_centre + kNear);
-  for (int pv = near_j0; pv <= near_j1; ++pv) {
+  for (int pv = witnesses_tried ? near_j1 + 1 : near_j0; pv <= near_j1; ++pv) {
     for (int pu = near_i0; pu <= near_i1; ++pu) {
       const size_t s = static_cast<size_t>(pv) * cols + pu;
       if (s_end_lo_[s] > 0.0f && reach_[s] >= f.min_reach &&
@@ -273,7 +297,7 @@ bool ScanIntegrator::cleared_by_some_ray(const Key& cell, int idx) {
   // tile by tile.
   auto candidate = [&](int pu, int pv) {
     const size_t s = static_cast<size_t>(pv) * cols + pu;
-    return reach_[s] >= f.min_reach && reach_[s] > 0.0f && end_cell_[s] != idx &&
+    return reach_[s] >= f.min_reach && reach_[s] > 0.0f && end_cell_[s] != idx && !traced(s) &&
            projector_.may_clear(f, pu, pv, reach_[s]);
   };
   for (int pv = near_j0; pv <= near_j1; ++pv) {
@@ -325,11 +349,13 @@ void ScanIntegrator::grow_from_origin() {
       if (f == 0) touched_.emplace_back(idx, cell);
       f = static_cast<uint8_t>(f | kTested);
       ++cells_tested_;
-      if (!some_ray_may_reach(cell)) continue;
-      if (witness_clears(cell)) {
+      float min_reach = 0.0f;
+      if (!some_ray_may_reach(cell, min_reach)) continue;
+      bool witnesses_tried = false;
+      if (witness_clears(cell, min_reach, witnesses_tried)) {
         ++cells_witnessed_;
         set_cleared(idx, cell);
-      } else if (cleared_by_some_ray(cell, idx)) {
+      } else if (cleared_by_some_ray(cell, idx, witnesses_tried)) {
         set_cleared(idx, cell);
       }
     }

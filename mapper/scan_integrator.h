@@ -76,8 +76,6 @@ class ScanIntegrator {
   struct RayCache {
     Ray ray;
     RayBounds bounds;
-    uint32_t epoch = 0;  // bounds belong to the scan of this epoch
-    bool traced = false;
   };
   enum : uint8_t { kTested = 1, kCleared = 2, kOccupied = 4 };
 
@@ -87,11 +85,12 @@ class ScanIntegrator {
   void mark(int idx, const Key& key, uint8_t flags);
   int index(const Key& key) const;
   RayCache& ray(size_t sample);
+  bool traced(size_t sample) const { return ray_state_[sample] == built_ + 1; }
   void trace_sample(size_t sample);
   void set_cleared(int idx, const Key& key);
-  bool witness_clears(const Key& cell);
-  bool some_ray_may_reach(const Key& cell) const;
-  bool cleared_by_some_ray(const Key& cell, int idx);
+  bool witness_clears(const Key& cell, float min_reach, bool& tried);
+  bool some_ray_may_reach(const Key& cell, float& min_reach) const;
+  bool cleared_by_some_ray(const Key& cell, int idx, bool witnesses_tried);
   bool try_ray(size_t sample, const Key& cell, int idx);
   void grow_from_origin();
   void collect(ScanUpdate& update);
@@ -106,7 +105,9 @@ class ScanIntegrator {
   int side_ = 0;                 // the scratch grid is side_^3 cells around the origin
   FootprintProjector projector_;
   std::optional<RayCellClassifier> classifier_;
-  uint32_t epoch_ = 0;
+  // rays_[s] belongs to this scan if ray_state_[s] >= built_, and has been walked if it is
+  // built_ + 1 (kept apart from the rays: the cell search checks it for many pixels).
+  uint32_t built_ = 0;
   size_t cells_tested_ = 0;
   size_t cells_witnessed_ = 0;
   size_t rays_traced_ = 0;
@@ -132,6 +133,7 @@ class ScanIntegrator {
   double quick_margin_ = 0.0;
   std::vector<int> end_cell_;              // grid index of each hit's cell (-1: none)
   std::vector<RayCache> rays_;
+  std::vector<uint32_t> ray_state_;
 };
 
 }  // namespace kestrel::mapper
