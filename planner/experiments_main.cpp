@@ -57,7 +57,7 @@ int main(int argc, char** argv) {
   eval::ExperimentOptions o;
   std::string only = "all", out_path, which = "all", map_yaml = KESTREL_DEFAULT_STATA_MAP, png_dir;
   WorldFeatureOptions features;
-  RoadmapOptions roadmap;
+  eval::Scenario base;
   app.add_option("--trials", o.trials, "Trials per start/goal pair and setting")->check(cli::Positive);
   app.add_option("--samples", o.samples, "Samples per roadmap")->check(cli::Positive);
   app.add_option("--seed", o.seed, "Seed of every random draw (features, samplers)");
@@ -68,10 +68,10 @@ int main(int argc, char** argv) {
       ->check(cli::Positive);
   app.add_option("--only", only, "One experiment: table3, table4, table5, fig7, fig12, fig13, laser, precision, or all")
       ->check(CLI::IsMember({"all", "table3", "table4", "table5", "fig7", "fig12", "fig13", "laser", "precision"}));
-  app.add_option("--connect-radius", roadmap.connect_radius_m, "Roadmap edges join nodes at most this far apart (m)")
-      ->check(cli::Positive);
-  app.add_option("--neighbours", roadmap.max_neighbours,
-                 "Each node tries its nearest this many within the radius (0: all)")
+  app.add_option("--radius", base.space.radius_m, "Vehicle radius (m)")->check(cli::Positive);
+  app.add_option("--connect-radius", base.roadmap.connect_radius_m, "Longest edge (m)")->check(cli::Positive);
+  app.add_option("--neighbours", base.roadmap.max_neighbours,
+                 "Each node tries its nearest this many within the connect radius (0: all)")
       ->check(CLI::NonNegativeNumber);
   app.add_option("--out", out_path, "Also write the Markdown to this file");
   app.add_option("--png-dir", png_dir, "Draw <world>_paths.png (PRM red, BRM-SU blue, all five pairs) here");
@@ -93,8 +93,6 @@ int main(int argc, char** argv) {
     section("table3", "Table 3: cost of the sensor-uncertainty weight per sample",
             [&] { return eval::table3_weight_cost(o.seed); });
 
-    eval::Scenario base;
-    base.roadmap = roadmap;
     std::vector<ExperimentWorld> worlds;
     if (which != "stata") worlds.push_back(floor_experiment_world(features, base.space.radius_m));
     if (which != "floor") {

@@ -56,7 +56,12 @@ int main(int argc, char** argv) {
   app.add_option("--height", height, "Flight height of the roadmap's samples (m)")->check(cli::Positive);
   app.add_option("--map-z-min", o.map_z_min_m, "Lowest map height that counts for collisions (m)");
   app.add_option("--map-z-max", o.map_z_max_m, "Highest map height that counts for collisions (m)");
-  app.add_option("--samples", o.roadmap.samples, "Roadmap samples")->check(cli::Positive);
+  app.add_option("--samples", o.roadmap.samples, "Roadmap samples (drawn again while start and goal are not connected)")
+      ->check(cli::Positive)
+      ->capture_default_str();
+  app.add_option("--max-samples", o.roadmap.max_samples, "Most samples a roadmap grows to (<= --samples: no growth)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   app.add_option("--connect-radius", o.roadmap.connect_radius_m, "Longest edge (m)")->check(cli::Positive);
   app.add_option("--sampler", o.sampler, "uniform, su, gaussian, bridge")
       ->check(CLI::IsMember({"uniform", "su", "gaussian", "bridge"}));

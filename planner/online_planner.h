@@ -19,11 +19,18 @@
 
 namespace kestrel::planner {
 
+/// The paper's 100 samples, grown up to 1000 while start and goal are not connected.
+inline RoadmapOptions grown_roadmap() {
+  RoadmapOptions r;
+  r.max_samples = 1000;
+  return r;
+}
+
 struct OnlinePlannerOptions {
   SpaceOptions space;  ///< z_min_m / z_max_m: flight band for samples
   FeatureSensorOptions sensor = FeatureSensorOptions::kinect();
   MotionOptions motion;
-  RoadmapOptions roadmap;
+  RoadmapOptions roadmap = grown_roadmap();
   double map_z_min_m = 0.3, map_z_max_m = 2.0;  ///< band of the map that matters for collisions
   double feature_density_per_m2 = 4.0;          ///< features assumed on the map's walls
   std::string sampler = "su";                   ///< uniform | su | gaussian | bridge

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 
 #include "estimator/information.h"
 
@@ -59,22 +60,17 @@ int Roadmap::edge_count() const {
   return n;
 }
 
-Roadmap build_roadmap(const ConfigurationSpace& space, Sampler& sampler, const Config& start,
-                      const Config& goal, const RoadmapOptions& options, const BeliefModel* model, Rng& rng) {
-  Roadmap map;
-  map.add_node(start);
-  map.add_node(goal);
-  for (int i = 0; i < options.samples; ++i) {
-    const std::optional<Config> q = sampler.sample(rng);
-    if (!q) break;  // the sampler cannot find more: plan on what there is
-    map.add_node(*q);
-  }
-  // Candidate pairs: each node's nearest neighbours within the radius; a pair is tried once.
+namespace {
+
+// Each node's nearest max_neighbours within the radius; each pair once, as (lower, higher).
+std::vector<std::pair<int, int>> candidate_pairs(const std::vector<Config>& nodes, const RoadmapOptions& options) {
   std::vector<std::pair<int, int>> pairs;
-  for (int a = 0; a < map.size(); ++a) {
-    std::vector<std::pair<double, int>> near;
-    for (int b = 0; b < map.size(); ++b) {
-      const double d = ConfigurationSpace::distance(map.node(a), map.node(b));
+  const int n = static_cast<int>(nodes.size());
+  std::vector<std::pair<double, int>> near;
+  for (int a = 0; a < n; ++a) {
+    near.clear();
+    for (int b = 0; b < n; ++b) {
+      const double d = ConfigurationSpace::distance(nodes[a], nodes[b]);
       if (b != a && d <= options.connect_radius_m) near.push_back({d, b});
     }
     std::sort(near.begin(), near.end());
@@ -84,8 +80,56 @@ Roadmap build_roadmap(const ConfigurationSpace& space, Sampler& sampler, const C
   }
   std::sort(pairs.begin(), pairs.end());
   pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
-  for (const auto& [a, b] : pairs)
-    if (space.motion_valid(map.node(a), map.node(b))) map.connect(a, b, model);
+  return pairs;
+}
+
+bool connected(int n, const std::vector<std::pair<int, int>>& edges, int from, int to) {
+  std::vector<int> parent(n);
+  for (int i = 0; i < n; ++i) parent[i] = i;
+  const auto root = [&](int i) {
+    while (parent[i] != i) i = parent[i] = parent[parent[i]];
+    return i;
+  };
+  for (const auto& [a, b] : edges) parent[root(a)] = root(b);
+  return root(from) == root(to);
+}
+
+}  // namespace
+
+Roadmap build_roadmap(const ConfigurationSpace& space, Sampler& sampler, const Config& start,
+                      const Config& goal, const RoadmapOptions& options, const BeliefModel* model, Rng& rng) {
+  std::vector<Config> nodes{start, goal};
+  bool exhausted = false;
+  const auto draw = [&](int count) {
+    for (int i = 0; i < count && !exhausted; ++i) {
+      const std::optional<Config> q = sampler.sample(rng);
+      if (q) nodes.push_back(*q);
+      else exhausted = true;  // the sampler cannot find more: plan on what there is
+    }
+  };
+  // Collision checks are the cost of a connection attempt: each pair is checked once however
+  // often the roadmap grows.
+  std::map<std::pair<int, int>, bool> valid;
+  std::vector<std::pair<int, int>> edges;
+  const auto connect_all = [&] {
+    edges.clear();
+    for (const auto& ab : candidate_pairs(nodes, options)) {
+      auto [it, inserted] = valid.try_emplace(ab, false);
+      if (inserted) it->second = space.motion_valid(nodes[ab.first], nodes[ab.second]);
+      if (it->second) edges.push_back(ab);
+    }
+  };
+  draw(options.samples);
+  connect_all();
+  const int budget = std::max(options.samples, options.max_samples);
+  while (!exhausted && static_cast<int>(nodes.size()) - 2 < budget &&
+         !connected(static_cast<int>(nodes.size()), edges, 0, 1)) {
+    draw(std::min(std::max(options.samples, 1), budget - (static_cast<int>(nodes.size()) - 2)));
+    connect_all();
+  }
+  Roadmap map;
+  for (const Config& q : nodes) map.add_node(q);
+  for (const auto& [a, b] : edges) map.connect(a, b, model);
   return map;
 }
 

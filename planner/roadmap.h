@@ -48,6 +48,9 @@ struct Edge {
 
 struct RoadmapOptions {
   int samples = 100;
+  /// While start and goal are not connected, draw `samples` more (up to this many in all) and
+  /// connect again; 0 or <= samples: a fixed count, as in the paper's experiments.
+  int max_samples = 0;
   double connect_radius_m = 6.0;
   int max_neighbours = 20;  ///< each node tries its nearest this many within the radius (0: all)
 };
@@ -70,9 +73,11 @@ class Roadmap {
   std::vector<std::vector<Edge>> adjacency_;
 };
 
-/// Node 0 = start, node 1 = goal, then up to options.samples samples; each node is joined to
-/// its nearest max_neighbours within the radius whose motion is valid (the union of both
-/// directions' choices). `model` may be null (PRM).
+/// Node 0 = start, node 1 = goal, then up to options.samples samples (more, up to
+/// options.max_samples, while start and goal are not connected); each node is joined to its
+/// nearest max_neighbours within the radius whose motion is valid (the union of both
+/// directions' choices). A grown roadmap is the one built at once from all its samples, and
+/// belief transfers are computed only for the final edges. `model` may be null (PRM).
 Roadmap build_roadmap(const ConfigurationSpace& space, Sampler& sampler, const Config& start,
                       const Config& goal, const RoadmapOptions& options, const BeliefModel* model, Rng& rng);
 

@@ -31,9 +31,10 @@ double median(std::vector<double> v) {
 }
 
 struct Summary {
-  int trials = 0, successes = 0;
+  int trials = 0, found = 0, successes = 0;
   std::vector<double> goal_traces, build_s, search_s, lengths;
   double success_pct() const { return trials ? 100.0 * successes / trials : 0.0; }
+  double found_pct() const { return trials ? 100.0 * found / trials : 0.0; }
   double mean_trace() const {
     return goal_traces.empty() ? 0.0 : std::accumulate(goal_traces.begin(), goal_traces.end(), 0.0) / goal_traces.size();
   }
@@ -63,6 +64,7 @@ Summary run_many(const Scenario& sc, const Setting& s, const Pairs& pairs, const
       ++sum.trials;
       sum.build_s.push_back(r.build_s);
       sum.search_s.push_back(r.search_s);
+      sum.found += r.found;
       if (!r.success) continue;
       ++sum.successes;
       sum.goal_traces.push_back(r.goal_trace);
@@ -172,11 +174,11 @@ std::string table5_planners(const Scenario& sc, const Pairs& pairs, const Experi
                       {"brm", "su", "12.31 · 323.12 · 0.55"},      {"brm", "su-ukf", "—"},
                       {"brm", "gaussian", "22.82 · 88.14 · 0.21"}, {"brm", "bridge", "21.92 · 178.58 · 0.30"}};
   std::ostringstream out;
-  out << "| planner | sampler | success % | goal tr(Σ) | length m | build s (median) | search ms (median) | paper tr · build s · search s |\n"
-         "|---|---|---|---|---|---|---|---|\n";
+  out << "| planner | sampler | path found % | success % | goal tr(Σ) | length m | build s (median) | search ms (median) | paper tr · build s · search s |\n"
+         "|---|---|---|---|---|---|---|---|---|\n";
   for (const Row& r : rows) {
     const Summary s = run_many(sc, Setting{r.planner, r.sampler, o.samples}, pairs, o);
-    out << "| " << r.planner << " | " << r.sampler << " | " << fmt("%.1f", s.success_pct()) << " | "
+    out << "| " << r.planner << " | " << r.sampler << " | " << fmt("%.1f", s.found_pct()) << " | " << fmt("%.1f", s.success_pct()) << " | "
         << fmt("%.2f", s.mean_trace()) << " | " << fmt("%.1f", s.mean_length()) << " | " << fmt("%.3f", median(s.build_s))
         << " | " << fmt("%.3f", 1e3 * median(s.search_s)) << " | " << r.paper << " |\n";
   }

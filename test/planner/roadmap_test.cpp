@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "planner/roadmap.h"
+#include "test/planner/test_environments.h"
 
 namespace kestrel::planner {
 namespace {
@@ -62,6 +63,78 @@ TEST(BeliefModel, ProcessNoiseGrowsWithTheDistanceFlownNotWithTheSteps) {
 TEST(BeliefModel, AZeroLengthEdgeHasNoSteps) {
   Recorder r;
   EXPECT_TRUE(r.model().steps(Config(1, 2, 1, 0), Config(1, 2, 1, 0)).empty());
+}
+
+// Two 10 x 10 m rooms split by a wall at x = 10 with a 0.3 m gap at y in [4.85, 5.15]: few
+// samples rarely join them.
+testing::PredicateEnvironment two_rooms() {
+  return testing::PredicateEnvironment(Eigen::AlignedBox3d(Eigen::Vector3d(0, 0, 1), Eigen::Vector3d(20, 10, 1)),
+                                       [](const Eigen::Vector3d& p) {
+                                         return std::abs(p.x() - 10.0) > 0.1 || std::abs(p.y() - 5.0) < 0.15;
+                                       });
+}
+
+bool joins(const Roadmap& map, int from, int to) {
+  std::vector<int> stack{from};
+  std::vector<bool> seen(map.size(), false);
+  seen[from] = true;
+  while (!stack.empty()) {
+    const int a = stack.back();
+    stack.pop_back();
+    for (const Edge& e : map.edges(a))
+      if (!seen[e.to]) seen[e.to] = true, stack.push_back(e.to);
+  }
+  return seen[to];
+}
+
+TEST(BuildRoadmap, GrowsUntilStartAndGoalConnectAndEqualsTheRoadmapBuiltAtOnce) {
+  const auto env = two_rooms();
+  SpaceOptions so;
+  so.radius_m = 0.1;
+  const ConfigurationSpace space(env, so);
+  const Config start(2, 2, 1, 0), goal(18, 8, 1, 0);
+  RoadmapOptions fixed;
+  fixed.samples = 20;
+  fixed.connect_radius_m = 8.0;
+  fixed.max_neighbours = 0;
+  RoadmapOptions grown = fixed;
+  grown.max_samples = 2000;
+  auto uniform = make_uniform_sampler(space);
+  Rng rng_fixed(7), rng_grown(7);
+  const Roadmap small = build_roadmap(space, *uniform, start, goal, fixed, nullptr, rng_fixed);
+  ASSERT_FALSE(joins(small, 0, 1)) << "the test needs a seed whose 20 samples do not cross the gap";
+  const Roadmap big = build_roadmap(space, *uniform, start, goal, grown, nullptr, rng_grown);
+  EXPECT_TRUE(joins(big, 0, 1));
+  const int samples = big.size() - 2;
+  EXPECT_EQ(samples % 20, 0);  // whole batches
+  EXPECT_LT(samples, 2000);
+
+  // The same as drawing all those samples at once: nodes and edges alike.
+  RoadmapOptions at_once = fixed;
+  at_once.samples = samples;
+  Rng rng_once(7);
+  const Roadmap once = build_roadmap(space, *uniform, start, goal, at_once, nullptr, rng_once);
+  ASSERT_EQ(once.size(), big.size());
+  for (int i = 0; i < big.size(); ++i) {
+    EXPECT_TRUE(once.node(i) == big.node(i)) << i;
+    ASSERT_EQ(once.edges(i).size(), big.edges(i).size()) << i;
+    for (size_t k = 0; k < big.edges(i).size(); ++k) EXPECT_EQ(once.edges(i)[k].to, big.edges(i)[k].to);
+  }
+}
+
+TEST(BuildRoadmap, StopsGrowingAtItsBudget) {
+  // A wall with no gap: start and goal never connect; the roadmap stops at max_samples.
+  const testing::PredicateEnvironment env(Eigen::AlignedBox3d(Eigen::Vector3d(0, 0, 1), Eigen::Vector3d(20, 10, 1)),
+                                          [](const Eigen::Vector3d& p) { return std::abs(p.x() - 10.0) > 0.1; });
+  const ConfigurationSpace space(env, SpaceOptions{});
+  RoadmapOptions o;
+  o.samples = 30;
+  o.max_samples = 100;
+  auto uniform = make_uniform_sampler(space);
+  Rng rng(1);
+  const Roadmap map = build_roadmap(space, *uniform, Config(2, 2, 1, 0), Config(18, 8, 1, 0), o, nullptr, rng);
+  EXPECT_EQ(map.size(), 2 + 100);  // 30 + 30 + 30 + 10
+  EXPECT_FALSE(joins(map, 0, 1));
 }
 
 }  // namespace
