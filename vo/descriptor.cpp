@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdlib>
+#include <cstring>
 #include <stdexcept>
 
 #if defined(__SSE2__)
@@ -31,17 +32,25 @@ void DescriptorSet::add(const cv::Mat& image, int x, int y) {
   data_.resize(at + static_cast<size_t>(bytes_), 0);
   uint8_t* out = data_.data() + at;
   const int n = std::min(window_ * window_, bytes_);  // pixels kept
+  // The patch row by row (the last one cut at n pixels), then its sum and the normalisation
+  // as plain loops over the bytes, which vectorise; the padding stays zero.
+  for (int dy = -r, k = 0; k < n; ++dy, k += window_)
+    std::memcpy(out + k, image.ptr<uint8_t>(y + dy) + (x - r), static_cast<size_t>(std::min(window_, n - k)));
   int sum = 0;
-  int k = 0;
-  for (int dy = -r; dy <= r && k < n; ++dy) {
-    const uint8_t* row = image.ptr<uint8_t>(y + dy) + x;
-    for (int dx = -r; dx <= r && k < n; ++dx, ++k) {
-      out[k] = row[dx];
-      sum += row[dx];
-    }
-  }
+  for (int i = 0; i < n; ++i) sum += out[i];
   const int mean = (sum + n / 2) / n;
-  for (int i = 0; i < n; ++i) out[i] = static_cast<uint8_t>(std::clamp(out[i] - mean + 128, 0, 255));
+  int i = 0;
+#if defined(__SSE2__)
+  // clamp(v - mean + 128, 0, 255) as one saturating byte addition or subtraction.
+  const int shift = 128 - mean;  // -127 .. 128
+  const __m128i delta = _mm_set1_epi8(static_cast<char>(static_cast<uint8_t>(std::abs(shift))));
+  for (; i + 16 <= n; i += 16) {
+    const __m128i v = _mm_loadu_si128(reinterpret_cast<const __m128i*>(out + i));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(out + i),
+                     shift >= 0 ? _mm_adds_epu8(v, delta) : _mm_subs_epu8(v, delta));
+  }
+#endif
+  for (; i < n; ++i) out[i] = static_cast<uint8_t>(std::clamp(out[i] - mean + 128, 0, 255));
   ++count_;
 }
 
