@@ -14,7 +14,8 @@ namespace {
 constexpr int kTile = kTilePixels;
 constexpr int kTileLevel = 2;  // the reach pyramid's level of kTile-pixel squares
 static_assert(kTile == 1 << kTileLevel);
-constexpr int kNear = 1;  // the (2 kNear + 1)^2 pixels around the centre are tried first
+constexpr int kNear = 1;
+constexpr int kClipArea = 400;  // footprints of more pixels are clipped row by row  // the (2 kNear + 1)^2 pixels around the centre are tried first
 }  // namespace
 
 void ScanUpdate::clear() {
@@ -305,16 +306,24 @@ bool ScanIntegrator::cleared_by_some_ray(const Key& cell, int idx, bool witnesse
       if (candidate(pu, pv) && try_ray(static_cast<size_t>(pv) * cols + pu, cell, idx)) return true;
     }
   }
+  // A large image (a cell next to the camera) is cut row by row to the pixels whose lines head
+  // towards the cell (row_lo_ / row_hi_).
+  const bool clipped = (f.i1 - f.i0 + 1) * (f.j1 - f.j0 + 1) > kClipArea && clip_rows(f);
   for (int tj = tj0; tj <= tj1; ++tj) {
     for (int ti = ti0; ti <= ti1; ++ti) {
       if (reach_max_.square(kTileLevel, ti * kTile, tj * kTile) < f.min_reach ||
           !projector_.tile_may_pass(f, ti, tj))
         continue;
       const int pv_end = std::min(f.j1, tj * kTile + kTile - 1);
-      const int pu_end = std::min(f.i1, ti * kTile + kTile - 1);
       for (int pv = std::max(f.j0, tj * kTile); pv <= pv_end; ++pv) {
         const bool near_row = pv >= near_j0 && pv <= near_j1;
-        for (int pu = std::max(f.i0, ti * kTile); pu <= pu_end; ++pu) {
+        int pu_begin = std::max(f.i0, ti * kTile);
+        int pu_end = std::min(f.i1, ti * kTile + kTile - 1);
+        if (clipped) {
+          pu_begin = std::max(pu_begin, row_lo_[static_cast<size_t>(pv)]);
+          pu_end = std::min(pu_end, row_hi_[static_cast<size_t>(pv)]);
+        }
+        for (int pu = pu_begin; pu <= pu_end; ++pu) {
           if (near_row && pu >= near_i0 && pu <= near_i1) continue;  // tried above
           if (candidate(pu, pv) && try_ray(static_cast<size_t>(pv) * cols + pu, cell, idx))
             return true;
@@ -323,6 +332,60 @@ bool ScanIntegrator::cleared_by_some_ray(const Key& cell, int idx, bool witnesse
     }
   }
   return false;
+}
+
+bool ScanIntegrator::clip_rows(const CellFootprint& f) {
+  // Along an axis a whose slab the origin lies outside of by more than the distance between
+  // OctoMap's ray and the pixel's line (and the footprint's margin), a line can only meet the
+  // cell if its direction d heads towards the slab: side_a d_a > 0. In the camera frame
+  // d = R (x, y, 1), x = (u - cx) / fx, so d_a is linear in u along a row: a half-line of
+  // pixels, kept with one pixel to spare.
+  const Eigen::Matrix3d R = scan_->T_world_camera.linear();
+  const PinholeCamera& cam = scan_->camera;
+  const double origin[3] = {static_cast<double>(scan_->origin.x()), static_cast<double>(scan_->origin.y()),
+                            static_cast<double>(scan_->origin.z())};
+  // (The 1e-6 relative error of OctoMap's direction moves a ray by at most 1e-6 of its length.)
+  const double far_enough = 2.0 * (projector_.line_error() + projector_.margin()) +
+                            2e-6 * options_.max_range_m + 1e-6;
+  int axes[3], sides[3], n = 0;
+  for (int a = 0; a < 3; ++a) {
+    if (f.lo[a] - origin[a] > far_enough) {
+      axes[n] = a;
+      sides[n++] = 1;
+    } else if (origin[a] - f.hi[a] > far_enough) {
+      axes[n] = a;
+      sides[n++] = -1;
+    }
+  }
+  if (n == 0) return false;
+  const size_t rows = static_cast<size_t>(scan_->rows);
+  if (row_lo_.size() < rows) {
+    row_lo_.resize(rows);
+    row_hi_.resize(rows);
+  }
+  for (int v = f.j0; v <= f.j1; ++v) {
+    const double y = (v - cam.cy) / cam.fy;
+    double u_lo = -1e9, u_hi = 1e9;
+    for (int c = 0; c < n; ++c) {
+      const int a = axes[c];
+      // side * (slope u + offset) > 0
+      const double slope = sides[c] * R(a, 0) / cam.fx;
+      const double offset = sides[c] * (R(a, 1) * y + R(a, 2) - R(a, 0) * cam.cx / cam.fx);
+      if (std::fabs(slope) < 1e-12) {
+        if (offset <= 0.0) u_hi = -1e9;  // the whole row heads away
+        continue;
+      }
+      const double threshold = -offset / slope;
+      if (slope > 0.0) {
+        u_lo = std::max(u_lo, threshold - 1.0);
+      } else {
+        u_hi = std::min(u_hi, threshold + 1.0);
+      }
+    }
+    row_lo_[static_cast<size_t>(v)] = static_cast<int>(std::clamp(std::floor(u_lo), -1.0, static_cast<double>(scan_->cols)));
+    row_hi_[static_cast<size_t>(v)] = static_cast<int>(std::clamp(std::ceil(u_hi), -1.0, static_cast<double>(scan_->cols)));
+  }
+  return true;
 }
 
 void ScanIntegrator::grow_from_origin() {

@@ -91,6 +91,7 @@ class ScanIntegrator {
   bool witness_clears(const Key& cell, float min_reach, bool& tried);
   bool some_ray_may_reach(const Key& cell, float& min_reach) const;
   bool cleared_by_some_ray(const Key& cell, int idx, bool witnesses_tried);
+  bool clip_rows(const CellFootprint& f);
   bool try_ray(size_t sample, const Key& cell, int idx);
   void grow_from_origin();
   void collect(ScanUpdate& update);
@@ -133,6 +134,7 @@ class ScanIntegrator {
   double quick_margin_ = 0.0;
   std::vector<int> end_cell_;              // grid index of each hit's cell (-1: none)
   std::vector<RayCache> rays_;
+  std::vector<int> row_lo_, row_hi_;       // clip_rows(): pixel range per row
   std::vector<uint32_t> ray_state_;
 };
 
