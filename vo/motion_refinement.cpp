@@ -4,6 +4,10 @@
 #include <cmath>
 #include <limits>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include "common/geometry/so3.h"
 
 namespace kestrel::vo {
@@ -46,6 +50,22 @@ struct Accumulator {
 template <int Rows>
 void rank_update(Matrix6d& H, const Eigen::Matrix<double, Rows, 6>& J, double w) {
   double* h = H.data();  // column-major
+#if defined(__SSE2__)
+  // Each column in three registers, which receive row 0's term and then row 1's, the order
+  // of the scalar loop below.
+  __m128d c[Rows][3];
+  for (int r = 0; r < Rows; ++r)
+    for (int p = 0; p < 3; ++p) c[r][p] = _mm_set_pd(J(r, 2 * p + 1), J(r, 2 * p));
+  for (int j = 0; j < 6; ++j) {
+    __m128d a[Rows];
+    for (int r = 0; r < Rows; ++r) a[r] = _mm_set1_pd(w * J(r, j));
+    for (int p = 0; p < 3; ++p) {
+      __m128d x = _mm_loadu_pd(h + 6 * j + 2 * p);
+      for (int r = 0; r < Rows; ++r) x = _mm_add_pd(x, _mm_mul_pd(a[r], c[r][p]));
+      _mm_storeu_pd(h + 6 * j + 2 * p, x);
+    }
+  }
+#else
   for (int r = 0; r < Rows; ++r) {
     double col[6];
     for (int i = 0; i < 6; ++i) col[i] = J(r, i);
@@ -54,6 +74,7 @@ void rank_update(Matrix6d& H, const Eigen::Matrix<double, Rows, 6>& J, double w)
       for (int i = 0; i < 6; ++i) h[6 * j + i] += a * col[i];
     }
   }
+#endif
 }
 
 // Adds one scalar residual r with Jacobian J and standard deviation sigma.
