@@ -24,13 +24,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string text_of(const fs::path& p) {
-  std::ifstream in(p);
-  std::ostringstream all;
-  all << in.rdbuf();
-  return all.str();
-}
-
 struct Hold {
   std::vector<kestrel::ground_truth_t> truth;
   std::vector<kestrel::state_t> states;
@@ -54,7 +47,7 @@ Hold fly(const fs::path& out, const std::string& duration, const std::vector<std
   h.truth = transport::read_messages<kestrel::ground_truth_t>(log, channel::kGroundTruth);
   h.states = transport::read_messages<kestrel::state_t>(log, channel::kState);
   h.score = r.out;
-  h.sim = text_of(out / "sim.txt");
+  h.sim = kestrel::test::read_file(out / "sim.txt");
   return h;
 }
 

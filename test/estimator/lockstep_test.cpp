@@ -22,13 +22,6 @@
 namespace kestrel::estimator {
 namespace {
 
-std::string bytes_of(const std::filesystem::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream all;
-  all << in.rdbuf();
-  return all.str();
-}
-
 TEST(EstimatorProcess, LockStepReplayIsDeterministicResetsAndEqualsTheLibrary) {
   if (!kestrel::test::can_isolate_network()) GTEST_SKIP() << "no network namespace available";
   if (!std::filesystem::exists(kestrel::test::tool("replay")))
@@ -45,9 +38,9 @@ TEST(EstimatorProcess, LockStepReplayIsDeterministicResetsAndEqualsTheLibrary) {
       " || exit 12; kill -INT $P; wait $P";
   const auto r = kestrel::test::run({kestrel::test::tool("isolated").string(), "--", "sh", "-c", script}, 240.0);
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  const std::string a = bytes_of(dir / "a.lcmlog");
+  const std::string a = kestrel::test::read_file(dir / "a.lcmlog");
   ASSERT_FALSE(a.empty());
-  EXPECT_EQ(a, bytes_of(dir / "b.lcmlog")) << "the second replay (after RESET) must publish the same states";
+  EXPECT_EQ(a, kestrel::test::read_file(dir / "b.lcmlog")) << "the second replay (after RESET) must publish the same states";
 
   EstimatorOptions options;
   options.init.yaw = 0.3;

@@ -18,6 +18,7 @@
 #include "common/transport/rgbd_codec.h"
 #include "kestrel/ground_truth_t.hpp"
 #include "kestrel/imu_t.hpp"
+#include "test/support/test_support.h"
 #include "tools/launch/isolation.h"
 
 namespace kestrel::test {
@@ -30,13 +31,6 @@ uint32_t mix(uint32_t x) {  // a small integer hash: texture that JPEG cannot fl
   x *= 0x846ca68bU;
   x ^= x >> 16;
   return x;
-}
-
-std::string slurp(const std::filesystem::path& p) {
-  std::ifstream in(p);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
 }
 
 }  // namespace
@@ -194,8 +188,8 @@ std::optional<int> Background::wait_exit(double timeout_s) {
 
 bool Background::running() { return !wait_exit(0.0).has_value(); }
 
-std::string Background::out() const { return slurp(out_path_); }
-std::string Background::err() const { return slurp(err_path_); }
+std::string Background::out() const { return read_file(out_path_); }
+std::string Background::err() const { return read_file(err_path_); }
 
 bool Background::wait_for_output(const std::string& needle, double timeout_s, bool in_stderr) {
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);

@@ -33,13 +33,6 @@ int data_lines(const fs::path& file) {
   return n;
 }
 
-std::string bytes_of(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  std::ostringstream out;
-  out << in.rdbuf();
-  return out.str();
-}
-
 // The whole 20 s of flight and of 200 Hz ground truth and IMU, but frames at 3 Hz: the
 // export, its time stamps and the evaluation are the same code at any frame rate, and
 // rendering and PNG-writing 601 frames cost most of a minute of CPU.
@@ -81,7 +74,7 @@ TEST(SimToolTest, SameSeedGivesTheSameLogBytes) {
     const auto r = run({tool("sim").string(), "--world", "office", "--flight", "figure8", "--duration", "0.4",
                         "--seed", seed, "--log", (dir / name).string(), "-q"});
     EXPECT_EQ(r.exit_code, 0) << r.err;
-    return bytes_of(dir / name);
+    return kestrel::test::read_file(dir / name);
   };
   const std::string a = once("3", "a.lcmlog"), b = once("3", "b.lcmlog"), c = once("4", "c.lcmlog");
   EXPECT_GT(a.size(), 100000u);

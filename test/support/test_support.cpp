@@ -10,6 +10,8 @@
 #include <array>
 #include <chrono>
 #include <cstdlib>
+#include <fstream>
+#include <sstream>
 #include <random>
 
 namespace kestrel::test {
@@ -34,6 +36,13 @@ std::filesystem::path tool(const std::string& name) {
 }
 
 std::filesystem::path source_dir() { return std::filesystem::path(KESTREL_SOURCE_DIR); }
+
+std::string read_file(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream all;
+  all << in.rdbuf();
+  return all.str();
+}
 
 TempDir::TempDir() {
   std::random_device rd;

@@ -20,6 +20,9 @@ std::filesystem::path tool(const std::string& name);
 /// The repository's root (for its scripts, e.g. tools/demo/fly_to_goal).
 std::filesystem::path source_dir();
 
+/// The whole file's bytes (empty if it cannot be read).
+std::string read_file(const std::filesystem::path& path);
+
 /// A fresh folder removed at destruction.
 class TempDir {
  public:

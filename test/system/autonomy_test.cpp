@@ -30,13 +30,6 @@
 namespace kestrel {
 namespace {
 
-std::string read_text(const std::filesystem::path& p) {
-  std::ifstream in(p);
-  std::ostringstream all;
-  all << in.rdbuf();
-  return all.str();
-}
-
 TEST(System, TheVehicleFliesToAGoalOnItsOwnMap) {
   if (!test::can_isolate_network()) GTEST_SKIP() << "no network namespace available";
   if (!std::filesystem::exists("/usr/bin/lcm-logger")) GTEST_SKIP() << "lcm-logger is not installed";
@@ -46,13 +39,13 @@ TEST(System, TheVehicleFliesToAGoalOnItsOwnMap) {
                             test::tool("sim").parent_path().string(), dir.path().string(), "9.5", "3.5", "1.3", "0"},
                            300.0);
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  const std::string status = read_text(dir / "status.txt");
-  const std::string go = read_text(dir / "goto.txt");
+  const std::string status = kestrel::test::read_file(dir / "status.txt");
+  const std::string go = kestrel::test::read_file(dir / "goto.txt");
   EXPECT_EQ(status, "0 0\n") << "sim, goto exit codes; goto said:\n" << go << "\nfollow said:\n"
-                             << read_text(dir / "follow.txt") << "\nsim said:\n" << read_text(dir / "sim.txt");
+                             << kestrel::test::read_file(dir / "follow.txt") << "\nsim said:\n" << kestrel::test::read_file(dir / "sim.txt");
   EXPECT_NE(go.find("arrived"), std::string::npos) << go;
   // The planner keeps 0.3 m from what the map knows; the true vehicle (0.25 m) never touched the room.
-  const std::string sim = read_text(dir / "sim.txt");
+  const std::string sim = kestrel::test::read_file(dir / "sim.txt");
   EXPECT_NE(sim.find("contacts: 0\n"), std::string::npos) << sim;
 
   std::optional<Eigen::Vector3d> truth, estimate;

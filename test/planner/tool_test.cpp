@@ -1,0 +1,93 @@
+// `kestrel plan` and `kestrel plan-experiments` as a user runs them: a plan in the shipped
+// floor world (a roadmap that grows until it connects), bad world and map files named in the
+// error, and the experiments' tables and plot from one command.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <opencv2/imgcodecs.hpp>
+#include <sstream>
+
+#include "test/support/test_support.h"
+
+namespace kestrel::planner {
+namespace {
+
+std::vector<std::vector<double>> waypoints(const std::string& out) {
+  std::vector<std::vector<double>> rows;
+  std::istringstream in(out);
+  for (std::string line; std::getline(in, line);) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream fields(line);
+    std::vector<double> row;
+    for (double v; fields >> v;) row.push_back(v);
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+const std::vector<std::string> kPrmSeed5 = {"--map",     "floor", "--start",   "2.5",     "2.5",    "1",
+                                            "0",         "--goal", "10.5",     "17.5",    "1",      "0",
+                                            "--planner", "prm",    "--sampler", "uniform", "--seed", "5"};
+
+TEST(PlanTool, ARoadmapThatDoesNotConnectGrowsUntilItDoes) {
+  // Seed 5's 300 samples leave the two rooms unconnected (exit 1); drawn again, they connect.
+  std::vector<std::string> fixed{test::tool("plan").string()};
+  fixed.insert(fixed.end(), kPrmSeed5.begin(), kPrmSeed5.end());
+  fixed.insert(fixed.end(), {"--max-samples", "0"});
+  const test::RunResult no = test::run(fixed);
+  EXPECT_EQ(no.exit_code, 1) << no.err;
+  EXPECT_NE(no.err.find("no path found with 300 samples"), std::string::npos) << no.err;
+
+  std::vector<std::string> grown{test::tool("plan").string()};
+  grown.insert(grown.end(), kPrmSeed5.begin(), kPrmSeed5.end());
+  const test::RunResult yes = test::run(grown);
+  ASSERT_EQ(yes.exit_code, 0) << yes.err;
+  const auto path = waypoints(yes.out);
+  ASSERT_GE(path.size(), 3u) << yes.out;
+  for (const auto& w : path) ASSERT_EQ(w.size(), 5u) << yes.out;  // x y z yaw tr(Sigma)
+  EXPECT_EQ(path.front(), (std::vector<double>{2.5, 2.5, 1, 0, 0.4}));
+  EXPECT_EQ(std::vector<double>(path.back().begin(), path.back().begin() + 4), (std::vector<double>{10.5, 17.5, 1, 0}));
+  double length = 0.0;
+  for (size_t i = 1; i < path.size(); ++i)
+    length += std::hypot(path[i][0] - path[i - 1][0], path[i][1] - path[i - 1][1]);
+  EXPECT_GT(length, std::hypot(8.0, 15.0));  // at least the straight line
+  EXPECT_NE(yes.out.find("length"), std::string::npos);
+}
+
+TEST(PlanTool, BadWorldAndMapFilesAreNamedWithExitCode3) {
+  test::TempDir dir;
+  std::ofstream(dir / "bad.world") << "wall nonsense\n";
+  std::ofstream(dir / "bad.yaml") << "image: nothere.pgm\nresolution: 0.05\n";
+  for (const char* name : {"bad.world", "bad.yaml"}) {
+    const std::string file = (dir / name).string();
+    const test::RunResult r = test::run({test::tool("plan").string(), "--map", file});
+    EXPECT_EQ(r.exit_code, 3) << r.err;
+    EXPECT_NE(r.err.find(file), std::string::npos) << r.err;
+  }
+}
+
+TEST(PlanExperimentsTool, OneCommandWritesTheTableAndThePlot) {
+  test::TempDir dir;
+  const test::RunResult r =
+      test::run({test::tool("plan-experiments").string(), "--world", "floor", "--only", "table5", "--trials", "1",
+                 "--out", (dir / "tables.md").string(), "--png-dir", dir.path().string(), "-q"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string md = test::read_file(dir / "tables.md");
+  EXPECT_EQ(md, r.out);  // --out holds what was printed
+  EXPECT_NE(md.find("### Table 5"), std::string::npos) << md;
+  for (const char* row : {"| prm | uniform |", "| brm | su |", "| brm | su-ukf |", "| brm | gaussian |", "| brm | bridge |"})
+    EXPECT_NE(md.find(row), std::string::npos) << row << "\n" << md;
+  const cv::Mat png = cv::imread((dir / "floor_paths.png").string());
+  ASSERT_FALSE(png.empty());
+  EXPECT_GT(png.rows, 200);
+}
+
+TEST(PlanExperimentsTool, WithoutTheStataMapItSaysSoAndGoesOn) {
+  const test::RunResult r = test::run({test::tool("plan-experiments").string(), "--world", "stata", "--map",
+                                       "/nonexistent/stata.yaml", "--only", "table5", "--trials", "1", "-q"});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("Skipped: the map /nonexistent/stata.yaml is absent"), std::string::npos) << r.out;
+}
+
+}  // namespace
+}  // namespace kestrel::planner
