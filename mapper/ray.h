@@ -58,13 +58,23 @@ void trace(const KeySpace& keys, const octomap::point3d& origin, const Key& key_
   const double length = static_cast<double>(ray.length);
   Key key = key_origin;
   visit(key);
+  // The crossing times live in scalars, not an array indexed by the axis (which made every step
+  // wait on a store and a reload); the choice of axis and the arithmetic are OctoMap's.
+  double tx = t_max[0], ty = t_max[1], tz = t_max[2];
+  const double dx = t_delta[0], dy = t_delta[1], dz = t_delta[2];
   for (;;) {
-    const int a = t_max[0] < t_max[1] ? (t_max[0] < t_max[2] ? 0 : 2)
-                                      : (t_max[1] < t_max[2] ? 1 : 2);
-    key[a] = static_cast<uint16_t>(key[a] + ray.step[a]);
-    t_max[a] += t_delta[a];
+    if (tx < ty ? tx < tz : false) {
+      key[0] = static_cast<uint16_t>(key[0] + ray.step[0]);
+      tx += dx;
+    } else if (!(tx < ty) && ty < tz) {
+      key[1] = static_cast<uint16_t>(key[1] + ray.step[1]);
+      ty += dy;
+    } else {
+      key[2] = static_cast<uint16_t>(key[2] + ray.step[2]);
+      tz += dz;
+    }
     if (key == ray.key_end) return;
-    if (std::min(std::min(t_max[0], t_max[1]), t_max[2]) > length) return;
+    if (std::min(std::min(tx, ty), tz) > length) return;
     visit(key);
   }
 }
