@@ -8,12 +8,20 @@
 #include <emmintrin.h>
 #endif
 
-#include "common/geometry/so3.h"
 
 namespace kestrel::vo {
 namespace {
 
 using Matrix26d = Eigen::Matrix<double, 2, 6>;
+
+// so3::hat's matrix, here so that the compiler sees it (the products with it are the same).
+inline Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
+  Eigen::Matrix3d m;
+  m << 0.0, -v.z(), v.y(),  //
+      v.z(), 0.0, -v.x(),   //
+      -v.y(), v.x(), 0.0;
+  return m;
+}
 
 struct Projection {
   Eigen::Vector2d pixel;
@@ -22,7 +30,7 @@ struct Projection {
 
 // Projection of X and its Jacobian; for ESM the Jacobian is taken halfway to the measurement,
 // the pixel the projection reaches at the optimum (at the same depth).
-Projection project(const Eigen::Vector3d& X, const PinholeCamera& cam,
+inline Projection project(const Eigen::Vector3d& X, const PinholeCamera& cam,
                    const Eigen::Vector2d& measured, bool esm) {
   Projection p;
   const double iz = 1.0 / X.z();
@@ -150,7 +158,7 @@ Accumulator linearise(const std::vector<Correspondence>& cs, const std::vector<i
       const Projection pr = project(Y, cam, c.cur_pixel, esm);
       Matrix26d J;
       J.leftCols<3>() = -pr.J * Rt;
-      J.rightCols<3>() = pr.J * so3::hat(Y);
+      J.rightCols<3>() = pr.J * skew(Y);
       const Eigen::Vector3d dY_dz = Rt * (c.ref_point / c.ref_point.z());
       add(acc, pr.pixel - c.cur_pixel, J, pr.J * dY_dz, c.ref_sigma_z, o);
     }
@@ -162,7 +170,7 @@ Accumulator linearise(const std::vector<Correspondence>& cs, const std::vector<i
       const Eigen::Vector3d u = c.ref_point.normalized();
       Eigen::Matrix<double, 1, 6> J;
       J.leftCols<3>() = u.transpose();
-      J.rightCols<3>() = -u.transpose() * R * so3::hat(c.cur_point);
+      J.rightCols<3>() = -u.transpose() * R * skew(c.cur_point);
       const double sigma = std::sqrt(c.ref_sigma_z * c.ref_sigma_z + c.cur_sigma_z * c.cur_sigma_z + 1e-6 * o.depth_sigma_floor_mm * o.depth_sigma_floor_mm);
       add_scalar(acc, u.dot(X - c.ref_point), J, sigma, o);
     }
@@ -171,7 +179,7 @@ Accumulator linearise(const std::vector<Correspondence>& cs, const std::vector<i
       const Projection pr = project(X, cam, c.ref_pixel, esm);
       Matrix26d J;
       J.leftCols<3>() = pr.J;
-      J.rightCols<3>() = -pr.J * R * so3::hat(c.cur_point);
+      J.rightCols<3>() = -pr.J * R * skew(c.cur_point);
       const Eigen::Vector3d dX_dz = R * (c.cur_point / c.cur_point.z());
       add(acc, pr.pixel - c.ref_pixel, J, pr.J * dX_dz, c.cur_sigma_z, o);
     }
