@@ -36,28 +36,6 @@ void ReachPyramid::build(const float* values, int cols, int rows) {
   }
 }
 
-inline int ReachPyramid::level_for(int w, int h) const {
-  const unsigned shorter = static_cast<unsigned>(std::min(w, h));
-  const int level = 31 - __builtin_clz(shorter);  // floor(log2(shorter)), shorter >= 1
-  return std::min(level, kLevels - 1);
-}
-
-bool ReachPyramid::any_at_least(int i0, int i1, int j0, int j1, float threshold) const {
-  const int level = level_for(i1 - i0 + 1, j1 - j0 + 1);
-  const int side = 1 << level;
-  const int u_last = i1 - side + 1, v_last = j1 - side + 1;
-  const float* values = levels_[static_cast<size_t>(level)].data();
-  for (int v = j0;; v = std::min(v + side, v_last)) {
-    const float* row = values + static_cast<size_t>(v) * cols_;
-    for (int u = i0;; u = std::min(u + side, u_last)) {
-      if (row[u] >= threshold) return true;
-      if (u == u_last) break;
-    }
-    if (v == v_last) break;
-  }
-  return false;
-}
-
 float ReachPyramid::max_over(int i0, int i1, int j0, int j1) const {
   const int level = level_for(i1 - i0 + 1, j1 - j0 + 1);
   const int side = 1 << level;

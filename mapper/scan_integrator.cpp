@@ -33,6 +33,12 @@ ScanIntegrator::ScanIntegrator(double resolution_m, const ScanOptions& options)
   const int half = static_cast<int>(std::ceil(options_.max_range_m / resolution_m)) + 2;
   side_ = 2 * half + 1;
   cells_.assign(static_cast<size_t>(side_) * side_ * side_, 0);
+  // The largest x with sqrt(x) <= max range (the root is monotonic and correctly rounded).
+  const double max_range = options_.max_range_m;
+  const double inf = std::numeric_limits<double>::infinity();
+  hit_range2_ = max_range * max_range;
+  while (std::sqrt(hit_range2_) > max_range) hit_range2_ = std::nextafter(hit_range2_, 0.0);
+  while (std::sqrt(std::nextafter(hit_range2_, inf)) <= max_range) hit_range2_ = std::nextafter(hit_range2_, inf);
 }
 
 inline int ScanIntegrator::index(const Key& key) const {
@@ -129,12 +135,13 @@ void ScanIntegrator::begin_pixels(const Scan& scan) {
       if (!scan.valid[i]) continue;
       const octomap::point3d& p = scan.points[i];
       const octomap::point3d offset = p - scan.origin;
-      const double range = offset.norm();  // float sum of squares, double root: OctoMap's
+      const double range2 = offset.norm_sq();  // float sum of squares: OctoMap's
+      const double range = std::sqrt(range2);   // ... and its double root
       const double depth = z_axis.x() * static_cast<double>(offset.x()) +
                            z_axis.y() * static_cast<double>(offset.y()) +
                            z_axis.z() * static_cast<double>(offset.z());
       double s_end = 0.0;
-      if (range <= max_range) {
+      if (range2 <= hit_range2_) {  // range <= max_range, without waiting for the root
         Key k;
         if (!keys_.key(p, k)) continue;  // OctoMap drops such a point altogether
         // Neighbouring pixels mostly hit the same cell: mark it once.

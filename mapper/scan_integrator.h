@@ -103,6 +103,7 @@ class ScanIntegrator {
   const Scan* scan_ = nullptr;
   Key key_origin_;
   int base_[3] = {0, 0, 0};      // key of grid cell (0, 0, 0)
+  double hit_range2_ = 0.0;      // a point is a hit iff its squared range is <= this
   int side_ = 0;                 // the scratch grid is side_^3 cells around the origin
   FootprintProjector projector_;
   std::optional<RayCellClassifier> classifier_;
