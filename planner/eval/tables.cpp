@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <iomanip>
+#include <limits>
 #include <numeric>
 #include <sstream>
 
@@ -33,6 +34,7 @@ double median(std::vector<double> v) {
 struct Summary {
   int trials = 0, found = 0, successes = 0;
   std::vector<double> goal_traces, build_s, search_s, lengths;
+  std::vector<double> trial_traces;  ///< per trial in run order; NaN where it failed
   double success_pct() const { return trials ? 100.0 * successes / trials : 0.0; }
   double found_pct() const { return trials ? 100.0 * found / trials : 0.0; }
   double mean_trace() const {
@@ -65,6 +67,7 @@ Summary run_many(const Scenario& sc, const Setting& s, const Pairs& pairs, const
       sum.build_s.push_back(r.build_s);
       sum.search_s.push_back(r.search_s);
       sum.found += r.found;
+      sum.trial_traces.push_back(r.success ? r.goal_trace : std::numeric_limits<double>::quiet_NaN());
       if (!r.success) continue;
       ++sum.successes;
       sum.goal_traces.push_back(r.goal_trace);
@@ -173,14 +176,34 @@ std::string table5_planners(const Scenario& sc, const Pairs& pairs, const Experi
   const Row rows[] = {{"prm", "uniform", "56.38 · 0.79 · 0.15"},   {"brm", "uniform", "19.11 · 110.75 · 0.38"},
                       {"brm", "su", "12.31 · 323.12 · 0.55"},      {"brm", "su-ukf", "—"},
                       {"brm", "gaussian", "22.82 · 88.14 · 0.21"}, {"brm", "bridge", "21.92 · 178.58 · 0.30"}};
+  std::vector<Summary> runs;
+  for (const Row& r : rows) runs.push_back(run_many(sc, Setting{r.planner, r.sampler, o.samples}, pairs, o));
+  // Each setting's mean is over its own successes, which differ from row to row; the trials a
+  // setting and PRM both solved (same seeds per pair and trial) compare like with like.
+  const Summary& prm = runs.front();
+  const auto ratio_to_prm = [&](const Summary& s, int* n) {
+    double mine = 0.0, theirs = 0.0;
+    *n = 0;
+    for (size_t t = 0; t < s.trial_traces.size(); ++t)
+      if (!std::isnan(s.trial_traces[t]) && !std::isnan(prm.trial_traces[t])) {
+        mine += s.trial_traces[t];
+        theirs += prm.trial_traces[t];
+        ++*n;
+      }
+    return *n > 0 ? mine / theirs : std::numeric_limits<double>::quiet_NaN();
+  };
   std::ostringstream out;
-  out << "| planner | sampler | path found % | success % | goal tr(Σ) | length m | build s (median) | search ms (median) | paper tr · build s · search s |\n"
-         "|---|---|---|---|---|---|---|---|---|\n";
-  for (const Row& r : rows) {
-    const Summary s = run_many(sc, Setting{r.planner, r.sampler, o.samples}, pairs, o);
+  out << "| planner | sampler | path found % | success % | goal tr(Σ) | ÷ PRM's, trials both solved (n) | length m | build s (median) | search ms (median) | paper tr · build s · search s |\n"
+         "|---|---|---|---|---|---|---|---|---|---|\n";
+  for (size_t i = 0; i < runs.size(); ++i) {
+    const Row& r = rows[i];
+    const Summary& s = runs[i];
+    int n = 0;
+    const double ratio = ratio_to_prm(s, &n);
     out << "| " << r.planner << " | " << r.sampler << " | " << fmt("%.1f", s.found_pct()) << " | " << fmt("%.1f", s.success_pct()) << " | "
-        << fmt("%.2f", s.mean_trace()) << " | " << fmt("%.1f", s.mean_length()) << " | " << fmt("%.3f", median(s.build_s))
-        << " | " << fmt("%.3f", 1e3 * median(s.search_s)) << " | " << r.paper << " |\n";
+        << fmt("%.2f", s.mean_trace()) << " | " << fmt("%.2f", ratio) << " (" << n << ") | " << fmt("%.1f", s.mean_length())
+        << " | " << fmt("%.3f", median(s.build_s)) << " | " << fmt("%.3f", 1e3 * median(s.search_s)) << " | " << r.paper
+        << " |\n";
   }
   return out.str();
 }
