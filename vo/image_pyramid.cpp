@@ -122,8 +122,9 @@ void blur_rows(const cv::Mat& grey, const int* kernel, cv::Mat& out, std::vector
     }
     uint16_t* o = column.data() + static_cast<size_t>(y) * static_cast<size_t>(w);
     for (int x = 0; x < w; ++x) {
-      uint16_t s = 8;  // rounding of the >> 4
-      for (int i = 0; i <= 2 * R; ++i) s = static_cast<uint16_t>(s + k[i] * p[x + i]);
+      // The kernel is symmetric: mirrored taps share a multiplication (the same integer sum).
+      uint16_t s = static_cast<uint16_t>(8 + k[R] * p[x + R]);  // 8: rounding of the >> 4
+      for (int i = 0; i < R; ++i) s = static_cast<uint16_t>(s + k[i] * (p[x + i] + p[x + 2 * R - i]));
       o[x] = static_cast<uint16_t>(s >> 4);
     }
   }
@@ -134,8 +135,8 @@ void blur_rows(const cv::Mat& grey, const int* kernel, cv::Mat& out, std::vector
       rows[i + R] = column.data() + static_cast<size_t>(reflect101(y + i, h)) * static_cast<size_t>(w);
     uint8_t* o = out.ptr<uint8_t>(y);
     for (int x = 0; x < w; ++x) {
-      uint16_t s = 128;
-      for (int i = 0; i <= 2 * R; ++i) s = static_cast<uint16_t>(s + k[i] * rows[i][x]);
+      uint16_t s = static_cast<uint16_t>(128 + k[R] * rows[R][x]);
+      for (int i = 0; i < R; ++i) s = static_cast<uint16_t>(s + k[i] * (rows[i][x] + rows[2 * R - i][x]));
       o[x] = static_cast<uint8_t>(s >> 8);
     }
   }
@@ -167,6 +168,9 @@ void ImagePyramid::blur(const cv::Mat& grey, double sigma, cv::Mat& out) {
     return;
   }
   out.create(grey.size(), CV_8UC1);
+  for (int i = 0; i < r; ++i)  // gaussian_kernel_64 makes symmetric kernels; blur_rows relies on it
+    if (kernel_[static_cast<size_t>(i)] != kernel_[static_cast<size_t>(2 * r - i)])
+      throw std::logic_error("ImagePyramid: asymmetric blur kernel");
   if (r == 1) blur_rows<1>(grey, kernel_.data(), out, row_, column_);
   if (r == 2) blur_rows<2>(grey, kernel_.data(), out, row_, column_);
   if (r == 3) blur_rows<3>(grey, kernel_.data(), out, row_, column_);

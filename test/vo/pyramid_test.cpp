@@ -95,6 +95,30 @@ TEST(Pyramid, HalvingEqualsTheScalarLoopsForAnySize) {
   }
 }
 
+TEST(Pyramid, BlurOfAnImpulseIsTheRoundedSeparableKernel) {
+  // Known answer of the integer filter: the horizontal pass gives (8 + k[dx] * 255) >> 4 on
+  // the impulse's row (0 elsewhere), the vertical one (128 + k[dy] * that) >> 8.
+  std::vector<int> k;
+  gaussian_kernel_64(0.85, k);
+  const int r = static_cast<int>(k.size() / 2);
+  cv::Mat grey(21, 23, CV_8UC1, cv::Scalar(0));
+  grey.at<uint8_t>(10, 11) = 255;
+  ImagePyramid pyramid;
+  pyramid.build(grey, 1, 0.85);
+  const cv::Mat& out = pyramid.level(0);
+  for (int y = 0; y < grey.rows; ++y) {
+    for (int x = 0; x < grey.cols; ++x) {
+      const int dx = x - 11, dy = y - 10;
+      int expected = 0;
+      if (std::abs(dx) <= r && std::abs(dy) <= r) {
+        const int h = (8 + k[static_cast<size_t>(dx + r)] * 255) >> 4;
+        expected = (128 + k[static_cast<size_t>(dy + r)] * h) >> 8;
+      }
+      ASSERT_EQ(int(out.at<uint8_t>(y, x)), expected) << x << "," << y;
+    }
+  }
+}
+
 TEST(Pyramid, KernelSumsTo64AndIsSymmetric) {
   std::vector<int> k;
   gaussian_kernel_64(0.85, k);
