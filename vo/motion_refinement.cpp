@@ -56,7 +56,10 @@ struct Accumulator {
 // matrix is updated because fixed-length columns vectorise and a triangle's ragged loops did
 // not, and each upper entry still sees exactly the same operations in the same order.
 template <int Rows>
-void rank_update(Matrix6d& H, const Eigen::Matrix<double, Rows, 6>& J, double w) {
+#if defined(__GNUC__)
+[[gnu::always_inline]]
+#endif
+inline void rank_update(Matrix6d& H, const Eigen::Matrix<double, Rows, 6>& J, double w) {
   double* h = H.data();  // column-major
 #if defined(__SSE2__)
   // Each column in three registers, which receive row 0's term and then row 1's, the order
@@ -103,7 +106,10 @@ void add_scalar(Accumulator& acc, double r, const Eigen::Matrix<double, 1, 6>& J
 
 // Adds one residual r = pixel(T) - measured with Jacobian J (2x6), whitened by pixel noise
 // sigma and depth noise along g (the image motion per metre of depth of the projected point).
-void add(Accumulator& acc, const Eigen::Vector2d& r, const Matrix26d& J, const Eigen::Vector2d& g,
+#if defined(__GNUC__)
+[[gnu::always_inline]]
+#endif
+inline void add(Accumulator& acc, const Eigen::Vector2d& r, const Matrix26d& J, const Eigen::Vector2d& g,
          double sigma_z, const RefinementOptions& o) {
   const double s = o.pixel_sigma;
   Eigen::Matrix2d W = Eigen::Matrix2d::Identity() / s;  // Sigma^-1/2
