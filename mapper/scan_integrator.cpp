@@ -181,12 +181,20 @@ inline void ScanIntegrator::set_cleared(int idx, const Key& key) {
   queue_.push_back({idx, key});
 }
 
-inline bool ScanIntegrator::witness_clears(const Key& cell, float min_reach, bool& tried) {
-  // The ray through the pixel nearest the cell's centre, then the others of the
-  // (2 kNear + 1)^2 around it (the centre's may end in a hole of the depth or before the cell).
+inline bool ScanIntegrator::witness_clears(const Key& cell, const Eigen::Vector3d& centre,
+                                           float min_reach, bool& tried) {
+  // The ray through the pixel nearest the cell's centre (given in the camera frame), then the
+  // others of the (2 kNear + 1)^2 around it (the centre's may end in a hole of the depth or
+  // before the cell).
   tried = false;
-  int u = 0, v = 0;
-  if (!projector_.centre_pixel(cell, u, v)) return false;
+  if (!(centre.z() > 0.0)) return false;
+  const PinholeCamera& cam = scan_->camera;
+  const double inv_z = 1.0 / centre.z();
+  // Nearest pixel, rounding halves up (a cast truncates, which is floor here).
+  const double ur = cam.fx * centre.x() * inv_z + cam.cx + 0.5;
+  const double vr = cam.fy * centre.y() * inv_z + cam.cy + 0.5;
+  if (!(ur >= 0.0 && vr >= 0.0 && ur < scan_->cols && vr < scan_->rows)) return false;
+  const int u = static_cast<int>(ur), v = static_cast<int>(vr);
   tried = true;
   const int cols = scan_->cols;
   auto clears = [&](int pu, int pv) {
@@ -235,7 +243,8 @@ inline bool ScanIntegrator::try_ray(size_t sample, const Key& cell, int idx) {
   return false;
 }
 
-inline bool ScanIntegrator::some_ray_may_reach(const Key& cell, float& min_reach) const {
+inline bool ScanIntegrator::some_ray_may_reach(const Key& cell, float& min_reach,
+                                               Eigen::Vector3d& centre) const {
   // No pixel in (a rectangle around) the cell's image has a ray reaching the cell's exit: the
   // common case behind surfaces and beside the image. Then cleared_by_some_ray() is false too
   // (every ray it accepts has a pixel in footprint(cell) and reach >= min_reach); this test
@@ -247,6 +256,7 @@ inline bool ScanIntegrator::some_ray_may_reach(const Key& cell, float& min_reach
   const double cx = x.camera[0] + y.camera[0] + z.camera[0];
   const double cy = x.camera[1] + y.camera[1] + z.camera[1];
   const double cz = x.camera[2] + y.camera[2] + z.camera[2];
+  centre = Eigen::Vector3d(cx, cy, cz);
   const double z_near = cz - box_half_.z(), z_far = cz + box_half_.z();
   // A camera within 2 margins of the cell makes footprint() give the whole image; such a cell
   // reaches nearer than 2 sqrt(3) margins in depth, so it never passes this.
@@ -420,9 +430,10 @@ void ScanIntegrator::grow_from_origin() {
       f = static_cast<uint8_t>(f | kTested);
       ++cells_tested_;
       float min_reach = 0.0f;
-      if (!some_ray_may_reach(cell, min_reach)) continue;
+      Eigen::Vector3d centre;
+      if (!some_ray_may_reach(cell, min_reach, centre)) continue;
       bool witnesses_tried = false;
-      if (witness_clears(cell, min_reach, witnesses_tried)) {
+      if (witness_clears(cell, centre, min_reach, witnesses_tried)) {
         ++cells_witnessed_;
         set_cleared(idx, cell);
       } else if (cleared_by_some_ray(cell, idx, witnesses_tried)) {
