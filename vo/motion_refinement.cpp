@@ -1,7 +1,9 @@
 #include "vo/motion_refinement.h"
 
 #include <Eigen/Cholesky>
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 
 #if defined(__SSE2__)
@@ -148,6 +150,16 @@ Matrix6d information(const Accumulator& acc, const RefinementOptions& o) {
   return full(share * acc.H_image + acc.H_depth);
 }
 
+// One residual as linearise() computes it, before whitening: a reprojection (kImage: r, J, g,
+// sigma_z as add() takes them) or a depth residual (kDepth: r(0), Jd, sigma as add_scalar()).
+struct RawResidual {
+  enum Kind : uint8_t { kImage, kDepth } kind = kImage;
+  Eigen::Vector2d r, g;
+  Matrix26d J;
+  Eigen::Matrix<double, 1, 6> Jd;
+  double sigma = 0.0;  // sigma_z for an image residual
+};
+
 Accumulator linearise(const std::vector<Correspondence>& cs, const std::vector<int>& use,
                       const PinholeCamera& cam, const Eigen::Isometry3d& T,
                       const RefinementOptions& o) {
@@ -156,38 +168,63 @@ Accumulator linearise(const std::vector<Correspondence>& cs, const std::vector<i
   const Eigen::Matrix3d Rt = R.transpose();
   const Eigen::Vector3d p = T.translation();
   const bool esm = o.solver == Solver::kEsm;
-  for (int i : use) {
-    const Correspondence& c = cs[static_cast<size_t>(i)];
-    // Reference point into the current image: Y = R^T (P - p).
-    const Eigen::Vector3d Y = Rt * (c.ref_point - p);
-    if (Y.z() > 1e-6) {
-      const Projection pr = project(Y, cam, c.cur_pixel, esm);
-      Matrix26d J;
-      J.leftCols<3>() = -pr.J * Rt;
-      J.rightCols<3>() = pr.J * skew(Y);
-      const Eigen::Vector3d dY_dz = Rt * (c.ref_point / c.ref_point.z());
-      add(acc, pr.pixel - c.cur_pixel, J, pr.J * dY_dz, c.ref_sigma_z, o);
+  // In blocks of correspondences: their residuals first, then whitened and accumulated in
+  // the same order as one at a time. The whitening is a chain of square roots and divisions;
+  // in a loop of its own, several residuals' chains are in flight at once (the values and
+  // the order of every sum are unchanged).
+  constexpr size_t kBlock = 16;
+  RawResidual block[3 * kBlock];
+  size_t i_use = 0;
+  while (i_use < use.size()) {
+    size_t count = 0;
+    for (const size_t end = std::min(use.size(), i_use + kBlock); i_use < end; ++i_use) {
+      const Correspondence& c = cs[static_cast<size_t>(use[i_use])];
+      // Reference point into the current image: Y = R^T (P - p).
+      const Eigen::Vector3d Y = Rt * (c.ref_point - p);
+      if (Y.z() > 1e-6) {
+        const Projection pr = project(Y, cam, c.cur_pixel, esm);
+        RawResidual& q = block[count++];
+        q.kind = RawResidual::kImage;
+        q.J.leftCols<3>() = -pr.J * Rt;
+        q.J.rightCols<3>() = pr.J * skew(Y);
+        const Eigen::Vector3d dY_dz = Rt * (c.ref_point / c.ref_point.z());
+        q.r = pr.pixel - c.cur_pixel;
+        q.g = pr.J * dY_dz;
+        q.sigma = c.ref_sigma_z;
+      }
+      // Current point in the reference frame: X = R Q + p.
+      const Eigen::Vector3d X = R * c.cur_point + p;
+      if (o.depth_residuals) {
+        // Its distance along the reference ray against the reference depth: the information
+        // the image residuals lack, which tells a sideways translation from a rotation.
+        const Eigen::Vector3d u = c.ref_point.normalized();
+        RawResidual& q = block[count++];
+        q.kind = RawResidual::kDepth;
+        q.Jd.leftCols<3>() = u.transpose();
+        q.Jd.rightCols<3>() = -u.transpose() * R * skew(c.cur_point);
+        q.sigma = std::sqrt(c.ref_sigma_z * c.ref_sigma_z + c.cur_sigma_z * c.cur_sigma_z + 1e-6 * o.depth_sigma_floor_mm * o.depth_sigma_floor_mm);
+        q.r(0) = u.dot(X - c.ref_point);
+      }
+      if (!o.bidirectional) continue;
+      if (X.z() > 1e-6) {
+        const Projection pr = project(X, cam, c.ref_pixel, esm);
+        RawResidual& q = block[count++];
+        q.kind = RawResidual::kImage;
+        q.J.leftCols<3>() = pr.J;
+        q.J.rightCols<3>() = -pr.J * R * skew(c.cur_point);
+        const Eigen::Vector3d dX_dz = R * (c.cur_point / c.cur_point.z());
+        q.r = pr.pixel - c.ref_pixel;
+        q.g = pr.J * dX_dz;
+        q.sigma = c.cur_sigma_z;
+      }
     }
-    // Current point in the reference frame: X = R Q + p.
-    const Eigen::Vector3d X = R * c.cur_point + p;
-    if (o.depth_residuals) {
-      // Its distance along the reference ray against the reference depth: the information the
-      // image residuals lack, which tells a sideways translation from a rotation.
-      const Eigen::Vector3d u = c.ref_point.normalized();
-      Eigen::Matrix<double, 1, 6> J;
-      J.leftCols<3>() = u.transpose();
-      J.rightCols<3>() = -u.transpose() * R * skew(c.cur_point);
-      const double sigma = std::sqrt(c.ref_sigma_z * c.ref_sigma_z + c.cur_sigma_z * c.cur_sigma_z + 1e-6 * o.depth_sigma_floor_mm * o.depth_sigma_floor_mm);
-      add_scalar(acc, u.dot(X - c.ref_point), J, sigma, o);
-    }
-    if (!o.bidirectional) continue;
-    if (X.z() > 1e-6) {
-      const Projection pr = project(X, cam, c.ref_pixel, esm);
-      Matrix26d J;
-      J.leftCols<3>() = pr.J;
-      J.rightCols<3>() = -pr.J * R * skew(c.cur_point);
-      const Eigen::Vector3d dX_dz = R * (c.cur_point / c.cur_point.z());
-      add(acc, pr.pixel - c.ref_pixel, J, pr.J * dX_dz, c.cur_sigma_z, o);
+    for (size_t k = 0; k < count; ++k) {
+      const RawResidual& q = block[k];
+      if (q.kind == RawResidual::kImage) {
+        add(acc, q.r, q.J, q.g, q.sigma, o);
+      } else {
+        add_scalar(acc, q.r(0), q.Jd, q.sigma, o);
+      }
     }
   }
   return acc;
