@@ -27,6 +27,8 @@ class KeySpace {
       : resolution_(resolution_m), factor_(1.0 / resolution_m) {}
 
   double resolution() const { return resolution_; }
+  /// 1 / resolution: key(c) is floor(factor() * c) + kMaxVal.
+  double factor() const { return factor_; }
 
   /// The key along one axis; false outside the tree (or for a non-finite coordinate).
   bool key(double coordinate, uint16_t& k) const {

@@ -129,6 +129,8 @@ void ScanIntegrator::begin_pixels(const Scan& scan) {
   bool witness_ok = true;
   for (int a = 0; a < 3; ++a) witness_ok = witness_ok && std::fabs(static_cast<double>(scan.origin(a))) < edge;
   int last_hit = -1;
+  double last_floor[3] = {0.0, 0.0, 0.0};  // floor(factor * coordinate) of last_hit's key
+  const double factor = keys_.factor();
   for (int v = 0; v < scan.rows; ++v) {
     for (int u = 0; u < scan.cols; ++u) {
       const size_t i = static_cast<size_t>(v) * scan.cols + u;
@@ -142,15 +144,21 @@ void ScanIntegrator::begin_pixels(const Scan& scan) {
                            z_axis.z() * static_cast<double>(offset.z());
       double s_end = 0.0;
       if (range2 <= hit_range2_) {  // range <= max_range, without waiting for the root
-        Key k;
-        if (!keys_.key(p, k)) continue;  // OctoMap drops such a point altogether
-        // Neighbouring pixels mostly hit the same cell: mark it once.
-        const int idx = index(k);
-        if (idx != last_hit) {
-          mark(idx, k, kOccupied);
-          last_hit = idx;
+        // Neighbouring pixels mostly hit the same cell: the key is floor(factor * coordinate),
+        // so a point whose scaled coordinates lie in the last hit cell's [n, n + 1) has its
+        // key, and the cell is marked already.
+        const double sx = factor * static_cast<double>(p.x());
+        const double sy = factor * static_cast<double>(p.y());
+        const double sz = factor * static_cast<double>(p.z());
+        if (!(last_hit >= 0 && sx >= last_floor[0] && sx < last_floor[0] + 1.0 && sy >= last_floor[1] &&
+              sy < last_floor[1] + 1.0 && sz >= last_floor[2] && sz < last_floor[2] + 1.0)) {
+          Key k;
+          if (!keys_.key(p, k)) continue;  // OctoMap drops such a point altogether
+          last_hit = index(k);
+          mark(last_hit, k, kOccupied);
+          for (int a = 0; a < 3; ++a) last_floor[a] = static_cast<double>(static_cast<int>(k[a]) - KeySpace::kMaxVal);
         }
-        end_cell_[i] = idx;
+        end_cell_[i] = last_hit;
         s_end = depth - 4.0 * line - 1e-6 * range;
       } else if (depth > 0.0) {
         const double dir_norm = range / depth * (1.0 + 1e-6);
