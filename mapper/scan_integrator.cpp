@@ -75,10 +75,12 @@ void ScanIntegrator::begin(const Scan& scan) {
   projector_.begin(scan);
 
   const size_t n = scan.points.size();
-  if (rays_.size() < n) {
-    rays_.resize(n);
+  if (ray_state_.size() < n) {
     ray_state_.resize(n, 0u);
+    ray_slot_.resize(n);
+    rays_.reserve(n);  // never reallocates during a scan: references into it stay valid
   }
+  rays_.clear();
   reach_.assign(n, 0.0f);
   s_end_lo_.assign(n, 0.0f);
   end_cell_.assign(n, -1);
@@ -172,13 +174,17 @@ void ScanIntegrator::begin_pixels(const Scan& scan) {
 }
 
 inline ScanIntegrator::RayCache& ScanIntegrator::ray(size_t sample) {
-  RayCache& r = rays_[sample];
   if (ray_state_[sample] < built_) {
+    // Appended, not stored by pixel: the few hundred rays a scan builds stay in a few cache
+    // lines instead of one cold line each in a 1.3 MB array.
+    ray_slot_[sample] = static_cast<uint32_t>(rays_.size());
+    RayCache& r = rays_.emplace_back();
     r.ray = make_ray(keys_, scan_->origin, key_origin_, scan_->points[sample], options_.max_range_m);
     r.bounds = classifier_->bounds(r.ray);
     ray_state_[sample] = built_;
+    return r;
   }
-  return r;
+  return rays_[ray_slot_[sample]];
 }
 
 inline void ScanIntegrator::set_cleared(int idx, const Key& key) {

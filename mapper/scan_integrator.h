@@ -107,8 +107,9 @@ class ScanIntegrator {
   int side_ = 0;                 // the scratch grid is side_^3 cells around the origin
   FootprintProjector projector_;
   std::optional<RayCellClassifier> classifier_;
-  // rays_[s] belongs to this scan if ray_state_[s] >= built_, and has been walked if it is
-  // built_ + 1 (kept apart from the rays: the cell search checks it for many pixels).
+  // Pixel s's ray is built for this scan (at rays_[ray_slot_[s]]) if ray_state_[s] >= built_,
+  // and has been walked if it is built_ + 1 (kept apart from the rays: the cell search checks
+  // it for many pixels).
   uint32_t built_ = 0;
   size_t cells_tested_ = 0;
   size_t cells_witnessed_ = 0;
@@ -137,6 +138,7 @@ class ScanIntegrator {
   std::vector<RayCache> rays_;
   std::vector<int> row_lo_, row_hi_;       // clip_rows(): pixel range per row
   std::vector<uint32_t> ray_state_;
+  std::vector<uint32_t> ray_slot_;         // where in rays_ a built ray is
 };
 
 }  // namespace kestrel::mapper
