@@ -1,0 +1,79 @@
+// The depth/RGB time offset (DepthOptions::compensate_time_offset): a synthetic scene seen from
+// a moving camera, its depth image rendered 12 ms before the colour image (as fr1_xyz's frames
+// are stamped). Given the true motion, the compensated lookup reads each feature's depth where
+// its point was at depth time, and so recovers the depth at RGB time.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <iostream>
+
+#include "common/geometry/se3.h"
+#include "test/vo/synthetic_scene.h"
+#include "vo/depth_lookup.h"
+
+namespace kestrel::vo {
+namespace {
+
+constexpr double kDepthOffsetS = -0.012;
+
+// 0.6 m/s and 30 deg/s: 7 mm and 0.36 degrees in 12 ms.
+Vector6d twist_per_s() { return (Vector6d() << 0.45, -0.10, 0.35, 0.05, 0.50, -0.08).finished(); }
+
+TEST(DepthTimeOffset, CompensatedLookupReadsTheDepthAtRgbTime) {
+  const test::SyntheticScene scene(11);
+  const PinholeCamera cam = test::test_camera();
+  const Eigen::Isometry3d T_world_rgb = se3::exp(0.2 * twist_per_s());
+  const Eigen::Isometry3d T_world_depth = T_world_rgb * se3::exp(kDepthOffsetS * twist_per_s());
+  const cv::Mat depth_at_rgb_time = scene.render(T_world_rgb, cam, 1000000).depth_mm;
+  const cv::Mat depth_image = scene.render(T_world_depth, cam, 1000000).depth_mm;
+  Lens lens;
+  lens.reset(cam, true);
+  Frame frame;
+  for (int v = 40; v < 440; v += 20)
+    for (int u = 40; u < 600; u += 20) {
+      Feature f;
+      f.u = f.u0 = float(u);
+      f.v = f.v0 = float(v);
+      frame.features.push_back(f);
+    }
+  frame.level_begin.fill(int(frame.features.size()));
+  frame.level_begin[0] = 0;
+  FrameMotion motion;
+  motion.known = true;
+  motion.twist_per_s = twist_per_s();
+  motion.depth_offset_s = kDepthOffsetS;
+  DepthOptions plain_options;
+  DepthOptions compensated_options;
+  compensated_options.compensate_time_offset = true;
+  Frame plain = frame, compensated = frame;
+  attach_depth(depth_image, lens, plain_options, motion, plain);
+  attach_depth(depth_image, lens, compensated_options, motion, compensated);
+  ASSERT_GT(compensated.features.size(), 0.9 * double(plain.features.size()));
+
+  // Each feature's depth against the depth at RGB time at its own pixel (both lookups keep the
+  // features in order; match them by pixel).
+  auto rms = [&](const Frame& f) {
+    double sum = 0.0;
+    int n = 0;
+    for (const Feature& x : f.features) {
+      const float z_true = reliable_depth_m(depth_at_rgb_time, x.u0, x.v0, plain_options);
+      if (!(z_true > 0.0f)) continue;
+      sum += std::pow(double(x.depth_m - z_true), 2);
+      ++n;
+    }
+    EXPECT_GT(n, 400);
+    return std::sqrt(sum / n);
+  };
+  const double e_plain = rms(plain), e_compensated = rms(compensated);
+  std::cout << "depth error at RGB time (RMS): uncompensated " << 1e3 * e_plain << " mm, compensated "
+            << 1e3 * e_compensated << " mm\n";
+  // Measured: 12.5 mm uncompensated, 0.9 mm compensated (the rest is millimetre rounding and
+  // nearest-pixel reads on slanted walls).
+  EXPECT_GT(e_plain, 0.008);
+  EXPECT_LT(e_compensated, 0.002);
+  EXPECT_LT(e_compensated, 0.15 * e_plain);
+}
+
+}  // namespace
+}  // namespace kestrel::vo
