@@ -39,6 +39,18 @@ inline void to_float_row(const uint8_t* in, float* out) {
 // differences averaged) over the window, and the cost.
 struct NormalSums {
   float hxx = 0, hxy = 0, hyy = 0, sx = 0, sy = 0, ex = 0, ey = 0, se = 0, cost = 0;
+  /// One pixel's terms: gradient (gx, gy) and residual e.
+  void add(float gx, float gy, float e) {
+    hxx += gx * gx;
+    hxy += gx * gy;
+    hyy += gy * gy;
+    sx += gx;
+    sy += gy;
+    ex += gx * e;
+    ey += gy * e;
+    se += e;
+    cost += e * e;
+  }
 };
 
 // The reference: one pass, every sum in pixel (raster) order, as scalars the compiler keeps in
@@ -54,15 +66,7 @@ NormalSums accumulate_scalar(const Patch& s, const Patch& t, const Patch& tgx, c
       const float gx = 0.25f * (s[i + 1] - s[i - 1] + tgx[i]);
       const float gy = 0.25f * (s[i + sd] - s[i - sd] + tgy[i]);
       const float e = s[i] - t[i] - bias;
-      a.hxx += gx * gx;
-      a.hxy += gx * gy;
-      a.hyy += gy * gy;
-      a.sx += gx;
-      a.sy += gy;
-      a.ex += gx * e;
-      a.ey += gy * e;
-      a.se += e;
-      a.cost += e * e;
+      a.add(gx, gy, e);
     }
   }
   return a;
@@ -122,16 +126,7 @@ NormalSums accumulate(const Patch& s, const Patch& t, const Patch& tgx, const Pa
   a.se = gs[3];
   a.cost = cost;
   for (; p < n; ++p) {
-    const float gx = gxa[p], gy = gya[p], e = ea[p];
-    a.hxx += gx * gx;
-    a.hxy += gx * gy;
-    a.hyy += gy * gy;
-    a.sx += gx;
-    a.sy += gy;
-    a.ex += gx * e;
-    a.ey += gy * e;
-    a.se += e;
-    a.cost += e * e;
+    a.add(gxa[p], gya[p], ea[p]);
   }
   return a;
 }
