@@ -27,13 +27,6 @@ Eigen::Isometry3d pose_at(int64_t utime) {
   return test::look_at({-1.2 + 0.2 * t, 0.013, 1.2}, {2.0, 0.5 - 0.5 * t, 0.7});
 }
 
-std::string bytes_of(const std::filesystem::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream all;
-  all << in.rdbuf();
-  return all.str();
-}
-
 TEST(MapperProcess, LockStepReplayIsDeterministicAndResets) {
   if (!kestrel::test::can_isolate_network()) GTEST_SKIP() << "no network namespace available";
   kestrel::test::TempDir dir;
@@ -62,9 +55,9 @@ TEST(MapperProcess, LockStepReplayIsDeterministicAndResets) {
       " --expect mapper --record " + (dir / "b.lcmlog").string() + " || exit 12; kill -INT $P; wait $P";
   const auto r = kestrel::test::run({kestrel::test::tool("isolated").string(), "--", "sh", "-c", script}, 240.0);
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  const std::string a = bytes_of(dir / "a.lcmlog");
+  const std::string a = kestrel::test::read_file(dir / "a.lcmlog");
   ASSERT_FALSE(a.empty());
-  EXPECT_EQ(a, bytes_of(dir / "b.lcmlog")) << "the second replay (after RESET) must publish the same maps";
+  EXPECT_EQ(a, kestrel::test::read_file(dir / "b.lcmlog")) << "the second replay (after RESET) must publish the same maps";
 
   transport::LogReader recorded((dir / "a.lcmlog").string());
   std::optional<kestrel::octomap_t> last;

@@ -256,13 +256,7 @@ TEST(OctreeFiles, WrittenFilesReadBackIdentical) {
   EXPECT_EQ(binary.num_cells(), map.num_cells());
   map.for_each_cell([&](const Key& k, float v) { ASSERT_EQ(binary.occupancy(k), map.occupancy(v)); });
   write_map_file(binary, (dir / "again.bt").string());
-  auto bytes = [](const std::filesystem::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    std::ostringstream all;
-    all << in.rdbuf();
-    return all.str();
-  };
-  EXPECT_EQ(bytes(dir / "again.bt"), bytes(dir / "map.bt"));
+  EXPECT_EQ(kestrel::test::read_file(dir / "again.bt"), kestrel::test::read_file(dir / "map.bt"));
 
   // The message form round-trips the same way.
   const auto stream = encode_octree(map, OctreeFormat::kFull);
