@@ -87,21 +87,20 @@ const ScanUpdate& Mapper::insert(const RgbdFrame& frame, const Eigen::Isometry3d
   frame.validate(what);
   if (frame.depth_mm.empty()) throw InputError(std::string(what) + ": frame has no depth image");
   map_is_sequence_ = false;  // the map now holds a frame no rebuild inserts
-  // Colour is decimated only for a keyframe (the PLY export): picking it from every full-size
-  // frame cost as much as a tenth of a 128x96 insertion (cache misses on the big image).
-  RgbdFrame depth_only = frame;
-  depth_only.rgb = cv::Mat();
-  RgbdFrame small = decimate(depth_only, options_.scan.stride);
+  // The rays are built straight from the full-size depth image (each picked pixel read once);
+  // the decimated frame is made only for a keyframe, with colour (the PLY export).
   const int64_t utime = frame.depth_utime != 0 ? frame.depth_utime : frame.utime;
-  integrate(small, T_world_camera, utime, what);
+  make_decimated_scan(frame, T_world_camera, options_.scan, what, scan_);
+  integrator_.compute(scan_, update_);
+  map_.integrate(update_, utime);
+  ++frames_inserted_;
   if (!have_last_keyframe_ || moved(last_keyframe_pose_, T_world_camera,
                                     options_.keyframe_translation_m, options_.keyframe_rotation_deg)) {
-    if (!frame.rgb.empty()) small.rgb = decimate(frame, options_.scan.stride).rgb;
     StoredKeyframe kf;
     kf.id = next_keyframe_id_++;
     kf.utime = utime;
     kf.T_world_camera = T_world_camera;
-    kf.frame = std::move(small);
+    kf.frame = decimate(frame, options_.scan.stride);
     keyframes_.add(std::move(kf));
     last_keyframe_pose_ = T_world_camera;
     have_last_keyframe_ = true;

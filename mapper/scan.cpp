@@ -1,6 +1,7 @@
 #include "mapper/scan.h"
 
 #include <cstring>
+#include <stdexcept>
 #include <string>
 #include <type_traits>
 
@@ -58,28 +59,88 @@ cv::Mat pick(const cv::Mat& image, int stride, int u0, int v0, int cols, int row
   return out;
 }
 
+// The picked grid of an image of `camera`'s size at `stride` (throws when it is empty), and the
+// camera re-scaled to it: picked pixel c sits at u = u0 + stride * c of the original image.
+PinholeCamera decimated_camera(const PinholeCamera& camera, int stride, int& u0, int& v0) {
+  if (stride < 1) throw std::invalid_argument("decimate: stride must be >= 1");
+  int cols = 0, rows = 0;
+  pick_grid(camera.width, stride, u0, cols);
+  pick_grid(camera.height, stride, v0, rows);
+  if (cols < 1 || rows < 1) {
+    throw std::invalid_argument("decimate: stride " + std::to_string(stride) +
+                                " is larger than the image");
+  }
+  PinholeCamera out = camera;
+  out.width = cols;
+  out.height = rows;
+  out.fx = camera.fx / stride;
+  out.fy = camera.fy / stride;
+  out.cx = (camera.cx - u0) / stride;
+  out.cy = (camera.cy - v0) / stride;
+  return out;
+}
+
+void check_scan_input(const RgbdFrame& frame, const Eigen::Isometry3d& T_world_camera, const char* what) {
+  frame.validate(what);
+  if (frame.depth_mm.empty()) throw InputError(std::string(what) + ": frame has no depth image");
+  if (!se3::is_valid(T_world_camera, 1e-6)) {
+    throw InputError(std::string(what) + ": camera pose is not a finite rigid transform");
+  }
+}
+
+// The rays of the pixels (u0 + stride * c, v0 + stride * r) of frame.depth_mm, c < cam.width,
+// r < cam.height, with `cam` the camera of the picked grid.
+void fill_scan(const RgbdFrame& frame, const PinholeCamera& cam, int stride, int u0, int v0,
+               const Eigen::Isometry3d& T_world_camera, const ScanOptions& options, Scan& scan) {
+  scan.num_points = 0;
+  scan.utime = frame.depth_utime != 0 ? frame.depth_utime : frame.utime;
+  scan.T_world_camera = T_world_camera;
+  scan.camera = cam;
+  scan.cols = cam.width;
+  scan.rows = cam.height;
+  const Eigen::Vector3d t = T_world_camera.translation();
+  scan.origin = octomap::point3d(static_cast<float>(t.x()), static_cast<float>(t.y()),
+                                 static_cast<float>(t.z()));
+  const size_t n = static_cast<size_t>(scan.cols) * static_cast<size_t>(scan.rows);
+  scan.points.resize(n);
+  scan.valid.resize(n);
+
+  const Eigen::Matrix3d R = T_world_camera.linear();
+  const double min_depth_mm = options.min_range_m * 1000.0;
+  size_t num_points = 0;
+  for (int v = 0; v < scan.rows; ++v) {
+    const uint16_t* depth = frame.depth_mm.ptr<uint16_t>(v0 + v * stride) + u0;
+    const double y_over_z = (v - cam.cy) / cam.fy;
+    const size_t row = static_cast<size_t>(v) * static_cast<size_t>(scan.cols);
+    uint8_t* valid = scan.valid.data() + row;
+    octomap::point3d* points = scan.points.data() + row;
+    for (int u = 0; u < scan.cols; ++u) {
+      const uint16_t mm = depth[static_cast<size_t>(u) * static_cast<size_t>(stride)];
+      const bool ok = mm != 0 && !(mm < min_depth_mm);
+      valid[u] = ok ? 1 : 0;
+      if (!ok) continue;
+      const double z = 0.001 * mm;
+      const Eigen::Vector3d p_in_camera((u - cam.cx) / cam.fx * z, y_over_z * z, z);
+      const Eigen::Vector3d p = R * p_in_camera + t;
+      points[u] = octomap::point3d(static_cast<float>(p.x()), static_cast<float>(p.y()),
+                                   static_cast<float>(p.z()));
+      ++num_points;
+    }
+  }
+  scan.num_points = num_points;
+}
+
 }  // namespace
 
 RgbdFrame decimate(const RgbdFrame& frame, int stride) {
   if (stride < 1) throw std::invalid_argument("decimate: stride must be >= 1");
   if (stride == 1) return frame;
-  int u0 = 0, v0 = 0, cols = 0, rows = 0;
-  pick_grid(frame.camera.width, stride, u0, cols);
-  pick_grid(frame.camera.height, stride, v0, rows);
-  if (cols < 1 || rows < 1) {
-    throw std::invalid_argument("decimate: stride " + std::to_string(stride) +
-                                " is larger than the image");
-  }
+  int u0 = 0, v0 = 0;
+  const PinholeCamera cam = decimated_camera(frame.camera, stride, u0, v0);
   RgbdFrame out = frame;
-  out.rgb = pick(frame.rgb, stride, u0, v0, cols, rows);
-  out.depth_mm = pick(frame.depth_mm, stride, u0, v0, cols, rows);
-  // Picked pixel c sits at u = u0 + stride * c of the original image.
-  out.camera.width = cols;
-  out.camera.height = rows;
-  out.camera.fx = frame.camera.fx / stride;
-  out.camera.fy = frame.camera.fy / stride;
-  out.camera.cx = (frame.camera.cx - u0) / stride;
-  out.camera.cy = (frame.camera.cy - v0) / stride;
+  out.rgb = pick(frame.rgb, stride, u0, v0, cam.width, cam.height);
+  out.depth_mm = pick(frame.depth_mm, stride, u0, v0, cam.width, cam.height);
+  out.camera = cam;
   return out;
 }
 
@@ -92,43 +153,16 @@ Scan make_scan(const RgbdFrame& frame, const Eigen::Isometry3d& T_world_camera,
 
 void make_scan(const RgbdFrame& frame, const Eigen::Isometry3d& T_world_camera,
                const ScanOptions& options, const char* what, Scan& scan) {
-  frame.validate(what);
-  if (frame.depth_mm.empty()) throw InputError(std::string(what) + ": frame has no depth image");
-  if (!se3::is_valid(T_world_camera, 1e-6)) {
-    throw InputError(std::string(what) + ": camera pose is not a finite rigid transform");
-  }
-  scan.num_points = 0;
-  scan.utime = frame.depth_utime != 0 ? frame.depth_utime : frame.utime;
-  scan.T_world_camera = T_world_camera;
-  scan.camera = frame.camera;
-  scan.cols = frame.camera.width;
-  scan.rows = frame.camera.height;
-  const Eigen::Vector3d t = T_world_camera.translation();
-  scan.origin = octomap::point3d(static_cast<float>(t.x()), static_cast<float>(t.y()),
-                                 static_cast<float>(t.z()));
-  const size_t n = static_cast<size_t>(scan.cols) * static_cast<size_t>(scan.rows);
-  scan.points.resize(n);
-  scan.valid.assign(n, 0);
+  check_scan_input(frame, T_world_camera, what);
+  fill_scan(frame, frame.camera, 1, 0, 0, T_world_camera, options, scan);
+}
 
-  const Eigen::Matrix3d R = T_world_camera.linear();
-  const PinholeCamera& cam = frame.camera;
-  const double min_depth_mm = options.min_range_m * 1000.0;
-  for (int v = 0; v < scan.rows; ++v) {
-    const uint16_t* depth = frame.depth_mm.ptr<uint16_t>(v);
-    const double y_over_z = (v - cam.cy) / cam.fy;
-    for (int u = 0; u < scan.cols; ++u) {
-      const uint16_t mm = depth[u];
-      if (mm == 0 || mm < min_depth_mm) continue;
-      const double z = 0.001 * mm;
-      const Eigen::Vector3d p_in_camera((u - cam.cx) / cam.fx * z, y_over_z * z, z);
-      const Eigen::Vector3d p = R * p_in_camera + t;
-      const size_t i = static_cast<size_t>(v) * static_cast<size_t>(scan.cols) + u;
-      scan.points[i] = octomap::point3d(static_cast<float>(p.x()), static_cast<float>(p.y()),
-                                        static_cast<float>(p.z()));
-      scan.valid[i] = 1;
-      ++scan.num_points;
-    }
-  }
+void make_decimated_scan(const RgbdFrame& frame, const Eigen::Isometry3d& T_world_camera,
+                         const ScanOptions& options, const char* what, Scan& scan) {
+  check_scan_input(frame, T_world_camera, what);
+  int u0 = 0, v0 = 0;
+  const PinholeCamera cam = decimated_camera(frame.camera, options.stride, u0, v0);
+  fill_scan(frame, cam, options.stride, u0, v0, T_world_camera, options, scan);
 }
 
 }  // namespace kestrel::mapper

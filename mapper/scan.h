@@ -48,5 +48,9 @@ Scan make_scan(const RgbdFrame& frame, const Eigen::Isometry3d& T_world_camera,
 /// The same into `scan`, reusing its storage (no allocation once it has held a frame as big).
 void make_scan(const RgbdFrame& frame, const Eigen::Isometry3d& T_world_camera,
                const ScanOptions& options, const char* what, Scan& scan);
+/// make_scan(decimate(frame, options.stride), ...) in one pass over the full-size depth image
+/// (no decimated copy is made): the same scan, bit for bit.
+void make_decimated_scan(const RgbdFrame& frame, const Eigen::Isometry3d& T_world_camera,
+                         const ScanOptions& options, const char* what, Scan& scan);
 
 }  // namespace kestrel::mapper

@@ -100,6 +100,36 @@ TEST(ScanIntegrator, CellSearchTracesOnlyAFewRays) {
   EXPECT_GT(update.free.size(), 100u);
 }
 
+TEST(Scan, DecimatedScanEqualsMakeScanOfTheDecimatedFrame) {
+  std::mt19937 rng(11);
+  const Scene scene = random_scene(rng);
+  const Eigen::Isometry3d T = test::look_at({-1.0, 0.2, 1.1}, {1.5, -0.3, 0.8});
+  RgbdFrame frame = scene.render(test::kinect_camera(), T, 5);
+  frame.depth_mm.at<uint16_t>(237, 322) = 0;   // a hole and a too-near reading on the stride-5 grid
+  frame.depth_mm.at<uint16_t>(242, 327) = 50;
+  for (const int stride : {1, 2, 3, 5, 7}) {
+    ScanOptions options;
+    options.stride = stride;
+    options.min_range_m = 0.1;
+    const Scan expected = make_scan(decimate(frame, stride), T, options, "test");
+    Scan scan;
+    make_decimated_scan(frame, T, options, "test", scan);
+    ASSERT_EQ(scan.cols, expected.cols) << "stride " << stride;
+    ASSERT_EQ(scan.rows, expected.rows);
+    EXPECT_EQ(scan.camera.fx, expected.camera.fx);
+    EXPECT_EQ(scan.camera.cx, expected.camera.cx);
+    EXPECT_EQ(scan.camera.cy, expected.camera.cy);
+    EXPECT_EQ(scan.num_points, expected.num_points);
+    EXPECT_GT(scan.num_points, 0u);
+    EXPECT_EQ(scan.valid, expected.valid);
+    for (size_t i = 0; i < scan.points.size(); ++i) {
+      if (!expected.valid[i]) continue;
+      ASSERT_EQ(scan.points[i], expected.points[i]) << "stride " << stride << " pixel " << i;
+    }
+  }
+  EXPECT_EQ(decimate(frame, 5).depth_mm.at<uint16_t>(47, 64), 0);  // the hole is on the grid
+}
+
 TEST(ScanIntegrator, ZeroDepthMarksNothing) {
   RgbdFrame frame;
   frame.camera = test::kinect_camera(32, 24);
