@@ -133,43 +133,50 @@ void ScanIntegrator::begin_pixels(const Scan& scan) {
   int last_hit = -1;
   double last_floor[3] = {0.0, 0.0, 0.0};  // floor(factor * coordinate) of last_hit's key
   const double factor = keys_.factor();
-  for (int v = 0; v < scan.rows; ++v) {
-    for (int u = 0; u < scan.cols; ++u) {
-      const size_t i = static_cast<size_t>(v) * scan.cols + u;
-      if (!scan.valid[i]) continue;
-      const octomap::point3d& p = scan.points[i];
-      const octomap::point3d offset = p - scan.origin;
-      const double range2 = offset.norm_sq();  // float sum of squares: OctoMap's
-      const double range = std::sqrt(range2);   // ... and its double root
-      const double depth = z_axis.x() * static_cast<double>(offset.x()) +
-                           z_axis.y() * static_cast<double>(offset.y()) +
-                           z_axis.z() * static_cast<double>(offset.z());
-      double s_end = 0.0;
-      if (range2 <= hit_range2_) {  // range <= max_range, without waiting for the root
-        // Neighbouring pixels mostly hit the same cell: the key is floor(factor * coordinate),
-        // so a point whose scaled coordinates lie in the last hit cell's [n, n + 1) has its
-        // key, and the cell is marked already.
-        const double sx = factor * static_cast<double>(p.x());
-        const double sy = factor * static_cast<double>(p.y());
-        const double sz = factor * static_cast<double>(p.z());
-        if (!(last_hit >= 0 && sx >= last_floor[0] && sx < last_floor[0] + 1.0 && sy >= last_floor[1] &&
-              sy < last_floor[1] + 1.0 && sz >= last_floor[2] && sz < last_floor[2] + 1.0)) {
-          Key k;
-          if (!keys_.key(p, k)) continue;  // OctoMap drops such a point altogether
-          last_hit = index(k);
-          mark(last_hit, k, kOccupied);
-          for (int a = 0; a < 3; ++a) last_floor[a] = static_cast<double>(static_cast<int>(k[a]) - KeySpace::kMaxVal);
-        }
-        end_cell_[i] = last_hit;
-        s_end = depth - 4.0 * line - 1e-6 * range;
-      } else if (depth > 0.0) {
-        const double dir_norm = range / depth * (1.0 + 1e-6);
-        s_end = (max_range * (1.0 - 2e-6) - 2.0 * line) / dir_norm;
+  // Everything the loop reads, in locals: the byte stores of mark() may alias anything, so
+  // members and vector data would be reloaded for every pixel.
+  const uint8_t* const valid = scan.valid.data();
+  const octomap::point3d* const points = scan.points.data();
+  const octomap::point3d origin = scan.origin;
+  const double hit_range2 = hit_range2_;
+  float* const reach_out = reach_.data();
+  float* const s_end_lo_out = s_end_lo_.data();
+  int* const end_cell_out = end_cell_.data();
+  const size_t n = static_cast<size_t>(scan.cols) * static_cast<size_t>(scan.rows);
+  for (size_t i = 0; i < n; ++i) {
+    if (!valid[i]) continue;
+    const octomap::point3d p = points[i];
+    const octomap::point3d offset = p - origin;
+    const double range2 = offset.norm_sq();  // float sum of squares: OctoMap's
+    const double range = std::sqrt(range2);   // ... and its double root
+    const double depth = z_axis.x() * static_cast<double>(offset.x()) +
+                         z_axis.y() * static_cast<double>(offset.y()) +
+                         z_axis.z() * static_cast<double>(offset.z());
+    double s_end = 0.0;
+    if (range2 <= hit_range2) {  // range <= max_range, without waiting for the root
+      // Neighbouring pixels mostly hit the same cell: the key is floor(factor * coordinate),
+      // so a point whose scaled coordinates lie in the last hit cell's [n, n + 1) has its
+      // key, and the cell is marked already.
+      const double sx = factor * static_cast<double>(p.x());
+      const double sy = factor * static_cast<double>(p.y());
+      const double sz = factor * static_cast<double>(p.z());
+      if (!(last_hit >= 0 && sx >= last_floor[0] && sx < last_floor[0] + 1.0 && sy >= last_floor[1] &&
+            sy < last_floor[1] + 1.0 && sz >= last_floor[2] && sz < last_floor[2] + 1.0)) {
+        Key k;
+        if (!keys_.key(p, k)) continue;  // OctoMap drops such a point altogether
+        last_hit = index(k);
+        mark(last_hit, k, kOccupied);
+        for (int a = 0; a < 3; ++a) last_floor[a] = static_cast<double>(static_cast<int>(k[a]) - KeySpace::kMaxVal);
       }
-      if (witness_ok && s_end > 0.0) s_end_lo_[i] = static_cast<float>(s_end * (1.0 - 1e-6));
-      const float reach = static_cast<float>(std::min(range, max_range) * (1.0 + 1e-6) + 1e-6);
-      reach_[i] = reach;
+      end_cell_out[i] = last_hit;
+      s_end = depth - 4.0 * line - 1e-6 * range;
+    } else if (depth > 0.0) {
+      const double dir_norm = range / depth * (1.0 + 1e-6);
+      s_end = (max_range * (1.0 - 2e-6) - 2.0 * line) / dir_norm;
     }
+    if (witness_ok && s_end > 0.0) s_end_lo_out[i] = static_cast<float>(s_end * (1.0 - 1e-6));
+    const float reach = static_cast<float>(std::min(range, max_range) * (1.0 + 1e-6) + 1e-6);
+    reach_out[i] = reach;
   }
 }
 
