@@ -33,10 +33,13 @@ struct Ray {
 Ray make_ray(const KeySpace& keys, const octomap::point3d& origin, const Key& key_origin,
              const octomap::point3d& p, double max_range_m);
 
-/// Calls visit(key) for every cell the ray clears, in order, starting with the origin's cell.
+/// Calls visit(key, index) for every cell the ray clears, in order, starting with the origin's
+/// cell, where index starts at `origin_index` and moves by index_step[a] * step_a whenever the
+/// key moves along axis a (a linear index into a grid around the origin, kept without
+/// recomputing it from the key for every cell).
 template <class Visit>
-void trace(const KeySpace& keys, const octomap::point3d& origin, const Key& key_origin,
-           const Ray& ray, Visit&& visit) {
+void trace_indexed(const KeySpace& keys, const octomap::point3d& origin, const Key& key_origin,
+                   const Ray& ray, int origin_index, const int index_step[3], Visit&& visit) {
   if (!ray.clears) return;
   const double res = keys.resolution();
   double t_max[3];
@@ -57,7 +60,10 @@ void trace(const KeySpace& keys, const octomap::point3d& origin, const Key& key_
   }
   const double length = static_cast<double>(ray.length);
   Key key = key_origin;
-  visit(key);
+  int index = origin_index;
+  const int ix = ray.step[0] * index_step[0], iy = ray.step[1] * index_step[1],
+            iz = ray.step[2] * index_step[2];
+  visit(key, index);
   // The crossing times live in scalars, not an array indexed by the axis (which made every step
   // wait on a store and a reload); the choice of axis and the arithmetic are OctoMap's.
   double tx = t_max[0], ty = t_max[1], tz = t_max[2];
@@ -65,18 +71,30 @@ void trace(const KeySpace& keys, const octomap::point3d& origin, const Key& key_
   for (;;) {
     if (tx < ty ? tx < tz : false) {
       key[0] = static_cast<uint16_t>(key[0] + ray.step[0]);
+      index += ix;
       tx += dx;
     } else if (!(tx < ty) && ty < tz) {
       key[1] = static_cast<uint16_t>(key[1] + ray.step[1]);
+      index += iy;
       ty += dy;
     } else {
       key[2] = static_cast<uint16_t>(key[2] + ray.step[2]);
+      index += iz;
       tz += dz;
     }
     if (key == ray.key_end) return;
     if (std::min(std::min(tx, ty), tz) > length) return;
-    visit(key);
+    visit(key, index);
   }
+}
+
+/// Calls visit(key) for every cell the ray clears, in order, starting with the origin's cell.
+template <class Visit>
+void trace(const KeySpace& keys, const octomap::point3d& origin, const Key& key_origin,
+           const Ray& ray, Visit&& visit) {
+  const int no_index[3] = {0, 0, 0};
+  trace_indexed(keys, origin, key_origin, ray, 0, no_index,
+                [&](const Key& key, int) { visit(key); });
 }
 
 }  // namespace kestrel::mapper

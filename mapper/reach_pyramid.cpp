@@ -6,13 +6,25 @@
 namespace kestrel::mapper {
 
 void ReachPyramid::build(const float* values, int cols, int rows) {
+  float* image = level0(cols, rows);
+  const size_t n = static_cast<size_t>(cols) * static_cast<size_t>(rows);
+  if (n > 0) std::memcpy(image, values, n * sizeof(float));
+  build_levels();
+}
+
+float* ReachPyramid::level0(int cols, int rows) {
   cols_ = cols;
   rows_ = rows;
   const size_t n = static_cast<size_t>(cols) * static_cast<size_t>(rows);
   for (std::vector<float>& level : levels_) level.resize(n);
   scratch_.resize(n);
+  return levels_[0].data();
+}
+
+void ReachPyramid::build_levels() {
+  const int cols = cols_, rows = rows_;
+  const size_t n = static_cast<size_t>(cols) * static_cast<size_t>(rows);
   if (n == 0) return;
-  std::memcpy(levels_[0].data(), values, n * sizeof(float));
   for (int level = 1; level < kLevels; ++level) {
     const int half = 1 << (level - 1);
     const float* in = levels_[level - 1].data();

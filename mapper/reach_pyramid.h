@@ -23,6 +23,10 @@ class ReachPyramid {
 
   /// Rebuilds from `values` (cols * rows, row-major); storage is reused between calls.
   void build(const float* values, int cols, int rows);
+  /// The same in two steps, without copying the image: fill the returned level 0 (cols * rows,
+  /// row-major; valid until the next call), then call build_levels().
+  float* level0(int cols, int rows);
+  void build_levels();
 
   int cols() const { return cols_; }
   int rows() const { return rows_; }

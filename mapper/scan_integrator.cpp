@@ -81,11 +81,14 @@ void ScanIntegrator::begin(const Scan& scan) {
     rays_.reserve(n);  // never reallocates during a scan: references into it stay valid
   }
   rays_.clear();
-  reach_.assign(n, 0.0f);
-  s_end_lo_.assign(n, 0.0f);
-  end_cell_.assign(n, -1);
+  // begin_pixels() writes every pixel's entry (no clearing pass first); the reach goes straight
+  // into the pyramid's level 0.
+  pixels_ = n;
+  reach_ = reach_max_.level0(scan.cols, scan.rows);
+  s_end_lo_.resize(n);
+  end_cell_.resize(n);
   begin_pixels(scan);
-  reach_max_.build(reach_.data(), scan.cols, scan.rows);
+  reach_max_.build_levels();
   begin_axis_parts(scan);
 }
 
@@ -139,44 +142,51 @@ void ScanIntegrator::begin_pixels(const Scan& scan) {
   const octomap::point3d* const points = scan.points.data();
   const octomap::point3d origin = scan.origin;
   const double hit_range2 = hit_range2_;
-  float* const reach_out = reach_.data();
+  float* const reach_out = reach_;
   float* const s_end_lo_out = s_end_lo_.data();
   int* const end_cell_out = end_cell_.data();
   const size_t n = static_cast<size_t>(scan.cols) * static_cast<size_t>(scan.rows);
   for (size_t i = 0; i < n; ++i) {
-    if (!valid[i]) continue;
-    const octomap::point3d p = points[i];
-    const octomap::point3d offset = p - origin;
-    const double range2 = offset.norm_sq();  // float sum of squares: OctoMap's
-    const double range = std::sqrt(range2);   // ... and its double root
-    const double depth = z_axis.x() * static_cast<double>(offset.x()) +
-                         z_axis.y() * static_cast<double>(offset.y()) +
-                         z_axis.z() * static_cast<double>(offset.z());
-    double s_end = 0.0;
-    if (range2 <= hit_range2) {  // range <= max_range, without waiting for the root
-      // Neighbouring pixels mostly hit the same cell: the key is floor(factor * coordinate),
-      // so a point whose scaled coordinates lie in the last hit cell's [n, n + 1) has its
-      // key, and the cell is marked already.
-      const double sx = factor * static_cast<double>(p.x());
-      const double sy = factor * static_cast<double>(p.y());
-      const double sz = factor * static_cast<double>(p.z());
-      if (!(last_hit >= 0 && sx >= last_floor[0] && sx < last_floor[0] + 1.0 && sy >= last_floor[1] &&
-            sy < last_floor[1] + 1.0 && sz >= last_floor[2] && sz < last_floor[2] + 1.0)) {
-        Key k;
-        if (!keys_.key(p, k)) continue;  // OctoMap drops such a point altogether
-        last_hit = index(k);
-        mark(last_hit, k, kOccupied);
-        for (int a = 0; a < 3; ++a) last_floor[a] = static_cast<double>(static_cast<int>(k[a]) - KeySpace::kMaxVal);
+    // Every entry is written (no clearing pass first); no ray: reach 0, no witness, no hit cell.
+    float reach = 0.0f, s_lo = 0.0f;
+    int end_cell = -1;
+    do {
+      if (!valid[i]) break;
+      const octomap::point3d p = points[i];
+      const octomap::point3d offset = p - origin;
+      const double range2 = offset.norm_sq();  // float sum of squares: OctoMap's
+      const double range = std::sqrt(range2);   // ... and its double root
+      const double depth = z_axis.x() * static_cast<double>(offset.x()) +
+                           z_axis.y() * static_cast<double>(offset.y()) +
+                           z_axis.z() * static_cast<double>(offset.z());
+      double s_end = 0.0;
+      if (range2 <= hit_range2) {  // range <= max_range, without waiting for the root
+        // Neighbouring pixels mostly hit the same cell: the key is floor(factor * coordinate),
+        // so a point whose scaled coordinates lie in the last hit cell's [n, n + 1) has its
+        // key, and the cell is marked already.
+        const double sx = factor * static_cast<double>(p.x());
+        const double sy = factor * static_cast<double>(p.y());
+        const double sz = factor * static_cast<double>(p.z());
+        if (!(last_hit >= 0 && sx >= last_floor[0] && sx < last_floor[0] + 1.0 && sy >= last_floor[1] &&
+              sy < last_floor[1] + 1.0 && sz >= last_floor[2] && sz < last_floor[2] + 1.0)) {
+          Key k;
+          if (!keys_.key(p, k)) break;  // OctoMap drops such a point altogether
+          last_hit = index(k);
+          mark(last_hit, k, kOccupied);
+          for (int a = 0; a < 3; ++a) last_floor[a] = static_cast<double>(static_cast<int>(k[a]) - KeySpace::kMaxVal);
+        }
+        end_cell = last_hit;
+        s_end = depth - 4.0 * line - 1e-6 * range;
+      } else if (depth > 0.0) {
+        const double dir_norm = range / depth * (1.0 + 1e-6);
+        s_end = (max_range * (1.0 - 2e-6) - 2.0 * line) / dir_norm;
       }
-      end_cell_out[i] = last_hit;
-      s_end = depth - 4.0 * line - 1e-6 * range;
-    } else if (depth > 0.0) {
-      const double dir_norm = range / depth * (1.0 + 1e-6);
-      s_end = (max_range * (1.0 - 2e-6) - 2.0 * line) / dir_norm;
-    }
-    if (witness_ok && s_end > 0.0) s_end_lo_out[i] = static_cast<float>(s_end * (1.0 - 1e-6));
-    const float reach = static_cast<float>(std::min(range, max_range) * (1.0 + 1e-6) + 1e-6);
+      if (witness_ok && s_end > 0.0) s_lo = static_cast<float>(s_end * (1.0 - 1e-6));
+      reach = static_cast<float>(std::min(range, max_range) * (1.0 + 1e-6) + 1e-6);
+    } while (false);
     reach_out[i] = reach;
+    s_end_lo_out[i] = s_lo;
+    end_cell_out[i] = end_cell;
   }
 }
 
@@ -239,10 +249,10 @@ inline void ScanIntegrator::trace_sample(size_t sample) {
   RayCache& r = ray(sample);
   ray_state_[sample] = built_ + 1;
   ++rays_traced_;
-  trace(keys_, scan_->origin, key_origin_, r.ray, [&](const Key& k) {
-    const int idx = index(k);
-    if (idx >= 0) set_cleared(idx, k);
-  });
+  // Every cell the walk clears lies within max range of the origin, two cells inside the
+  // grid, so its index is kept along the walk rather than recomputed from its key.
+  trace_indexed(keys_, scan_->origin, key_origin_, r.ray, index(key_origin_), stride_,
+                [&](const Key& k, int idx) { set_cleared(idx, k); });
 }
 
 inline bool ScanIntegrator::try_ray(size_t sample, const Key& cell, int idx) {
@@ -428,7 +438,7 @@ bool ScanIntegrator::clip_rows(const CellFootprint& f) {
 
 void ScanIntegrator::grow_from_origin() {
   // The origin's cell is cleared by every ray that clears anything.
-  for (size_t s = 0; s < reach_.size(); ++s) {
+  for (size_t s = 0; s < pixels_; ++s) {
     if (reach_[s] > 0.0f && ray(s).ray.clears) {
       set_cleared(index(key_origin_), key_origin_);
       break;
@@ -482,7 +492,7 @@ void ScanIntegrator::compute(const Scan& scan, ScanUpdate& update, Method method
   update.rays = scan.num_points;
   begin(scan);
   if (method == Method::kRayTrace) {
-    for (size_t s = 0; s < reach_.size(); ++s) {
+    for (size_t s = 0; s < pixels_; ++s) {
       if (reach_[s] > 0.0f) trace_sample(s);
     }
   } else {

@@ -121,7 +121,9 @@ class ScanIntegrator {
   std::vector<uint8_t> cells_;             // flags per grid cell
   std::vector<std::pair<int, Key>> touched_;
   std::vector<Pending> queue_;
-  std::vector<float> reach_;               // upper bound of each ray's length (0: no ray)
+  size_t pixels_ = 0;                      // cols * rows of the scan
+  float* reach_ = nullptr;                 // upper bound of each ray's length (0: no ray);
+                                           // level 0 of reach_max_
   std::vector<float> s_end_lo_;            // lower bound of its end's camera depth (0: clears nothing)
   ReachPyramid reach_max_;                 // max of reach_ over any pixel rectangle
   // Per axis and grid coordinate (key - base_): the camera-frame part of the cell centre, and
