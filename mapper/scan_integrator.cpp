@@ -7,6 +7,7 @@
 #include <string>
 
 #include "common/error.h"
+#include "mapper/reach_mask.h"
 
 namespace kestrel::mapper {
 
@@ -355,25 +356,37 @@ bool ScanIntegrator::cleared_by_some_ray(const Key& cell, int idx, bool witnesse
     }
   }
   // A large image (a cell next to the camera) is cut row by row to the pixels whose lines head
-  // towards the cell (row_lo_ / row_hi_).
+  // towards the cell (row_lo_ / row_hi_). Each tile row's four pixels are screened at once by
+  // their reach (reaching4), then the rest of candidate() runs on the pixels that pass, in the
+  // same order as a pixel-by-pixel scan.
   const bool clipped = (f.i1 - f.i0 + 1) * (f.j1 - f.j0 + 1) > kClipArea && clip_rows(f);
+  const float min_reach = f.min_reach;
   for (int tj = tj0; tj <= tj1; ++tj) {
     for (int ti = ti0; ti <= ti1; ++ti) {
-      if (reach_max_.square(kTileLevel, ti * kTile, tj * kTile) < f.min_reach ||
+      if (reach_max_.square(kTileLevel, ti * kTile, tj * kTile) < min_reach ||
           !projector_.tile_may_pass(f, ti, tj))
         continue;
+      const int u0 = ti * kTile;
+      const bool whole = u0 + kTile <= cols;  // four pixels readable
       const int pv_end = std::min(f.j1, tj * kTile + kTile - 1);
       for (int pv = std::max(f.j0, tj * kTile); pv <= pv_end; ++pv) {
-        const bool near_row = pv >= near_j0 && pv <= near_j1;
-        int pu_begin = std::max(f.i0, ti * kTile);
-        int pu_end = std::min(f.i1, ti * kTile + kTile - 1);
+        int pu_begin = f.i0, pu_end = f.i1;
         if (clipped) {
           pu_begin = std::max(pu_begin, row_lo_[static_cast<size_t>(pv)]);
           pu_end = std::min(pu_end, row_hi_[static_cast<size_t>(pv)]);
         }
-        for (int pu = pu_begin; pu <= pu_end; ++pu) {
-          if (near_row && pu >= near_i0 && pu <= near_i1) continue;  // tried above
-          if (candidate(pu, pv) && try_ray(static_cast<size_t>(pv) * cols + pu, cell, idx))
+        unsigned mask = pixel_bits(pu_begin, pu_end, u0);
+        if (pv >= near_j0 && pv <= near_j1) mask &= ~pixel_bits(near_i0, near_i1, u0);  // tried above
+        if (mask == 0) continue;
+        const size_t row = static_cast<size_t>(pv) * cols;
+        mask &= whole ? reaching4(reach_ + row + u0, min_reach)
+                      : reaching_scalar(reach_ + row + u0, cols - u0, min_reach);
+        while (mask != 0) {
+          const int pu = u0 + __builtin_ctz(mask);
+          mask &= mask - 1;
+          const size_t s = row + static_cast<size_t>(pu);
+          if (end_cell_[s] != idx && !traced(s) && projector_.may_clear(f, pu, pv, reach_[s]) &&
+              try_ray(s, cell, idx))
             return true;
         }
       }

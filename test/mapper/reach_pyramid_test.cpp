@@ -1,6 +1,7 @@
 // The reach pyramid's answers equal a brute-force scan of the rectangle (exact maximum, never a
 // bound below it), and KeySpace::key equals OctoMap's floor-based rule at cell edges, signs and
-// the ends of the key range.
+// the ends of the key range. The four-pixel reach masks (SSE2 where built with it) equal the
+// scalar fallback and a pixel-by-pixel test.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -10,6 +11,7 @@
 #include <vector>
 
 #include "mapper/key_space.h"
+#include "mapper/reach_mask.h"
 #include "mapper/reach_pyramid.h"
 
 namespace kestrel::mapper {
@@ -100,6 +102,41 @@ TEST(KeySpace, KeyIsOctomapsFloorRule) {
   EXPECT_FALSE(keys.key(std::numeric_limits<double>::infinity(), k));
   EXPECT_TRUE(keys.key(-0.05, k));
   EXPECT_EQ(k, 32767);
+}
+
+TEST(ReachMask, FourPixelMaskEqualsScalarAndPixelByPixel) {
+  std::mt19937 rng(7);
+  const float special[] = {0.0f, -0.0f, -1.0f, 1e-6f, 0.5f, 2.0f, std::numeric_limits<float>::quiet_NaN(),
+                           std::numeric_limits<float>::infinity(), std::numeric_limits<float>::denorm_min()};
+  std::uniform_int_distribution<int> pick(0, 8);
+  std::uniform_real_distribution<float> any(-1.0f, 3.0f);
+  for (int trial = 0; trial < 20000; ++trial) {
+    float values[4];
+    for (float& v : values) v = trial % 2 ? special[pick(rng)] : any(rng);
+    const float threshold = trial % 3 ? any(rng) : special[pick(rng)];
+    unsigned expected = 0;
+    for (int k = 0; k < 4; ++k) {
+      if (values[k] >= threshold && values[k] > 0.0f) expected |= 1u << k;
+    }
+    ASSERT_EQ(reaching4(values, threshold), expected) << trial;
+    ASSERT_EQ(reaching4_scalar(values, threshold), expected) << trial;
+    for (int count = 0; count <= 4; ++count)
+      ASSERT_EQ(reaching_scalar(values, count, threshold), expected & ((1u << count) - 1u)) << trial;
+  }
+}
+
+TEST(ReachMask, PixelBitsAreTheRangeWithinTheFourPixels) {
+  for (int u0 = 0; u0 <= 12; u0 += 4) {
+    for (int lo = -2; lo <= 18; ++lo) {
+      for (int hi = -2; hi <= 18; ++hi) {
+        unsigned expected = 0;
+        for (int k = 0; k < 4; ++k) {
+          if (u0 + k >= lo && u0 + k <= hi) expected |= 1u << k;
+        }
+        ASSERT_EQ(pixel_bits(lo, hi, u0), expected) << u0 << " " << lo << " " << hi;
+      }
+    }
+  }
 }
 
 }  // namespace
