@@ -13,20 +13,15 @@
 #include <cstdint>
 #include <vector>
 
+#include "vo/dense_depth.h"
 #include "vo/descriptor.h"
+#include "vo/frame_motion.h"
 #include "vo/image_pyramid.h"
 
 namespace kestrel::vo {
 
 constexpr int kMaxLevels = 4;
 
-/// The camera's motion around a frame's time, for the timing corrections.
-struct FrameMotion {
-  bool known = false;
-  Eigen::Matrix<double, 6, 1> twist_per_s = Eigen::Matrix<double, 6, 1>::Zero();  ///< [rho; phi]: pose(t + s) = pose(t) exp(s twist)
-  double depth_offset_s = 0.0;  ///< depth time minus RGB time
-  double readout_s = 0.0;       ///< rolling shutter: time from the first to the last image row
-};
 
 struct Feature {
   float u = 0, v = 0;                  ///< position on its level, pixels
@@ -65,6 +60,7 @@ struct Frame {
   std::vector<Feature> features;
   std::array<int, kMaxLevels + 1> level_begin{};
   DescriptorSet descriptors;
+  DenseDepth dense;  ///< coarse depth grid, only when DenseOptions::enabled
   std::array<FeatureGrid, kMaxLevels> grids;
   int num_detected = 0;       ///< FAST corners over all levels, before bucketing
   int num_bucketed = 0;       ///< after bucketing and the border

@@ -32,6 +32,7 @@ class Lens {
 
   const PinholeCamera& camera() const { return camera_; }
   bool distorted() const { return !table_.empty(); }
+  bool uses_distortion() const { return use_distortion_; }  ///< the setting reset() was given
 
  private:
   PinholeCamera camera_;

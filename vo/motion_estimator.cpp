@@ -94,7 +94,18 @@ MotionEstimate MotionEstimator::estimate(const Frame& ref, const Frame& cur,
       return out;
     }
     // With nothing dropped the second refinement would start at the first one's optimum.
-    if (dropped_any) refined = refine_motion(correspondences_, inliers_, cam, refined.T_ref_cur, ro);
+    const bool dense = options.dense.enabled && !ref.dense.empty() && !cur.dense.empty();
+    if (dense) {
+      DenseTerm term;
+      term.ref = &ref.dense;
+      term.cur = &cur.dense;
+      term.options = options.dense;
+      term.sigma_z_coeff = options.depth.sigma_z_coeff;
+      term.use_distortion = lens.distorted();
+      refined = refine_motion(correspondences_, inliers_, cam, refined.T_ref_cur, ro, &term);
+    } else if (dropped_any) {
+      refined = refine_motion(correspondences_, inliers_, cam, refined.T_ref_cur, ro);
+    }
     T = refined.T_ref_cur;
   } else {
     // Absolute orientation only: the information at Horn's estimate still gives a covariance.

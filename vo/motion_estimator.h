@@ -2,7 +2,7 @@
 // Motion from matches, the steps 5 and 6 of the pipeline: inliers (greedy max-clique on the
 // distance-preservation graph, or RANSAC / preemptive RANSAC), absolute orientation (Horn) on
 // the inliers, reprojection refinement, removal of the matches whose reprojection error
-// exceeds the threshold, and refinement again.
+// exceeds the threshold, and refinement again (with the dense depth term when enabled).
 //
 // Invariant: status is kOk exactly when T_ref_cur and covariance hold an estimate from at least
 // RefinementOptions::min_inliers reprojection inliers (InlierOptions::min_inliers without

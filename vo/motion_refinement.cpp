@@ -47,6 +47,8 @@ inline Projection project(const Eigen::Vector3d& X, const PinholeCamera& cam,
 struct Accumulator {
   Matrix6d H_image = Matrix6d::Zero();
   Matrix6d H_depth = Matrix6d::Zero();
+  Matrix6d H_dense = Matrix6d::Zero();
+  int dense = 0;
   Vector6d g = Vector6d::Zero();
   double cost = 0.0;         // robust, whitened
   double sq_px = 0.0;        // unwhitened squared pixel error
@@ -140,14 +142,14 @@ inline void add(Accumulator& acc, const Eigen::Vector2d& r, const Matrix26d& J, 
 
 Matrix6d full(const Matrix6d& upper) { return upper.selfadjointView<Eigen::Upper>(); }
 
-Matrix6d hessian(const Accumulator& acc) { return full(acc.H_image + acc.H_depth); }
+Matrix6d hessian(const Accumulator& acc) { return full(acc.H_image + acc.H_depth + acc.H_dense); }
 
 // Each measurement counted once: a reprojection residual involves two noisy pixels (the measured
 // one and the ray the point lies on), and the two directions of a bidirectional refinement
 // measure the same pair again.
 Matrix6d information(const Accumulator& acc, const RefinementOptions& o) {
   const double share = o.bidirectional ? 0.25 : 0.5;
-  return full(share * acc.H_image + acc.H_depth);
+  return full(share * acc.H_image + acc.H_depth + acc.H_dense);
 }
 
 // One residual as linearise() computes it, before whitening: a reprojection (kImage: r, J, g,
@@ -160,10 +162,96 @@ struct RawResidual {
   double sigma = 0.0;  // sigma_z for an image residual
 };
 
+// The dense point-to-plane residuals, linearised once at the refinement's start T0 (the feature
+// estimate): each current grid point X = R q + p against the plane of the reference grid cell it
+// projects into, weighted (Huber) there. The residuals are nearly linear in the pose over the
+// few millimetres the refinement moves, so the term is kept as the quadratic
+// c0 + 2 g^T d + d^T H d in d = T boxminus T0, one pass over the grid per refinement.
+struct DenseQuadratic {
+  Matrix6d H = Matrix6d::Zero();  // upper triangle
+  Vector6d g = Vector6d::Zero();
+  double cost = 0.0;
+  int residuals = 0;
+  Eigen::Isometry3d T0 = Eigen::Isometry3d::Identity();
+};
+
+DenseQuadratic linearise_dense(const DenseTerm& d, const PinholeCamera& cam, const Eigen::Isometry3d& T) {
+  DenseQuadratic out;
+  out.T0 = T;
+  const DenseOptions& o = d.options;
+  const DenseDepth& ref = *d.ref;
+  const DenseDepth& cur = *d.cur;
+  const Eigen::Matrix3f R = T.linear().cast<float>();
+  const Eigen::Vector3f p = T.translation().cast<float>();
+  const float cos_max = static_cast<float>(std::cos(o.max_normal_angle_deg * M_PI / 180.0));
+  const float floor2 = static_cast<float>(1e-6 * o.sigma_floor_mm * o.sigma_floor_mm);
+  const float max_d2 = static_cast<float>(o.max_distance_m * o.max_distance_m);
+  const float k2 = static_cast<float>(d.sigma_z_coeff * d.sigma_z_coeff);
+  const float huber = static_cast<float>(o.huber_sigmas);
+  const float inv_s = 1.0f / float(ref.scale);
+  const float fx = float(cam.fx), fy = float(cam.fy), cx = float(cam.cx), cy = float(cam.cy);
+  // Without distortion the cell follows from the pinhole pixel alone.
+  for (int y = 0; y < cur.height; y += o.stride) {
+    for (int x = 0; x < cur.width; x += o.stride) {
+      const size_t i = static_cast<size_t>(y * cur.width + x);
+      const Eigen::Vector3f& nq = cur.normals[i];
+      if (nq.z() == 0.0f) continue;  // invalid (a valid normal faces the camera: z < 0)
+      const Eigen::Vector3f& q = cur.points[i];
+      const Eigen::Vector3f X = R * q + p;
+      if (!(X.z() > 1e-3f)) continue;
+      float u = fx * X.x() / X.z() + cx, v = fy * X.y() / X.z() + cy;
+      if (d.use_distortion) {
+        const Eigen::Vector2d raw = distort_pixel(cam, true, u, v);
+        u = static_cast<float>(raw.x());
+        v = static_cast<float>(raw.y());
+      }
+      const float fu = std::floor((u + 0.5f) * inv_s), fv = std::floor((v + 0.5f) * inv_s);
+      if (!(fu >= 0.0f && fv >= 0.0f && fu < float(ref.width) && fv < float(ref.height))) continue;
+      const size_t j = static_cast<size_t>(fv) * static_cast<size_t>(ref.width) + static_cast<size_t>(fu);
+      const Eigen::Vector3f& n = ref.normals[j];
+      if (n.z() == 0.0f) continue;
+      const Eigen::Vector3f diff = X - ref.points[j];
+      if (diff.squaredNorm() > max_d2) continue;
+      if ((R * nq).dot(n) < cos_max) continue;
+      const float zp = ref.points[j].z(), zq = q.z();
+      const float inv_sigma = 1.0f / std::sqrt(k2 * (zp * zp * zp * zp + zq * zq * zq * zq) + floor2);
+      const float rw = n.dot(diff) * inv_sigma;
+      // d r / d[dp; dtheta] = [n^T, -n^T R [q]x] = [n^T, (q x R^T n)^T].
+      const Eigen::Vector3f m = q.cross(R.transpose() * n);
+      Eigen::Matrix<double, 1, 6> Jw;
+      Jw << n.x() * inv_sigma, n.y() * inv_sigma, n.z() * inv_sigma, m.x() * inv_sigma, m.y() * inv_sigma,
+          m.z() * inv_sigma;
+      const float e = std::abs(rw);
+      double weight = o.weight, rho = double(e) * double(e);
+      if (huber > 0.0f && e > huber) {
+        weight *= double(huber / e);
+        rho = 2.0 * double(huber) * double(e) - double(huber) * double(huber);
+      }
+      rank_update<1>(out.H, Jw, weight);
+      out.g.noalias() += (weight * double(rw)) * Jw.transpose();
+      out.cost += o.weight * rho;
+      ++out.residuals;
+    }
+  }
+  return out;
+}
+
+// Adds the dense quadratic at pose T.
+void add_dense(Accumulator& acc, const DenseQuadratic& dq, const Eigen::Isometry3d& T) {
+  const Vector6d d = se3::boxminus(T, dq.T0);
+  const Matrix6d H = full(dq.H);
+  const Vector6d Hd = H * d;
+  acc.H_dense = dq.H;
+  acc.g += dq.g + Hd;
+  acc.cost += dq.cost + 2.0 * dq.g.dot(d) + d.dot(Hd);
+  acc.dense = dq.residuals;
+}
+
 Accumulator linearise(const std::vector<Correspondence>& cs, const std::vector<int>& use,
                       const PinholeCamera& cam, const Eigen::Isometry3d& T,
-                      const RefinementOptions& o) {
+                      const RefinementOptions& o, const DenseQuadratic* dense) {
   Accumulator acc;
+  if (dense != nullptr) add_dense(acc, *dense, T);
   const Eigen::Matrix3d R = T.linear();
   const Eigen::Matrix3d Rt = R.transpose();
   const Eigen::Vector3d p = T.translation();
@@ -246,19 +334,22 @@ double reprojection_error_px(const Correspondence& c, const PinholeCamera& cam,
 
 RefinementResult refine_motion(const std::vector<Correspondence>& cs, const std::vector<int>& use,
                                const PinholeCamera& cam, const Eigen::Isometry3d& T_ref_cur,
-                               const RefinementOptions& o) {
+                               const RefinementOptions& o, const DenseTerm* dense) {
   RefinementResult result;
   Eigen::Isometry3d T = T_ref_cur;
-  Accumulator acc = linearise(cs, use, cam, T, o);
+  DenseQuadratic dq;
+  if (dense != nullptr) dq = linearise_dense(*dense, cam, T);
+  const DenseQuadratic* dqp = dense != nullptr ? &dq : nullptr;
+  Accumulator acc = linearise(cs, use, cam, T, o, dqp);
   double lambda = 0.0;  // Levenberg-Marquardt damping, only once a step fails
-  for (int it = 0; it < o.max_iterations && acc.residuals >= 6; ++it) {
+  for (int it = 0; it < o.max_iterations && acc.residuals + acc.dense >= 6; ++it) {
     result.iterations = it + 1;
     Matrix6d A = hessian(acc);
     A.diagonal() *= 1.0 + lambda;
     const Vector6d delta = A.ldlt().solve(-acc.g);
     if (!delta.allFinite()) break;
     const Eigen::Isometry3d T_new = se3::boxplus(T, delta);
-    const Accumulator acc_new = linearise(cs, use, cam, T_new, o);
+    const Accumulator acc_new = linearise(cs, use, cam, T_new, o, dqp);
     if (acc_new.residuals < acc.residuals || acc_new.cost > acc.cost) {
       lambda = lambda == 0.0 ? 1e-3 : lambda * 10.0;
       if (lambda > 1e3) break;
@@ -273,7 +364,7 @@ RefinementResult refine_motion(const std::vector<Correspondence>& cs, const std:
       break;
     }
   }
-  if (!result.converged && acc.residuals >= 6) {
+  if (!result.converged && acc.residuals + acc.dense >= 6) {
     // Stopped by the iteration limit or a step that no damping could make descend: a local
     // minimum to within what the data resolves.
     const Vector6d step = hessian(acc).ldlt().solve(-acc.g);
@@ -281,6 +372,7 @@ RefinementResult refine_motion(const std::vector<Correspondence>& cs, const std:
   }
   result.T_ref_cur = T;
   result.information = information(acc, o);
+  result.dense_residuals = acc.dense;
   result.rms_error_px = acc.residuals > 0 ? std::sqrt(acc.sq_px / acc.residuals) : 0.0;
   return result;
 }

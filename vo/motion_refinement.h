@@ -11,6 +11,11 @@
 // projection Jacobian at the predicted pixel; ESM averages it with the Jacobian at the measured
 // pixel (where the prediction lands at the optimum), which converges in fewer iterations.
 //
+// With a DenseTerm, point-to-plane residuals of the current frame's depth grid against the
+// reference's (DenseOptions) join the features': associated and linearised once at the start
+// pose, then kept as a quadratic in the pose error (see motion_refinement.cpp); their
+// information is added to the reported one.
+//
 // Invariant: `information` is the whitened Gauss-Newton information at the returned estimate,
 // each measurement counted once (a reprojection residual carries the noise of two pixels, and
 // a bidirectional pair measures the same two pixels twice); it is only as right as
@@ -22,6 +27,7 @@
 
 #include "common/camera.h"
 #include "common/geometry/se3.h"
+#include "vo/dense_depth.h"
 #include "vo/options.h"
 
 namespace kestrel::vo {
@@ -35,18 +41,30 @@ struct Correspondence {
   double cur_sigma_z = 0.0;
 };
 
+/// The dense geometric term (DenseOptions): current-frame grid points against the reference's
+/// points and normals, associated by projection into the reference grid.
+struct DenseTerm {
+  const DenseDepth* ref = nullptr;
+  const DenseDepth* cur = nullptr;
+  DenseOptions options;
+  double sigma_z_coeff = 0.0;   ///< depth noise sigma_z = coeff * z^2
+  bool use_distortion = false;  ///< the grids are on the raw pixel grid of a distorted lens
+};
+
 struct RefinementResult {
   Eigen::Isometry3d T_ref_cur = Eigen::Isometry3d::Identity();
   Matrix6d information = Matrix6d::Zero();  ///< of the estimate: inverse of its covariance
   double rms_error_px = 0.0;                ///< unwhitened, over the residuals used
   int iterations = 0;
   bool converged = false;
+  int dense_residuals = 0;  ///< associated dense residuals at the estimate
 };
 
 /// Refines `T_ref_cur` over the correspondences whose index is in `use`.
 RefinementResult refine_motion(const std::vector<Correspondence>& correspondences,
                                const std::vector<int>& use, const PinholeCamera& camera,
-                               const Eigen::Isometry3d& T_ref_cur, const RefinementOptions& options);
+                               const Eigen::Isometry3d& T_ref_cur, const RefinementOptions& options,
+                               const DenseTerm* dense = nullptr);
 
 /// Reprojection error (pixels) of correspondence `c` under `T_ref_cur`: the larger of the two
 /// directions when bidirectional, else that of the reference point in the current image.

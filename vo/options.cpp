@@ -50,6 +50,14 @@ void VoOptions::validate() const {
   require(refinement.outlier_threshold_px > 0.0, "refinement.outlier_threshold_px", "must be > 0");
   require(refinement.max_iterations >= 1, "refinement.max_iterations", "must be >= 1");
   require(refinement.min_inliers >= 3, "refinement.min_inliers", "must be >= 3");
+  require(dense.level >= 0 && dense.level <= 4, "dense.level", "must be 0..4");
+  require(dense.stride >= 1, "dense.stride", "must be >= 1");
+  require(dense.weight >= 0.0, "dense.weight", "must be >= 0");
+  require(dense.max_distance_m > 0.0, "dense.max_distance_m", "must be > 0");
+  require(dense.max_normal_angle_deg > 0.0 && dense.max_normal_angle_deg <= 180.0,
+          "dense.max_normal_angle_deg", "must be in (0, 180]");
+  require(dense.sigma_floor_mm >= 0.0, "dense.sigma_floor_mm", "must be >= 0");
+  require(dense.huber_sigmas >= 0.0, "dense.huber_sigmas", "must be >= 0");
   require(covariance.model_scale > 0.0, "covariance.model_scale", "must be > 0");
   require(covariance.translation_floor_m >= 0.0, "covariance.translation_floor_m", "must be >= 0");
   require(covariance.rotation_floor_rad >= 0.0, "covariance.rotation_floor_rad", "must be >= 0");

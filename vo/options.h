@@ -92,6 +92,21 @@ struct RefinementOptions {
   int min_inliers = 10;           ///< fewer after outlier removal = optimisation failure
 };
 
+/// Dense geometric term of the final refinement: point-to-plane residuals of the current frame's
+/// depth (a coarse grid) against the reference's depth and normals, by projective association,
+/// whitened by the depth noise, robust, jointly with the feature residuals.
+struct DenseOptions {
+  bool enabled = true;
+  int level = 3;                  ///< grid of 1/2^level of the image (3: 80 x 60 for VGA)
+  int stride = 2;                 ///< every stride-th cell of the current grid, each direction
+  double weight = 0.4;            ///< multiplies the information of each dense residual
+  double max_distance_m = 0.05;   ///< association gate on the point distance
+  double max_normal_angle_deg = 30.0;  ///< association gate on the normals' angle
+  double sigma_floor_mm = 1.0;    ///< added in quadrature to the depth noise of a residual
+  double huber_sigmas = 1.5;      ///< robust loss threshold on a whitened residual; 0 = none
+  bool to_rgb_time = false;       ///< carry the grids from depth time to RGB time (predicted motion)
+};
+
 /// What the reported covariance adds to the refinement's own (whose noise model only holds
 /// pixel and depth noise): the per-estimate error the model does not contain (colour/depth time
 /// offset and misregistration, rolling shutter), measured as the RMS per axis of the relative-
@@ -121,6 +136,7 @@ struct VoOptions {
   MatchOptions match;
   InlierOptions inliers;
   RefinementOptions refinement;
+  DenseOptions dense;
   CovarianceOptions covariance;
   KeyframeOptions keyframe;
   int min_features = 30;          ///< fewer detections: "too few features"

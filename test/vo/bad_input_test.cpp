@@ -155,7 +155,10 @@ TEST(Options, SetByNameAndRejectedByName) {
   set_option(o, "keyframe.min_inlier_fraction_to_keep", "0.8");
   EXPECT_EQ(o.keyframe.min_inlier_fraction_to_keep, 0.8);
   EXPECT_THROW(set_option(o, "keyframe.min_inlier_fraction_to_keep", "1.5"), std::invalid_argument);
-  EXPECT_EQ(describe_options(o).size(), 55u);
+  set_option(o, "dense.weight", "0.1");
+  EXPECT_EQ(o.dense.weight, 0.1);
+  EXPECT_THROW(set_option(o, "dense.stride", "0"), std::invalid_argument);
+  EXPECT_EQ(describe_options(o).size(), 64u);
 }
 
 }  // namespace
