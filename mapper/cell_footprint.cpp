@@ -12,9 +12,26 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 // Inclusive index range [lo, hi] of the pixels whose centre (at integer coordinates) lies in
 // [a, b], clamped to [0, n). The corners were grown by the margin, which covers rounding.
 void pixel_range(double a, double b, int n, int& lo, int& hi) {
-  lo = a <= -1e9 ? 0 : static_cast<int>(std::max(std::ceil(a), 0.0));
-  hi = b >= 1e9 ? n - 1 : static_cast<int>(std::min(std::floor(b), n - 1.0));
-  if (a > n + 1.0 || b < -1.0) hi = lo - 1;
+  // lo = max(ceil(a), 0), hi = min(floor(b), n - 1), by truncation (std::ceil and std::floor
+  // are long sequences on the baseline x86-64 target) once a and b are known to be in range.
+  if (a > n + 1.0 || b < -1.0) {  // outside the image (a NaN never comes here)
+    lo = 0;
+    hi = -1;
+    return;
+  }
+  if (!(a > 0.0)) {
+    lo = 0;
+  } else {
+    const int t = static_cast<int>(a);  // 0 < a <= n + 1
+    lo = t + (static_cast<double>(t) < a ? 1 : 0);
+  }
+  if (!(b < n - 1.0)) {
+    hi = n - 1;
+  } else if (b < 0.0) {
+    hi = -1;  // floor of [-1, 0)
+  } else {
+    hi = static_cast<int>(b);  // 0 <= b < n - 1
+  }
 }
 
 bool same_camera(const PinholeCamera& a, const PinholeCamera& b) {
@@ -26,6 +43,7 @@ bool same_camera(const PinholeCamera& a, const PinholeCamera& b) {
 void FootprintProjector::begin(const Scan& scan) {
   cols_ = scan.cols;
   rows_ = scan.rows;
+  camera_ = scan.camera;
   const PinholeCamera& c = scan.camera;
   Eigen::Matrix3d K;
   K << c.fx, 0.0, c.cx, 0.0, c.fy, c.cy, 0.0, 0.0, 1.0;
@@ -151,6 +169,14 @@ bool FootprintProjector::centre_pixel(const Key& cell, int& u, int& v) const {
 }
 
 CellFootprint FootprintProjector::footprint(const Key& cell) const {
+  CellFootprint f = rectangle(cell);
+  if (f.empty()) return f;
+  const Eigen::Vector3d centre(keys_.centre(cell[0]), keys_.centre(cell[1]), keys_.centre(cell[2]));
+  complete(f, R_camera_world_ * centre + t_camera_world_);
+  return f;
+}
+
+CellFootprint FootprintProjector::rectangle(const Key& cell) const {
   CellFootprint f;
   double lo[3], hi[3], gap[3];
   bool origin_near = true;
@@ -173,15 +199,6 @@ CellFootprint FootprintProjector::footprint(const Key& cell) const {
   f.min_reach = static_cast<float>(std::sqrt(exit2) - margin_);
 
   const double res = keys_.resolution();
-  const Eigen::Vector3d centre(keys_.centre(cell[0]), keys_.centre(cell[1]), keys_.centre(cell[2]));
-  f.centre_in_camera = R_camera_world_ * centre + t_camera_world_;
-  const double radius = 0.5 * std::sqrt(3.0) * res + 2.0 * margin_;
-  f.radius2 = radius * radius;
-  f.centre_distance = f.centre_in_camera.norm();
-  if (f.centre_distance > radius) {
-    f.sin_sphere = radius / f.centre_distance;
-    f.cos_sphere = std::sqrt(1.0 - f.sin_sphere * f.sin_sphere);
-  }
 
   // The image of the grown cell: its corners in front of the camera project normally; where
   // the cell crosses the camera plane, its image reaches to infinity in the direction of the
@@ -200,37 +217,64 @@ CellFootprint FootprintProjector::footprint(const Key& cell) const {
     umax = vmax = kInf;
     any = true;
   } else {
-    // The grown cell's corners: one projected, the others by adding the projected edges.
-    Eigen::Vector3d corner[8];
+    // The grown cell's corners: one projected, the others by adding the projected edges
+    // (corner c = corner c without its lowest bit + the edge of that bit), in scalars.
     const double side = res + 2.0 * margin_;
-    const Eigen::Vector3d edge[3] = {P_.col(0) * side, P_.col(1) * side, P_.col(2) * side};
-    corner[0] = P_.leftCols<3>() * Eigen::Vector3d(lo[0] - margin_, lo[1] - margin_, lo[2] - margin_) + P_.col(3);
-    bool all_in_front = true;
-    for (int c = 0; c < 8; ++c) {
-      if (c > 0) corner[c] = corner[c & ~(c & -c)] + edge[__builtin_ctz(static_cast<unsigned>(c))];
-      const Eigen::Vector3d& h = corner[c];
-      if (h.z() > 0.0) {
-        const double inv = 1.0 / h.z();
-        const double u = h.x() * inv, v = h.y() * inv;
+    const double ex[3] = {P_(0, 0) * side, P_(0, 1) * side, P_(0, 2) * side};
+    const double ey[3] = {P_(1, 0) * side, P_(1, 1) * side, P_(1, 2) * side};
+    const double ez[3] = {P_(2, 0) * side, P_(2, 1) * side, P_(2, 2) * side};
+    const Eigen::Vector3d h0 =
+        P_.leftCols<3>() * Eigen::Vector3d(lo[0] - margin_, lo[1] - margin_, lo[2] - margin_) + P_.col(3);
+    double x[8], y[8], z[8];
+    x[0] = h0.x();
+    y[0] = h0.y();
+    z[0] = h0.z();
+    auto add = [&](int c, int from, int axis) {
+      x[c] = x[from] + ex[axis];
+      y[c] = y[from] + ey[axis];
+      z[c] = z[from] + ez[axis];
+    };
+    add(1, 0, 0);
+    add(2, 0, 1);
+    add(3, 2, 0);
+    add(4, 0, 2);
+    add(5, 4, 0);
+    add(6, 4, 1);
+    add(7, 6, 0);
+    const double z_min = std::min({z[0], z[1], z[2], z[3], z[4], z[5], z[6], z[7]});
+    if (z_min > 0.0) {  // the usual case: every corner in front of the camera
+      for (int c = 0; c < 8; ++c) {
+        const double inv = 1.0 / z[c];
+        const double u = x[c] * inv, v = y[c] * inv;
         umin = std::min(umin, u);
         umax = std::max(umax, u);
         vmin = std::min(vmin, v);
         vmax = std::max(vmax, v);
-        any = true;
-      } else {
-        all_in_front = false;
-        if (h.z() == 0.0) towards_infinity(h.x(), h.y());
       }
-    }
-    // Only a cell crossing the camera plane has an image reaching to infinity.
-    for (int c = 0; c < 8 && !all_in_front; ++c) {
-      for (int bit = 1; bit < 8; bit <<= 1) {
-        if (c & bit) continue;
-        const Eigen::Vector3d& a = corner[c];
-        const Eigen::Vector3d& b = corner[c | bit];
-        if ((a.z() > 0.0 && b.z() < 0.0) || (a.z() < 0.0 && b.z() > 0.0)) {
-          const double s = a.z() / (a.z() - b.z());
-          towards_infinity(a.x() + s * (b.x() - a.x()), a.y() + s * (b.y() - a.y()));
+      any = true;
+    } else {
+      for (int c = 0; c < 8; ++c) {
+        if (z[c] > 0.0) {
+          const double inv = 1.0 / z[c];
+          const double u = x[c] * inv, v = y[c] * inv;
+          umin = std::min(umin, u);
+          umax = std::max(umax, u);
+          vmin = std::min(vmin, v);
+          vmax = std::max(vmax, v);
+          any = true;
+        } else if (z[c] == 0.0) {
+          towards_infinity(x[c], y[c]);
+        }
+      }
+      // Only a cell crossing the camera plane has an image reaching to infinity.
+      for (int c = 0; c < 8; ++c) {
+        for (int bit = 1; bit < 8; bit <<= 1) {
+          if (c & bit) continue;
+          const int d = c | bit;
+          if ((z[c] > 0.0 && z[d] < 0.0) || (z[c] < 0.0 && z[d] > 0.0)) {
+            const double s = z[c] / (z[c] - z[d]);
+            towards_infinity(x[c] + s * (x[d] - x[c]), y[c] + s * (y[d] - y[c]));
+          }
         }
       }
     }
@@ -238,16 +282,33 @@ CellFootprint FootprintProjector::footprint(const Key& cell) const {
   if (!any) return f;  // entirely behind the camera: empty rectangle
   pixel_range(umin, umax, cols_, f.i0, f.i1);
   pixel_range(vmin, vmax, rows_, f.j0, f.j1);
-  if (f.empty()) return f;
-  int u = 0, v = 0;
-  if (centre_pixel(cell, u, v)) {
-    f.u_centre = std::clamp(u, f.i0, f.i1);
-    f.v_centre = std::clamp(v, f.j0, f.j1);
-  } else {
-    f.u_centre = (f.i0 + f.i1) / 2;
-    f.v_centre = (f.j0 + f.j1) / 2;
-  }
   return f;
+}
+
+void FootprintProjector::complete(CellFootprint& f, const Eigen::Vector3d& centre_in_camera) const {
+  f.centre_in_camera = centre_in_camera;
+  const double radius = 0.5 * std::sqrt(3.0) * keys_.resolution() + 2.0 * margin_;
+  f.radius2 = radius * radius;
+  f.centre_distance = f.centre_in_camera.norm();
+  if (f.centre_distance > radius) {
+    f.sin_sphere = radius / f.centre_distance;
+    f.cos_sphere = std::sqrt(1.0 - f.sin_sphere * f.sin_sphere);
+  }
+  // The pixel nearest the centre's image (rounding halves up; a cast truncates, which is floor
+  // here), clamped into the rectangle; the rectangle's middle if the centre is not in front.
+  const double z = centre_in_camera.z();
+  if (z > 0.0) {
+    const double inv_z = 1.0 / z;
+    const double ur = camera_.fx * centre_in_camera.x() * inv_z + camera_.cx + 0.5;
+    const double vr = camera_.fy * centre_in_camera.y() * inv_z + camera_.cy + 0.5;
+    if (ur >= 0.0 && vr >= 0.0 && ur < cols_ && vr < rows_) {
+      f.u_centre = std::clamp(static_cast<int>(ur), f.i0, f.i1);
+      f.v_centre = std::clamp(static_cast<int>(vr), f.j0, f.j1);
+      return;
+    }
+  }
+  f.u_centre = (f.i0 + f.i1) / 2;
+  f.v_centre = (f.j0 + f.j1) / 2;
 }
 
 }  // namespace kestrel::mapper

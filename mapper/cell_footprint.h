@@ -51,6 +51,11 @@ class FootprintProjector {
   /// and projects into the grid.
   bool centre_pixel(const Key& cell, int& u, int& v) const;
   CellFootprint footprint(const Key& cell) const;
+  /// footprint() in two steps, so that a caller can drop the cell after the first: the cell's
+  /// bounds, min_reach and pixel rectangle; then, if the rectangle is not empty, the rest (the
+  /// sphere around the cell and the centre pixel) from the cell centre's camera-frame position.
+  CellFootprint rectangle(const Key& cell) const;
+  void complete(CellFootprint& f, const Eigen::Vector3d& centre_in_camera) const;
 
   /// True if OctoMap's walk of the ray through pixel (u, v) certainly clears the cell, given
   /// that the ray's end lies at camera depth >= s_end_lo along the pixel's direction: the
@@ -95,6 +100,7 @@ class FootprintProjector {
   void make_tiles(const PinholeCamera& camera);
 
   const KeySpace& keys_;
+  PinholeCamera camera_;                  // the scan's
   PinholeCamera tile_camera_;             // the camera the tiles were made for
   bool have_tiles_ = false;
   Eigen::Matrix<double, 3, 4> P_;         // world -> homogeneous pixel (u z, v z, z)

@@ -321,13 +321,15 @@ inline bool ScanIntegrator::some_ray_may_reach(const Key& cell, float& min_reach
   return reach_max_.any_at_least(i0, i1, j0, j1, min_reach);
 }
 
-bool ScanIntegrator::cleared_by_some_ray(const Key& cell, int idx, bool witnesses_tried) {
-  const CellFootprint f = projector_.footprint(cell);
+bool ScanIntegrator::cleared_by_some_ray(const Key& cell, const Eigen::Vector3d& centre, int idx,
+                                         bool witnesses_tried) {
+  CellFootprint f = projector_.rectangle(cell);
   if (f.empty()) return false;
-  const int cols = scan_->cols;
-  const int tj0 = f.j0 / kTile, tj1 = f.j1 / kTile, ti0 = f.i0 / kTile, ti1 = f.i1 / kTile;
   // No ray in the cell's image reaches the cell's far side.
   if (!reach_max_.any_at_least(f.i0, f.i1, f.j0, f.j1, f.min_reach)) return false;
+  projector_.complete(f, centre);
+  const int cols = scan_->cols;
+  const int tj0 = f.j0 / kTile, tj1 = f.j1 / kTile, ti0 = f.i0 / kTile, ti1 = f.i1 / kTile;
   // Rays near the centre that certainly clear it, when witness_clears() could not look (the
   // centre projects outside the image); no walk needed.
   const int near_i0 = std::max(f.i0, f.u_centre - kNear), near_i1 = std::min(f.i1, f.u_centre + kNear);
@@ -457,33 +459,41 @@ void ScanIntegrator::grow_from_origin() {
       break;
     }
   }
+  // The six face neighbours as grid index offsets; a cleared cell lies within max range, two
+  // cells inside the grid, so its neighbours are in the grid (checked once per cell anyway).
+  const int offset[6] = {-stride_[0], stride_[0], -stride_[1], stride_[1], -stride_[2], stride_[2]};
   for (size_t head = 0; head < queue_.size(); ++head) {
     const Pending from = queue_[head];
-    for (int n = 0; n < 6; ++n) {
-      const int axis = n >> 1;
-      const int step = (n & 1) ? 1 : -1;
-      const int k = from.key[axis] + step;
-      // Cleared cells lie within max range, two cells inside the grid; this never fails.
-      if (k - base_[axis] < 0 || k - base_[axis] >= side_) continue;
-      const int idx = from.idx + step * stride_[axis];
-      uint8_t& f = cells_[static_cast<size_t>(idx)];
-      if (f & kTested) continue;
-      Key cell = from.key;
-      cell[axis] = static_cast<uint16_t>(k);
-      if (f == 0) touched_.emplace_back(idx, cell);
-      f = static_cast<uint8_t>(f | kTested);
-      ++cells_tested_;
-      float min_reach = 0.0f;
-      Eigen::Vector3d centre;
-      if (!some_ray_may_reach(cell, min_reach, centre)) continue;
-      bool witnesses_tried = false;
-      if (witness_clears(cell, centre, min_reach, witnesses_tried)) {
-        ++cells_witnessed_;
-        set_cleared(idx, cell);
-      } else if (cleared_by_some_ray(cell, idx, witnesses_tried)) {
-        set_cleared(idx, cell);
-      }
+    bool interior = true;
+    for (int a = 0; a < 3; ++a) {
+      const int g = from.key[a] - base_[a];
+      interior = interior && g >= 1 && g <= side_ - 2;
     }
+    if (!interior) continue;  // never: see above
+    for (int n = 0; n < 6; ++n) {
+      const int idx = from.idx + offset[n];
+      if (cells_[static_cast<size_t>(idx)] & kTested) continue;
+      Key cell = from.key;
+      cell[n >> 1] = static_cast<uint16_t>(cell[n >> 1] + ((n & 1) ? 1 : -1));
+      test_cell(idx, cell);
+    }
+  }
+}
+
+void ScanIntegrator::test_cell(int idx, const Key& cell) {
+  uint8_t& f = cells_[static_cast<size_t>(idx)];
+  if (f == 0) touched_.emplace_back(idx, cell);
+  f = static_cast<uint8_t>(f | kTested);
+  ++cells_tested_;
+  float min_reach = 0.0f;
+  Eigen::Vector3d centre;
+  if (!some_ray_may_reach(cell, min_reach, centre)) return;
+  bool witnesses_tried = false;
+  if (witness_clears(cell, centre, min_reach, witnesses_tried)) {
+    ++cells_witnessed_;
+    set_cleared(idx, cell);
+  } else if (cleared_by_some_ray(cell, centre, idx, witnesses_tried)) {
+    set_cleared(idx, cell);
   }
 }
 

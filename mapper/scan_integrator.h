@@ -90,10 +90,11 @@ class ScanIntegrator {
   void set_cleared(int idx, const Key& key);
   bool witness_clears(const Key& cell, const Eigen::Vector3d& centre, float min_reach, bool& tried);
   bool some_ray_may_reach(const Key& cell, float& min_reach, Eigen::Vector3d& centre) const;
-  bool cleared_by_some_ray(const Key& cell, int idx, bool witnesses_tried);
+  bool cleared_by_some_ray(const Key& cell, const Eigen::Vector3d& centre, int idx, bool witnesses_tried);
   bool clip_rows(const CellFootprint& f);
   bool try_ray(size_t sample, const Key& cell, int idx);
   void grow_from_origin();
+  void test_cell(int idx, const Key& cell);
   void collect(ScanUpdate& update);
 
   KeySpace keys_;
