@@ -18,26 +18,41 @@ VoxelMap::VoxelMap(const MapOptions& options)
   clamp_min_ = octomap::logodds(options_.clamp_min);
   clamp_max_ = octomap::logodds(options_.clamp_max);
   threshold_ = octomap::logodds(options_.occupancy_threshold);
+  forget_cache();
 }
 
-float* VoxelMap::cell(const Key& key, bool create) {
+void VoxelMap::forget_cache() {
+  cache_.fill({~0ULL, nullptr});
+  last_id_ = ~0ULL;
+  last_brick_ = nullptr;
+}
+
+float* VoxelMap::cell(const Key& key, bool create) { return lookup(key, create); }
+
+inline float* VoxelMap::lookup(const Key& key, bool create) {
   const uint64_t id = brick_id(key);
   if (id != last_id_) {
-    auto it = bricks_.find(id);
-    if (it == bricks_.end()) {
-      if (!create) return nullptr;
-      auto brick = std::make_unique<Brick>();
-      brick->log_odds.fill(std::numeric_limits<float>::quiet_NaN());
-      it = bricks_.emplace(id, std::move(brick)).first;
+    CacheSlot& slot = cache_[cache_slot(id)];
+    if (slot.id != id) {
+      auto it = bricks_.find(id);
+      if (it == bricks_.end()) {
+        if (!create) return nullptr;
+        auto brick = std::make_unique<Brick>();
+        brick->log_odds.fill(std::numeric_limits<float>::quiet_NaN());
+        it = bricks_.emplace(id, std::move(brick)).first;
+      }
+      slot = {id, it->second.get()};
     }
     last_id_ = id;
-    last_brick_ = it->second.get();
+    last_brick_ = slot.brick;
   }
   return &last_brick_->log_odds[static_cast<size_t>(cell_index(key))];
 }
 
-void VoxelMap::update(const Key& key, float change) {
-  float* v = cell(key, true);
+void VoxelMap::update(const Key& key, float change) { apply(key, change); }
+
+inline void VoxelMap::apply(const Key& key, float change) {
+  float* v = lookup(key, true);
   if (*v != *v) {  // unknown: a new cell starts at 0, as a new OcTree node does
     *v = 0.0f;
     ++last_brick_->known;
@@ -62,8 +77,7 @@ void VoxelMap::erase(const Key& key) {
   --num_cells_;
   if (--last_brick_->known == 0) {
     bricks_.erase(last_id_);
-    last_id_ = ~0ULL;
-    last_brick_ = nullptr;
+    forget_cache();
   }
 }
 
@@ -78,6 +92,7 @@ VoxelMap::VoxelMap(const VoxelMap& other)
       num_cells_(other.num_cells_),
       utime_(other.utime_),
       decay_utime_(other.decay_utime_) {
+  forget_cache();
   bricks_.reserve(other.bricks_.size());
   for (const auto& [id, brick] : other.bricks_) bricks_.emplace(id, std::make_unique<Brick>(*brick));
 }
@@ -89,8 +104,7 @@ VoxelMap& VoxelMap::operator=(const VoxelMap& other) {
 
 void VoxelMap::clear() {
   bricks_.clear();
-  last_id_ = ~0ULL;
-  last_brick_ = nullptr;
+  forget_cache();
   num_cells_ = 0;
   utime_ = 0;
   decay_utime_ = -1;
@@ -99,8 +113,8 @@ void VoxelMap::clear() {
 void VoxelMap::integrate(const ScanUpdate& update_set, int64_t utime) {
   decay_to(utime);
   if (utime > utime_) utime_ = utime;
-  for (const Key& k : update_set.free) update(k, miss_);
-  for (const Key& k : update_set.occupied) update(k, hit_);
+  for (const Key& k : update_set.free) apply(k, miss_);
+  for (const Key& k : update_set.occupied) apply(k, hit_);
 }
 
 std::optional<float> VoxelMap::log_odds(const Key& key) const {
@@ -146,8 +160,7 @@ void VoxelMap::decay_to(int64_t utime) {
     if (brick->known == 0) empty.push_back(id);
   }
   for (const uint64_t id : empty) bricks_.erase(id);
-  last_id_ = ~0ULL;
-  last_brick_ = nullptr;
+  forget_cache();
 }
 
 size_t VoxelMap::num_occupied() const {

@@ -134,13 +134,25 @@ class VoxelMap {
                static_cast<uint16_t>(base[2] + ((i >> (2 * kBrickBits)) & m)));
   }
   float* cell(const Key& key, bool create);
+  inline float* lookup(const Key& key, bool create);  // cell(), inlined within voxel_map.cpp
+  inline void apply(const Key& key, float change);     // update(), inlined within voxel_map.cpp
   float clamp(float v) const { return v < clamp_min_ ? clamp_min_ : (v > clamp_max_ ? clamp_max_ : v); }
 
   MapOptions options_;
   KeySpace keys_;
   float hit_, miss_, clamp_min_, clamp_max_, threshold_;
   std::unordered_map<uint64_t, std::unique_ptr<Brick>, IdHash> bricks_;
-  uint64_t last_id_ = ~0ULL;  // one-brick lookup cache (scans touch cells brick by brick)
+  // A direct-mapped cache of recently used bricks in front of the hash table: a scan updates a
+  // few thousand cells in a few dozen bricks, not brick by brick. Emptied whenever a brick goes.
+  struct CacheSlot {
+    uint64_t id;
+    Brick* brick;
+  };
+  static constexpr size_t kCacheSlots = 64;
+  static size_t cache_slot(uint64_t id) { return (id ^ (id >> 11) ^ (id >> 22)) & (kCacheSlots - 1); }
+  void forget_cache();
+  std::array<CacheSlot, kCacheSlots> cache_;
+  uint64_t last_id_ = ~0ULL;  // the brick of the last cell() call
   Brick* last_brick_ = nullptr;
   size_t num_cells_ = 0;
   int64_t utime_ = 0;
