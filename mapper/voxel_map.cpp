@@ -97,6 +97,29 @@ VoxelMap::VoxelMap(const VoxelMap& other)
   for (const auto& [id, brick] : other.bricks_) bricks_.emplace(id, std::make_unique<Brick>(*brick));
 }
 
+VoxelMap::VoxelMap(VoxelMap&& other) noexcept : keys_(other.keys_) { *this = std::move(other); }
+
+VoxelMap& VoxelMap::operator=(VoxelMap&& other) noexcept {
+  if (this == &other) return *this;
+  options_ = std::move(other.options_);
+  keys_ = other.keys_;
+  hit_ = other.hit_;
+  miss_ = other.miss_;
+  clamp_min_ = other.clamp_min_;
+  clamp_max_ = other.clamp_max_;
+  threshold_ = other.threshold_;
+  bricks_ = std::move(other.bricks_);
+  num_cells_ = other.num_cells_;
+  utime_ = other.utime_;
+  decay_utime_ = other.decay_utime_;
+  forget_cache();
+  // The source keeps no bricks, and no cache pointing at them.
+  other.bricks_.clear();
+  other.num_cells_ = 0;
+  other.forget_cache();
+  return *this;
+}
+
 VoxelMap& VoxelMap::operator=(const VoxelMap& other) {
   if (this != &other) *this = VoxelMap(other);
   return *this;

@@ -43,8 +43,9 @@ class VoxelMap {
   /// Deep copies (the rebuild's checkpoints are copies of the map).
   VoxelMap(const VoxelMap& other);
   VoxelMap& operator=(const VoxelMap& other);
-  VoxelMap(VoxelMap&&) = default;
-  VoxelMap& operator=(VoxelMap&&) = default;
+  /// Moves leave `other` empty.
+  VoxelMap(VoxelMap&& other) noexcept;
+  VoxelMap& operator=(VoxelMap&& other) noexcept;
 
   const MapOptions& options() const { return options_; }
   const KeySpace& keys() const { return keys_; }

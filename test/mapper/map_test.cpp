@@ -153,6 +153,29 @@ TEST(VoxelMap, UpdatesClampLikeOctomap) {
   EXPECT_EQ(map.occupancy(Key(1, 2, 3)), Occupancy::kUnknown);
 }
 
+TEST(VoxelMap, CopiesAndMovesKeepTheirOwnCells) {
+  // The brick cache in front of the hash table must never let one map reach another's bricks.
+  VoxelMap a;
+  for (uint16_t i = 0; i < 40; ++i) a.update(Key(32768 + i, 32768 + 2 * i, 32760), a.hit());
+  VoxelMap copy = a;
+  copy.update(Key(32768, 32768, 32760), copy.miss());
+  EXPECT_EQ(*a.log_odds(Key(32768, 32768, 32760)), a.hit());
+  VoxelMap moved = std::move(a);
+  EXPECT_EQ(moved.num_cells(), 40u);
+  EXPECT_EQ(a.num_cells(), 0u);  // NOLINT(bugprone-use-after-move): moves leave the source empty
+  EXPECT_FALSE(a.log_odds(Key(32768, 32768, 32760)).has_value());
+  a.update(Key(32768, 32768, 32760), a.miss());  // a new cell in the source, not in `moved`
+  EXPECT_EQ(*a.log_odds(Key(32768, 32768, 32760)), a.miss());
+  EXPECT_EQ(*moved.log_odds(Key(32768, 32768, 32760)), moved.hit());
+  moved = std::move(copy);
+  EXPECT_EQ(*moved.log_odds(Key(32768, 32768, 32760)), moved.hit() + moved.miss());
+  EXPECT_EQ(copy.num_cells(), 0u);  // NOLINT(bugprone-use-after-move)
+  moved.erase(Key(32768, 32768, 32760));
+  EXPECT_FALSE(moved.log_odds(Key(32768, 32768, 32760)).has_value());
+  moved.update(Key(32768, 32768, 32760), moved.hit());
+  EXPECT_EQ(*moved.log_odds(Key(32768, 32768, 32760)), moved.hit());
+}
+
 TEST(VoxelMap, ForgettingClearsAMovedObstacle) {
   // A box is seen for a second, then moves out of the camera's view. Without forgetting its
   // cells stay occupied for ever; with a 1 s half-life they fade and become unknown.
