@@ -126,6 +126,8 @@ int main(int argc, char** argv) {
     vo::VoOptions options;
     try {
       options = vo::variant(o.variant).options;
+      // Offline over a TUM folder: the Kinect's rolling shutter (before --set, which may change it).
+      if (!o.tum.empty()) options = vo::with_tum_sensor(options);
     } catch (const std::invalid_argument& e) {
       throw CLI::ValidationError("--variant", e.what());
     }

@@ -42,7 +42,9 @@ struct DepthOptions {
   double sigma_z_coeff = 1.4e-3;        ///< depth noise sigma_z = coeff * z^2 (metres; Khoshelham 2011)
   bool compensate_time_offset = false;  ///< look depth up where the point was at depth time
   bool undistort = true;                ///< use the camera's lens distortion for rays and reprojection
-  double rolling_shutter_readout_s = 0.0;  ///< first-to-last row time; 0 = global shutter
+  /// Colour rolling shutter, first-to-last row time; 0 = global shutter (the simulator's camera).
+  /// A TUM run uses the Kinect's (with_tum_sensor(), vo/sequence_run.h).
+  double rolling_shutter_readout_s = 0.0;
 };
 
 /// Initial rotation by aligning heavily down-sampled images (Mei et al.).
@@ -113,8 +115,8 @@ struct DenseOptions {
 /// pose errors against ground truth on fr1_xyz and fr1_rpy (vo/README.md, "Covariance").
 struct CovarianceOptions {
   double model_scale = 1.0;              ///< multiplies the refinement's covariance
-  double translation_floor_m = 0.0032;   ///< per-axis sigma added in quadrature, metres
-  double rotation_floor_rad = 0.0038;    ///< per-axis sigma added in quadrature, radians
+  double translation_floor_m = 0.0027;   ///< per-axis sigma added in quadrature, metres
+  double rotation_floor_rad = 0.0032;    ///< per-axis sigma added in quadrature, radians
 };
 
 /// Reference (key) frame policy.

@@ -53,6 +53,12 @@ LoadedSequence load_tum_sequence(const std::string& folder) {
   return out;
 }
 
+VoOptions with_tum_sensor(VoOptions options) {
+  options.depth.rolling_shutter_readout_s = kTumRollingShutterReadoutS;
+  options.validate();
+  return options;
+}
+
 SequenceRun run_sequence(const std::vector<RgbdFrame>& frames, const VoOptions& options) {
   SequenceRun run;
   VisualOdometry vo(options);

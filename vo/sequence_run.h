@@ -48,6 +48,16 @@ struct LoadedSequence {
 };
 LoadedSequence load_tum_sequence(const std::string& folder);
 
+/// The TUM sequences' camera (Kinect v1) has a rolling colour shutter, which VoOptions{} (for a
+/// global-shutter camera, as the simulator renders) does not assume: its first-to-last row time
+/// as the odometry uses it, 10 ms (the best of a sweep that improves both fr1_xyz and fr1_rpy,
+/// vo/README.md "Open"), one value for every TUM sequence.
+constexpr double kTumRollingShutterReadoutS = 0.01;
+
+/// `options` for a TUM sequence: the sensor's rolling-shutter readout set (every offline TUM run
+/// — kestrel-vo --tum, the ablation, the data test, the benchmark — applies it before any --set).
+VoOptions with_tum_sensor(VoOptions options);
+
 /// Feeds every frame to a fresh VisualOdometry(options).
 SequenceRun run_sequence(const std::vector<RgbdFrame>& frames, const VoOptions& options);
 
