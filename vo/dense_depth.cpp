@@ -8,7 +8,6 @@
 #include <emmintrin.h>
 #endif
 
-#include "common/geometry/se3.h"
 
 namespace kestrel::vo {
 
@@ -118,7 +117,7 @@ void block_depths(const cv::Mat& depth_mm, const DepthOptions& o, int level, boo
 }
 
 void build_dense_depth(const cv::Mat& depth_mm, const Lens& lens, const DepthOptions& o, int level,
-                       const FrameMotion& motion, bool to_rgb_time, DenseDepth& out) {
+                       DenseDepth& out) {
   const int s = 1 << level;
   out.scale = s;
   out.width = depth_mm.cols / s;
@@ -159,14 +158,6 @@ void build_dense_depth(const cv::Mat& depth_mm, const Lens& lens, const DepthOpt
       nrm /= len;
       if (nrm.dot(P) > 0.0f) nrm = -nrm;
       out.normals[i] = nrm;
-    }
-  }
-  if (to_rgb_time && motion.known && motion.depth_offset_s != 0.0) {
-    const Eigen::Isometry3f T_rgb_depth = se3::exp(motion.twist_per_s * motion.depth_offset_s).cast<float>();
-    for (size_t i = 0; i < n; ++i) {
-      if (out.points[i].z() <= 0.0f) continue;
-      out.points[i] = T_rgb_depth * out.points[i];
-      out.normals[i] = T_rgb_depth.linear() * out.normals[i];
     }
   }
 }

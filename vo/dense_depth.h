@@ -14,7 +14,6 @@
 #include <vector>
 
 #include "vo/lens.h"
-#include "vo/frame_motion.h"
 #include "vo/options.h"
 
 namespace kestrel::vo {
@@ -34,10 +33,8 @@ struct DenseDepth {
 };
 
 /// Fills `out` from the registered depth image (millimetres) at grid level `level`.
-/// With `to_rgb_time`, points and normals are carried from depth time to the frame's RGB time
-/// by `motion` (when known).
 void build_dense_depth(const cv::Mat& depth_mm, const Lens& lens, const DepthOptions& depth,
-                       int level, const FrameMotion& motion, bool to_rgb_time, DenseDepth& out);
+                       int level, DenseDepth& out);
 
 /// The grid's depths (metres, 0 = invalid) at `level`, row-major: the mean of the central half
 /// (each side) of every block's readings in [min_m, max_m] when at least half of them are and

@@ -185,8 +185,7 @@ VoResult VisualOdometry::process(const RgbdFrame& input) {
     return result;
   }
   if (options_.dense.enabled)
-    build_dense_depth(input.depth_mm, lens_, options_.depth, options_.dense.level, cur.motion,
-                      options_.dense.to_rgb_time, cur.dense);
+    build_dense_depth(input.depth_mm, lens_, options_.depth, options_.dense.level, cur.dense);
   describe_features(cur, options_.match.window_size, static_cast<float>(options_.match.search_radius_px));
 
   if (keyframe_ == nullptr) {

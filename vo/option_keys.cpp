@@ -65,7 +65,6 @@ std::vector<std::pair<std::string, Field>> fields(VoOptions& o) {
       {"dense.max_normal_angle_deg", &o.dense.max_normal_angle_deg},
       {"dense.sigma_floor_mm", &o.dense.sigma_floor_mm},
       {"dense.huber_sigmas", &o.dense.huber_sigmas},
-      {"dense.to_rgb_time", &o.dense.to_rgb_time},
       {"covariance.model_scale", &o.covariance.model_scale},
       {"covariance.translation_floor_m", &o.covariance.translation_floor_m},
       {"covariance.rotation_floor_rad", &o.covariance.rotation_floor_rad},

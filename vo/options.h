@@ -106,7 +106,6 @@ struct DenseOptions {
   double max_normal_angle_deg = 30.0;  ///< association gate on the normals' angle
   double sigma_floor_mm = 1.0;    ///< added in quadrature to the depth noise of a residual
   double huber_sigmas = 1.5;      ///< robust loss threshold on a whitened residual; 0 = none
-  bool to_rgb_time = false;       ///< carry the grids from depth time to RGB time (predicted motion)
 };
 
 /// What the reported covariance adds to the refinement's own (whose noise model only holds

@@ -23,7 +23,7 @@ TEST(DenseDepth, WallGivesItsPointsAndNormal) {
   lens.reset(cam, false);
   const cv::Mat depth(cam.height, cam.width, CV_16UC1, cv::Scalar(1500));  // a wall at 1.5 m
   DenseDepth grid;
-  build_dense_depth(depth, lens, DepthOptions{}, 3, FrameMotion{}, false, grid);
+  build_dense_depth(depth, lens, DepthOptions{}, 3, grid);
   ASSERT_EQ(grid.width, cam.width / 8);
   ASSERT_EQ(grid.height, cam.height / 8);
   int normals = 0;
@@ -55,7 +55,7 @@ TEST(DenseDepth, DepthEdgeHasNoNormal) {
   cv::Mat depth(cam.height, cam.width, CV_16UC1, cv::Scalar(1500));
   depth.colRange(0, 320).setTo(cv::Scalar(1000));  // a step at column 320 (a block boundary)
   DenseDepth grid;
-  build_dense_depth(depth, lens, DepthOptions{}, 3, FrameMotion{}, false, grid);
+  build_dense_depth(depth, lens, DepthOptions{}, 3, grid);
   const int y = grid.height / 2;
   EXPECT_EQ(grid.normals[static_cast<size_t>(y * grid.width + 39)].squaredNorm(), 0.0f);
   EXPECT_EQ(grid.normals[static_cast<size_t>(y * grid.width + 40)].squaredNorm(), 0.0f);
@@ -119,8 +119,8 @@ TEST(DenseRefinement, RecoversAKnownMotionFromDepthAlone) {
   Lens lens;
   lens.reset(cam, false);
   DenseDepth ref, cur;
-  build_dense_depth(ref_frame.depth_mm, lens, DepthOptions{}, 3, FrameMotion{}, false, ref);
-  build_dense_depth(cur_frame.depth_mm, lens, DepthOptions{}, 3, FrameMotion{}, false, cur);
+  build_dense_depth(ref_frame.depth_mm, lens, DepthOptions{}, 3, ref);
+  build_dense_depth(cur_frame.depth_mm, lens, DepthOptions{}, 3, cur);
 
   DenseTerm term;
   term.ref = &ref;
