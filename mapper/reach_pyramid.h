@@ -19,7 +19,7 @@ namespace kestrel::mapper {
 
 class ReachPyramid {
  public:
-  static constexpr int kLevels = 5;  ///< squares of 1, 2, 4, 8, 16 pixels
+  static constexpr int kLevels = 4;  ///< squares of 1, 2, 4, 8 pixels
 
   /// Rebuilds from `values` (cols * rows, row-major); storage is reused between calls.
   void build(const float* values, int cols, int rows);

@@ -1,5 +1,7 @@
 #include "mapper/scan.h"
 
+#include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <stdexcept>
 #include <string>
@@ -106,21 +108,30 @@ void fill_scan(const RgbdFrame& frame, const PinholeCamera& cam, int stride, int
   scan.valid.resize(n);
 
   const Eigen::Matrix3d R = T_world_camera.linear();
+  // A reading is a ray iff mm != 0 and !(mm < min_range in mm): for an integer mm that is
+  // mm >= the smallest integer not below the minimum (and >= 1).
   const double min_depth_mm = options.min_range_m * 1000.0;
+  int min_mm = 1;
+  if (min_depth_mm > 1.0) min_mm = static_cast<int>(std::ceil(std::min(min_depth_mm, 65536.0)));
+  // Everything the loop reads, in locals: its byte stores (valid) may alias anything, so
+  // members would be reloaded for every pixel.
+  const int cols = scan.cols, rows = scan.rows;
+  const double cx = cam.cx, fx = cam.fx, cy = cam.cy, fy = cam.fy;
+  const size_t step = static_cast<size_t>(stride);
   size_t num_points = 0;
-  for (int v = 0; v < scan.rows; ++v) {
+  for (int v = 0; v < rows; ++v) {
     const uint16_t* depth = frame.depth_mm.ptr<uint16_t>(v0 + v * stride) + u0;
-    const double y_over_z = (v - cam.cy) / cam.fy;
-    const size_t row = static_cast<size_t>(v) * static_cast<size_t>(scan.cols);
+    const double y_over_z = (v - cy) / fy;
+    const size_t row = static_cast<size_t>(v) * static_cast<size_t>(cols);
     uint8_t* valid = scan.valid.data() + row;
     octomap::point3d* points = scan.points.data() + row;
-    for (int u = 0; u < scan.cols; ++u) {
-      const uint16_t mm = depth[static_cast<size_t>(u) * static_cast<size_t>(stride)];
-      const bool ok = mm != 0 && !(mm < min_depth_mm);
+    for (int u = 0; u < cols; ++u) {
+      const int mm = depth[static_cast<size_t>(u) * step];
+      const bool ok = mm >= min_mm;
       valid[u] = ok ? 1 : 0;
       if (!ok) continue;
       const double z = 0.001 * mm;
-      const Eigen::Vector3d p_in_camera((u - cam.cx) / cam.fx * z, y_over_z * z, z);
+      const Eigen::Vector3d p_in_camera((u - cx) / fx * z, y_over_z * z, z);
       const Eigen::Vector3d p = R * p_in_camera + t;
       points[u] = octomap::point3d(static_cast<float>(p.x()), static_cast<float>(p.y()),
                                    static_cast<float>(p.z()));

@@ -136,6 +136,7 @@ void ScanIntegrator::begin_pixels(const Scan& scan) {
   for (int a = 0; a < 3; ++a) witness_ok = witness_ok && std::fabs(static_cast<double>(scan.origin(a))) < edge;
   int last_hit = -1;
   double last_floor[3] = {0.0, 0.0, 0.0};  // floor(factor * coordinate) of last_hit's key
+  double last_ceil[3] = {0.0, 0.0, 0.0};   // ... + 1
   const double factor = keys_.factor();
   // Everything the loop reads, in locals: the byte stores of mark() may alias anything, so
   // members and vector data would be reloaded for every pixel.
@@ -168,13 +169,16 @@ void ScanIntegrator::begin_pixels(const Scan& scan) {
         const double sx = factor * static_cast<double>(p.x());
         const double sy = factor * static_cast<double>(p.y());
         const double sz = factor * static_cast<double>(p.z());
-        if (!(last_hit >= 0 && sx >= last_floor[0] && sx < last_floor[0] + 1.0 && sy >= last_floor[1] &&
-              sy < last_floor[1] + 1.0 && sz >= last_floor[2] && sz < last_floor[2] + 1.0)) {
+        if (!(last_hit >= 0 && sx >= last_floor[0] && sx < last_ceil[0] && sy >= last_floor[1] &&
+              sy < last_ceil[1] && sz >= last_floor[2] && sz < last_ceil[2])) {
           Key k;
           if (!keys_.key(p, k)) break;  // OctoMap drops such a point altogether
           last_hit = index(k);
           mark(last_hit, k, kOccupied);
-          for (int a = 0; a < 3; ++a) last_floor[a] = static_cast<double>(static_cast<int>(k[a]) - KeySpace::kMaxVal);
+          for (int a = 0; a < 3; ++a) {
+            last_floor[a] = static_cast<double>(static_cast<int>(k[a]) - KeySpace::kMaxVal);
+            last_ceil[a] = last_floor[a] + 1.0;
+          }
         }
         end_cell = last_hit;
         s_end = depth - 4.0 * line - 1e-6 * range;

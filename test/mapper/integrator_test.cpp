@@ -130,6 +130,27 @@ TEST(Scan, DecimatedScanEqualsMakeScanOfTheDecimatedFrame) {
   EXPECT_EQ(decimate(frame, 5).depth_mm.at<uint16_t>(47, 64), 0);  // the hole is on the grid
 }
 
+TEST(Scan, MinRangeKeepsReadingsAtOrBeyondIt) {
+  // A reading is a ray iff it is not 0 and not nearer than min_range (a reading exactly at
+  // min_range is kept), for whole and fractional millimetre limits.
+  RgbdFrame frame;
+  frame.camera = test::kinect_camera(8, 1);
+  frame.depth_mm = cv::Mat(1, 8, CV_16UC1);
+  const uint16_t mm[8] = {0, 1, 2, 499, 500, 501, 65534, 65535};
+  for (int u = 0; u < 8; ++u) frame.depth_mm.at<uint16_t>(0, u) = mm[u];
+  for (const double min_range : {0.0, 0.0005, 0.001, 0.0015, 0.4995, 0.5, 0.5001, 65.535, 70.0}) {
+    ScanOptions options;
+    options.stride = 1;
+    options.max_range_m = 100.0;
+    options.min_range_m = min_range;
+    const Scan scan = make_scan(frame, Eigen::Isometry3d::Identity(), options, "test");
+    for (int u = 0; u < 8; ++u) {
+      const bool expected = mm[u] != 0 && !(mm[u] < min_range * 1000.0);
+      EXPECT_EQ(scan.valid[static_cast<size_t>(u)] != 0, expected) << min_range << " " << mm[u];
+    }
+  }
+}
+
 TEST(ScanIntegrator, ZeroDepthMarksNothing) {
   RgbdFrame frame;
   frame.camera = test::kinect_camera(32, 24);
