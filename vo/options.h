@@ -90,7 +90,7 @@ struct RefinementOptions {
   double pixel_sigma = 1.2;       ///< measurement noise of a feature position, pixels
   double huber_px = 1.5;          ///< robust loss threshold on a whitened residual (sigmas); 0 = none
   double outlier_threshold_px = 2.0;   ///< residuals above this (pixels) are dropped before re-refining
-  int max_iterations = 5;
+  int max_iterations = 4;         ///< 5 until the dense term: 4 is within 0.5 % on every figure and ~0.1 ms faster
   int min_inliers = 10;           ///< fewer after outlier removal = optimisation failure
 };
 
