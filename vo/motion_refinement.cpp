@@ -195,7 +195,7 @@ DenseQuadratic linearise_dense(const DenseTerm& d, const PinholeCamera& cam, con
     for (int x = 0; x < cur.width; x += o.stride) {
       const size_t i = static_cast<size_t>(y * cur.width + x);
       const Eigen::Vector3f& nq = cur.normals[i];
-      if (nq.z() == 0.0f) continue;  // invalid (a valid normal faces the camera: z < 0)
+      if (nq.z() == 0.0f) continue;  // invalid (zero), or exactly grazing: skipped alike
       const Eigen::Vector3f& q = cur.points[i];
       const Eigen::Vector3f X = R * q + p;
       if (!(X.z() > 1e-3f)) continue;
