@@ -217,7 +217,7 @@ inline void ScanIntegrator::set_cleared(int idx, const Key& key) {
   queue_.push_back({idx, key});
 }
 
-inline bool ScanIntegrator::witness_clears(const Key& cell, const Eigen::Vector3d& centre,
+inline bool ScanIntegrator::witness_clears(const Key& cell, int idx, const Eigen::Vector3d& centre,
                                            float min_reach, bool& tried) {
   // The ray through the pixel nearest the cell's centre (given in the camera frame), then the
   // others of the (2 kNear + 1)^2 around it (the centre's may end in a hole of the depth or
@@ -233,9 +233,11 @@ inline bool ScanIntegrator::witness_clears(const Key& cell, const Eigen::Vector3
   const int u = static_cast<int>(ur), v = static_cast<int>(vr);
   tried = true;
   const int cols = scan_->cols;
+  // A ray ending in the cell never clears it (the cells of the surface: most witness tests that
+  // fail would fail there, after the slab test).
   auto clears = [&](int pu, int pv) {
     const size_t s = static_cast<size_t>(pv) * cols + pu;
-    return s_end_lo_[s] > 0.0f && reach_[s] >= min_reach &&
+    return s_end_lo_[s] > 0.0f && reach_[s] >= min_reach && end_cell_[s] != idx &&
            projector_.certainly_clears(cell, pu, pv, s_end_lo_[s]);
   };
   if (clears(u, v)) return true;
@@ -493,7 +495,7 @@ void ScanIntegrator::test_cell(int idx, const Key& cell) {
   Eigen::Vector3d centre;
   if (!some_ray_may_reach(cell, min_reach, centre)) return;
   bool witnesses_tried = false;
-  if (witness_clears(cell, centre, min_reach, witnesses_tried)) {
+  if (witness_clears(cell, idx, centre, min_reach, witnesses_tried)) {
     ++cells_witnessed_;
     set_cleared(idx, cell);
   } else if (cleared_by_some_ray(cell, centre, idx, witnesses_tried)) {

@@ -88,7 +88,8 @@ class ScanIntegrator {
   bool traced(size_t sample) const { return ray_state_[sample] == built_ + 1; }
   void trace_sample(size_t sample);
   void set_cleared(int idx, const Key& key);
-  bool witness_clears(const Key& cell, const Eigen::Vector3d& centre, float min_reach, bool& tried);
+  bool witness_clears(const Key& cell, int idx, const Eigen::Vector3d& centre, float min_reach,
+                      bool& tried);
   bool some_ray_may_reach(const Key& cell, float& min_reach, Eigen::Vector3d& centre) const;
   bool cleared_by_some_ray(const Key& cell, const Eigen::Vector3d& centre, int idx, bool witnesses_tried);
   bool clip_rows(const CellFootprint& f);
