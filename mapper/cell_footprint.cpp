@@ -241,26 +241,23 @@ CellFootprint FootprintProjector::rectangle(const Key& cell) const {
     add(5, 4, 0);
     add(6, 4, 1);
     add(7, 6, 0);
+    // Widens the image box by corner c, which lies in front of the camera.
+    const auto project = [&](int c) {
+      const double inv = 1.0 / z[c];
+      const double u = x[c] * inv, v = y[c] * inv;
+      umin = std::min(umin, u);
+      umax = std::max(umax, u);
+      vmin = std::min(vmin, v);
+      vmax = std::max(vmax, v);
+    };
     const double z_min = std::min({z[0], z[1], z[2], z[3], z[4], z[5], z[6], z[7]});
     if (z_min > 0.0) {  // the usual case: every corner in front of the camera
-      for (int c = 0; c < 8; ++c) {
-        const double inv = 1.0 / z[c];
-        const double u = x[c] * inv, v = y[c] * inv;
-        umin = std::min(umin, u);
-        umax = std::max(umax, u);
-        vmin = std::min(vmin, v);
-        vmax = std::max(vmax, v);
-      }
+      for (int c = 0; c < 8; ++c) project(c);
       any = true;
     } else {
       for (int c = 0; c < 8; ++c) {
         if (z[c] > 0.0) {
-          const double inv = 1.0 / z[c];
-          const double u = x[c] * inv, v = y[c] * inv;
-          umin = std::min(umin, u);
-          umax = std::max(umax, u);
-          vmin = std::min(vmin, v);
-          vmax = std::max(vmax, v);
+          project(c);
           any = true;
         } else if (z[c] == 0.0) {
           towards_infinity(x[c], y[c]);
