@@ -8,20 +8,7 @@
 #include <emmintrin.h>
 #endif
 
-
 namespace kestrel::vo {
-
-Eigen::Vector2d distort_pixel(const PinholeCamera& c, bool use_distortion, double u, double v) {
-  if (!use_distortion) return {u, v};
-  const double k1 = c.distortion[0], k2 = c.distortion[1], p1 = c.distortion[2], p2 = c.distortion[3],
-               k3 = c.distortion[4];
-  const double x = (u - c.cx) / c.fx, y = (v - c.cy) / c.fy;
-  const double r2 = x * x + y * y;
-  const double radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3));
-  const double xd = x * radial + 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x);
-  const double yd = y * radial + p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y;
-  return {c.fx * xd + c.cx, c.fy * yd + c.cy};
-}
 
 namespace {
 

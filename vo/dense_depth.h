@@ -43,8 +43,4 @@ void build_dense_depth(const cv::Mat& depth_mm, const Lens& lens, const DepthOpt
 void block_depths(const cv::Mat& depth_mm, const DepthOptions& depth, int level, bool allow_simd,
                   std::vector<float>& z);
 
-/// Raw (distorted) level-0 pixel of the ideal pinhole pixel (u, v) under the camera's
-/// Brown-Conrady distortion (OpenCV's model); the identity without distortion.
-Eigen::Vector2d distort_pixel(const PinholeCamera& camera, bool use_distortion, double u, double v);
-
 }  // namespace kestrel::vo

@@ -22,7 +22,6 @@ namespace kestrel::vo {
 
 constexpr int kMaxLevels = 4;
 
-
 struct Feature {
   float u = 0, v = 0;                  ///< position on its level, pixels
   float u0 = 0, v0 = 0;                ///< the same on level 0, raw (distorted) pixels
