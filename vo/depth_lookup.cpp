@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 
 #include "common/geometry/se3.h"
 
@@ -47,9 +48,11 @@ Eigen::Vector3f point_at_frame_time(const Lens& lens, const FrameMotion& motion,
   return p;
 }
 
-void retime_features(const Lens& lens, const FrameMotion& motion, Frame& frame) {
-  frame.motion = motion;
-  for (Feature& f : frame.features) f.p_camera = point_at_frame_time(lens, motion, f.u0, f.v0, f.depth_m, &f.ideal);
+double depth_time_offset_s(const DepthOptions& options, int64_t rgb_utime, int64_t depth_utime) {
+  if (!options.time_offset_from_stamps) return options.time_offset_s;
+  constexpr int64_t kMaxStampOffsetUs = 100000;
+  const int64_t offset_us = depth_utime - rgb_utime;
+  return std::abs(offset_us) < kMaxStampOffsetUs ? 1e-6 * double(offset_us) : 0.0;
 }
 
 void attach_depth(const cv::Mat& depth_mm, const Lens& lens, const DepthOptions& options,

@@ -9,6 +9,7 @@
 // through its ideal pixel, with z in [min_m, max_m].
 
 #include <Eigen/Geometry>
+#include <cstdint>
 #include <opencv2/core/mat.hpp>
 
 #include "vo/frame.h"
@@ -27,8 +28,9 @@ void attach_depth(const cv::Mat& depth_mm, const Lens& lens, const DepthOptions&
 Eigen::Vector3f point_at_frame_time(const Lens& lens, const FrameMotion& motion, float u0, float v0,
                                     float z, Eigen::Vector2f* ideal);
 
-/// Recomputes every feature's point and ideal pixel for `motion` (kept in frame.motion).
-void retime_features(const Lens& lens, const FrameMotion& motion, Frame& frame);
+/// Depth capture time minus colour capture time, seconds, as `options` say to take it: from
+/// the stamps (0 when they are 0.1 s or more apart: not one capture) or the configured value.
+double depth_time_offset_s(const DepthOptions& options, int64_t rgb_utime, int64_t depth_utime);
 
 /// Depth in metres at raw pixel (u, v) (nearest pixel), or 0 when there is no reliable reading:
 /// out of range, outside the image, or spread over its 3x3 neighbourhood by more than

@@ -10,8 +10,6 @@
 namespace kestrel::vo {
 namespace {
 
-// A depth stamp farther than this from the RGB stamp is not trusted for compensation.
-constexpr int64_t kMaxDepthOffsetUs = 100000;
 // A rotation prior farther than this from the velocity prediction is taken as a failed alignment.
 constexpr double kMaxPriorDisagreementRad = 0.35;
 
@@ -166,12 +164,11 @@ VoResult VisualOdometry::process(const RgbdFrame& input) {
   Eigen::Isometry3d T_prev_cur_predicted = Eigen::Isometry3d::Identity();
   if (previous_ != nullptr) T_prev_cur_predicted = predict_prev_cur(cur);
   FrameMotion motion;
-  const int64_t offset_us = input.depth_utime - input.utime;
   if (previous_ != nullptr) {
     const double dt = 1e-6 * double(cur.utime - previous_->utime);
     motion.known = dt > 0.0;
     motion.twist_per_s = se3::log(T_prev_cur_predicted) / dt;
-    if (std::abs(offset_us) < kMaxDepthOffsetUs) motion.depth_offset_s = 1e-6 * double(offset_us);
+    motion.depth_offset_s = depth_time_offset_s(options_.depth, input.utime, input.depth_utime);
     motion.readout_s = options_.depth.rolling_shutter_readout_s;
   }
   cur.motion = motion;

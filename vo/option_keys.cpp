@@ -28,6 +28,8 @@ std::vector<std::pair<std::string, Field>> fields(VoOptions& o) {
       {"depth.max_discontinuity", &o.depth.max_discontinuity},
       {"depth.sigma_z_coeff", &o.depth.sigma_z_coeff},
       {"depth.compensate_time_offset", &o.depth.compensate_time_offset},
+      {"depth.time_offset_from_stamps", &o.depth.time_offset_from_stamps},
+      {"depth.time_offset_s", &o.depth.time_offset_s},
       {"depth.undistort", &o.depth.undistort},
       {"depth.rolling_shutter_readout_s", &o.depth.rolling_shutter_readout_s},
       {"rotation_prior.enabled", &o.rotation_prior.enabled},

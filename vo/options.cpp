@@ -1,5 +1,6 @@
 #include "vo/options.h"
 
+#include <cmath>
 #include <stdexcept>
 
 #include "vo/frame.h"
@@ -27,6 +28,7 @@ void VoOptions::validate() const {
   require(depth.min_m > 0.0 && depth.min_m < depth.max_m, "depth.min_m/max_m", "need 0 < min < max");
   require(depth.max_discontinuity > 0.0, "depth.max_discontinuity", "must be > 0");
   require(depth.sigma_z_coeff >= 0.0, "depth.sigma_z_coeff", "must be >= 0");
+  require(std::abs(depth.time_offset_s) < 0.1, "depth.time_offset_s", "must be within (-0.1, 0.1)");
   require(depth.rolling_shutter_readout_s >= 0.0 && depth.rolling_shutter_readout_s < 0.1,
           "depth.rolling_shutter_readout_s", "must be in [0, 0.1)");
   require(rotation_prior.downsample_level >= 1 && rotation_prior.downsample_level <= 6,

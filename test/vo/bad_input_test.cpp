@@ -158,7 +158,7 @@ TEST(Options, SetByNameAndRejectedByName) {
   set_option(o, "dense.weight", "0.1");
   EXPECT_EQ(o.dense.weight, 0.1);
   EXPECT_THROW(set_option(o, "dense.stride", "0"), std::invalid_argument);
-  EXPECT_EQ(describe_options(o).size(), 63u);
+  EXPECT_EQ(describe_options(o).size(), 65u);
 }
 
 }  // namespace

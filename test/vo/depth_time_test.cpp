@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <iostream>
+#include <stdexcept>
 
 #include "common/geometry/se3.h"
 #include "test/vo/synthetic_scene.h"
@@ -73,6 +74,25 @@ TEST(DepthTimeOffset, CompensatedLookupReadsTheDepthAtRgbTime) {
   EXPECT_GT(e_plain, 0.008);
   EXPECT_LT(e_compensated, 0.002);
   EXPECT_LT(e_compensated, 0.15 * e_plain);
+}
+
+// Which offset is compensated: the stamps' difference (a capture 0.1 s or more away is not one
+// capture: none), or, for a source whose stamps are arrival times, the configured value.
+TEST(DepthTimeOffset, TakenFromTheStampsOrTheConfiguredValue) {
+  DepthOptions options;
+  EXPECT_DOUBLE_EQ(depth_time_offset_s(options, 1'000'000, 988'000), -0.012);
+  EXPECT_DOUBLE_EQ(depth_time_offset_s(options, 1'000'000, 1'007'500), 0.0075);
+  EXPECT_DOUBLE_EQ(depth_time_offset_s(options, 1'000'000, 1'100'000), 0.0);
+  EXPECT_DOUBLE_EQ(depth_time_offset_s(options, 1'000'000, 850'000), 0.0);
+
+  options.time_offset_from_stamps = false;
+  options.time_offset_s = -0.012;
+  EXPECT_DOUBLE_EQ(depth_time_offset_s(options, 1'000'000, 1'000'000), -0.012);
+  EXPECT_DOUBLE_EQ(depth_time_offset_s(options, 1'000'000, 1'009'000), -0.012);
+
+  VoOptions vo;
+  vo.depth.time_offset_s = 0.15;
+  EXPECT_THROW(vo.validate(), std::invalid_argument);
 }
 
 }  // namespace
