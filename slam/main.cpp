@@ -65,6 +65,9 @@ void add_options(cli::App& app, Options& o, SlamOptions& s) {
       ->check(CLI::NonNegativeNumber)->capture_default_str();
   app.add_option("--min-inliers", s.verification.min_inliers, "Inliers a loop closure needs")
       ->check(CLI::PositiveNumber)->capture_default_str();
+  app.add_flag("--odometry-covariance,!--no-odometry-covariance", s.odometry.use_reported,
+               "Odometry edges take the VO's reported covariance (else the constant noise model)")
+      ->capture_default_str();
   app.add_option("--kernel", o.kernel, "Robust kernel on loop closures: none, huber, cauchy or dcs")
       ->check(CLI::IsMember({"none", "huber", "cauchy", "dcs"}))->capture_default_str();
   app.add_option("--tum", o.tum, "Offline: run VO + SLAM over this TUM RGB-D folder");

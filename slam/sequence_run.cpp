@@ -26,6 +26,7 @@ SlamRun run_slam_sequence(size_t count, const std::function<RgbdFrame(size_t)>& 
     Eigen::Isometry3d T_keyframe_camera;  // odometry since that keyframe
   };
   std::vector<Placed> placed;
+  std::optional<OdometryPose> keyframe_pose;  // the chain's pose of the newest keyframe
   for (size_t i = 0; i < count; ++i) {
     const RgbdFrame frame = frame_at(i);
     const vo::VoResult r = odometry.process(frame);
@@ -36,12 +37,18 @@ SlamRun run_slam_sequence(size_t count, const std::function<RgbdFrame(size_t)>& 
     m.new_reference = r.new_reference;
     m.T_reference_current = r.T_reference_current;
     m.T_body_camera = frame.T_body_camera;
+    if (m.ok) m.covariance = r.covariance;
     const std::optional<OdometryPose> pose = chain.add(m);
     if (!pose) continue;
     const OdometryLink link = pose->broken ? OdometryLink::kBroken : OdometryLink::kContinuous;
     if (slam.wants_keyframe(pose->T_odom_camera, link)) {
       const auto t0 = std::chrono::steady_clock::now();
-      const SlamStep step = slam.add(frame, pose->T_odom_camera, link);
+      std::optional<Matrix6d> odometry_covariance;
+      if (link == OdometryLink::kContinuous && keyframe_pose) {
+        odometry_covariance = chain.relative_covariance(*keyframe_pose, *pose);
+      }
+      const SlamStep step = slam.add(frame, pose->T_odom_camera, link, odometry_covariance);
+      if (step.keyframe) keyframe_pose = *pose;
       run.keyframe_ms.push_back(
           std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
       run.candidates_verified += step.candidates;

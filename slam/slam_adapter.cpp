@@ -29,6 +29,7 @@ void SlamAdapter::reset() {
   recent_.clear();
   odometry_fix_ = Eigen::Isometry3d::Identity();
   last_pose_.reset();
+  keyframe_pose_.reset();
   bridges_ = 0;
 }
 
@@ -194,7 +195,12 @@ AdapterOutputs SlamAdapter::process(const kestrel::rgbd_frame_t& message, const 
     return out;
   }
   const RgbdFrame frame = transport::decode_rgbd(message, options_.camera_channel.c_str());
-  const SlamStep step = slam_.add(frame, pose.T_odom_camera, link);
+  std::optional<Matrix6d> odometry_covariance;
+  if (link == OdometryLink::kContinuous && keyframe_pose_) {
+    odometry_covariance = chain_.relative_covariance(*keyframe_pose_, chained);
+  }
+  const SlamStep step = slam_.add(frame, pose.T_odom_camera, link, odometry_covariance);
+  if (step.keyframe) keyframe_pose_ = chained;
   lost_break_ = false;
   remember(*last_pose_, step.keyframe);
   if (!step.keyframe) {

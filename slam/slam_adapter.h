@@ -114,6 +114,7 @@ class SlamAdapter {
   };
   std::deque<StateSample> states_;  ///< the last max_bridge_s (+1 s) of states
   std::optional<FramePose> last_pose_;  ///< the last processed frame
+  std::optional<OdometryPose> keyframe_pose_;  ///< the chain's pose of the newest keyframe
   Eigen::Isometry3d odometry_fix_ = Eigen::Isometry3d::Identity();  ///< chain -> SLAM's odometry frame
   int bridges_ = 0;
   std::deque<FramePose> recent_;  ///< frames since the newest keyframe, until anchored

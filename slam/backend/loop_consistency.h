@@ -10,7 +10,9 @@
 // better). Over a long loop the bound is metres, so only short-range aliasing is caught.
 
 #include <Eigen/Geometry>
+#include <vector>
 
+#include "common/geometry/se3.h"
 #include "slam/posegraph/pose_graph.h"
 
 namespace kestrel::slam {
@@ -30,9 +32,13 @@ struct LoopConsistency {
 };
 
 /// Compares the loop measurement T_from_to (from < to) with graph.poses[from]^-1 poses[to],
-/// allowing for the odometry edges (kind kOdometry) between the two vertices.
+/// allowing for the odometry edges (kind kOdometry) between the two vertices: their information
+/// in the graph, or `odometry_information[e]` for edge e when given (one per edge; the back-end
+/// passes its constant noise model there, so that the gate stays as conservative as it was
+/// when the graph's odometry edges take the VO's own, tighter covariance).
 LoopConsistency check_loop_against_odometry(const PoseGraph3d& graph, int from, int to,
                                             const Eigen::Isometry3d& T_from_to,
-                                            const LoopConsistencyOptions& options);
+                                            const LoopConsistencyOptions& options,
+                                            const std::vector<Matrix6d>* odometry_information = nullptr);
 
 }  // namespace kestrel::slam

@@ -24,9 +24,23 @@ std::optional<OdometryPose> OdometryChain::add(const VoMotion& m) {
   last_utime_ = m.utime;
 
   std::optional<Eigen::Isometry3d> T_odom_camera;
+  OdometryPose out;
+  out.utime = m.utime;
   if (m.ok) {
     const auto ref = references_.find(m.reference_utime);
-    if (ref != references_.end()) T_odom_camera = ref->second * m.T_reference_current;
+    if (ref != references_.end()) {
+      T_odom_camera = ref->second.T_odom_camera * m.T_reference_current;
+      out.reference_utime = m.reference_utime;
+      out.T_reference_camera = m.T_reference_current;
+      if (m.covariance.allFinite() && !m.covariance.isZero(0.0)) {
+        // [dp; dtheta] with dp in the reference frame -> right perturbation: rho = R^T dp.
+        Matrix6d J = Matrix6d::Identity();
+        J.topLeftCorner<3, 3>() = m.T_reference_current.linear().transpose();
+        out.covariance = J * m.covariance * J.transpose();
+        out.covariance = 0.5 * (out.covariance + out.covariance.transpose()).eval();
+        out.has_covariance = true;
+      }
+    }
   }
   if (!T_odom_camera) {
     if (!m.new_reference) {
@@ -39,13 +53,57 @@ std::optional<OdometryPose> OdometryChain::add(const VoMotion& m) {
     T_odom_camera = last_ ? *last_ : m.T_body_camera;
   }
   if (m.new_reference) {
-    references_[m.utime] = *T_odom_camera;
+    references_[m.utime] = Reference{*T_odom_camera, out.reference_utime, out.covariance, out.has_covariance};
     while (references_.size() > kMaxReferences) references_.erase(references_.begin());
   }
-  OdometryPose out{*T_odom_camera, pending_break_};
+  out.T_odom_camera = *T_odom_camera;
+  out.broken = pending_break_;
   pending_break_ = false;
   last_ = *T_odom_camera;
   return out;
+}
+
+std::optional<Matrix6d> OdometryChain::relative_covariance(const OdometryPose& a, const OdometryPose& b) const {
+  if (!b.has_covariance || a.utime >= b.utime) return std::nullopt;
+  // Walk from b's reference back to a (when a is itself a reference) or to a's reference,
+  // accumulating the motion z from there to b's reference and its covariance.
+  Eigen::Isometry3d z = Eigen::Isometry3d::Identity();
+  Matrix6d cov_z = Matrix6d::Zero();
+  int64_t node = b.reference_utime;
+  bool from_a = false;  // the walk reached a itself: a's own motion is part of z's path
+  for (size_t steps = 0;; ++steps) {
+    if (node == a.utime) {
+      from_a = true;
+      break;
+    }
+    if (node == a.reference_utime && node != 0) break;
+    const auto it = references_.find(node);
+    if (it == references_.end() || !it->second.has_covariance || it->second.parent_utime == 0 ||
+        steps > kMaxReferences) {
+      return std::nullopt;
+    }
+    const Reference& r = it->second;
+    const auto parent = references_.find(r.parent_utime);
+    if (parent == references_.end()) return std::nullopt;
+    // x = T_parent_node; the path parent -> b's reference is x * z.
+    const Eigen::Isometry3d x = parent->second.T_odom_camera.inverse() * r.T_odom_camera;
+    const Matrix6d A = se3::adjoint(z.inverse());
+    cov_z = A * r.covariance * A.transpose() + cov_z;
+    z = x * z;
+    node = r.parent_utime;
+  }
+  // T_a_b = x_a^-1 z y with y = b's motion from its reference (x_a = identity when the walk
+  // reached a itself).
+  const Eigen::Isometry3d& y = b.T_reference_camera;
+  const Matrix6d Ay = se3::adjoint(y.inverse());
+  Matrix6d cov = Ay * cov_z * Ay.transpose() + b.covariance;
+  if (!from_a) {
+    if (!a.has_covariance) return std::nullopt;
+    const Eigen::Isometry3d T_a_b = a.T_reference_camera.inverse() * z * y;
+    const Matrix6d Aa = se3::adjoint(T_a_b.inverse());
+    cov += Aa * a.covariance * Aa.transpose();
+  }
+  return Matrix6d(0.5 * (cov + cov.transpose()));
 }
 
 }  // namespace kestrel::slam

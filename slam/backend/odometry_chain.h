@@ -6,11 +6,19 @@
 // odometry restarts (no reference, or a reference this chain never saw), the new segment starts
 // at the last known pose and the pose is flagged `broken`: it is not related to the earlier
 // ones. Invariants: utimes increase; at most kMaxReferences references are remembered.
+//
+// Uncertainty: when the VO reports a covariance with each motion, the chain keeps it with each
+// reference (relative to the reference it was measured from), so that relative_covariance()
+// gives the covariance of the motion between two frames of one segment: the frames' own
+// motions from their references plus the references' motions between them, carried to the
+// later frame (first order; the terms are taken as independent).
 
 #include <Eigen/Geometry>
 #include <cstdint>
 #include <map>
 #include <optional>
+
+#include "common/geometry/se3.h"
 
 namespace kestrel::slam {
 
@@ -22,11 +30,23 @@ struct VoMotion {
   bool new_reference = false;       ///< this frame is the reference of the next ones
   Eigen::Isometry3d T_reference_current = Eigen::Isometry3d::Identity();
   Eigen::Isometry3d T_body_camera = Eigen::Isometry3d::Identity();
+  /// Of T_reference_current, [dp; dtheta] as in vo_update_t (dp in the reference frame,
+  /// dtheta in the current frame); all zero when the VO gave none.
+  Matrix6d covariance = Matrix6d::Zero();
 };
 
 struct OdometryPose {
   Eigen::Isometry3d T_odom_camera = Eigen::Isometry3d::Identity();
   bool broken = false;              ///< the odometry restarted since the previous pose
+  /// How the pose was chained, for relative_covariance(): the reference it was measured from
+  /// (0: none, the start of a segment), the motion from it, and that motion's covariance as a
+  /// right perturbation xi = [rho; phi] of T_reference_camera (T * Exp(xi)); has_covariance
+  /// when the VO reported one.
+  int64_t reference_utime = 0;
+  Eigen::Isometry3d T_reference_camera = Eigen::Isometry3d::Identity();
+  Matrix6d covariance = Matrix6d::Zero();
+  bool has_covariance = false;
+  int64_t utime = 0;
 };
 
 class OdometryChain {
@@ -38,8 +58,19 @@ class OdometryChain {
   std::optional<OdometryPose> add(const VoMotion& motion);
   void reset();
 
+  /// Covariance of T_a_b = T_odom_a^-1 T_odom_b as a right perturbation [rho; phi], for two
+  /// poses this chain gave (a before b, one segment), when the VO reported covariances for
+  /// every motion in between and the references joining them are still remembered.
+  std::optional<Matrix6d> relative_covariance(const OdometryPose& a, const OdometryPose& b) const;
+
  private:
-  std::map<int64_t, Eigen::Isometry3d> references_;  ///< utime -> T_odom_camera
+  struct Reference {
+    Eigen::Isometry3d T_odom_camera = Eigen::Isometry3d::Identity();
+    int64_t parent_utime = 0;  ///< the reference it was measured from (0: segment start)
+    Matrix6d covariance = Matrix6d::Zero();  ///< right perturbation of T_parent_this
+    bool has_covariance = false;
+  };
+  std::map<int64_t, Reference> references_;  ///< utime -> reference
   std::optional<Eigen::Isometry3d> last_;            ///< last pose given out
   int64_t last_utime_ = 0;
   bool pending_break_ = false;  ///< a restart was seen; flag the next pose

@@ -1,5 +1,6 @@
 #include "slam/backend/slam.h"
 
+#include <Eigen/Eigenvalues>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -25,6 +26,8 @@ void check_options(const SlamOptions& o) {
           "odometry noise rates must be >= 0");
   require(n.break_translation_m > 0.0 && n.break_rotation_rad > 0.0, "odometry break noise must be > 0");
   require(n.bridge_translation_m > 0.0 && n.bridge_rotation_rad > 0.0, "odometry bridge noise must be > 0");
+  require(n.reported_translation_floor_m > 0.0 && n.reported_rotation_floor_rad > 0.0,
+          "odometry reported-covariance floors must be > 0");
 }
 
 // Information of an odometry edge in the pose graph's error convention (spaces.h): the
@@ -48,7 +51,31 @@ Matrix6d odometry_information(const Eigen::Isometry3d& T_prev_cur, const Odometr
   return info;
 }
 
+// The same from the odometry's own covariance of a right perturbation [rho; phi] of T_prev_cur
+// (the measurement Z of the edge): the error of Z * Exp(xi) is [rho; phi / 2] to first order.
+Matrix6d reported_odometry_information(const Matrix6d& covariance, const OdometryNoise& n) {
+  Matrix6d cov = covariance;
+  cov.diagonal().head<3>().array() += n.reported_translation_floor_m * n.reported_translation_floor_m;
+  cov.diagonal().tail<3>().array() += n.reported_rotation_floor_rad * n.reported_rotation_floor_rad;
+  Matrix6d S = Matrix6d::Identity();
+  S.bottomRightCorner<3, 3>() *= 0.5;
+  const Matrix6d info = (S * cov * S).inverse();
+  return 0.5 * (info + info.transpose());
+}
+
 }  // namespace
+
+Matrix6d odometry_edge_information(const Eigen::Isometry3d& T_prev_cur, const OdometryNoise& noise, OdometryLink link,
+                                   const std::optional<Matrix6d>& reported_covariance) {
+  if (link == OdometryLink::kContinuous && reported_covariance && noise.use_reported &&
+      reported_covariance->allFinite()) {
+    const Matrix6d reported = reported_odometry_information(*reported_covariance, noise);
+    if (reported.allFinite() && Eigen::SelfAdjointEigenSolver<Matrix6d>(reported).eigenvalues().minCoeff() > 0.0) {
+      return reported;
+    }
+  }
+  return odometry_information(T_prev_cur, noise, link);
+}
 
 Slam::Slam(const SlamOptions& options, std::shared_ptr<const Vocabulary> vocabulary)
     : options_(options), vocabulary_(std::move(vocabulary)), extractor_(options.features) {
@@ -60,6 +87,7 @@ void Slam::reset() {
   places_ = std::make_unique<PlaceRecognizer>(options_.place, vocabulary_);
   keyframes_.clear();
   graph_ = PoseGraph3d{};
+  gate_information_.clear();
   revision_ = 0;
   loop_closures_ = 0;
   inconsistent_loops_ = 0;
@@ -89,16 +117,20 @@ Eigen::Isometry3d Slam::world_pose(const Eigen::Isometry3d& T_odom_camera) const
   return graph_.poses.back() * keyframes_.back().T_odom_camera.inverse() * T_odom_camera;
 }
 
-void Slam::add_odometry_edge(const Keyframe& previous, const Keyframe& current, OdometryLink link) {
+void Slam::add_odometry_edge(const Keyframe& previous, const Keyframe& current, OdometryLink link,
+                             const std::optional<Matrix6d>& covariance) {
   // After a break the odometry poses of the two are unrelated: assume no motion, weakly.
   const Eigen::Isometry3d T_prev_cur = link == OdometryLink::kBroken
                                            ? Eigen::Isometry3d::Identity()
                                            : previous.T_odom_camera.inverse() * current.T_odom_camera;
   graph_.add_edge(static_cast<int>(previous.id), static_cast<int>(current.id), T_prev_cur,
-                  odometry_information(T_prev_cur, options_.odometry, link), EdgeKind::kOdometry);
+                  odometry_edge_information(T_prev_cur, options_.odometry, link, covariance), EdgeKind::kOdometry);
+  gate_information_.resize(graph_.edges.size() - 1, Matrix6d::Identity());
+  gate_information_.push_back(odometry_information(T_prev_cur, options_.odometry, link));
 }
 
-SlamStep Slam::add(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera, OdometryLink link) {
+SlamStep Slam::add(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera, OdometryLink link,
+                   const std::optional<Matrix6d>& odometry_covariance) {
   const bool odometry_broken = link == OdometryLink::kBroken;
   if (have_frame_ && frame.utime <= last_utime_) {
     throw InputError("slam: frame utime " + std::to_string(frame.utime) + " does not follow " +
@@ -123,7 +155,7 @@ SlamStep Slam::add(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camer
       keyframes_.empty() ? T_odom_camera
                          : (odometry_broken ? graph_.poses.back() : world_pose(T_odom_camera));
   graph_.add_vertex(kf.id, T_world_camera, keyframes_.empty());
-  if (!keyframes_.empty()) add_odometry_edge(keyframes_.back(), kf, link);
+  if (!keyframes_.empty()) add_odometry_edge(keyframes_.back(), kf, link, odometry_covariance);
   keyframes_.push_back(std::move(kf));
   step.keyframe = true;
   step.keyframe_id = keyframes_.back().id;
@@ -157,7 +189,8 @@ SlamStep Slam::close_loop(SlamStep step) {
     step.loop = verify_loop(query.features, earlier.features, options_.verification, seed);
     if (!step.loop.accepted) continue;
     if (gate && !check_loop_against_odometry(graph_, static_cast<int>(earlier.id), static_cast<int>(query.id),
-                                             step.loop.T_candidate_query, options_.loop_consistency)
+                                             step.loop.T_candidate_query, options_.loop_consistency,
+                                             &gate_information_)
                      .consistent) {
       step.loop.accepted = false;
       ++step.inconsistent;

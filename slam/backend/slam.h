@@ -55,6 +55,13 @@ struct SlamStep {
   std::optional<OptimizerSummary> optimisation;  ///< when the graph was optimised
 };
 
+/// Information (pose-graph error convention, spaces.h) of the odometry edge previous -> current
+/// keyframe with motion T_prev_cur: from the odometry's reported covariance of that motion (a
+/// right perturbation [rho; phi]) plus the noise's small floors, when there is one, the link is
+/// continuous and noise.use_reported; else the constant model (break/bridge values as `link` says).
+Matrix6d odometry_edge_information(const Eigen::Isometry3d& T_prev_cur, const OdometryNoise& noise, OdometryLink link,
+                                   const std::optional<Matrix6d>& reported_covariance = std::nullopt);
+
 class Slam {
  public:
   /// With `vocabulary` null, place recognition builds its vocabulary online. Throws
@@ -68,9 +75,13 @@ class Slam {
   /// Adds a frame seen at T_odom_camera; `link` says how that pose relates to the previous
   /// frame's (a bridged restart gives an odometry edge with the bridge's larger uncertainty, a
   /// broken one a weak edge of no motion). Throws InputError when the frame's utime does not
-  /// increase or the pose is not a finite rigid transform.
+  /// increase or the pose is not a finite rigid transform. `odometry_covariance`, when given
+  /// (continuous link only), is the odometry's own covariance of the motion from the previous
+  /// keyframe to this frame (right perturbation [rho; phi], OdometryChain::relative_covariance):
+  /// the odometry edge then takes it (OdometryNoise::use_reported) instead of the constant model.
   SlamStep add(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera,
-               OdometryLink link = OdometryLink::kContinuous);
+               OdometryLink link = OdometryLink::kContinuous,
+               const std::optional<Matrix6d>& odometry_covariance = std::nullopt);
 
   const std::vector<Keyframe>& keyframes() const { return keyframes_; }
   /// Vertices are keyframes (poses T_world_camera); edges odometry and loop closures.
@@ -98,7 +109,11 @@ class Slam {
   void reset();
 
  private:
-  void add_odometry_edge(const Keyframe& previous, const Keyframe& current, OdometryLink link);
+  /// Per graph edge: the constant model's information of each odometry edge (identity for
+  /// loop closures), for the loop-consistency gate (loop_consistency.h).
+  std::vector<Matrix6d> gate_information_;
+  void add_odometry_edge(const Keyframe& previous, const Keyframe& current, OdometryLink link,
+                         const std::optional<Matrix6d>& covariance);
   SlamStep close_loop(SlamStep step);
 
   SlamOptions options_;

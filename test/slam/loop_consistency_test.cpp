@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <vector>
 
 #include "slam/backend/loop_consistency.h"
 
@@ -67,6 +68,23 @@ TEST(LoopConsistency, RotationOutsideTheChainsUncertaintyIsRefusedAndZeroSigmasD
   LoopConsistencyOptions off;
   off.sigmas = 0.0;
   EXPECT_TRUE(check_loop_against_odometry(g, 0, 4, T, off).consistent);
+}
+
+TEST(LoopConsistency, TheGivenOdometryInformationReplacesTheGraphsForTheBound) {
+  // The graph's odometry edges as tight as a good VO reports (1 mm, 0.001 rad): 25 cm off over
+  // 2.5 m is refused against them, and passes against the constant model given per edge.
+  PoseGraph3d g = straight_chain(10, 0.25);
+  std::vector<Matrix6d> model;
+  for (auto& e : g.edges) {
+    model.push_back(e.information);
+    e.information.diagonal().head<3>().setConstant(1e6);
+    e.information.diagonal().tail<3>().setConstant(4e6);
+  }
+  Eigen::Isometry3d T = g.poses[0].inverse() * g.poses[10];
+  T.translation() += Eigen::Vector3d(0.0, 0.25, 0.0);
+  EXPECT_FALSE(check_loop_against_odometry(g, 0, 10, T, {}).consistent);
+  const LoopConsistency c = check_loop_against_odometry(g, 0, 10, T, {}, &model);
+  EXPECT_TRUE(c.consistent) << c.translation_m << " allowed " << c.allowed_translation_m;
 }
 
 }  // namespace

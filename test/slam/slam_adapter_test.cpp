@@ -110,6 +110,23 @@ TEST_F(AdapterTest, AnchorsTheGraphInTheEstimatorsWorldAtTheFirstKeyframeItsStat
   EXPECT_FALSE(adapter_.on_state(state(6.5, Eigen::Isometry3d::Identity())).graph);
 }
 
+TEST_F(AdapterTest, OdometryEdgesTakeTheVosReportedCovarianceChainedBetweenKeyframes) {
+  // Every frame is the next one's reference, 2 mm (per axis) of translation noise per step:
+  // keyframe 1 is frame 3, three steps on, so its edge has 3 * (2 mm)^2 plus the 1 mm floor.
+  for (int k = 0; k <= 3; ++k) {
+    kestrel::vo_update_t u = update(k);
+    if (k > 0) {
+      for (int i = 0; i < 3; ++i) u.covariance[7 * i] = 4e-6;
+    }
+    adapter_.on_frame(frame(k));
+    adapter_.on_vo_update(u);
+  }
+  const PoseGraph3d& g = adapter_.slam().graph();
+  ASSERT_EQ(g.edges.size(), 1u);
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(g.edges[0].information(i, i), 1.0 / (3 * 4e-6 + 1e-6), 1e-3);
+  EXPECT_NEAR(g.edges[0].information(3, 3), 4.0 / 1e-6, 1.0) << "no rotation noise reported: the floor";
+}
+
 TEST_F(AdapterTest, AHoveringVehicleIsAnchoredAtAFrameThatIsNoKeyframe) {
   // Keyframe 0 comes before the estimator starts; frame 1 (10 cm on, no keyframe) is the
   // first the states bracket: the anchor composes keyframe 0 with the odometry since.
