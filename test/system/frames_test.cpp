@@ -15,6 +15,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <iostream>
 #include <limits>
 #include <map>
 #include <optional>
@@ -89,8 +90,8 @@ double aligned_rmse(const std::vector<Eigen::Vector3d>& est, const std::vector<E
   return std::sqrt(((*T * a) - b).colwise().squaredNorm().mean());
 }
 
-TEST(System, SlamKeyframesAndCorrectionsAreInTheEstimatorsWorld) {
-  if (!test::can_isolate_network()) GTEST_SKIP() << "no network namespace available";
+// The flight through the processes; `vo_options` are added to kestrel-vo's command line.
+void fly_figure_eight(const std::string& vo_options) {
   test::TempDir dir;
   const std::string source = (dir / "source.lcmlog").string();
   const std::string recorded = (dir / "system.lcmlog").string();
@@ -99,7 +100,7 @@ TEST(System, SlamKeyframesAndCorrectionsAreInTheEstimatorsWorld) {
                              300.0);
   ASSERT_EQ(sim.exit_code, 0) << sim.err;
 
-  const std::string script = test::tool("vo").string() + " -q & V=$!; " + test::tool("estimator").string() +
+  const std::string script = test::tool("vo").string() + " -q " + vo_options + " & V=$!; " + test::tool("estimator").string() +
                              " -q & E=$!; " + test::tool("slam").string() + " -q & S=$!; " +
                              test::tool("replay").string() + " " + source +
                              " --expect vo,estimator,slam --ack-timeout 60 --record " + recorded +
@@ -125,6 +126,8 @@ TEST(System, SlamKeyframesAndCorrectionsAreInTheEstimatorsWorld) {
     worst = std::max(worst, (T_world_body.translation() - nearest->second.translation()).norm());
   }
   EXPECT_LT(worst, 0.04) << "SLAM's map and the estimator's world disagree";
+  std::cout << "keyframes " << rec.graph->keyframes.size() << ", corrections " << rec.corrections
+            << ", worst keyframe vs STATE " << worst << " m\n";
 
   // With the corrections the estimator stays within a centimetre or two of the truth.
   const auto truth = read_truth(source);
@@ -136,7 +139,22 @@ TEST(System, SlamKeyframesAndCorrectionsAreInTheEstimatorsWorld) {
     gt.push_back(g->second);
   }
   ASSERT_GE(est.size(), 2000u);
-  EXPECT_LT(aligned_rmse(est, gt), 0.02);
+  const double ate = aligned_rmse(est, gt);
+  EXPECT_LT(ate, 0.02);
+  std::cout << "estimator ATE " << ate << " m\n";
+}
+
+TEST(System, SlamKeyframesAndCorrectionsAreInTheEstimatorsWorld) {
+  if (!test::can_isolate_network()) GTEST_SKIP() << "no network namespace available";
+  fly_figure_eight("");
+}
+
+// The same with the VO's dense depth term on: a better odometry, which SLAM's constant odometry
+// noise model weighted as if it were no better than the real-data fit, so that two verified but
+// weak loop closures bent the last keyframes 6.1 cm from STATE (slam/README.md, odometry).
+TEST(System, SlamKeyframesAreInTheEstimatorsWorldWithTheVoDenseTerm) {
+  if (!test::can_isolate_network()) GTEST_SKIP() << "no network namespace available";
+  fly_figure_eight("--set dense.enabled=true");
 }
 
 }  // namespace
