@@ -102,14 +102,8 @@ struct RefinementOptions {
 /// Dense geometric term of the final refinement: point-to-plane residuals of the current frame's
 /// depth (a coarse grid) against the reference's depth and normals, by projective association,
 /// whitened by the depth noise, robust, jointly with the feature residuals.
-///
-/// Off by default (the `dense` variant turns it on): it improves the odometry on fr1_xyz,
-/// fr1_rpy and the simulator, but in the whole system (test/system/frames_test.cpp, sim room
-/// figure-eight) the slightly different keyframes let SLAM accept two weak loop closures (23 and
-/// 42 inliers) that put its last keyframes 4-6 cm off the truth; until SLAM's loop verification
-/// rejects or down-weights such loops, the system flies without it (vo/README.md, "Open").
 struct DenseOptions {
-  bool enabled = false;
+  bool enabled = true;
   int level = 3;                  ///< grid of 1/2^level of the image (3: 80 x 60 for VGA)
   int stride = 2;                 ///< every stride-th cell of the current grid, each direction
   double weight = 0.4;            ///< multiplies the information of each dense residual

@@ -55,6 +55,11 @@ LoadedSequence load_tum_sequence(const std::string& folder) {
 
 VoOptions with_tum_sensor(VoOptions options) {
   options.depth.rolling_shutter_readout_s = kTumRollingShutterReadoutS;
+  options.depth.compensate_time_offset = true;
+  options.depth.time_offset_from_stamps = false;
+  options.depth.time_offset_s = kTumDepthTimeOffsetS;
+  options.covariance.translation_floor_m = kTumTranslationFloorM;
+  options.covariance.rotation_floor_rad = kTumRotationFloorRad;
   options.validate();
   return options;
 }

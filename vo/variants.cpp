@@ -49,7 +49,7 @@ std::vector<Variant> build() {
     o.fast.adaptive = false;
     o.fast.threshold = 10;
   }));
-  out.push_back(make("dense", "dense point-to-plane term on", [](VoOptions& o) { o.dense.enabled = true; }));
+  out.push_back(make("no-dense", "no dense point-to-plane term", [](VoOptions& o) { o.dense.enabled = false; }));
   out.push_back(make("no-bucketing", "no bucketing", [](VoOptions& o) { o.bucket.enabled = false; }));
   return out;
 }

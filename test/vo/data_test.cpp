@@ -1,7 +1,7 @@
 // The odometry on the real Kinect sequences (label `data`; skips without ../shared/data):
 // accuracy with thresholds 10 % above the figures measured when this test was written
-// (vo/README.md), so that a regression of more than 10 % on any of them fails. (kestrel does
-// not yet reach the best peer of ../shared/BASELINES.md on these figures; see the README.)
+// (vo/README.md), so that a regression of more than 10 % on any of them fails. (kestrel beats
+// the best peer of ../shared/BASELINES.md on every figure but fr1_xyz's ATE; see the README.)
 
 #include <gtest/gtest.h>
 
@@ -9,7 +9,6 @@
 
 #include "test/support/test_support.h"
 #include "vo/sequence_run.h"
-#include "vo/variants.h"
 
 namespace kestrel::vo {
 namespace {
@@ -42,14 +41,12 @@ void check(const std::filesystem::path& folder, const VoOptions& options, const 
 
 TEST(VoData, Fr1Xyz) {
   KESTREL_REQUIRE_TUM(folder, "rgbd_dataset_freiburg1_xyz");
-  check(folder, VoOptions{}, {0.0185, 0.0227, 0.884, 0.1211, 1});
-  check(folder, variant("dense").options, {0.0180, 0.0208, 0.771, 0.1020, 1});
+  check(folder, VoOptions{}, {0.0133, 0.0177, 0.645, 0.0889, 1});
 }
 
 TEST(VoData, Fr1Rpy) {
   KESTREL_REQUIRE_TUM(folder, "rgbd_dataset_freiburg1_rpy");
-  check(folder, VoOptions{}, {0.0330, 0.0372, 1.917, 0.1241, 0});
-  check(folder, variant("dense").options, {0.0319, 0.0386, 1.812, 0.1047, 0});
+  check(folder, VoOptions{}, {0.0293, 0.0342, 1.769, 0.1079, 0});
 }
 
 }  // namespace
