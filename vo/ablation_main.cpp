@@ -79,7 +79,7 @@ int main(int argc, char** argv) {
               << "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     for (const vo::Variant& v : vo::variants()) {
       if (!only.empty() && std::find(only.begin(), only.end(), v.name) == only.end()) continue;
-      const vo::SequenceRun run = vo::run_sequence(sequence.frames, vo::with_tum_sensor(v.options));
+      const vo::SequenceRun run = vo::run_sequence(sequence.frames, vo::with_tum_sensor(folder, v.options));
       const vo::RunFigures f = vo::score(run, sequence.ground_truth);
       const PaperRow p = paper().at(v.name);
       std::cout << "| " << v.name << " | " << p.vel << " | " << p.fail << " | " << p.ms << " | "

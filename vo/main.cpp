@@ -126,8 +126,13 @@ int main(int argc, char** argv) {
     vo::VoOptions options;
     try {
       options = vo::variant(o.variant).options;
-      // Offline over a TUM folder: the Kinect's rolling shutter (before --set, which may change it).
-      if (!o.tum.empty()) options = vo::with_tum_sensor(options);
+      // Offline over a TUM folder: its sensor's model (before --set, which may change it).
+      if (!o.tum.empty()) {
+        options = vo::with_tum_sensor(o.tum, options);
+        spdlog::info("{}: {}", o.tum,
+                     vo::has_tum_sensor_model(o.tum) ? "freiburg1 Kinect timing (rolling shutter, depth offset)"
+                                                     : "no sensor model: VoOptions as given");
+      }
     } catch (const std::invalid_argument& e) {
       throw CLI::ValidationError("--variant", e.what());
     }

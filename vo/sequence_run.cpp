@@ -53,7 +53,12 @@ LoadedSequence load_tum_sequence(const std::string& folder) {
   return out;
 }
 
-VoOptions with_tum_sensor(VoOptions options) {
+bool has_tum_sensor_model(const std::string& folder) {
+  return tum::detect_camera(folder) == tum::TumCamera::kFreiburg1;
+}
+
+VoOptions with_tum_sensor(const std::string& folder, VoOptions options) {
+  if (!has_tum_sensor_model(folder)) return options;
   options.depth.rolling_shutter_readout_s = kTumRollingShutterReadoutS;
   options.depth.compensate_time_offset = true;
   options.depth.time_offset_from_stamps = false;

@@ -48,7 +48,7 @@ struct LoadedSequence {
 };
 LoadedSequence load_tum_sequence(const std::string& folder);
 
-/// The TUM recordings' sensor model (Kinect v1), which VoOptions{} (a global-shutter camera
+/// The sensor model of TUM's freiburg1 Kinect (v1), which VoOptions{} (a global-shutter camera
 /// whose depth and colour share one capture time, as the simulator renders) does not assume:
 /// - a rolling colour shutter, first-to-last row time as the odometry uses it;
 /// - the depth captured before the colour image's middle row by a fixed time, whatever the
@@ -64,9 +64,15 @@ constexpr double kTumDepthTimeOffsetS = -0.012;
 constexpr double kTumTranslationFloorM = 0.002;
 constexpr double kTumRotationFloorRad = 0.0045;
 
-/// `options` for a TUM sequence: the sensor model above set (every offline TUM run —
-/// kestrel-vo --tum, the ablation, the data test, the benchmark — applies it before any --set).
-VoOptions with_tum_sensor(VoOptions options);
+/// `options` for the sequence in `folder`: the model above set when the folder is a freiburg1
+/// recording (named as TUM names them, tum::detect_camera); unchanged for any other folder —
+/// freiburg2/3, whose timing was not measured, and the simulator's TUM-format exports. Every
+/// offline run (kestrel-vo --tum, the ablation, the data test, the benchmark) applies it before
+/// any --set.
+VoOptions with_tum_sensor(const std::string& folder, VoOptions options);
+
+/// True when with_tum_sensor() applies the freiburg1 Kinect model to `folder`.
+bool has_tum_sensor_model(const std::string& folder);
 
 /// Feeds every frame to a fresh VisualOdometry(options).
 SequenceRun run_sequence(const std::vector<RgbdFrame>& frames, const VoOptions& options);

@@ -20,7 +20,7 @@ struct Expected {
 
 void check(const std::filesystem::path& folder, const VoOptions& options, const Expected& measured) {
   const LoadedSequence sequence = load_tum_sequence(folder.string());
-  const SequenceRun run = run_sequence(sequence.frames, with_tum_sensor(options));
+  const SequenceRun run = run_sequence(sequence.frames, with_tum_sensor(folder.string(), options));
   const RunFigures f = score(run, sequence.ground_truth);
   std::cout << folder.filename().string() << ": ATE " << f.ate_rmse_m << " m, RPE " << f.rpe_translation_mps
             << " m/s " << f.rpe_rotation_degps << " deg/s, vel " << f.velocity_error_mps << " m/s, gross "

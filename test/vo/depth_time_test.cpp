@@ -12,6 +12,7 @@
 #include "common/geometry/se3.h"
 #include "test/vo/synthetic_scene.h"
 #include "vo/depth_lookup.h"
+#include "vo/sequence_run.h"
 
 namespace kestrel::vo {
 namespace {
@@ -93,6 +94,24 @@ TEST(DepthTimeOffset, TakenFromTheStampsOrTheConfiguredValue) {
   VoOptions vo;
   vo.depth.time_offset_s = 0.15;
   EXPECT_THROW(vo.validate(), std::invalid_argument);
+}
+
+// The freiburg1 Kinect's timing is applied to freiburg1 recordings only: not to the simulator's
+// TUM-format exports (global shutter, one capture time) nor to the unmeasured freiburg2/3.
+TEST(DepthTimeOffset, TheKinectTimingIsForFreiburg1RecordingsOnly) {
+  const VoOptions given;
+  const VoOptions fr1 = with_tum_sensor("../data/tum/rgbd_dataset_freiburg1_rpy", given);
+  EXPECT_TRUE(fr1.depth.compensate_time_offset);
+  EXPECT_FALSE(fr1.depth.time_offset_from_stamps);
+  EXPECT_DOUBLE_EQ(fr1.depth.time_offset_s, kTumDepthTimeOffsetS);
+  EXPECT_DOUBLE_EQ(fr1.depth.rolling_shutter_readout_s, kTumRollingShutterReadoutS);
+  EXPECT_DOUBLE_EQ(fr1.covariance.translation_floor_m, kTumTranslationFloorM);
+  for (const char* other : {"/tmp/sim_room_export", "rgbd_dataset_freiburg2_desk", "rgbd_dataset_freiburg3_office"}) {
+    const VoOptions o = with_tum_sensor(other, given);
+    EXPECT_FALSE(o.depth.compensate_time_offset) << other;
+    EXPECT_DOUBLE_EQ(o.depth.rolling_shutter_readout_s, 0.0) << other;
+    EXPECT_DOUBLE_EQ(o.covariance.translation_floor_m, given.covariance.translation_floor_m) << other;
+  }
 }
 
 }  // namespace

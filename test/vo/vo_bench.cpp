@@ -24,7 +24,7 @@ void run(benchmark::State& state, const std::string& name, const std::string& va
   static std::map<std::string, vo::LoadedSequence> cache;
   if (!cache.count(name)) cache.emplace(name, vo::load_tum_sequence(folder.string()));
   const vo::LoadedSequence& sequence = cache.at(name);
-  const vo::VoOptions options = vo::with_tum_sensor(vo::variant(variant).options);
+  const vo::VoOptions options = vo::with_tum_sensor(folder.string(), vo::variant(variant).options);
   std::vector<double> medians, p95s;
   for (auto _ : state) {
     const vo::SequenceRun r = vo::run_sequence(sequence.frames, options);
