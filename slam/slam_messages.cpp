@@ -14,8 +14,7 @@ VoMotion motion_from_message(const kestrel::vo_update_t& m, const char* channel)
   motion.T_body_camera = transport::from_message(m.T_body_camera, channel);
   if (motion.ok) {
     motion.T_reference_current = transport::from_message(m.T_reference_current, channel);
-    for (int r = 0; r < 6; ++r)
-      for (int c = 0; c < 6; ++c) motion.covariance(r, c) = m.covariance[6 * r + c];
+    motion.covariance = transport::covariance_from(m.covariance);
   }
   return motion;
 }

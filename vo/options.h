@@ -48,7 +48,7 @@ struct DepthOptions {
   double time_offset_s = 0.0;           ///< seconds, used when time_offset_from_stamps is false
   bool undistort = true;                ///< use the camera's lens distortion for rays and reprojection
   /// Colour rolling shutter, first-to-last row time; 0 = global shutter (the simulator's camera).
-  /// A TUM run uses the Kinect's (with_tum_sensor(), vo/sequence_run.h).
+  /// A freiburg1 TUM run uses the Kinect's (with_tum_sensor(), vo/sequence_run.h).
   double rolling_shutter_readout_s = 0.0;
 };
 
