@@ -24,6 +24,11 @@ void add_mapper_options(CLI::App& app, MapperOptions& o) {
       ->group("Map");
   opt("--max-range", o.scan.max_range_m, "Readings beyond this only clear space, m");
   opt("--min-range", o.scan.min_range_m, "Readings nearer than this are ignored, m");
+  app.add_flag("--discretize,!--no-discretize", o.scan.discretize,
+               "Endpoint discretisation (OctoMap's insertPointCloud discretize=true): one ray per cell "
+               "the readings end in, to its centre; else every reading's own ray")
+      ->capture_default_str()
+      ->group("Map");
   opt("--keyframe-megabytes", o.keyframes.max_megabytes, "Memory budget of the stored keyframes, MB");
   opt("--keyframe-bin-size", o.keyframes.bin_size_m, "Keyframe thinning: position bin, m");
   opt("--keyframe-bin-angle", o.keyframes.bin_angle_deg, "Keyframe thinning: view direction bin, deg");

@@ -37,6 +37,11 @@ struct ScanOptions {
   double max_range_m = 4.0;
   /// Readings nearer than this are ignored (the Kinect reports nothing reliable below ~0.4 m).
   double min_range_m = 0.0;
+  /// Endpoint discretisation, OctoMap's insertPointCloud(..., discretize = true): the readings
+  /// are reduced to one per cell and replaced by that cell's centre before the rays are cast,
+  /// so fewer rays, and the map is OctoMap's discretised map rather than its per-ray one
+  /// (scan_integrator.h).
+  bool discretize = false;
 
   void validate() const;
 };

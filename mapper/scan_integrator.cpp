@@ -55,7 +55,7 @@ inline void ScanIntegrator::mark(int idx, const Key& key, uint8_t flags) {
   f = static_cast<uint8_t>(f | flags);
 }
 
-void ScanIntegrator::begin(const Scan& scan) {
+void ScanIntegrator::begin_grid(const Scan& scan) {
   scan_ = &scan;
   if (!keys_.key(scan.origin, key_origin_)) {
     throw InputError("scan at utime " + std::to_string(scan.utime) +
@@ -65,13 +65,17 @@ void ScanIntegrator::begin(const Scan& scan) {
   stride_[0] = 1;
   stride_[1] = side_;
   stride_[2] = side_ * side_;
+  cells_tested_ = cells_witnessed_ = rays_traced_ = ray_tests_ = 0;
+}
+
+void ScanIntegrator::begin(const Scan& scan) {
+  begin_grid(scan);
   classifier_.emplace(keys_, scan.origin, key_origin_);
   built_ += 2;
   if (built_ < 2) {  // wrapped around (after 2^31 scans): forget every state
     std::fill(ray_state_.begin(), ray_state_.end(), 0u);
     built_ = 2;
   }
-  cells_tested_ = cells_witnessed_ = rays_traced_ = ray_tests_ = 0;
   queue_.clear();
   projector_.begin(scan);
 
@@ -516,15 +520,73 @@ void ScanIntegrator::collect(ScanUpdate& update) {
   touched_.clear();
 }
 
+inline void ScanIntegrator::trace_cell_centre(const Key& key) {
+  // computeDiscreteUpdate's point: the centre of the cell, each coordinate rounded to float
+  // (keyToCoord), then computeUpdate's rules for it (hit or cut at max range; ray.h).
+  const octomap::point3d centre(static_cast<float>(keys_.centre(key[0])),
+                                static_cast<float>(keys_.centre(key[1])),
+                                static_cast<float>(keys_.centre(key[2])));
+  const Ray r = make_ray(keys_, scan_->origin, key_origin_, centre, options_.max_range_m);
+  // A hit lies within max range of the origin, so its cell and every cell a walk clears are in
+  // the grid.
+  if (r.hit) mark(index(r.key_end), r.key_end, kOccupied);
+  ++rays_traced_;
+  trace_indexed(keys_, scan_->origin, key_origin_, r, index(key_origin_), stride_,
+                [&](const Key& k, int idx) { mark(idx, k, kCleared); });
+}
+
+void ScanIntegrator::compute_discretized() {
+  // One ray per distinct endpoint key. Keys inside the grid are deduplicated by a flag in it;
+  // the others (readings well beyond max range, whose centres are too: only cut rays) by
+  // sorting. Neighbouring pixels mostly share a key, so the previous key is checked first.
+  const Scan& scan = *scan_;
+  const uint8_t* const valid = scan.valid.data();
+  const octomap::point3d* const points = scan.points.data();
+  const size_t n = static_cast<size_t>(scan.cols) * static_cast<size_t>(scan.rows);
+  far_endpoints_.clear();
+  Key last;
+  bool have_last = false;
+  for (size_t i = 0; i < n; ++i) {
+    if (!valid[i]) continue;
+    Key k;
+    if (!keys_.key(points[i], k)) continue;  // outside the key range: see scan_integrator.h
+    if (have_last && k == last) continue;
+    last = k;
+    have_last = true;
+    const int idx = index(k);
+    if (idx < 0) {
+      far_endpoints_.push_back(static_cast<uint64_t>(k[0]) | static_cast<uint64_t>(k[1]) << 16 |
+                               static_cast<uint64_t>(k[2]) << 32);
+      continue;
+    }
+    uint8_t& f = cells_[static_cast<size_t>(idx)];
+    if (f & kEndpoint) continue;
+    if (f == 0) touched_.emplace_back(idx, k);
+    f = static_cast<uint8_t>(f | kEndpoint);
+    trace_cell_centre(k);
+  }
+  std::sort(far_endpoints_.begin(), far_endpoints_.end());
+  far_endpoints_.erase(std::unique(far_endpoints_.begin(), far_endpoints_.end()), far_endpoints_.end());
+  for (const uint64_t packed : far_endpoints_) {
+    trace_cell_centre(Key(static_cast<uint16_t>(packed), static_cast<uint16_t>(packed >> 16),
+                          static_cast<uint16_t>(packed >> 32)));
+  }
+}
+
 void ScanIntegrator::compute(const Scan& scan, ScanUpdate& update, Method method) {
   update.clear();
   update.rays = scan.num_points;
-  begin(scan);
+  if (method == Method::kDiscretized) {
+    begin_grid(scan);
+    compute_discretized();
+  } else {
+    begin(scan);
+  }
   if (method == Method::kRayTrace) {
     for (size_t s = 0; s < pixels_; ++s) {
       if (reach_[s] > 0.0f) trace_sample(s);
     }
-  } else {
+  } else if (method == Method::kCellSearch) {
     grow_from_origin();
   }
   update.cells_tested = cells_tested_;

@@ -22,6 +22,17 @@
 //
 // Method::kRayTrace is the plain per-ray walk (the reference, same result).
 //
+// Method::kDiscretized is a different map: OctoMap's endpoint-discretised insertion
+// (insertPointCloud(..., discretize = true), i.e. OccupancyOcTreeBase::computeDiscreteUpdate).
+// The scan's points are reduced to one per cell (the first point with each key), each replaced
+// by its cell's centre (float(keyToCoord)), and those centres go through computeUpdate's rules
+// (ray.h: a centre within max range is a hit, one beyond is cut at max range and only clears).
+// A few hundred rays instead of thousands, so they are simply walked with OctoMap's DDA. Same
+// cells as computeDiscreteUpdate, with one deliberate exception: a point outside the tree's key
+// range (about +-3.3 km at 10 cm) gives no ray here, where OctoMap's unchecked coordToKey wraps
+// its key to the far side of the key range and clears max range towards that cell's centre.
+// ScanOptions::discretize selects it for compute(scan, update).
+//
 // Not thread-safe (scratch space is reused between calls); use one integrator per thread.
 
 #include <cstdint>
@@ -55,7 +66,7 @@ struct ScanUpdate {
 
 class ScanIntegrator {
  public:
-  enum class Method { kCellSearch, kRayTrace };
+  enum class Method { kCellSearch, kRayTrace, kDiscretized };
 
   ScanIntegrator(double resolution_m, const ScanOptions& options);
   ScanIntegrator(const ScanIntegrator&) = delete;
@@ -63,7 +74,12 @@ class ScanIntegrator {
 
   /// Fills `update` for `scan`. Throws InputError if the camera centre lies outside the
   /// map's key range (about +-3.3 km at 10 cm).
-  void compute(const Scan& scan, ScanUpdate& update, Method method = Method::kCellSearch);
+  void compute(const Scan& scan, ScanUpdate& update, Method method);
+  /// The same with the method the options choose: kDiscretized if options().discretize, else
+  /// kCellSearch.
+  void compute(const Scan& scan, ScanUpdate& update) {
+    compute(scan, update, options_.discretize ? Method::kDiscretized : Method::kCellSearch);
+  }
 
   const KeySpace& keys() const { return keys_; }
   const ScanOptions& options() const { return options_; }
@@ -77,8 +93,9 @@ class ScanIntegrator {
     Ray ray;
     RayBounds bounds;
   };
-  enum : uint8_t { kTested = 1, kCleared = 2, kOccupied = 4 };
+  enum : uint8_t { kTested = 1, kCleared = 2, kOccupied = 4, kEndpoint = 8 };
 
+  void begin_grid(const Scan& scan);
   void begin(const Scan& scan);
   void begin_pixels(const Scan& scan);
   void begin_axis_parts(const Scan& scan);
@@ -97,6 +114,8 @@ class ScanIntegrator {
   void grow_from_origin();
   void test_cell(int idx, const Key& cell);
   void collect(ScanUpdate& update);
+  void compute_discretized();
+  void trace_cell_centre(const Key& key);
 
   KeySpace keys_;
   ScanOptions options_;
@@ -143,6 +162,7 @@ class ScanIntegrator {
   std::vector<int> row_lo_, row_hi_;       // clip_rows(): pixel range per row
   std::vector<uint32_t> ray_state_;
   std::vector<uint32_t> ray_slot_;         // where in rays_ a built ray is
+  std::vector<uint64_t> far_endpoints_;    // kDiscretized: packed endpoint keys outside the grid
 };
 
 }  // namespace kestrel::mapper

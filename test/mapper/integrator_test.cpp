@@ -42,6 +42,19 @@ void expect_same_as_octomap(const Scan& scan, double resolution, const ScanOptio
   }
 }
 
+void expect_same_as_octomap_discretized(const Scan& scan, double resolution, const ScanOptions& options,
+                                        const std::string& label) {
+  const test::OctomapUpdate reference = test::octomap_discrete_update(scan, resolution, options.max_range_m);
+  ScanIntegrator integrator(resolution, options);
+  ScanUpdate update;
+  integrator.compute(scan, update, Method::kDiscretized);
+  EXPECT_EQ(test::count_differences(update, reference), 0u)
+      << label << " (discretized): octomap free " << reference.free.size() << " occupied "
+      << reference.occupied.size() << ", mine free " << update.free.size() << " occupied "
+      << update.occupied.size();
+  EXPECT_GT(reference.free.size() + reference.occupied.size(), 0u) << label;
+}
+
 TEST(ScanIntegrator, SameCellsAsOctomapInRandomClutter) {
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> pos(-2.0, 2.0), z(0.3, 2.2);
@@ -57,6 +70,7 @@ TEST(ScanIntegrator, SameCellsAsOctomapInRandomClutter) {
     const double resolution = trial % 4 == 3 ? 0.05 : 0.1;
     const Scan scan = make_scan(decimate(frame, options.stride), test::look_at(eye, target), options, "test");
     expect_same_as_octomap(scan, resolution, options, "trial " + std::to_string(trial));
+    expect_same_as_octomap_discretized(scan, resolution, options, "trial " + std::to_string(trial));
   }
 }
 
@@ -78,9 +92,58 @@ TEST(ScanIntegrator, SameCellsAsOctomapWhenRaysRunAlongCellBoundaries) {
       ScanOptions options;
       options.stride = 1;
       const Scan scan = make_scan(frame, T, options, "test");
-      expect_same_as_octomap(scan, 0.1, options, "case " + std::to_string(case_no++));
+      expect_same_as_octomap(scan, 0.1, options, "case " + std::to_string(case_no));
+      expect_same_as_octomap_discretized(scan, 0.1, options, "case " + std::to_string(case_no++));
     }
   }
+}
+
+TEST(ScanIntegrator, DiscretizedIsOctomapsDiscreteUpdateAndCastsOneRayPerEndpointCell) {
+  // The discretised mode: the cells of OctoMap's computeDiscreteUpdate, with one walked ray per
+  // distinct endpoint cell, chosen by ScanOptions::discretize; a different map from the exact
+  // one.
+  std::mt19937 rng(5);
+  const Scene scene = random_scene(rng);
+  const Eigen::Isometry3d T = test::look_at({0.13, 0.27, 1.21}, {2.0, 1.0, 0.8});
+  for (const double max_range : {4.0, 1.5}) {  // 1.5 m: most endpoint centres are cut
+    ScanOptions options;
+    options.max_range_m = max_range;
+    options.discretize = true;
+    const Scan scan = make_scan(decimate(scene.render(test::kinect_camera(), T, 0), options.stride), T,
+                                options, "test");
+    ScanIntegrator integrator(0.1, options);
+    ScanUpdate update;
+    integrator.compute(scan, update);  // the options' method
+    const test::OctomapUpdate discrete = test::octomap_discrete_update(scan, 0.1, max_range);
+    EXPECT_EQ(test::count_differences(update, discrete), 0u) << max_range;
+    // One ray per distinct key of the scan's points.
+    octomap::OcTree tree(0.1);
+    octomap::KeySet endpoint_keys;
+    for (const auto& p : scan.valid_points()) endpoint_keys.insert(tree.coordToKey(p));
+    EXPECT_EQ(update.rays_traced, endpoint_keys.size());
+    EXPECT_LT(update.rays_traced, update.rays / 5);
+    EXPECT_LE(update.occupied.size(), endpoint_keys.size());  // centres beyond max range: none
+    if (max_range == 4.0) {
+      EXPECT_GT(update.occupied.size(), endpoint_keys.size() / 2);
+    }
+    // Not the exact map (other rays: to the cells' centres, one per cell).
+    const test::OctomapUpdate exact = test::octomap_update(scan, 0.1, max_range);
+    EXPECT_GT(test::count_differences(update, exact), 0u);
+  }
+}
+
+TEST(ScanIntegrator, DiscretizedWithReadingsFarBeyondMaxRange) {
+  // Readings up to 60 m (beyond the integrator's grid) with a 2 m max range: their endpoint
+  // cells are deduplicated outside the grid, and their centres' rays cut at max range.
+  Scene scene(Eigen::Vector3d(-40.0, -40.0, -30.0), Eigen::Vector3d(60.0, 40.0, 30.0));
+  scene.add_box(Eigen::Vector3d(1.0, -0.5, -0.5), Eigen::Vector3d(1.6, 0.4, 0.4));
+  const Eigen::Isometry3d T = test::look_at({0.03, 0.02, 0.01}, {10.0, 0.7, 0.2});
+  ScanOptions options;
+  options.stride = 2;
+  options.max_range_m = 2.0;
+  const Scan scan = make_scan(decimate(scene.render(test::kinect_camera(), T, 0), options.stride), T,
+                              options, "test");
+  expect_same_as_octomap_discretized(scan, 0.1, options, "far readings");
 }
 
 TEST(ScanIntegrator, CellSearchTracesOnlyAFewRays) {
@@ -161,7 +224,7 @@ TEST(ScanIntegrator, ZeroDepthMarksNothing) {
   EXPECT_EQ(scan.num_points, 0u);
   ScanIntegrator integrator(0.1, options);
   ScanUpdate update;
-  for (const Method method : {Method::kCellSearch, Method::kRayTrace}) {
+  for (const Method method : {Method::kCellSearch, Method::kRayTrace, Method::kDiscretized}) {
     integrator.compute(scan, update, method);
     EXPECT_TRUE(update.free.empty());
     EXPECT_TRUE(update.occupied.empty());

@@ -91,6 +91,44 @@ TEST(VoxelMap, EqualsOctomapInsertPointCloudValueForValue) {
   EXPECT_EQ(octree_bytes(*mine, false), octree_bytes(reference, false));
 }
 
+TEST(VoxelMap, DiscretizedEqualsOctomapDiscretizedInsertPointCloudValueForValue) {
+  const Scene scene = box_scene();
+  ScanOptions options;
+  options.stride = 2;
+  options.max_range_m = 2.0;  // cuts the far walls' rays
+  options.discretize = true;
+  ScanIntegrator integrator(0.1, options);
+  VoxelMap map;
+  octomap::OcTree reference(0.1);
+  int64_t utime = 0;
+  for (const auto& T : circle_poses(12, 1.6, {0.6, 0.0, 0.3})) {
+    const Scan scan = make_scan(decimate(scene.render(test::kinect_camera(), T, utime), options.stride), T,
+                                options, "test");
+    ScanUpdate update;
+    integrator.compute(scan, update);
+    map.integrate(update, utime);
+    reference.insertPointCloud(scan.valid_points(), scan.origin, options.max_range_m, false, true);
+    utime += 33333;
+  }
+  size_t cells = 0;
+  for (auto it = reference.begin_leafs(); it != reference.end_leafs(); ++it) {
+    const int n = 1 << (16 - it.getDepth());
+    const Key base = it.getIndexKey();
+    for (int z = 0; z < n; ++z)
+      for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x) {
+          const auto v = map.log_odds(Key(base[0] + x, base[1] + y, base[2] + z));
+          ASSERT_TRUE(v.has_value());
+          ASSERT_EQ(*v, it->getLogOdds());
+          ++cells;
+        }
+  }
+  EXPECT_EQ(cells, map.num_cells());
+  EXPECT_GT(map.num_occupied(), 50u);
+  const auto mine = to_octree(map);
+  EXPECT_EQ(octree_bytes(*mine, true), octree_bytes(reference, true));
+}
+
 TEST(VoxelMap, KnownBoxSceneGivesExpectedCells) {
   const Scene scene = box_scene();
   ScanOptions options;

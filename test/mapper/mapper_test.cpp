@@ -173,21 +173,25 @@ TEST(Mapper, NanAndZeroDepthNeverMarkCells) {
   with_nan.depth_mm = depth_to_millimetres(metres);
   RgbdFrame with_zero = frame;
   with_zero.depth_mm = holes;
-  MapperOptions options;
-  options.scan.stride = 1;
-  Mapper a(options), b(options);
-  a.insert(with_nan, T);
-  b.insert(with_zero, T);
-  expect_same_maps(a.map(), b.map());  // a NaN reading is no reading
-  ASSERT_GT(a.map().num_cells(), 0u);
-
-  // All depth missing: nothing at all, not even the camera's own cell.
   RgbdFrame empty = frame;
-  metres.setTo(NAN);
-  empty.depth_mm = depth_to_millimetres(metres);
-  Mapper c(options);
-  c.insert(empty, T);
-  EXPECT_EQ(c.map().num_cells(), 0u);
+  cv::Mat all_nan = metres.clone();
+  all_nan.setTo(NAN);
+  empty.depth_mm = depth_to_millimetres(all_nan);
+  for (const bool discretize : {false, true}) {
+    MapperOptions options;
+    options.scan.stride = 1;
+    options.scan.discretize = discretize;
+    Mapper a(options), b(options);
+    a.insert(with_nan, T);
+    b.insert(with_zero, T);
+    expect_same_maps(a.map(), b.map());  // a NaN reading is no reading
+    ASSERT_GT(a.map().num_cells(), 0u);
+
+    // All depth missing: nothing at all, not even the camera's own cell.
+    Mapper c(options);
+    c.insert(empty, T);
+    EXPECT_EQ(c.map().num_cells(), 0u) << "discretize " << discretize;
+  }
 }
 
 TEST(KeyframeStore, BudgetThinsCrowdedViewsFirst) {

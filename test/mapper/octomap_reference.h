@@ -1,6 +1,6 @@
 #pragma once
-// OctoMap's own answers, for comparison: the cells computeUpdate would clear and mark
-// occupied for a scan, and differences between those and a ScanUpdate.
+// OctoMap's own answers, for comparison: the cells computeUpdate (or computeDiscreteUpdate)
+// would clear and mark occupied for a scan, and differences between those and a ScanUpdate.
 
 #include <octomap/OcTree.h>
 
@@ -19,6 +19,15 @@ inline OctomapUpdate octomap_update(const Scan& scan, double resolution, double 
   octomap::OcTree tree(resolution);
   OctomapUpdate u;
   tree.computeUpdate(scan.valid_points(), scan.origin, u.free, u.occupied, max_range);
+  return u;
+}
+
+/// The same for OctoMap's endpoint-discretised insertion (insertPointCloud(..., discretize =
+/// true)): computeDiscreteUpdate.
+inline OctomapUpdate octomap_discrete_update(const Scan& scan, double resolution, double max_range) {
+  octomap::OcTree tree(resolution);
+  OctomapUpdate u;
+  tree.computeDiscreteUpdate(scan.valid_points(), scan.origin, u.free, u.occupied, max_range);
   return u;
 }
 
