@@ -69,9 +69,11 @@ int main(int argc, char** argv) {
   app.add_option("--only", only, "One experiment: table3, table4, table5, fig7, fig12, fig13, laser, precision, or all")
       ->check(CLI::IsMember({"all", "table3", "table4", "table5", "fig7", "fig12", "fig13", "laser", "precision"}));
   app.add_option("--radius", base.space.radius_m, "Vehicle radius (m)")->check(cli::Positive);
-  app.add_option("--connect-radius", base.roadmap.connect_radius_m, "Longest edge (m)")->check(cli::Positive);
+  app.add_option("--connect-radius", base.roadmap.connect_radius_m,
+                 "Longest edge (m; default none: the paper joins every collision-free pair)")
+      ->check(cli::Positive);
   app.add_option("--neighbours", base.roadmap.max_neighbours,
-                 "Each node tries its nearest this many within the connect radius (0: all)")
+                 "Each node tries its nearest this many within the connect radius (0, the default: all)")
       ->check(CLI::NonNegativeNumber);
   app.add_option("--out", out_path, "Also write the Markdown to this file");
   app.add_option("--png-dir", png_dir, "Draw <world>_paths.png (PRM red, BRM-SU blue, all five pairs) here");

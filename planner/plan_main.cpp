@@ -29,6 +29,7 @@ int main(int argc, char** argv) {
   std::vector<double> start{2.5, 2.5, 1.0, 0.0}, goal{10.5, 20.0, 1.0, 0.0};
   eval::Scenario sc;
   int samples = 300;  // more than the paper's 100: BRM finds better-localised paths with more
+  sc.roadmap = RoadmapOptions{};  // 6 m / 20 neighbours: the grown roadmap reaches 3000 samples
   sc.roadmap.max_samples = 3000;
   uint64_t seed = 1;
   double density = 4.0, laser_range = 5.0, z_max = 3.0, start_trace = 0.4;

@@ -19,7 +19,7 @@ struct Scenario {
   SpaceOptions space;
   FeatureSensorOptions sensor = FeatureSensorOptions::paper_camera();
   MotionOptions motion;
-  RoadmapOptions roadmap;
+  RoadmapOptions roadmap = RoadmapOptions::all_pairs();  ///< the paper's rule: every collision-free pair
   Mat4 start_covariance = 0.1 * Mat4::Identity();
   double max_trace = 100.0;  ///< success: a path whose nodes all stay below this tr(Sigma)
   Mat4 ukf_prior = 0.1 * Mat4::Identity();  ///< the constant prior of the UKF information gain

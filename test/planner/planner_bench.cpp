@@ -25,7 +25,7 @@ void BM_BuildBrm(benchmark::State& state, const char* sampler_name) {
   for (auto _ : state) {
     Rng rng(seed++);
     auto sampler = eval::make_sampler(sampler_name, space, sensor, 0.1 * Mat4::Identity());
-    benchmark::DoNotOptimize(build_roadmap(space, *sampler, pair.first, pair.second, {}, &model, rng));
+    benchmark::DoNotOptimize(build_roadmap(space, *sampler, pair.first, pair.second, RoadmapOptions::all_pairs(), &model, rng));
   }
 }
 BENCHMARK_CAPTURE(BM_BuildBrm, su, "su")->Unit(benchmark::kMillisecond);
@@ -39,7 +39,7 @@ void BM_SearchBrm(benchmark::State& state) {
   const auto pair = floor().pairs[0];
   Rng rng(1);
   auto sampler = eval::make_sampler("su", space, sensor, 0.1 * Mat4::Identity());
-  const Roadmap map = build_roadmap(space, *sampler, pair.first, pair.second, {}, &model, rng);
+  const Roadmap map = build_roadmap(space, *sampler, pair.first, pair.second, RoadmapOptions::all_pairs(), &model, rng);
   BrmQuery q;
   q.start_covariance = 0.1 * Mat4::Identity();
   for (auto _ : state) benchmark::DoNotOptimize(belief_search(map, 0, 1, q));

@@ -122,6 +122,73 @@ TEST(BuildRoadmap, GrowsUntilStartAndGoalConnectAndEqualsTheRoadmapBuiltAtOnce) 
   }
 }
 
+// Returns the given configurations in order, then nothing.
+class ListSampler : public Sampler {
+ public:
+  explicit ListSampler(std::vector<Config> list) : list_(std::move(list)) {}
+  std::string name() const override { return "list"; }
+  std::optional<Config> sample(Rng&, SampleTrace*) override {
+    if (next_ >= list_.size()) return std::nullopt;
+    return list_[next_++];
+  }
+
+ private:
+  std::vector<Config> list_;
+  size_t next_ = 0;
+};
+
+testing::PredicateEnvironment open_space() {
+  return testing::PredicateEnvironment(Eigen::AlignedBox3d(Eigen::Vector3d(-20, -20, 1), Eigen::Vector3d(20, 20, 1)),
+                                       [](const Eigen::Vector3d&) { return true; });
+}
+
+TEST(BuildRoadmap, ThePapersRuleJoinsAPairBeyondTheRadius) {
+  // Start and goal 10 m apart in open space, no samples: the line is free, so Algorithm 1
+  // joins them; a 6 m radius does not.
+  const auto env = open_space();
+  const ConfigurationSpace space(env, SpaceOptions{});
+  const Config start(0, 0, 1, 0), goal(10, 0, 1, 0);
+  Rng rng(1);
+  ListSampler none_a({}), none_b({});
+  RoadmapOptions limited;
+  limited.samples = 0;
+  const Roadmap a = build_roadmap(space, none_a, start, goal, limited, nullptr, rng);
+  EXPECT_EQ(a.edge_count(), 0);
+  RoadmapOptions paper = RoadmapOptions::all_pairs();
+  paper.samples = 0;
+  const Roadmap b = build_roadmap(space, none_b, start, goal, paper, nullptr, rng);
+  ASSERT_EQ(b.edges(0).size(), 1u);
+  EXPECT_EQ(b.edges(0)[0].to, 1);
+  EXPECT_DOUBLE_EQ(b.edges(0)[0].length_m, 10.0);
+}
+
+TEST(BuildRoadmap, ThePapersRuleJoinsClustersANeighbourLimitKeepsApart) {
+  // 21 samples within 0.3 m of the start and 21 within 0.3 m of the goal, 5 m away, all in
+  // view of each other: every node's 20 nearest lie in its own cluster, so with 20 neighbours
+  // (inside the 6 m radius) no edge crosses; the paper's rule joins every pair: 44 nodes,
+  // 44 * 43 / 2 undirected edges.
+  const auto env = open_space();
+  const ConfigurationSpace space(env, SpaceOptions{});
+  const Config start(0, 0, 1, 0), goal(5, 0, 1, 0);
+  std::vector<Config> list;
+  for (int k = 0; k < 21; ++k) {
+    const double a = 2.0 * M_PI * k / 21.0, r = 0.1 + 0.01 * k;
+    list.push_back(Config(r * std::cos(a), r * std::sin(a), 1, 0));
+    list.push_back(Config(5 + r * std::cos(a), r * std::sin(a), 1, 0));
+  }
+  Rng rng(1);
+  RoadmapOptions limited;
+  limited.samples = 42;
+  ListSampler la(list), lb(list);
+  const Roadmap a = build_roadmap(space, la, start, goal, limited, nullptr, rng);
+  EXPECT_FALSE(joins(a, 0, 1));
+  RoadmapOptions paper = RoadmapOptions::all_pairs();
+  paper.samples = 42;
+  const Roadmap b = build_roadmap(space, lb, start, goal, paper, nullptr, rng);
+  EXPECT_TRUE(joins(b, 0, 1));
+  EXPECT_EQ(b.edge_count(), 44 * 43);  // directed: both ways
+}
+
 TEST(BuildRoadmap, StopsGrowingAtItsBudget) {
   // A wall with no gap: start and goal never connect; the roadmap stops at max_samples.
   const testing::PredicateEnvironment env(Eigen::AlignedBox3d(Eigen::Vector3d(0, 0, 1), Eigen::Vector3d(20, 10, 1)),
