@@ -51,6 +51,17 @@ class KeySpace {
     return key(x, k[0]) && key(y, k[1]) && key(z, k[2]);
   }
 
+  /// The smallest float coordinate whose key is >= k (so key k's floats are
+  /// [first_float(k), first_float(k + 1))): key() of a float is monotonic in it, so a float
+  /// can be placed in a cell by comparisons alone. k within the key range.
+  float first_float(int k) const {
+    const double n = static_cast<double>(k - kMaxVal);
+    float x = static_cast<float>(n * resolution_);
+    while (factor_ * static_cast<double>(x) >= n) x = std::nextafter(x, -HUGE_VALF);
+    while (!(factor_ * static_cast<double>(x) >= n)) x = std::nextafter(x, HUGE_VALF);
+    return x;
+  }
+
   /// Centre of cell k along one axis (OctoMap's keyToCoord).
   double centre(uint16_t k) const {
     return (static_cast<double>(static_cast<int>(k) - kMaxVal) + 0.5) * resolution_;

@@ -539,6 +539,14 @@ void ScanIntegrator::compute_discretized() {
   // One ray per distinct endpoint key. Keys inside the grid are deduplicated by a flag in it;
   // the others (readings well beyond max range, whose centres are too: only cut rays) by
   // sorting. Neighbouring pixels mostly share a key, so the previous key is checked first.
+  // The previous key's cell is tested by float comparisons of the point against the cell's
+  // float bounds (KeySpace::first_float), not by computing the key.
+  for (int a = 0; a < 3; ++a) {
+    if (float_base_[a] == base_[a] && first_float_[a].size() == static_cast<size_t>(side_) + 1) continue;
+    first_float_[a].resize(static_cast<size_t>(side_) + 1);
+    for (int g = 0; g <= side_; ++g) first_float_[a][static_cast<size_t>(g)] = keys_.first_float(base_[a] + g);
+    float_base_[a] = base_[a];
+  }
   const Scan& scan = *scan_;
   const uint8_t* const valid = scan.valid.data();
   const octomap::point3d* const points = scan.points.data();
@@ -546,18 +554,34 @@ void ScanIntegrator::compute_discretized() {
   far_endpoints_.clear();
   Key last;
   bool have_last = false;
+  constexpr float inf = std::numeric_limits<float>::infinity();
+  float lo[3] = {inf, inf, inf}, hi[3] = {-inf, -inf, -inf};  // the last key's cell (if in the grid)
   for (size_t i = 0; i < n; ++i) {
     if (!valid[i]) continue;
+    const octomap::point3d p = points[i];
+    if ((p.x() >= lo[0]) & (p.x() < hi[0]) & (p.y() >= lo[1]) & (p.y() < hi[1]) & (p.z() >= lo[2]) &
+        (p.z() < hi[2])) {
+      continue;
+    }
     Key k;
-    if (!keys_.key(points[i], k)) continue;  // outside the key range: see scan_integrator.h
+    if (!keys_.key(p, k)) continue;  // outside the key range: see scan_integrator.h
     if (have_last && k == last) continue;
     last = k;
     have_last = true;
     const int idx = index(k);
     if (idx < 0) {
+      for (int a = 0; a < 3; ++a) {
+        lo[a] = inf;
+        hi[a] = -inf;
+      }
       far_endpoints_.push_back(static_cast<uint64_t>(k[0]) | static_cast<uint64_t>(k[1]) << 16 |
                                static_cast<uint64_t>(k[2]) << 32);
       continue;
+    }
+    for (int a = 0; a < 3; ++a) {
+      const size_t g = static_cast<size_t>(k[a] - base_[a]);
+      lo[a] = first_float_[a][g];
+      hi[a] = first_float_[a][g + 1];
     }
     uint8_t& f = cells_[static_cast<size_t>(idx)];
     if (f & kEndpoint) continue;

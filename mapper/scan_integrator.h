@@ -163,6 +163,10 @@ class ScanIntegrator {
   std::vector<uint32_t> ray_state_;
   std::vector<uint32_t> ray_slot_;         // where in rays_ a built ray is
   std::vector<uint64_t> far_endpoints_;    // kDiscretized: packed endpoint keys outside the grid
+  // kDiscretized: per axis, first_float() of every grid coordinate 0..side_ (for base
+  // float_base_[a]), so that a point is placed in its cell by float comparisons.
+  std::vector<float> first_float_[3];
+  int float_base_[3] = {-1, -1, -1};
 };
 
 }  // namespace kestrel::mapper

@@ -104,6 +104,28 @@ TEST(KeySpace, KeyIsOctomapsFloorRule) {
   EXPECT_EQ(k, 32767);
 }
 
+TEST(KeySpace, FirstFloatIsTheLowestFloatOfTheKey) {
+  // first_float(k) has key k and the float below it key k - 1, at cell edges near 0, at
+  // coordinates where a float's spacing is a sizeable fraction of a millimetre, and for
+  // resolutions that are not powers of two or tenths.
+  std::mt19937 rng(9);
+  for (const double resolution : {0.1, 0.05, 0.07, 0.25}) {
+    const KeySpace keys(resolution);
+    std::uniform_int_distribution<int> any(1, 65535);
+    std::vector<int> ks = {32768, 32767, 32769, 32768 + 10, 32768 - 10, 40000, 20000};
+    for (int i = 0; i < 3000; ++i) ks.push_back(any(rng));
+    for (const int k : ks) {
+      const float x = keys.first_float(k);
+      uint16_t got = 0;
+      ASSERT_TRUE(keys.key(static_cast<double>(x), got)) << k;
+      ASSERT_EQ(got, k) << resolution << " " << k;
+      const float below = std::nextafter(x, -HUGE_VALF);
+      ASSERT_TRUE(keys.key(static_cast<double>(below), got)) << k;
+      ASSERT_EQ(got, k - 1) << resolution << " " << k;
+    }
+  }
+}
+
 TEST(ReachMask, FourPixelMaskEqualsScalarAndPixelByPixel) {
   std::mt19937 rng(7);
   const float special[] = {0.0f, -0.0f, -1.0f, 1e-6f, 0.5f, 2.0f, std::numeric_limits<float>::quiet_NaN(),
