@@ -1,12 +1,14 @@
 // Insertion speed: kestrel's exact cell search against OcTree::insertPointCloud on the same
-// rays, in one run, one thread (Release). Frames: every 10th frame of the real fr1_xyz sequence
+// rays, and kestrel's endpoint-discretised insertion against insertPointCloud(..., discretize =
+// true), in one run, one thread (Release). Frames: every 10th frame of the real fr1_xyz sequence
 // at its ground-truth poses (or the synthetic room of the tests when ../shared/data is absent),
 // at 128x96 (stride 5, the paper's size) and 640x480 (stride 1), 10 cm, max range 4 m.
 //
 // Each iteration inserts the next frame into a map that keeps growing, as a mapper does.
 // "Insert" is the whole update (decimated frame -> rays -> cells -> log-odds); "Cells" is the
-// cell computation alone; "Octomap" is the insertPointCloud call alone (its own rays in, its
-// tree updated and pruned), i.e. the comparison favours OctoMap. The rebuild benchmark times
+// cell computation alone; "Octomap" is the insertPointCloud call alone (/exact: every ray,
+// /discretized: discretize = true; its own rays in, its tree updated and pruned), i.e. the
+// comparison favours OctoMap. The rebuild benchmark times
 // a loop closure (Mapper::apply_graph moving the last quarter of the keyframes), without and
 // with the rebuild's checkpoints.
 //
@@ -73,9 +75,10 @@ std::vector<Scan> scans(int stride) {
   return out;
 }
 
-void BM_Insert(benchmark::State& state) {
+void BM_Insert(benchmark::State& state, bool discretize) {
   MapperOptions o;
   o.scan.stride = static_cast<int>(state.range(0));
+  o.scan.discretize = discretize;
   Mapper mapper(o);
   const Frames& f = frames();
   size_t i = 0;
@@ -115,7 +118,7 @@ void BM_Cells(benchmark::State& state, ScanIntegrator::Method method) {
   state.counters["tests"] = tests / n;
 }
 
-void BM_Octomap(benchmark::State& state) {
+void BM_Octomap(benchmark::State& state, bool discretize) {
   const std::vector<Scan> s = scans(static_cast<int>(state.range(0)));
   std::vector<octomap::Pointcloud> clouds;
   for (const Scan& scan : s) clouds.push_back(scan.valid_points());
@@ -123,7 +126,7 @@ void BM_Octomap(benchmark::State& state) {
   size_t i = 0;
   for (auto _ : state) {
     const size_t k = i++ % s.size();
-    tree.insertPointCloud(clouds[k], s[k].origin, 4.0);
+    tree.insertPointCloud(clouds[k], s[k].origin, 4.0, false, discretize);
   }
   state.SetLabel(frames().source);
 }
@@ -156,10 +159,13 @@ void BM_Rebuild(benchmark::State& state) {
   state.counters["reinserted"] = reinserted / n;
 }
 
-BENCHMARK(BM_Insert)->Arg(5)->Arg(1)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Insert, exact, false)->Arg(5)->Arg(1)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Insert, discretized, true)->Arg(5)->Arg(1)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_Cells, cell_search, ScanIntegrator::Method::kCellSearch)->Arg(5)->Arg(1)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_Cells, ray_trace, ScanIntegrator::Method::kRayTrace)->Arg(5)->Arg(1)->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_Octomap)->Arg(5)->Arg(1)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Cells, discretized, ScanIntegrator::Method::kDiscretized)->Arg(5)->Arg(1)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Octomap, exact, false)->Arg(5)->Arg(1)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Octomap, discretized, true)->Arg(5)->Arg(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Rebuild)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
 }  // namespace
