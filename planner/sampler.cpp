@@ -134,6 +134,11 @@ class SensorSampler : public Sampler {
       max_weight_ = std::max(max_weight_, w);
       const double normalised = max_weight_ > 0.0 ? w / max_weight_ : 0.0;
       if (!threshold_.accept(normalised, rng)) continue;
+      // Algorithm 2, line 12: a sample past the threshold is added with probability equal to
+      // its normalised weight ("accepted or rejected with probability proportional to the
+      // expected information gain", §3.2.1). While every weight so far is 0 nothing tells
+      // candidates apart and it is added (as the threshold does then).
+      if (max_weight_ > 0.0 && !(unit_(rng) < normalised)) continue;
       if (trace) {
         trace->attempts = i;
         trace->weight = normalised;
@@ -151,6 +156,7 @@ class SensorSampler : public Sampler {
   int max_;
   double max_weight_ = 0.0;
   RunningThreshold threshold_;
+  std::uniform_real_distribution<double> unit_{0.0, 1.0};
 };
 
 }  // namespace

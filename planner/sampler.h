@@ -8,8 +8,9 @@
 //  bridge    (Hsu et al.) q1 uniform, q2 = q1 + N(0, sigma^2); both invalid and their
 //            midpoint valid -> the midpoint (sigma = 2 x sensor range)
 //  sensor    (the paper's Algorithm 2) a valid uniform candidate with weight w (EKF tr(M) or
-//            UKF information gain), normalised by the largest weight seen so far; accepted
-//            when w exceeds a threshold drawn from N(mean, var) of the normalised weights seen
+//            UKF information gain), normalised by the largest weight seen so far; when w
+//            exceeds a threshold drawn from N(mean, var) of the normalised weights seen, it is
+//            added with probability w (line 12; always while every weight so far is 0)
 // The trace (optional) records the attempts and the witnesses that justified the sample, so
 // tests can check each sampler against its definition.
 

@@ -127,8 +127,9 @@ TEST(RunningThreshold, WhileEveryWeightIsTheSameItAcceptsAsUniformWould) {
 }
 
 TEST(SensorSampler, FavoursInformativeConfigurationsAsAlgorithm2Defines) {
-  // Weight = x on free space 0 < x < 10: normalised weights are U(0, 1), so accepted x has
-  // density proportional to Phi((x / 10 - 1/2) / sqrt(1/12)).
+  // Weight = x on free space 0 < x < 10: normalised weights w are U(0, 1), so past the
+  // threshold x has density proportional to Phi((w - 1/2) / sqrt(1/12)), and line 12 keeps
+  // it with probability w: accepted x has density proportional to w Phi(...).
   PredicateEnvironment env(box(0, 10, 0, 10), [](const Eigen::Vector3d& p) { return p.x() > 0.0; });
   ConfigurationSpace space(env, {});
   auto sampler = make_sensor_sampler(space, [](const Config& q) { return q[0]; });
@@ -143,12 +144,26 @@ TEST(SensorSampler, FavoursInformativeConfigurationsAsAlgorithm2Defines) {
   double num = 0.0, den = 0.0;
   for (int k = 0; k < 1000; ++k) {
     const double w = (k + 0.5) / 1000.0;
-    const double p = normal_cdf((w - 0.5) / std::sqrt(1.0 / 12.0));
+    const double p = w * normal_cdf((w - 0.5) / std::sqrt(1.0 / 12.0));
     num += 10.0 * w * p;
     den += p;
   }
   EXPECT_NEAR(mean_x, num / den, 0.15);  // the max normaliser settles near 10 within a few draws
-  EXPECT_GT(mean_x, 5.5);                // clearly above the uniform sampler's 5
+  EXPECT_GT(mean_x, 7.0);                // far above the uniform sampler's 5 (threshold only: 6.8)
+}
+
+TEST(SensorSampler, IsUniformWhileNoCandidateSeesAnything) {
+  // Weight 0 everywhere (no feature in view anywhere): every valid candidate is added at
+  // once, as the uniform sampler would (line 12's probability would be 0/0).
+  PredicateEnvironment env(box(0, 10, 0, 10), [](const Eigen::Vector3d& p) { return p.x() > 0.0; });
+  ConfigurationSpace space(env, {});
+  auto sampler = make_sensor_sampler(space, [](const Config&) { return 0.0; });
+  Rng rng(5);
+  for (int i = 0; i < 100; ++i) {
+    SampleTrace trace;
+    ASSERT_TRUE(sampler->sample(rng, &trace));
+    EXPECT_EQ(trace.attempts, 1) << i;
+  }
 }
 
 TEST(Samplers, RejectBadParameters) {
