@@ -32,6 +32,8 @@ MapAgreement compare_maps(const VoxelMap& a, const VoxelMap& b, int tolerance_ce
     if (cb != Occupancy::kUnknown) {
       ++r.known_both;
       r.same_class += ca == cb;
+      r.free_a_occupied_b += ca == Occupancy::kFree && cb == Occupancy::kOccupied;
+      r.occupied_a_free_b += ca == Occupancy::kOccupied && cb == Occupancy::kFree;
     }
     if (ca == Occupancy::kOccupied) {
       ++r.occupied_a;

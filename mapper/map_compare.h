@@ -16,6 +16,8 @@ struct MapAgreement {
   size_t known_a = 0, known_b = 0;
   size_t known_both = 0;
   size_t same_class = 0;          ///< known in both and the same class (free / occupied)
+  size_t free_a_occupied_b = 0;   ///< known in both: free in a, occupied in b
+  size_t occupied_a_free_b = 0;   ///< ... and the other way round
   size_t occupied_a = 0, occupied_b = 0;
   size_t occupied_both = 0;       ///< the same cell occupied in both
   size_t occupied_a_matched = 0;  ///< occupied in a, with an occupied cell of b within tolerance

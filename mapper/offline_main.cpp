@@ -150,6 +150,9 @@ int run(Options& o) {
                 "%zu the same cell; within one cell: precision %.4f, recall %.4f\n",
                 o.compare.c_str(), a.class_agreement(), a.known_both, a.occupied_a, a.occupied_b,
                 a.occupied_both, a.precision(), a.recall());
+    std::printf("  cells known here only %zu, there only %zu; free here and occupied there %zu, "
+                "occupied here and free there %zu\n",
+                a.known_a - a.known_both, a.known_b - a.known_both, a.free_a_occupied_b, a.occupied_a_free_b);
   }
   return kExitOk;
 }

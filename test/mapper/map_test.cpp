@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "common/error.h"
+#include "mapper/map_compare.h"
 #include "mapper/octree_io.h"
 #include "mapper/scan.h"
 #include "mapper/scan_integrator.h"
@@ -127,6 +128,34 @@ TEST(VoxelMap, DiscretizedEqualsOctomapDiscretizedInsertPointCloudValueForValue)
   EXPECT_GT(map.num_occupied(), 50u);
   const auto mine = to_octree(map);
   EXPECT_EQ(octree_bytes(*mine, true), octree_bytes(reference, true));
+}
+
+TEST(MapCompare, CountsAgreementAndClassDifferences) {
+  // a: two occupied cells side by side, one free cell, one free cell b does not know;
+  // b: the first occupied cell, the second one free, the free cell occupied, and a cell of its
+  // own one cell away from a's second occupied cell.
+  VoxelMap a, b;
+  const Key k1(100, 100, 100), k2(101, 100, 100), k3(100, 102, 100), k4(90, 90, 90), k5(102, 101, 100);
+  a.set(k1, 2.0f);
+  a.set(k2, 2.0f);
+  a.set(k3, -1.0f);
+  a.set(k4, -1.0f);
+  b.set(k1, 2.0f);
+  b.set(k2, -1.0f);
+  b.set(k3, 2.0f);
+  b.set(k5, 2.0f);
+  const MapAgreement r = compare_maps(a, b);
+  EXPECT_EQ(r.known_a, 4u);
+  EXPECT_EQ(r.known_b, 4u);
+  EXPECT_EQ(r.known_both, 3u);
+  EXPECT_EQ(r.same_class, 1u);
+  EXPECT_EQ(r.free_a_occupied_b, 1u);  // k3
+  EXPECT_EQ(r.occupied_a_free_b, 1u);  // k2
+  EXPECT_EQ(r.occupied_a, 2u);
+  EXPECT_EQ(r.occupied_b, 3u);
+  EXPECT_EQ(r.occupied_both, 1u);
+  EXPECT_EQ(r.occupied_a_matched, 2u);  // k2 has k1 and k5 next to it
+  EXPECT_EQ(r.occupied_b_matched, 2u);  // k1, and k5 next to k2; k3 is two cells from both
 }
 
 TEST(VoxelMap, KnownBoxSceneGivesExpectedCells) {
