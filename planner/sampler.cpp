@@ -123,8 +123,8 @@ class BridgeSampler : public Sampler {
 class SensorSampler : public Sampler {
  public:
   SensorSampler(const ConfigurationSpace& s, std::function<double(const Config&)> weight, std::string name,
-                int max_attempts)
-      : space_(s), weight_(std::move(weight)), name_(std::move(name)), max_(max_attempts) {}
+                int max_attempts, SuAcceptance acceptance)
+      : space_(s), weight_(std::move(weight)), name_(std::move(name)), max_(max_attempts), acceptance_(acceptance) {}
   std::string name() const override { return name_; }
   std::optional<Config> sample(Rng& rng, SampleTrace* trace) override {
     for (int i = 1; i <= max_; ++i) {
@@ -135,10 +135,10 @@ class SensorSampler : public Sampler {
       const double normalised = max_weight_ > 0.0 ? w / max_weight_ : 0.0;
       if (!threshold_.accept(normalised, rng)) continue;
       // Algorithm 2, line 12: a sample past the threshold is added with probability equal to
-      // its normalised weight ("accepted or rejected with probability proportional to the
-      // expected information gain", §3.2.1). While every weight so far is 0 nothing tells
-      // candidates apart and it is added (as the threshold does then).
-      if (max_weight_ > 0.0 && !(unit_(rng) < normalised)) continue;
+      // its normalised weight. While every weight so far is 0 nothing tells candidates apart
+      // and it is added (as the threshold does then).
+      if (acceptance_ == SuAcceptance::kThresholdThenWeight && max_weight_ > 0.0 && !(unit_(rng) < normalised))
+        continue;
       if (trace) {
         trace->attempts = i;
         trace->weight = normalised;
@@ -154,6 +154,7 @@ class SensorSampler : public Sampler {
   std::function<double(const Config&)> weight_;
   std::string name_;
   int max_;
+  SuAcceptance acceptance_;
   double max_weight_ = 0.0;
   RunningThreshold threshold_;
   std::uniform_real_distribution<double> unit_{0.0, 1.0};
@@ -172,8 +173,8 @@ std::unique_ptr<Sampler> make_bridge_sampler(const ConfigurationSpace& space, do
 }
 std::unique_ptr<Sampler> make_sensor_sampler(const ConfigurationSpace& space,
                                              std::function<double(const Config&)> weight, std::string name,
-                                             int max_attempts) {
-  return std::make_unique<SensorSampler>(space, std::move(weight), std::move(name), max_attempts);
+                                             int max_attempts, SuAcceptance acceptance) {
+  return std::make_unique<SensorSampler>(space, std::move(weight), std::move(name), max_attempts, acceptance);
 }
 
 }  // namespace kestrel::planner

@@ -7,10 +7,11 @@
 //            one is valid, that one is kept (sigma = the sensor's range in the paper)
 //  bridge    (Hsu et al.) q1 uniform, q2 = q1 + N(0, sigma^2); both invalid and their
 //            midpoint valid -> the midpoint (sigma = 2 x sensor range)
-//  sensor    (the paper's Algorithm 2) a valid uniform candidate with weight w (EKF tr(M) or
-//            UKF information gain), normalised by the largest weight seen so far; when w
-//            exceeds a threshold drawn from N(mean, var) of the normalised weights seen, it is
-//            added with probability w (line 12; always while every weight so far is 0)
+//  sensor    (the paper's §3.2.1 and Algorithm 2) a valid uniform candidate with weight w
+//            (EKF tr(M) or UKF information gain), normalised by the largest weight seen so far,
+//            passes when it exceeds a threshold drawn from N(mean, var) of the normalised
+//            weights seen; the EKF paragraph then keeps it, Algorithm 2 (the UKF sampler) adds
+//            it with probability w (line 12; always while every weight so far is 0)
 // The trace (optional) records the attempts and the witnesses that justified the sample, so
 // tests can check each sampler against its definition.
 
@@ -58,9 +59,16 @@ std::unique_ptr<Sampler> make_gaussian_sampler(const ConfigurationSpace& space, 
                                                int max_attempts = 100000);
 std::unique_ptr<Sampler> make_bridge_sampler(const ConfigurationSpace& space, double sigma_m,
                                              int max_attempts = 1000000);
+/// How a sensor-uncertainty candidate that passed the threshold is kept.
+enum class SuAcceptance {
+  kThreshold,             ///< kept (§3.2.1, the EKF sampler: "retain the sample if tr(M_k) > P_k")
+  kThresholdThenWeight,   ///< kept with probability = its normalised weight (Algorithm 2, line 12)
+};
+
 /// `weight` maps a valid configuration to its information (>= 0).
 std::unique_ptr<Sampler> make_sensor_sampler(const ConfigurationSpace& space,
                                              std::function<double(const Config&)> weight,
-                                             std::string name = "sensor", int max_attempts = 100000);
+                                             std::string name = "sensor", int max_attempts = 100000,
+                                             SuAcceptance acceptance = SuAcceptance::kThreshold);
 
 }  // namespace kestrel::planner

@@ -17,11 +17,14 @@ std::unique_ptr<Sampler> make_sampler(const std::string& name, const Configurati
   if (name == "uniform") return make_uniform_sampler(space);
   if (name == "gaussian") return make_gaussian_sampler(space, range);
   if (name == "bridge") return make_bridge_sampler(space, 2.0 * range);
+  // Each as the paper states it: the EKF sampler keeps what passes the threshold (§3.2.1),
+  // Algorithm 2 (the UKF sampler) then adds it with probability = its normalised weight.
   if (name == "su")
     return make_sensor_sampler(space, [&sensor](const Config& q) { return sensor.information(q).trace(); }, "su");
   if (name == "su-ukf")
     return make_sensor_sampler(
-        space, [&sensor, ukf_prior](const Config& q) { return sensor.ukf_information_gain(q, ukf_prior); }, "su-ukf");
+        space, [&sensor, ukf_prior](const Config& q) { return sensor.ukf_information_gain(q, ukf_prior); }, "su-ukf",
+        100000, SuAcceptance::kThresholdThenWeight);
   throw std::invalid_argument("unknown sampler '" + name + "' (uniform, su, su-ukf, gaussian, bridge)");
 }
 

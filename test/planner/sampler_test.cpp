@@ -126,30 +126,42 @@ TEST(RunningThreshold, WhileEveryWeightIsTheSameItAcceptsAsUniformWould) {
   EXPECT_FALSE(ones.accept(0.5, rng));
 }
 
-TEST(SensorSampler, FavoursInformativeConfigurationsAsAlgorithm2Defines) {
-  // Weight = x on free space 0 < x < 10: normalised weights w are U(0, 1), so past the
-  // threshold x has density proportional to Phi((w - 1/2) / sqrt(1/12)), and line 12 keeps
-  // it with probability w: accepted x has density proportional to w Phi(...).
+// Weight = x on free space 0 < x < 10: normalised weights w are U(0, 1), so past the
+// threshold x has density proportional to Phi((w - 1/2) / sqrt(1/12)); Algorithm 2's line 12
+// keeps it with probability w, giving density proportional to w Phi(...). Returns the mean x
+// of 6000 samples and the one the density predicts.
+std::pair<double, double> mean_accepted_x(SuAcceptance acceptance) {
   PredicateEnvironment env(box(0, 10, 0, 10), [](const Eigen::Vector3d& p) { return p.x() > 0.0; });
   ConfigurationSpace space(env, {});
-  auto sampler = make_sensor_sampler(space, [](const Config& q) { return q[0]; });
+  auto sampler = make_sensor_sampler(space, [](const Config& q) { return q[0]; }, "su", 100000, acceptance);
   Rng rng(12);
   double mean_x = 0.0;
   const int n = 6000;
   for (int i = 0; i < n; ++i) {
     const auto q = sampler->sample(rng);
-    ASSERT_TRUE(q);
+    if (!q) return {-1.0, 0.0};
     mean_x += (*q)[0] / n;
   }
   double num = 0.0, den = 0.0;
   for (int k = 0; k < 1000; ++k) {
     const double w = (k + 0.5) / 1000.0;
-    const double p = w * normal_cdf((w - 0.5) / std::sqrt(1.0 / 12.0));
+    const double p = normal_cdf((w - 0.5) / std::sqrt(1.0 / 12.0)) * (acceptance == SuAcceptance::kThreshold ? 1.0 : w);
     num += 10.0 * w * p;
     den += p;
   }
-  EXPECT_NEAR(mean_x, num / den, 0.15);  // the max normaliser settles near 10 within a few draws
-  EXPECT_GT(mean_x, 7.0);                // far above the uniform sampler's 5 (threshold only: 6.8)
+  return {mean_x, num / den};
+}
+
+TEST(SensorSampler, FavoursInformativeConfigurationsAsTheEkfParagraphDefines) {
+  const auto [mean_x, expected] = mean_accepted_x(SuAcceptance::kThreshold);
+  EXPECT_NEAR(mean_x, expected, 0.15);  // 6.78; the max normaliser settles near 10 within a few draws
+  EXPECT_GT(mean_x, 5.5);               // clearly above the uniform sampler's 5
+}
+
+TEST(SensorSampler, Algorithm2AlsoKeepsWithProbabilityEqualToTheWeight) {
+  const auto [mean_x, expected] = mean_accepted_x(SuAcceptance::kThresholdThenWeight);
+  EXPECT_NEAR(mean_x, expected, 0.15);  // 7.54
+  EXPECT_GT(mean_x, 7.0);               // far above the threshold alone's 6.78
 }
 
 TEST(SensorSampler, IsUniformWhileNoCandidateSeesAnything) {
@@ -157,7 +169,8 @@ TEST(SensorSampler, IsUniformWhileNoCandidateSeesAnything) {
   // once, as the uniform sampler would (line 12's probability would be 0/0).
   PredicateEnvironment env(box(0, 10, 0, 10), [](const Eigen::Vector3d& p) { return p.x() > 0.0; });
   ConfigurationSpace space(env, {});
-  auto sampler = make_sensor_sampler(space, [](const Config&) { return 0.0; });
+  auto sampler =
+      make_sensor_sampler(space, [](const Config&) { return 0.0; }, "su", 100000, SuAcceptance::kThresholdThenWeight);
   Rng rng(5);
   for (int i = 0; i < 100; ++i) {
     SampleTrace trace;
