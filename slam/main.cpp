@@ -22,6 +22,7 @@
 #include "slam/sequence_run.h"
 #include "drivers/tum/tum_sequence.h"
 #include "vo/options.h"
+#include "vo/sequence_run.h"
 #endif
 
 namespace {
@@ -94,7 +95,7 @@ int run_offline(const Options& o, const SlamOptions& options, std::shared_ptr<co
   // Frames are decoded one at a time: a long sequence (e.g. a sim flight) need not fit in memory.
   const tum::TumSequence sequence(o.tum);
   const SlamRun run = run_slam_sequence(
-      sequence.size(), [&sequence](size_t i) { return sequence.frame(i); }, vo::VoOptions{}, options,
+      sequence.size(), [&sequence](size_t i) { return sequence.frame(i); }, vo::with_tum_sensor(o.tum, vo::VoOptions{}), options,
       std::move(vocabulary));
   write_tum_trajectory(o.out, run.slam);
   if (!o.vo_out.empty()) write_tum_trajectory(o.vo_out, run.vo);

@@ -21,6 +21,7 @@
 #include "common/transport/rgbd_codec.h"
 #include "kestrel/rgbd_frame_t.hpp"
 #include "vo/option_keys.h"
+#include "vo/sensor_profile.h"
 #include "vo/sequence_run.h"
 #include "vo/update_message.h"
 #include "vo/variants.h"
@@ -32,6 +33,7 @@ using namespace kestrel;
 struct Options {
   std::string variant = "default";
   std::vector<std::string> settings;  // KEY=VALUE over the variant
+  std::string sensor;                 // a SensorProfile name; empty: the TUM folder's, else the simulator's
   // Offline.
   std::string tum;
   std::string out;
@@ -114,6 +116,11 @@ int main(int argc, char** argv) {
   app.add_option("--set", o.settings,
                  "Change one option of the variant, KEY=VALUE (repeatable; --list-options shows them)");
   bool list = false;
+  app.add_option("--sensor", o.sensor,
+                 "Camera profile: simulator (global shutter; the default live) or kinect1 (rolling "
+                 "shutter, depth before colour, larger covariance floors); with --tum the default "
+                 "is the folder's (kinect1 for freiburg1)")
+      ->check(CLI::IsMember({vo::to_string(vo::SensorProfile::kSimulator), vo::to_string(vo::SensorProfile::kKinect1)}));
   app.add_flag("--list-options", list, "Print every pipeline option of the variant with its value and exit");
   app.add_option("--tum", o.tum, "Offline: TUM RGB-D sequence folder to run over");
   app.add_option("--out", o.out, "Offline: write the camera trajectory here (TUM format)");
@@ -126,13 +133,16 @@ int main(int argc, char** argv) {
     vo::VoOptions options;
     try {
       options = vo::variant(o.variant).options;
-      // Offline over a TUM folder: its sensor's model (before --set, which may change it).
-      if (!o.tum.empty()) {
-        options = vo::with_tum_sensor(o.tum, options);
-        spdlog::info("{}: {}", o.tum,
-                     vo::has_tum_sensor_model(o.tum) ? "freiburg1 Kinect timing (rolling shutter, depth offset)"
-                                                     : "no sensor model: VoOptions as given");
+      // The camera's profile (before --set, which may change it): as told, else the TUM
+      // folder's, else the simulator's.
+      vo::SensorProfile sensor = vo::SensorProfile::kSimulator;
+      if (!o.sensor.empty()) {
+        sensor = *vo::parse_sensor_profile(o.sensor);
+      } else if (!o.tum.empty()) {
+        sensor = vo::tum_sensor(o.tum);
       }
+      options = vo::with_sensor(sensor, options);
+      spdlog::info("camera profile: {}", vo::to_string(sensor));
     } catch (const std::invalid_argument& e) {
       throw CLI::ValidationError("--variant", e.what());
     }

@@ -127,6 +127,7 @@ MotionEstimate MotionEstimator::estimate(const Frame& ref, const Frame& cur,
   out.covariance = ldlt.solve(Matrix6d::Identity());
   out.covariance = 0.5 * (out.covariance + out.covariance.transpose());
   out.model_covariance = out.covariance;
+  out.pixel_sigma_px = refined.pixel_sigma;
   const CovarianceOptions& co = options.covariance;
   out.covariance *= co.model_scale;
   out.covariance.diagonal().head<3>().array() += co.translation_floor_m * co.translation_floor_m;

@@ -32,6 +32,7 @@ struct MotionEstimate {
   int num_inliers = 0;                ///< after max-clique / RANSAC
   int num_reprojection_inliers = 0;   ///< after outlier removal
   double mean_reprojection_error_px = 0.0;
+  double pixel_sigma_px = 0.0;        ///< the pixel noise model_covariance assumes
 };
 
 class MotionEstimator {

@@ -53,6 +53,8 @@ struct Accumulator {
   double cost = 0.0;         // robust, whitened
   double sq_px = 0.0;        // unwhitened squared pixel error
   int residuals = 0;
+  // Squared component of each image residual across its depth direction g: pixel noise only.
+  std::vector<float> across_sq;
 };
 
 // H += w * J^T J, written out: Eigen's rankUpdate takes its general matrix-product path for
@@ -117,8 +119,12 @@ inline void add(Accumulator& acc, const Eigen::Vector2d& r, const Matrix26d& J, 
          double sigma_z, const RefinementOptions& o) {
   const double s = o.pixel_sigma;
   Eigen::Matrix2d W = Eigen::Matrix2d::Identity() / s;  // Sigma^-1/2
+  const double gn2 = g.squaredNorm();
+  if (gn2 > 1e-18) {
+    const double along_g = r.dot(g);
+    acc.across_sq.push_back(static_cast<float>(std::max(r.squaredNorm() - along_g * along_g / gn2, 0.0)));
+  }
   if (o.depth_weighted && sigma_z > 0.0) {
-    const double gn2 = g.squaredNorm();
     if (gn2 > 1e-18) {
       const Eigen::Vector2d u = g / std::sqrt(gn2);
       const double along = std::sqrt(s * s + sigma_z * sigma_z * gn2);
@@ -251,6 +257,7 @@ Accumulator linearise(const std::vector<Correspondence>& cs, const std::vector<i
                       const PinholeCamera& cam, const Eigen::Isometry3d& T,
                       const RefinementOptions& o, const DenseQuadratic* dense) {
   Accumulator acc;
+  acc.across_sq.reserve(2 * use.size());
   if (dense != nullptr) add_dense(acc, *dense, T);
   const Eigen::Matrix3d R = T.linear();
   const Eigen::Matrix3d Rt = R.transpose();
@@ -318,6 +325,18 @@ Accumulator linearise(const std::vector<Correspondence>& cs, const std::vector<i
   return acc;
 }
 
+// The pixel noise the residuals show: each residual's component across its depth direction is
+// the difference of two noisy feature positions (variance 2 sigma^2 per axis), and the median of
+// a squared standard normal is 0.4549. The median keeps the few bad matches that survive the
+// outlier removal from inflating it. 0 when there are too few residuals to tell.
+double pixel_sigma_from_residuals(std::vector<float>& across_sq) {
+  constexpr size_t kMinResiduals = 20;
+  if (across_sq.size() < kMinResiduals) return 0.0;
+  auto mid = across_sq.begin() + static_cast<std::ptrdiff_t>(across_sq.size() / 2);
+  std::nth_element(across_sq.begin(), mid, across_sq.end());
+  return std::sqrt(double(*mid) / (2.0 * 0.4549));
+}
+
 }  // namespace
 
 double reprojection_error_px(const Correspondence& c, const PinholeCamera& cam,
@@ -371,7 +390,23 @@ RefinementResult refine_motion(const std::vector<Correspondence>& cs, const std:
     result.converged = step.allFinite() && step.head<3>().norm() < 1e-4 && step.tail<3>().norm() < 1e-4;
   }
   result.T_ref_cur = T;
-  result.information = information(acc, o);
+  result.pixel_sigma = o.pixel_sigma;
+  if (o.pixel_sigma_from_residuals) {
+    const double estimated = pixel_sigma_from_residuals(acc.across_sq);
+    if (estimated > 0.0) {
+      // The information as the noise the residuals show would give it; the estimate itself
+      // keeps the configured weighting, which the accuracy figures were tuned with.
+      RefinementOptions measured = o;
+      measured.pixel_sigma = std::max(estimated, o.min_pixel_sigma);
+      result.pixel_sigma = measured.pixel_sigma;
+      acc = linearise(cs, use, cam, T, measured, dqp);
+      result.information = information(acc, measured);
+    } else {
+      result.information = information(acc, o);
+    }
+  } else {
+    result.information = information(acc, o);
+  }
   result.dense_residuals = acc.dense;
   result.rms_error_px = acc.residuals > 0 ? std::sqrt(acc.sq_px / acc.residuals) : 0.0;
   return result;

@@ -18,8 +18,9 @@
 //
 // Invariant: `information` is the whitened Gauss-Newton information at the returned estimate,
 // each measurement counted once (a reprojection residual carries the noise of two pixels, and
-// a bidirectional pair measures the same two pixels twice); it is only as right as
-// pixel_sigma and the depth model (vo/README.md checks it against ground truth).
+// a bidirectional pair measures the same two pixels twice); it is only as right as the pixel
+// noise (pixel_sigma, or by default the spread the final residuals show across their depth
+// direction) and the depth model (vo/README.md checks it against ground truth).
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -55,6 +56,7 @@ struct RefinementResult {
   Eigen::Isometry3d T_ref_cur = Eigen::Isometry3d::Identity();
   Matrix6d information = Matrix6d::Zero();  ///< of the estimate: inverse of its covariance
   double rms_error_px = 0.0;                ///< unwhitened, over the residuals used
+  double pixel_sigma = 0.0;                 ///< the pixel noise `information` assumes
   int iterations = 0;
   bool converged = false;
   int dense_residuals = 0;  ///< associated dense residuals at the estimate

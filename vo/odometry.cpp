@@ -211,6 +211,7 @@ VoResult VisualOdometry::process(const RgbdFrame& input) {
   result.num_inliers = e.num_inliers;
   result.num_reprojection_inliers = e.num_reprojection_inliers;
   result.mean_reprojection_error_px = e.mean_reprojection_error_px;
+  result.pixel_sigma_px = e.pixel_sigma_px;
   const double dt = 1e-6 * double(cur.utime - previous_->utime);
 
   if (e.status != VoStatus::kOk) {

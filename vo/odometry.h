@@ -51,6 +51,7 @@ struct VoResult {
   int num_inliers = 0;
   int num_reprojection_inliers = 0;
   double mean_reprojection_error_px = 0.0;
+  double pixel_sigma_px = 0.0;     ///< the pixel noise the covariance assumes (see RefinementOptions)
   int fast_threshold = 0;          ///< the threshold this frame was detected with
   std::string message;             ///< empty when ok; else what went wrong, with its numbers
 };

@@ -55,6 +55,8 @@ std::vector<std::pair<std::string, Field>> fields(VoOptions& o) {
       {"refinement.depth_residuals", &o.refinement.depth_residuals},
       {"refinement.depth_sigma_floor_mm", &o.refinement.depth_sigma_floor_mm},
       {"refinement.pixel_sigma", &o.refinement.pixel_sigma},
+      {"refinement.pixel_sigma_from_residuals", &o.refinement.pixel_sigma_from_residuals},
+      {"refinement.min_pixel_sigma", &o.refinement.min_pixel_sigma},
       {"refinement.huber_px", &o.refinement.huber_px},
       {"refinement.outlier_threshold_px", &o.refinement.outlier_threshold_px},
       {"refinement.max_iterations", &o.refinement.max_iterations},

@@ -48,6 +48,7 @@ void VoOptions::validate() const {
   require(inliers.ransac_block_size >= 1, "inliers.ransac_block_size", "must be >= 1");
   require(inliers.min_inliers >= 3, "inliers.min_inliers", "must be >= 3");
   require(refinement.pixel_sigma > 0.0, "refinement.pixel_sigma", "must be > 0");
+  require(refinement.min_pixel_sigma > 0.0, "refinement.min_pixel_sigma", "must be > 0");
   require(refinement.huber_px >= 0.0, "refinement.huber_px", "must be >= 0");
   require(refinement.outlier_threshold_px > 0.0, "refinement.outlier_threshold_px", "must be > 0");
   require(refinement.max_iterations >= 1, "refinement.max_iterations", "must be >= 1");

@@ -92,7 +92,11 @@ struct RefinementOptions {
   bool depth_weighted = true;     ///< whiten residuals by the projected depth noise
   bool depth_residuals = true;    ///< also compare the two depths of each match along its ray
   double depth_sigma_floor_mm = 1.0;  ///< added in quadrature to the depth noise of a depth residual
-  double pixel_sigma = 1.2;       ///< measurement noise of a feature position, pixels
+  double pixel_sigma = 1.2;       ///< measurement noise of a feature position, pixels (weighting)
+  /// The reported information takes the pixel noise from the final residuals (their spread
+  /// across the depth direction) instead of pixel_sigma; the weighting keeps pixel_sigma.
+  bool pixel_sigma_from_residuals = true;
+  double min_pixel_sigma = 0.05;  ///< floor on that estimate, pixels (subpixel resolution)
   double huber_px = 1.5;          ///< robust loss threshold on a whitened residual (sigmas); 0 = none
   double outlier_threshold_px = 2.0;   ///< residuals above this (pixels) are dropped before re-refining
   int max_iterations = 4;         ///< 5 until the dense term: 4 is within 0.5 % on every figure and ~0.1 ms faster
@@ -114,13 +118,15 @@ struct DenseOptions {
 };
 
 /// What the reported covariance adds to the refinement's own (whose noise model only holds
-/// pixel and depth noise): the per-estimate error the model does not contain (colour/depth time
-/// offset and misregistration, rolling shutter), measured as the RMS per axis of the relative-
-/// pose errors against ground truth on fr1_xyz and fr1_rpy (vo/README.md, "Covariance").
+/// independent pixel and depth noise): the per-estimate error the model does not contain, a
+/// property of the sensor. The defaults are the simulator's camera (global shutter, one capture
+/// time; its errors are correlated over a frame: depth quantised on whole surfaces, rendering),
+/// fitted so the mean NEES is near 6 on the room figure-eight and checked on two other flights
+/// (vo/README.md, "Covariance"); a Kinect's are larger (the freiburg1 profile, sequence_run.h).
 struct CovarianceOptions {
   double model_scale = 1.0;              ///< multiplies the refinement's covariance
-  double translation_floor_m = 0.0027;   ///< per-axis sigma added in quadrature, metres
-  double rotation_floor_rad = 0.0032;    ///< per-axis sigma added in quadrature, radians
+  double translation_floor_m = 0.0006;   ///< per-axis sigma added in quadrature, metres
+  double rotation_floor_rad = 0.0002;    ///< per-axis sigma added in quadrature, radians
 };
 
 /// Reference (key) frame policy.

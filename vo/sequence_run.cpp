@@ -53,20 +53,12 @@ LoadedSequence load_tum_sequence(const std::string& folder) {
   return out;
 }
 
-bool has_tum_sensor_model(const std::string& folder) {
-  return tum::detect_camera(folder) == tum::TumCamera::kFreiburg1;
+SensorProfile tum_sensor(const std::string& folder) {
+  return tum::detect_camera(folder) == tum::TumCamera::kFreiburg1 ? SensorProfile::kKinect1 : SensorProfile::kSimulator;
 }
 
 VoOptions with_tum_sensor(const std::string& folder, VoOptions options) {
-  if (!has_tum_sensor_model(folder)) return options;
-  options.depth.rolling_shutter_readout_s = kTumRollingShutterReadoutS;
-  options.depth.compensate_time_offset = true;
-  options.depth.time_offset_from_stamps = false;
-  options.depth.time_offset_s = kTumDepthTimeOffsetS;
-  options.covariance.translation_floor_m = kTumTranslationFloorM;
-  options.covariance.rotation_floor_rad = kTumRotationFloorRad;
-  options.validate();
-  return options;
+  return with_sensor(tum_sensor(folder), std::move(options));
 }
 
 SequenceRun run_sequence(const std::vector<RgbdFrame>& frames, const VoOptions& options) {
@@ -152,6 +144,7 @@ std::string stats_json(const SequenceRun& run, const RunFigures& f, const std::s
                          {"inliers", r.num_inliers},
                          {"reprojection_inliers", r.num_reprojection_inliers},
                          {"reprojection_error_px", r.mean_reprojection_error_px},
+                         {"pixel_sigma_px", r.pixel_sigma_px},
                          {"fast_threshold", r.fast_threshold},
                          {"ms", run.process_ms[i]}});
   }

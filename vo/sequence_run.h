@@ -14,6 +14,7 @@
 #include "common/rgbd_frame.h"
 #include "common/trajectory.h"
 #include "vo/odometry.h"
+#include "vo/sensor_profile.h"
 
 namespace kestrel::vo {
 
@@ -48,31 +49,14 @@ struct LoadedSequence {
 };
 LoadedSequence load_tum_sequence(const std::string& folder);
 
-/// The sensor model of TUM's freiburg1 Kinect (v1), which VoOptions{} (a global-shutter camera
-/// whose depth and colour share one capture time, as the simulator renders) does not assume:
-/// - a rolling colour shutter, first-to-last row time as the odometry uses it;
-/// - the depth captured before the colour image's middle row by a fixed time, whatever the
-///   stamps say: they are arrival times (fr1_rpy's are equal on ~30 % of its frames, fr1_xyz's
-///   jitter from -16 to -8 ms), and a fixed offset beats them on both sequences;
-/// - covariance floors for what the odometry's noise model leaves out on this sensor (refitted
-///   with the timing above: mean NEES against the ground truth 4.5 / 6.5 on fr1_xyz / fr1_rpy;
-///   the rotation floor also absorbs the ground truth's own orientation jitter, ~0.1 degrees).
-/// All are one calibration of the sensor, chosen by sweeps scored on both sequences
-/// (vo/README.md "Sensor timing"), not per sequence.
-constexpr double kTumRollingShutterReadoutS = 0.015;
-constexpr double kTumDepthTimeOffsetS = -0.012;
-constexpr double kTumTranslationFloorM = 0.002;
-constexpr double kTumRotationFloorRad = 0.0045;
+/// The sensor profile of the recording in `folder`: kKinect1 for a freiburg1 recording (named
+/// as TUM names them, tum::detect_camera); kSimulator for any other -- freiburg2/3, whose
+/// timing was not measured, and the simulator's TUM-format exports.
+SensorProfile tum_sensor(const std::string& folder);
 
-/// `options` for the sequence in `folder`: the model above set when the folder is a freiburg1
-/// recording (named as TUM names them, tum::detect_camera); unchanged for any other folder —
-/// freiburg2/3, whose timing was not measured, and the simulator's TUM-format exports. Every
-/// offline run (kestrel-vo --tum, the ablation, the data test, the benchmark) applies it before
-/// any --set.
+/// `options` with the profile of the recording in `folder` (tum_sensor()). Every offline run
+/// (kestrel-vo --tum, the ablation, the data tests, the benchmark) applies it before any --set.
 VoOptions with_tum_sensor(const std::string& folder, VoOptions options);
-
-/// True when with_tum_sensor() applies the freiburg1 Kinect model to `folder`.
-bool has_tum_sensor_model(const std::string& folder);
 
 /// Feeds every frame to a fresh VisualOdometry(options).
 SequenceRun run_sequence(const std::vector<RgbdFrame>& frames, const VoOptions& options);

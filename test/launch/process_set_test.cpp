@@ -119,5 +119,23 @@ TEST(ResolveExecutable, PrefersKestrelToolsThenPath) {
   EXPECT_THROW(resolve_executable((dir / "missing").string(), dir.path()), InputError);
 }
 
+// A Kinect source gives the odometry the Kinect's camera profile; the simulator and replays
+// leave its default; a profile named in the set's own command wins.
+TEST(CameraProfile, FollowsTheSource) {
+  EXPECT_EQ(camera_profile_of_source(split_command("kinect")), "kinect1");
+  EXPECT_EQ(camera_profile_of_source(split_command("/opt/kestrel/bin/kestrel-kinect --fakenect-dir x")), "kinect1");
+  EXPECT_EQ(camera_profile_of_source(split_command("tum-play --rate 0.5 ../data/tum/rgbd_dataset_freiburg1_xyz")),
+            "kinect1");
+  EXPECT_FALSE(camera_profile_of_source(split_command("tum-play /tmp/sim_export")).has_value());
+  EXPECT_FALSE(camera_profile_of_source(split_command("sim --world room")).has_value());
+  EXPECT_FALSE(camera_profile_of_source(split_command("replay flight.lcmlog")).has_value());
+
+  ProcessSet set = {{"vo", {"vo"}, "onboard"}, {"slam", {"slam"}, "offboard"}, {"vo2", {"vo", "--sensor", "simulator"}, "onboard"}};
+  set_camera_profile(set, "kinect1");
+  EXPECT_EQ(set[0].argv, (std::vector<std::string>{"vo", "--sensor", "kinect1"}));
+  EXPECT_EQ(set[1].argv, (std::vector<std::string>{"slam"}));
+  EXPECT_EQ(set[2].argv, (std::vector<std::string>{"vo", "--sensor", "simulator"}));
+}
+
 }  // namespace
 }  // namespace kestrel::launch

@@ -158,7 +158,10 @@ TEST(Options, SetByNameAndRejectedByName) {
   set_option(o, "dense.weight", "0.1");
   EXPECT_EQ(o.dense.weight, 0.1);
   EXPECT_THROW(set_option(o, "dense.stride", "0"), std::invalid_argument);
-  EXPECT_EQ(describe_options(o).size(), 65u);
+  set_option(o, "refinement.pixel_sigma_from_residuals", "false");
+  EXPECT_FALSE(o.refinement.pixel_sigma_from_residuals);
+  EXPECT_THROW(set_option(o, "refinement.min_pixel_sigma", "0"), std::invalid_argument);
+  EXPECT_EQ(describe_options(o).size(), 67u);
 }
 
 }  // namespace

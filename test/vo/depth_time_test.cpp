@@ -100,18 +100,36 @@ TEST(DepthTimeOffset, TakenFromTheStampsOrTheConfiguredValue) {
 // TUM-format exports (global shutter, one capture time) nor to the unmeasured freiburg2/3.
 TEST(DepthTimeOffset, TheKinectTimingIsForFreiburg1RecordingsOnly) {
   const VoOptions given;
+  EXPECT_EQ(tum_sensor("../data/tum/rgbd_dataset_freiburg1_rpy"), SensorProfile::kKinect1);
   const VoOptions fr1 = with_tum_sensor("../data/tum/rgbd_dataset_freiburg1_rpy", given);
   EXPECT_TRUE(fr1.depth.compensate_time_offset);
   EXPECT_FALSE(fr1.depth.time_offset_from_stamps);
-  EXPECT_DOUBLE_EQ(fr1.depth.time_offset_s, kTumDepthTimeOffsetS);
-  EXPECT_DOUBLE_EQ(fr1.depth.rolling_shutter_readout_s, kTumRollingShutterReadoutS);
-  EXPECT_DOUBLE_EQ(fr1.covariance.translation_floor_m, kTumTranslationFloorM);
+  EXPECT_DOUBLE_EQ(fr1.depth.time_offset_s, kKinect1DepthTimeOffsetS);
+  EXPECT_DOUBLE_EQ(fr1.depth.rolling_shutter_readout_s, kKinect1RollingShutterReadoutS);
+  EXPECT_DOUBLE_EQ(fr1.covariance.translation_floor_m, kKinect1TranslationFloorM);
+  EXPECT_DOUBLE_EQ(fr1.covariance.rotation_floor_rad, kKinect1RotationFloorRad);
   for (const char* other : {"/tmp/sim_room_export", "rgbd_dataset_freiburg2_desk", "rgbd_dataset_freiburg3_office"}) {
+    EXPECT_EQ(tum_sensor(other), SensorProfile::kSimulator) << other;
     const VoOptions o = with_tum_sensor(other, given);
     EXPECT_FALSE(o.depth.compensate_time_offset) << other;
     EXPECT_DOUBLE_EQ(o.depth.rolling_shutter_readout_s, 0.0) << other;
     EXPECT_DOUBLE_EQ(o.covariance.translation_floor_m, given.covariance.translation_floor_m) << other;
   }
+}
+
+// The profiles by name, as `kestrel vo --sensor` and `kestrel launch` give them.
+TEST(SensorProfiles, NamedAndAppliedByName) {
+  for (const SensorProfile p : {SensorProfile::kSimulator, SensorProfile::kKinect1})
+    EXPECT_EQ(parse_sensor_profile(to_string(p)), p);
+  EXPECT_FALSE(parse_sensor_profile("kinect2").has_value());
+  const VoOptions given;
+  const VoOptions sim = with_sensor(SensorProfile::kSimulator, given);
+  EXPECT_DOUBLE_EQ(sim.covariance.translation_floor_m, given.covariance.translation_floor_m);
+  EXPECT_FALSE(sim.depth.compensate_time_offset);
+  const VoOptions kinect = with_sensor(SensorProfile::kKinect1, given);
+  EXPECT_GT(kinect.covariance.translation_floor_m, given.covariance.translation_floor_m);
+  EXPECT_GT(kinect.covariance.rotation_floor_rad, given.covariance.rotation_floor_rad);
+  EXPECT_DOUBLE_EQ(kinect.depth.rolling_shutter_readout_s, kKinect1RollingShutterReadoutS);
 }
 
 }  // namespace

@@ -1,0 +1,27 @@
+#include "vo/sensor_profile.h"
+
+namespace kestrel::vo {
+
+VoOptions with_sensor(SensorProfile profile, VoOptions options) {
+  if (profile == SensorProfile::kSimulator) return options;
+  options.depth.rolling_shutter_readout_s = kKinect1RollingShutterReadoutS;
+  options.depth.compensate_time_offset = true;
+  options.depth.time_offset_from_stamps = false;
+  options.depth.time_offset_s = kKinect1DepthTimeOffsetS;
+  options.covariance.translation_floor_m = kKinect1TranslationFloorM;
+  options.covariance.rotation_floor_rad = kKinect1RotationFloorRad;
+  options.validate();
+  return options;
+}
+
+std::string to_string(SensorProfile profile) {
+  return profile == SensorProfile::kKinect1 ? "kinect1" : "simulator";
+}
+
+std::optional<SensorProfile> parse_sensor_profile(const std::string& name) {
+  for (const SensorProfile p : {SensorProfile::kSimulator, SensorProfile::kKinect1})
+    if (to_string(p) == name) return p;
+  return std::nullopt;
+}
+
+}  // namespace kestrel::vo
