@@ -1,5 +1,5 @@
 // kestrel-map and kestrel-mapper as built tools: the offline map of a small synthetic TUM
-// folder equals the library's, renders and the PLY are written, and usage errors and bad
+// folder equals the library's (also with --discretize), renders and the PLY are written, and usage errors and bad
 // input give the documented exit codes.
 #include <gtest/gtest.h>
 
@@ -75,6 +75,22 @@ TEST(MapTool, BuildsTheLibrarysMapAndRendersIt) {
                                          (tmp / "again.bt").string(), "--compare", (tmp / "map.ot").string()});
   ASSERT_EQ(again.exit_code, 0) << again.err;
   EXPECT_NE(again.out.find("class agreement 1.0000"), std::string::npos) << again.out;
+  EXPECT_NE(again.out.find("known here only 0, there only 0; free here and occupied there 0, occupied here and free there 0"),
+            std::string::npos) << again.out;
+
+  // --discretize: the library's endpoint-discretised map, a different one from the default's.
+  const auto discretized = kestrel::test::run({kestrel::test::tool("map").string(), "--tum", (tmp / "seq").string(),
+                                               "--poses", (tmp / "seq/truth.txt").string(), "--out",
+                                               (tmp / "discretized.ot").string(), "--discretize"});
+  ASSERT_EQ(discretized.exit_code, 0) << discretized.err;
+  MapperOptions discretize;
+  discretize.scan.discretize = true;
+  Mapper discretized_reference(discretize);
+  for (const auto& [frame, T] : frames) discretized_reference.insert(frame, T);
+  const VoxelMap discretized_map = read_map_file((tmp / "discretized.ot").string());
+  ASSERT_EQ(discretized_map.num_cells(), discretized_reference.map().num_cells());
+  discretized_reference.map().for_each_cell([&](const Key& k, float v) { ASSERT_EQ(discretized_map.log_odds(k), v); });
+  EXPECT_NE(discretized_map.num_cells(), map.num_cells());
 
   // The surface-only reference: every hit cell occupied, no free space at all.
   const auto surface = kestrel::test::run({kestrel::test::tool("map").string(), "--tum", (tmp / "seq").string(),
