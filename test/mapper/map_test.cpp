@@ -12,6 +12,7 @@
 #include "mapper/scan.h"
 #include "mapper/scan_integrator.h"
 #include "mapper/voxel_map.h"
+#include "test/mapper/octomap_reference.h"
 #include "test/mapper/scene.h"
 #include "test/support/test_support.h"
 
@@ -68,20 +69,7 @@ TEST(VoxelMap, EqualsOctomapInsertPointCloudValueForValue) {
     utime += 33333;
   }
   // Every leaf of OctoMap's tree, expanded to cells, has exactly our value, and vice versa.
-  size_t cells = 0;
-  for (auto it = reference.begin_leafs(); it != reference.end_leafs(); ++it) {
-    const int n = 1 << (16 - it.getDepth());
-    const Key base = it.getIndexKey();
-    for (int z = 0; z < n; ++z)
-      for (int y = 0; y < n; ++y)
-        for (int x = 0; x < n; ++x) {
-          const Key k(base[0] + x, base[1] + y, base[2] + z);
-          const auto v = map.log_odds(k);
-          ASSERT_TRUE(v.has_value());
-          ASSERT_EQ(*v, it->getLogOdds());  // bit for bit: the same float arithmetic
-          ++cells;
-        }
-  }
+  const size_t cells = test::expect_values_equal(map, reference);
   EXPECT_EQ(cells, map.num_cells());
   EXPECT_GT(map.num_occupied(), 50u);
 
@@ -111,19 +99,7 @@ TEST(VoxelMap, DiscretizedEqualsOctomapDiscretizedInsertPointCloudValueForValue)
     reference.insertPointCloud(scan.valid_points(), scan.origin, options.max_range_m, false, true);
     utime += 33333;
   }
-  size_t cells = 0;
-  for (auto it = reference.begin_leafs(); it != reference.end_leafs(); ++it) {
-    const int n = 1 << (16 - it.getDepth());
-    const Key base = it.getIndexKey();
-    for (int z = 0; z < n; ++z)
-      for (int y = 0; y < n; ++y)
-        for (int x = 0; x < n; ++x) {
-          const auto v = map.log_odds(Key(base[0] + x, base[1] + y, base[2] + z));
-          ASSERT_TRUE(v.has_value());
-          ASSERT_EQ(*v, it->getLogOdds());
-          ++cells;
-        }
-  }
+  const size_t cells = test::expect_values_equal(map, reference);
   EXPECT_EQ(cells, map.num_cells());
   EXPECT_GT(map.num_occupied(), 50u);
   const auto mine = to_octree(map);

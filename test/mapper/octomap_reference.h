@@ -2,12 +2,14 @@
 // OctoMap's own answers, for comparison: the cells computeUpdate (or computeDiscreteUpdate)
 // would clear and mark occupied for a scan, and differences between those and a ScanUpdate.
 
+#include <gtest/gtest.h>
 #include <octomap/OcTree.h>
 
 #include <string>
 
 #include "mapper/scan.h"
 #include "mapper/scan_integrator.h"
+#include "mapper/voxel_map.h"
 
 namespace kestrel::mapper::test {
 
@@ -44,6 +46,28 @@ inline size_t count_differences(const ScanUpdate& mine, const OctomapUpdate& the
     return d;
   };
   return diff(mine.free, theirs.free) + diff(mine.occupied, theirs.occupied);
+}
+
+/// Asserts that every leaf of OctoMap's tree, expanded to cells, has exactly `map`'s value
+/// (bit for bit: the same float arithmetic); returns the number of cells compared, which the
+/// caller checks against map.num_cells() (so nothing is in one and not the other).
+inline size_t expect_values_equal(const VoxelMap& map, const octomap::OcTree& reference) {
+  size_t cells = 0;
+  for (auto it = reference.begin_leafs(); it != reference.end_leafs(); ++it) {
+    const int n = 1 << (16 - it.getDepth());
+    const Key base = it.getIndexKey();
+    for (int z = 0; z < n; ++z)
+      for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x) {
+          const auto v = map.log_odds(Key(base[0] + x, base[1] + y, base[2] + z));
+          EXPECT_TRUE(v.has_value());
+          if (!v) return cells;
+          EXPECT_EQ(*v, it->getLogOdds());
+          if (*v != it->getLogOdds()) return cells;
+          ++cells;
+        }
+  }
+  return cells;
 }
 
 }  // namespace kestrel::mapper::test

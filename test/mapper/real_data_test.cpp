@@ -69,19 +69,7 @@ TEST(RealData, DiscretizedMapEqualsOctomapsDiscretizedInsertionOnFr1Xyz) {
     ++frames;
   }
   ASSERT_GE(frames, 40);
-  size_t cells = 0;
-  for (auto it = reference.begin_leafs(); it != reference.end_leafs(); ++it) {
-    const int n = 1 << (16 - it.getDepth());
-    const Key base = it.getIndexKey();
-    for (int z = 0; z < n; ++z)
-      for (int y = 0; y < n; ++y)
-        for (int x = 0; x < n; ++x) {
-          const auto v = mapper.map().log_odds(Key(base[0] + x, base[1] + y, base[2] + z));
-          ASSERT_TRUE(v.has_value());
-          ASSERT_EQ(*v, it->getLogOdds());
-          ++cells;
-        }
-  }
+  const size_t cells = test::expect_values_equal(mapper.map(), reference);
   EXPECT_EQ(cells, mapper.map().num_cells());
   EXPECT_GT(mapper.map().num_occupied(), 1500u);
 }
