@@ -78,7 +78,10 @@ MotionEstimate MotionEstimator::estimate(const Frame& ref, const Frame& cur,
   const RefinementOptions& ro = options.refinement;
   RefinementResult refined;
   if (ro.enabled) {
-    refined = refine_motion(correspondences_, inliers_, cam, T, ro);
+    // With the dense term a second refinement always follows and reports the information.
+    const bool dense = options.dense.enabled && !ref.dense.empty() && !cur.dense.empty();
+    refined = refine_motion(correspondences_, inliers_, cam, T, ro, nullptr,
+                            dense ? Information::kSkip : Information::kReport);
     // Drop the matches the refined motion cannot explain, then refine on the rest.
     std::vector<int> kept;
     kept.reserve(inliers_.size());
@@ -94,7 +97,6 @@ MotionEstimate MotionEstimator::estimate(const Frame& ref, const Frame& cur,
       return out;
     }
     // With nothing dropped the second refinement would start at the first one's optimum.
-    const bool dense = options.dense.enabled && !ref.dense.empty() && !cur.dense.empty();
     if (dense) {
       DenseTerm term;
       term.ref = &ref.dense;

@@ -53,8 +53,6 @@ struct Accumulator {
   double cost = 0.0;         // robust, whitened
   double sq_px = 0.0;        // unwhitened squared pixel error
   int residuals = 0;
-  // Squared component of each image residual across its depth direction g: pixel noise only.
-  std::vector<float> across_sq;
 };
 
 // H += w * J^T J, written out: Eigen's rankUpdate takes its general matrix-product path for
@@ -119,12 +117,8 @@ inline void add(Accumulator& acc, const Eigen::Vector2d& r, const Matrix26d& J, 
          double sigma_z, const RefinementOptions& o) {
   const double s = o.pixel_sigma;
   Eigen::Matrix2d W = Eigen::Matrix2d::Identity() / s;  // Sigma^-1/2
-  const double gn2 = g.squaredNorm();
-  if (gn2 > 1e-18) {
-    const double along_g = r.dot(g);
-    acc.across_sq.push_back(static_cast<float>(std::max(r.squaredNorm() - along_g * along_g / gn2, 0.0)));
-  }
   if (o.depth_weighted && sigma_z > 0.0) {
+    const double gn2 = g.squaredNorm();
     if (gn2 > 1e-18) {
       const Eigen::Vector2d u = g / std::sqrt(gn2);
       const double along = std::sqrt(s * s + sigma_z * sigma_z * gn2);
@@ -257,7 +251,6 @@ Accumulator linearise(const std::vector<Correspondence>& cs, const std::vector<i
                       const PinholeCamera& cam, const Eigen::Isometry3d& T,
                       const RefinementOptions& o, const DenseQuadratic* dense) {
   Accumulator acc;
-  acc.across_sq.reserve(2 * use.size());
   if (dense != nullptr) add_dense(acc, *dense, T);
   const Eigen::Matrix3d R = T.linear();
   const Eigen::Matrix3d Rt = R.transpose();
@@ -325,12 +318,37 @@ Accumulator linearise(const std::vector<Correspondence>& cs, const std::vector<i
   return acc;
 }
 
-// The pixel noise the residuals show: each residual's component across its depth direction is
-// the difference of two noisy feature positions (variance 2 sigma^2 per axis), and the median of
-// a squared standard normal is 0.4549. The median keeps the few bad matches that survive the
-// outlier removal from inflating it. 0 when there are too few residuals to tell.
-double pixel_sigma_from_residuals(std::vector<float>& across_sq) {
+// The pixel noise the image residuals at T show. Each residual's component across its depth
+// direction g (the image residuals and g exactly as linearise() forms them) is the difference of
+// two noisy feature positions (variance 2 sigma^2 per axis), and the median of a squared
+// standard normal is 0.4549. The median keeps the few bad matches that survive the outlier
+// removal from inflating it. 0 when there are too few residuals to tell. A pass of its own,
+// once per refinement: collecting the components in every linearise() cost more.
+double pixel_sigma_from_residuals(const std::vector<Correspondence>& cs, const std::vector<int>& use,
+                                  const PinholeCamera& cam, const Eigen::Isometry3d& T,
+                                  const RefinementOptions& o) {
   constexpr size_t kMinResiduals = 20;
+  std::vector<float> across_sq;
+  across_sq.reserve(2 * use.size());
+  const bool esm = o.solver == Solver::kEsm;
+  auto collect = [&](const Eigen::Vector3d& X, const Eigen::Vector3d& dX_dz, const Eigen::Vector2d& measured) {
+    if (X.z() <= 1e-6) return;
+    const Projection pr = project(X, cam, measured, esm);
+    const Eigen::Vector2d r = pr.pixel - measured;
+    const Eigen::Vector2d g = pr.J * dX_dz;
+    const double gn2 = g.squaredNorm();
+    if (gn2 <= 1e-18) return;
+    const double along_g = r.dot(g);
+    across_sq.push_back(static_cast<float>(std::max(r.squaredNorm() - along_g * along_g / gn2, 0.0)));
+  };
+  const Eigen::Matrix3d R = T.linear();
+  const Eigen::Matrix3d Rt = R.transpose();
+  const Eigen::Vector3d p = T.translation();
+  for (int i : use) {
+    const Correspondence& c = cs[static_cast<size_t>(i)];
+    collect(Rt * (c.ref_point - p), Rt * (c.ref_point / c.ref_point.z()), c.cur_pixel);
+    if (o.bidirectional) collect(R * c.cur_point + p, R * (c.cur_point / c.cur_point.z()), c.ref_pixel);
+  }
   if (across_sq.size() < kMinResiduals) return 0.0;
   auto mid = across_sq.begin() + static_cast<std::ptrdiff_t>(across_sq.size() / 2);
   std::nth_element(across_sq.begin(), mid, across_sq.end());
@@ -353,7 +371,7 @@ double reprojection_error_px(const Correspondence& c, const PinholeCamera& cam,
 
 RefinementResult refine_motion(const std::vector<Correspondence>& cs, const std::vector<int>& use,
                                const PinholeCamera& cam, const Eigen::Isometry3d& T_ref_cur,
-                               const RefinementOptions& o, const DenseTerm* dense) {
+                               const RefinementOptions& o, const DenseTerm* dense, Information report) {
   RefinementResult result;
   Eigen::Isometry3d T = T_ref_cur;
   DenseQuadratic dq;
@@ -390,22 +408,17 @@ RefinementResult refine_motion(const std::vector<Correspondence>& cs, const std:
     result.converged = step.allFinite() && step.head<3>().norm() < 1e-4 && step.tail<3>().norm() < 1e-4;
   }
   result.T_ref_cur = T;
-  result.pixel_sigma = o.pixel_sigma;
-  if (o.pixel_sigma_from_residuals) {
-    const double estimated = pixel_sigma_from_residuals(acc.across_sq);
+  if (report == Information::kReport) {
+    // The information as the noise the residuals show would give it; the estimate itself
+    // keeps the configured weighting, which the accuracy figures were tuned with.
+    RefinementOptions measured = o;
+    const double estimated = o.pixel_sigma_from_residuals ? pixel_sigma_from_residuals(cs, use, cam, T, o) : 0.0;
     if (estimated > 0.0) {
-      // The information as the noise the residuals show would give it; the estimate itself
-      // keeps the configured weighting, which the accuracy figures were tuned with.
-      RefinementOptions measured = o;
       measured.pixel_sigma = std::max(estimated, o.min_pixel_sigma);
-      result.pixel_sigma = measured.pixel_sigma;
       acc = linearise(cs, use, cam, T, measured, dqp);
-      result.information = information(acc, measured);
-    } else {
-      result.information = information(acc, o);
     }
-  } else {
-    result.information = information(acc, o);
+    result.information = information(acc, measured);
+    result.pixel_sigma = measured.pixel_sigma;
   }
   result.dense_residuals = acc.dense;
   result.rms_error_px = acc.residuals > 0 ? std::sqrt(acc.sq_px / acc.residuals) : 0.0;

@@ -62,11 +62,16 @@ struct RefinementResult {
   int dense_residuals = 0;  ///< associated dense residuals at the estimate
 };
 
-/// Refines `T_ref_cur` over the correspondences whose index is in `use`.
+/// Whether refine_motion() reports `information` (and `pixel_sigma`): a pass over the residuals
+/// of its own, worth skipping for an estimate that only seeds another refinement.
+enum class Information { kReport, kSkip };
+
+/// Refines `T_ref_cur` over the correspondences whose index is in `use`. With Information::kSkip,
+/// `information` stays zero and `pixel_sigma` 0.
 RefinementResult refine_motion(const std::vector<Correspondence>& correspondences,
                                const std::vector<int>& use, const PinholeCamera& camera,
                                const Eigen::Isometry3d& T_ref_cur, const RefinementOptions& options,
-                               const DenseTerm* dense = nullptr);
+                               const DenseTerm* dense = nullptr, Information report = Information::kReport);
 
 /// Reprojection error (pixels) of correspondence `c` under `T_ref_cur`: the larger of the two
 /// directions when bidirectional, else that of the reference point in the current image.

@@ -154,5 +154,22 @@ TEST(Refinement, KeepsTheConfiguredPixelNoiseWithTooFewResiduals) {
   EXPECT_DOUBLE_EQ(r.pixel_sigma, 1.2);
 }
 
+// Skipping the information changes nothing in the estimate.
+TEST(Refinement, SkippingTheInformationKeepsTheEstimate) {
+  std::mt19937 rng(7);
+  const auto cs = synthetic(kTrue, 60, 0.3, rng);
+  const Eigen::Isometry3d start = se3::boxplus(kTrue, (Vector6d() << 0.02, -0.01, 0.01, 0.01, 0.0, -0.02).finished());
+  const RefinementOptions o;
+  const RefinementResult with = refine_motion(cs, all(cs.size()), test::test_camera(), start, o);
+  const RefinementResult without =
+      refine_motion(cs, all(cs.size()), test::test_camera(), start, o, nullptr, Information::kSkip);
+  EXPECT_TRUE(with.T_ref_cur.isApprox(without.T_ref_cur, 0.0));
+  EXPECT_EQ(with.iterations, without.iterations);
+  EXPECT_GT(with.information.trace(), 0.0);
+  EXPECT_EQ(without.information, Matrix6d::Zero());
+  EXPECT_GT(with.pixel_sigma, 0.0);
+  EXPECT_EQ(without.pixel_sigma, 0.0);
+}
+
 }  // namespace
 }  // namespace kestrel::vo
