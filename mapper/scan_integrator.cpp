@@ -520,6 +520,12 @@ void ScanIntegrator::collect(ScanUpdate& update) {
   touched_.clear();
 }
 
+inline void ScanIntegrator::touch(int idx, uint8_t flags) {
+  uint8_t& f = cells_[static_cast<size_t>(idx)];
+  if (f == 0) touched_idx_[touched_count_++] = idx;
+  f = static_cast<uint8_t>(f | flags);
+}
+
 inline void ScanIntegrator::trace_cell_centre(const Key& key) {
   // computeDiscreteUpdate's point: the centre of the cell, each coordinate rounded to float
   // (keyToCoord), then computeUpdate's rules for it (hit or cut at max range; ray.h).
@@ -527,12 +533,53 @@ inline void ScanIntegrator::trace_cell_centre(const Key& key) {
                                 static_cast<float>(keys_.centre(key[1])),
                                 static_cast<float>(keys_.centre(key[2])));
   const Ray r = make_ray(keys_, scan_->origin, key_origin_, centre, options_.max_range_m);
-  // A hit lies within max range of the origin, so its cell and every cell a walk clears are in
-  // the grid.
-  if (r.hit) mark(index(r.key_end), r.key_end, kOccupied);
   ++rays_traced_;
-  trace_indexed(keys_, scan_->origin, key_origin_, r, index(key_origin_), stride_,
-                [&](const Key& k, int idx) { mark(idx, k, kCleared); });
+  if (!r.hit && !r.clears) return;
+  // A hit lies within max range of the origin, and so does a cut ray's end (both are in the
+  // grid), and so every cell a walk clears. A walk moves monotonically along each axis within
+  // the grid: at most 3 side_ cells, plus the hit's.
+  if (touched_idx_.size() < touched_count_ + 3 * static_cast<size_t>(side_) + 2)
+    touched_idx_.resize(2 * (touched_count_ + 3 * static_cast<size_t>(side_) + 2));
+  const int end = index(r.key_end);
+  if (r.hit) touch(end, kOccupied);
+  // The touched list is appended without a branch: the entry is written always and kept when
+  // the cell was untouched.
+  uint8_t* const cells = cells_.data();
+  int* const touched = touched_idx_.data();
+  size_t count = touched_count_;
+  trace_index_only(keys_, scan_->origin, key_origin_, r, index(key_origin_), end, stride_, [&](int idx) {
+    uint8_t& f = cells[static_cast<size_t>(idx)];
+    touched[count] = idx;
+    count += f == 0;
+    f = static_cast<uint8_t>(f | kCleared);
+  });
+  touched_count_ = count;
+}
+
+void ScanIntegrator::collect_discretized(ScanUpdate& update) {
+  // The key from the grid index: idx = x + side (y + side z). (n + 0.5) / d rounded down by
+  // truncation is exact here (the product's relative error, ~1e-16, is far below 0.5 / n).
+  const int side = side_, side2 = side_ * side_;
+  const double inv_side = 1.0 / side, inv_side2 = 1.0 / side2;
+  for (size_t i = 0; i < touched_count_; ++i) {
+    const int idx = touched_idx_[i];
+    uint8_t& f = cells_[static_cast<size_t>(idx)];
+    const uint8_t flags = f;
+    f = 0;
+    if (!(flags & (kOccupied | kCleared))) continue;
+    const int z = static_cast<int>((idx + 0.5) * inv_side2);
+    const int rest = idx - z * side2;
+    const int y = static_cast<int>((rest + 0.5) * inv_side);
+    const int x = rest - y * side;
+    const Key key(static_cast<uint16_t>(base_[0] + x), static_cast<uint16_t>(base_[1] + y),
+                  static_cast<uint16_t>(base_[2] + z));
+    if (flags & kOccupied) {
+      update.occupied.push_back(key);
+    } else {
+      update.free.push_back(key);
+    }
+  }
+  touched_count_ = 0;
 }
 
 void ScanIntegrator::compute_discretized() {
@@ -583,10 +630,9 @@ void ScanIntegrator::compute_discretized() {
       lo[a] = first_float_[a][g];
       hi[a] = first_float_[a][g + 1];
     }
-    uint8_t& f = cells_[static_cast<size_t>(idx)];
-    if (f & kEndpoint) continue;
-    if (f == 0) touched_.emplace_back(idx, k);
-    f = static_cast<uint8_t>(f | kEndpoint);
+    if (cells_[static_cast<size_t>(idx)] & kEndpoint) continue;
+    if (touched_idx_.size() <= touched_count_) touched_idx_.resize(2 * touched_count_ + 64);
+    touch(idx, kEndpoint);
     trace_cell_centre(k);
   }
   std::sort(far_endpoints_.begin(), far_endpoints_.end());
@@ -617,7 +663,11 @@ void ScanIntegrator::compute(const Scan& scan, ScanUpdate& update, Method method
   update.cells_witnessed = cells_witnessed_;
   update.rays_traced = rays_traced_;
   update.ray_tests = ray_tests_;
-  collect(update);
+  if (method == Method::kDiscretized) {
+    collect_discretized(update);
+  } else {
+    collect(update);
+  }
   scan_ = nullptr;
 }
 

@@ -116,6 +116,8 @@ class ScanIntegrator {
   void collect(ScanUpdate& update);
   void compute_discretized();
   void trace_cell_centre(const Key& key);
+  void touch(int idx, uint8_t flags);
+  void collect_discretized(ScanUpdate& update);
 
   KeySpace keys_;
   ScanOptions options_;
@@ -163,6 +165,10 @@ class ScanIntegrator {
   std::vector<uint32_t> ray_state_;
   std::vector<uint32_t> ray_slot_;         // where in rays_ a built ray is
   std::vector<uint64_t> far_endpoints_;    // kDiscretized: packed endpoint keys outside the grid
+  // kDiscretized: grid indices of the cells whose flags were set (touched_ without keys: the
+  // key follows from the index), the first touched_count_ entries.
+  std::vector<int> touched_idx_;
+  size_t touched_count_ = 0;
   // kDiscretized: per axis, first_float() of every grid coordinate 0..side_ (for base
   // float_base_[a]), so that a point is placed in its cell by float comparisons.
   std::vector<float> first_float_[3];

@@ -1,7 +1,8 @@
 // The reach pyramid's answers equal a brute-force scan of the rectangle (exact maximum, never a
 // bound below it), and KeySpace::key equals OctoMap's floor-based rule at cell edges, signs and
 // the ends of the key range. The four-pixel reach masks (SSE2 where built with it) equal the
-// scalar fallback and a pixel-by-pixel test.
+// scalar fallback and a pixel-by-pixel test. The index-only ray walk (branch-free, SSE2 where
+// built with it) visits OctoMap's computeRayKeys cells.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -10,7 +11,10 @@
 #include <random>
 #include <vector>
 
+#include <octomap/OcTree.h>
+
 #include "mapper/key_space.h"
+#include "mapper/ray.h"
 #include "mapper/reach_mask.h"
 #include "mapper/reach_pyramid.h"
 
@@ -124,6 +128,50 @@ TEST(KeySpace, FirstFloatIsTheLowestFloatOfTheKey) {
       ASSERT_EQ(got, k - 1) << resolution << " " << k;
     }
   }
+}
+
+TEST(Ray, IndexOnlyWalkVisitsOctomapsRayCells) {
+  // Rays from random origins (some on cell corners and edges) to random points (some on cell
+  // faces, some along an axis or a diagonal): trace_index_only() visits, by grid index, exactly
+  // the cells of OctoMap's computeRayKeys, in order.
+  std::mt19937 rng(11);
+  const double res = 0.1;
+  const KeySpace keys(res);
+  octomap::OcTree tree(res);
+  std::uniform_real_distribution<double> any(-3.0, 3.0), offset(-2.0, 2.0);
+  std::uniform_int_distribution<int> cell(-30, 30), kind(0, 5);
+  const int side = 101;  // a grid of side^3 cells centred on the origin's cell
+  const int stride[3] = {1, side, side * side};
+  size_t walked = 0;
+  for (int trial = 0; trial < 20000; ++trial) {
+    const int k = kind(rng);
+    octomap::point3d origin(static_cast<float>(any(rng)), static_cast<float>(any(rng)), static_cast<float>(any(rng)));
+    if (k == 1) origin = octomap::point3d(static_cast<float>(cell(rng) * res), static_cast<float>(cell(rng) * res), 0.5f);
+    octomap::point3d end = origin + octomap::point3d(static_cast<float>(offset(rng)), static_cast<float>(offset(rng)),
+                                                     static_cast<float>(offset(rng)));
+    if (k == 2) end = octomap::point3d(static_cast<float>(cell(rng) * res), end.y(), static_cast<float>(cell(rng) * res));
+    if (k == 3) end = octomap::point3d(origin.x() + 1.3f, origin.y(), origin.z());
+    if (k == 4) end = origin + octomap::point3d(0.7f, -0.7f, 0.7f);
+    Key key_origin;
+    ASSERT_TRUE(keys.key(origin, key_origin));
+    const Ray ray = make_ray(keys, origin, key_origin, end, 10.0);
+    if (!ray.clears) continue;
+    octomap::KeyRay expected;
+    ASSERT_TRUE(tree.computeRayKeys(origin, ray.end, expected));
+    auto grid_index = [&](const Key& key) {
+      int idx = 0;
+      for (int a = 0; a < 3; ++a) idx += (key[a] - key_origin[a] + side / 2) * stride[a];
+      return idx;
+    };
+    std::vector<int> got;
+    trace_index_only(keys, origin, key_origin, ray, grid_index(key_origin), grid_index(ray.key_end), stride,
+                     [&](int idx) { got.push_back(idx); });
+    std::vector<int> want;
+    for (const Key& key : expected) want.push_back(grid_index(key));
+    ASSERT_EQ(got, want) << "trial " << trial;
+    ++walked;
+  }
+  EXPECT_GT(walked, 15000u);
 }
 
 TEST(ReachMask, FourPixelMaskEqualsScalarAndPixelByPixel) {
