@@ -96,73 +96,191 @@ void trace_indexed(const KeySpace& keys, const octomap::point3d& origin, const K
   }
 }
 
-/// trace_indexed() for a ray whose end cell lies in the index's grid (end_index is its index;
-/// then index equality is key equality, and every cell the walk visits lies within the ray's
-/// length of the origin, in the grid too): calls visit(index) for every cell the ray clears, in
-/// the same order, without keeping the key. Each step picks its axis without a branch (the
-/// choice is unpredictable): the crossing times of the axes not chosen get + 0.0, which leaves
-/// them unchanged, so the arithmetic and the choice are OctoMap's, as in trace_indexed().
-template <class Visit>
-void trace_index_only(const KeySpace& keys, const octomap::point3d& origin, const Key& key_origin,
-                      const Ray& ray, int origin_index, int end_index, const int index_step[3],
-                      Visit&& visit) {
-  if (!ray.clears) return;
+/// The state of trace_indexed()'s walk for a ray whose end cell lies in the index's grid (then
+/// index equality is key equality, and every cell the walk visits lies within the ray's length
+/// of the origin, in the grid too), kept by grid index alone: crossing times, their steps, the
+/// length, the current and the end cell's index, and the index step by the axis chosen (0 z,
+/// 1 x, 2 y).
+struct IndexWalk {
+  double t[3];
+  double delta[3];
+  double length;
+  int index;
+  int end;
+  int move[4];
+};
+
+/// The walk of `ray` (ray.clears) at its first cell, the origin's (origin_index); end_index is
+/// the index of ray.key_end. The same arithmetic as trace_indexed() (and so OctoMap's).
+inline IndexWalk start_index_walk(const KeySpace& keys, const octomap::point3d& origin, const Key& key_origin,
+                                  const Ray& ray, int origin_index, int end_index, const int index_step[3]) {
+  IndexWalk w;
   const double res = keys.resolution();
-  double t_max[3];
-  double t_delta[3];
   for (int a = 0; a < 3; ++a) {
     if (ray.step[a] != 0) {
       double border = keys.centre(key_origin[a]);
       border += static_cast<double>(static_cast<float>(ray.step[a] * res * 0.5));
       const double d = static_cast<double>(ray.dir(a));
-      t_max[a] = (border - static_cast<double>(origin(a))) / d;
-      t_delta[a] = res / std::fabs(d);
+      w.t[a] = (border - static_cast<double>(origin(a))) / d;
+      w.delta[a] = res / std::fabs(d);
     } else {
-      t_max[a] = std::numeric_limits<double>::max();
-      t_delta[a] = std::numeric_limits<double>::max();
+      w.t[a] = std::numeric_limits<double>::max();
+      w.delta[a] = std::numeric_limits<double>::max();
     }
   }
-  int index = origin_index;
-  // Index step by the axis chosen: 0 z, 1 x, 2 y (the bits of the choice below).
-  const int index_move[4] = {ray.step[2] * index_step[2], ray.step[0] * index_step[0],
-                             ray.step[1] * index_step[1], 0};
-  visit(index);
-#ifdef __SSE2__
-  // Scalars in the low lanes; the comparisons give all-ones masks that select the increments.
-  __m128d tx = _mm_set_sd(t_max[0]), ty = _mm_set_sd(t_max[1]), tz = _mm_set_sd(t_max[2]);
-  const __m128d dx = _mm_set_sd(t_delta[0]), dy = _mm_set_sd(t_delta[1]), dz = _mm_set_sd(t_delta[2]);
-  const __m128d length = _mm_set_sd(static_cast<double>(ray.length));
-  for (;;) {
-    const __m128d x_below_y = _mm_cmplt_sd(tx, ty);
-    const __m128d step_x = _mm_and_pd(x_below_y, _mm_cmplt_sd(tx, tz));
-    const __m128d step_y = _mm_andnot_pd(x_below_y, _mm_cmplt_sd(ty, tz));
-    const __m128d step_x_or_y = _mm_or_pd(step_x, step_y);
-    tx = _mm_add_sd(tx, _mm_and_pd(step_x, dx));
-    ty = _mm_add_sd(ty, _mm_and_pd(step_y, dy));
-    tz = _mm_add_sd(tz, _mm_andnot_pd(step_x_or_y, dz));
-    index += index_move[_mm_movemask_pd(_mm_unpacklo_pd(step_x, step_y))];
-    if (index == end_index) return;
-    if (_mm_comigt_sd(_mm_min_sd(_mm_min_sd(tx, ty), tz), length)) return;
-    visit(index);
-  }
-#else
-  const double length = static_cast<double>(ray.length);
-  double tx = t_max[0], ty = t_max[1], tz = t_max[2];
-  const double dx = t_delta[0], dy = t_delta[1], dz = t_delta[2];
+  w.length = static_cast<double>(ray.length);
+  w.index = origin_index;
+  w.end = end_index;
+  w.move[0] = ray.step[2] * index_step[2];
+  w.move[1] = ray.step[0] * index_step[0];
+  w.move[2] = ray.step[1] * index_step[1];
+  w.move[3] = 0;
+  return w;
+}
+
+/// Continues walk `w` from its current cell to the end: visit(index) for every further cell the
+/// ray clears, in order. Each step picks its axis without a branch (the choice is
+/// unpredictable): the crossing times of the axes not chosen get + 0.0, which leaves them
+/// unchanged, so the arithmetic and the choice are OctoMap's, as in trace_indexed().
+template <class Visit>
+void continue_index_walk(IndexWalk& w, Visit&& visit) {
+  double tx = w.t[0], ty = w.t[1], tz = w.t[2];
+  const double dx = w.delta[0], dy = w.delta[1], dz = w.delta[2];
+  int index = w.index;
   for (;;) {
     const bool x_below_y = tx < ty;
     const bool step_x = x_below_y & (tx < tz);
     const bool step_y = !x_below_y & (ty < tz);
     const bool step_z = !(step_x | step_y);
-    index += index_move[static_cast<int>(step_x) | static_cast<int>(step_y) << 1];
+    index += w.move[static_cast<int>(step_x) | static_cast<int>(step_y) << 1];
     tx += step_x ? dx : 0.0;
     ty += step_y ? dy : 0.0;
     tz += step_z ? dz : 0.0;
-    if (index == end_index) return;
-    if (std::min(std::min(tx, ty), tz) > length) return;
+    if (index == w.end) break;
+    if (std::min(std::min(tx, ty), tz) > w.length) break;
     visit(index);
   }
+  w.t[0] = tx;
+  w.t[1] = ty;
+  w.t[2] = tz;
+  w.index = index;
+}
+
+/// Walks walks[0..count) (each at its first cell, which is not visited again) to their ends:
+/// visit(index, k) for every further cell walk k clears, in order for each walk; the walks are
+/// interleaved (two at a time in SSE2 lanes, so that one walk's dependent steps overlap the
+/// other's), each with the same steps as continue_index_walk(). Changes the walks.
+template <class Visit>
+void walk_index_walks(IndexWalk* walks, size_t count, Visit&& visit) {
+  size_t next = 0;
+#ifdef __SSE2__
+  if (count >= 2) {
+    // Lane 0 walks walks[a], lane 1 walks[b]; a finished lane takes the next walk.
+    size_t a = 0, b = 1;
+    next = 2;
+    __m128d tx = _mm_set_pd(walks[b].t[0], walks[a].t[0]), ty = _mm_set_pd(walks[b].t[1], walks[a].t[1]),
+            tz = _mm_set_pd(walks[b].t[2], walks[a].t[2]);
+    __m128d dx = _mm_set_pd(walks[b].delta[0], walks[a].delta[0]),
+            dy = _mm_set_pd(walks[b].delta[1], walks[a].delta[1]),
+            dz = _mm_set_pd(walks[b].delta[2], walks[a].delta[2]);
+    __m128d length = _mm_set_pd(walks[b].length, walks[a].length);
+    int index_a = walks[a].index, index_b = walks[b].index;
+    for (;;) {
+      const __m128d x_below_y = _mm_cmplt_pd(tx, ty);
+      const __m128d step_x = _mm_and_pd(x_below_y, _mm_cmplt_pd(tx, tz));
+      const __m128d step_y = _mm_andnot_pd(x_below_y, _mm_cmplt_pd(ty, tz));
+      tx = _mm_add_pd(tx, _mm_and_pd(step_x, dx));
+      ty = _mm_add_pd(ty, _mm_and_pd(step_y, dy));
+      tz = _mm_add_pd(tz, _mm_andnot_pd(_mm_or_pd(step_x, step_y), dz));
+      const int bits_x = _mm_movemask_pd(step_x), bits_y = _mm_movemask_pd(step_y);
+      index_a += walks[a].move[(bits_x & 1) | (bits_y & 1) << 1];
+      index_b += walks[b].move[(bits_x >> 1) | (bits_y & 2)];
+      const int past = _mm_movemask_pd(_mm_cmpgt_pd(_mm_min_pd(_mm_min_pd(tx, ty), tz), length));
+      const bool done_a = index_a == walks[a].end || (past & 1);
+      const bool done_b = index_b == walks[b].end || (past & 2);
+      if (!(done_a | done_b)) {
+        visit(index_a, a);
+        visit(index_b, b);
+        continue;
+      }
+      if (!done_a) visit(index_a, a);
+      if (!done_b) visit(index_b, b);
+      if (next >= count) {
+        // No walk left to start: the unfinished lane (if any) goes on alone.
+        double t[2][3];
+        _mm_storeu_pd(t[0], tx);  // (lane 0, lane 1) of x
+        _mm_storeu_pd(t[1], ty);
+        double tzs[2];
+        _mm_storeu_pd(tzs, tz);
+        if (!done_a || !done_b) {
+          const int lane = done_a ? 1 : 0;
+          IndexWalk& w = walks[lane == 0 ? a : b];
+          w.t[0] = t[0][lane];
+          w.t[1] = t[1][lane];
+          w.t[2] = tzs[lane];
+          w.index = lane == 0 ? index_a : index_b;
+          const size_t k = lane == 0 ? a : b;
+          continue_index_walk(w, [&](int index) { visit(index, k); });
+        }
+        return;
+      }
+      // A finished lane takes the next walk (at its first cell, already visited).
+      if (done_a) {
+        a = next++;
+        const IndexWalk& w = walks[a];
+        tx = _mm_move_sd(tx, _mm_set_sd(w.t[0]));
+        ty = _mm_move_sd(ty, _mm_set_sd(w.t[1]));
+        tz = _mm_move_sd(tz, _mm_set_sd(w.t[2]));
+        dx = _mm_move_sd(dx, _mm_set_sd(w.delta[0]));
+        dy = _mm_move_sd(dy, _mm_set_sd(w.delta[1]));
+        dz = _mm_move_sd(dz, _mm_set_sd(w.delta[2]));
+        length = _mm_move_sd(length, _mm_set_sd(w.length));
+        index_a = w.index;
+      }
+      if (done_b) {
+        if (next >= count) {
+          // Lane 0 goes on alone.
+          double t[3][2];
+          _mm_storeu_pd(t[0], tx);
+          _mm_storeu_pd(t[1], ty);
+          _mm_storeu_pd(t[2], tz);
+          IndexWalk& w = walks[a];
+          for (int axis = 0; axis < 3; ++axis) w.t[axis] = t[axis][0];
+          w.index = index_a;
+          const size_t k = a;
+          continue_index_walk(w, [&](int index) { visit(index, k); });
+          return;
+        }
+        b = next++;
+        const IndexWalk& w = walks[b];
+        tx = _mm_shuffle_pd(tx, _mm_set_sd(w.t[0]), 0);
+        ty = _mm_shuffle_pd(ty, _mm_set_sd(w.t[1]), 0);
+        tz = _mm_shuffle_pd(tz, _mm_set_sd(w.t[2]), 0);
+        dx = _mm_shuffle_pd(dx, _mm_set_sd(w.delta[0]), 0);
+        dy = _mm_shuffle_pd(dy, _mm_set_sd(w.delta[1]), 0);
+        dz = _mm_shuffle_pd(dz, _mm_set_sd(w.delta[2]), 0);
+        length = _mm_shuffle_pd(length, _mm_set_sd(w.length), 0);
+        index_b = w.index;
+      }
+    }
+  }
 #endif
+  for (; next < count; ++next) {
+    const size_t k = next;
+    continue_index_walk(walks[k], [&](int index) { visit(index, k); });
+  }
+}
+
+/// trace_indexed() for a ray whose end cell lies in the index's grid (end_index is its index),
+/// by grid index alone: visit(index) for every cell the ray clears, in order.
+template <class Visit>
+void trace_index_only(const KeySpace& keys, const octomap::point3d& origin, const Key& key_origin,
+                      const Ray& ray, int origin_index, int end_index, const int index_step[3],
+                      Visit&& visit) {
+  if (!ray.clears) return;
+  IndexWalk w = start_index_walk(keys, origin, key_origin, ray, origin_index, end_index, index_step);
+  visit(w.index);
+  continue_index_walk(w, visit);
 }
 
 /// Calls visit(key) for every cell the ray clears, in order, starting with the origin's cell.

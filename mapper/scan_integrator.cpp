@@ -522,7 +522,10 @@ void ScanIntegrator::collect(ScanUpdate& update) {
 
 inline void ScanIntegrator::touch(int idx, uint8_t flags) {
   uint8_t& f = cells_[static_cast<size_t>(idx)];
-  if (f == 0) touched_idx_[touched_count_++] = idx;
+  if (f == 0) {
+    if (touched_idx_.size() <= touched_count_) touched_idx_.resize(2 * touched_count_ + 64);
+    touched_idx_[touched_count_++] = idx;
+  }
   f = static_cast<uint8_t>(f | flags);
 }
 
@@ -534,26 +537,37 @@ inline void ScanIntegrator::trace_cell_centre(const Key& key) {
                                 static_cast<float>(keys_.centre(key[2])));
   const Ray r = make_ray(keys_, scan_->origin, key_origin_, centre, options_.max_range_m);
   ++rays_traced_;
-  if (!r.hit && !r.clears) return;
   // A hit lies within max range of the origin, and so does a cut ray's end (both are in the
-  // grid), and so every cell a walk clears. A walk moves monotonically along each axis within
-  // the grid: at most 3 side_ cells, plus the hit's.
-  if (touched_idx_.size() < touched_count_ + 3 * static_cast<size_t>(side_) + 2)
-    touched_idx_.resize(2 * (touched_count_ + 3 * static_cast<size_t>(side_) + 2));
+  // grid), and so every cell a walk clears.
+  if (!r.hit && !r.clears) return;
   const int end = index(r.key_end);
   if (r.hit) touch(end, kOccupied);
+  // The walk is made later, with the others (walk_rays()).
+  if (r.clears) walks_.push_back(start_index_walk(keys_, scan_->origin, key_origin_, r, index(key_origin_), end, stride_));
+}
+
+void ScanIntegrator::walk_rays() {
+  if (walks_.empty()) return;
+  // Every walk starts in the origin's cell.
+  touch(index(key_origin_), kCleared);
+  // A walk moves monotonically along each axis within the grid (at most 3 side_ cells), and the
+  // list holds distinct cells of the grid.
+  const size_t side = static_cast<size_t>(side_);
+  const size_t most = std::min(touched_count_ + walks_.size() * (3 * side + 2), side * side * side) + 1;
+  if (touched_idx_.size() < most) touched_idx_.resize(most);
   // The touched list is appended without a branch: the entry is written always and kept when
   // the cell was untouched.
   uint8_t* const cells = cells_.data();
   int* const touched = touched_idx_.data();
   size_t count = touched_count_;
-  trace_index_only(keys_, scan_->origin, key_origin_, r, index(key_origin_), end, stride_, [&](int idx) {
+  walk_index_walks(walks_.data(), walks_.size(), [&](int idx, size_t) {
     uint8_t& f = cells[static_cast<size_t>(idx)];
     touched[count] = idx;
     count += f == 0;
     f = static_cast<uint8_t>(f | kCleared);
   });
   touched_count_ = count;
+  walks_.clear();
 }
 
 void ScanIntegrator::collect_discretized(ScanUpdate& update) {
@@ -631,7 +645,6 @@ void ScanIntegrator::compute_discretized() {
       hi[a] = first_float_[a][g + 1];
     }
     if (cells_[static_cast<size_t>(idx)] & kEndpoint) continue;
-    if (touched_idx_.size() <= touched_count_) touched_idx_.resize(2 * touched_count_ + 64);
     touch(idx, kEndpoint);
     trace_cell_centre(k);
   }
@@ -641,6 +654,7 @@ void ScanIntegrator::compute_discretized() {
     trace_cell_centre(Key(static_cast<uint16_t>(packed), static_cast<uint16_t>(packed >> 16),
                           static_cast<uint16_t>(packed >> 32)));
   }
+  walk_rays();
 }
 
 void ScanIntegrator::compute(const Scan& scan, ScanUpdate& update, Method method) {

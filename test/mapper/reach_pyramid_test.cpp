@@ -130,10 +130,11 @@ TEST(KeySpace, FirstFloatIsTheLowestFloatOfTheKey) {
   }
 }
 
-TEST(Ray, IndexOnlyWalkVisitsOctomapsRayCells) {
+TEST(Ray, IndexOnlyWalksVisitOctomapsRayCells) {
   // Rays from random origins (some on cell corners and edges) to random points (some on cell
   // faces, some along an axis or a diagonal): trace_index_only() visits, by grid index, exactly
-  // the cells of OctoMap's computeRayKeys, in order.
+  // the cells of OctoMap's computeRayKeys, in order, and so does each walk when
+  // walk_index_walks() interleaves them.
   std::mt19937 rng(11);
   const double res = 0.1;
   const KeySpace keys(res);
@@ -143,6 +144,8 @@ TEST(Ray, IndexOnlyWalkVisitsOctomapsRayCells) {
   const int side = 101;  // a grid of side^3 cells centred on the origin's cell
   const int stride[3] = {1, side, side * side};
   size_t walked = 0;
+  std::vector<IndexWalk> walks;
+  std::vector<std::vector<int>> wanted;
   for (int trial = 0; trial < 20000; ++trial) {
     const int k = kind(rng);
     octomap::point3d origin(static_cast<float>(any(rng)), static_cast<float>(any(rng)), static_cast<float>(any(rng)));
@@ -170,8 +173,24 @@ TEST(Ray, IndexOnlyWalkVisitsOctomapsRayCells) {
     for (const Key& key : expected) want.push_back(grid_index(key));
     ASSERT_EQ(got, want) << "trial " << trial;
     ++walked;
+    walks.push_back(start_index_walk(keys, origin, key_origin, ray, grid_index(key_origin), grid_index(ray.key_end), stride));
+    want.erase(want.begin());  // the walks below start in the origin's cell, already visited
+    wanted.push_back(want);
   }
   EXPECT_GT(walked, 15000u);
+  // The same walks interleaved (two at a time where built with SSE2), in batches of every size
+  // from 0 to 9 and then larger: each walk's cells in order.
+  size_t begin = 0;
+  for (size_t batch = 0; begin < walks.size(); batch = batch < 9 ? batch + 1 : 2 * batch) {
+    const size_t n = std::min(batch, walks.size() - begin);
+    std::vector<std::vector<int>> got(n);
+    walk_index_walks(walks.data() + begin, n, [&](int idx, size_t k) {
+      ASSERT_LT(k, n);
+      got[k].push_back(idx);
+    });
+    for (size_t k = 0; k < n; ++k) ASSERT_EQ(got[k], wanted[begin + k]) << "walk " << begin + k << " of a batch of " << n;
+    begin += n;
+  }
 }
 
 TEST(ReachMask, FourPixelMaskEqualsScalarAndPixelByPixel) {
