@@ -52,7 +52,7 @@ double depth_time_offset_s(const DepthOptions& options, int64_t rgb_utime, int64
   if (!options.time_offset_from_stamps) return options.time_offset_s;
   constexpr int64_t kMaxStampOffsetUs = 100000;
   const int64_t offset_us = depth_utime - rgb_utime;
-  return std::abs(offset_us) < kMaxStampOffsetUs ? 1e-6 * double(offset_us) : 0.0;
+  return std::abs(offset_us) < kMaxStampOffsetUs ? 1e-6 * double(offset_us) + options.time_offset_s : 0.0;
 }
 
 void attach_depth(const cv::Mat& depth_mm, const Lens& lens, const DepthOptions& options,

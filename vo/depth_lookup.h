@@ -29,7 +29,8 @@ Eigen::Vector3f point_at_frame_time(const Lens& lens, const FrameMotion& motion,
                                     float z, Eigen::Vector2f* ideal);
 
 /// Depth capture time minus colour capture time, seconds, as `options` say to take it: from
-/// the stamps (0 when they are 0.1 s or more apart: not one capture) or the configured value.
+/// the stamps plus the configured latency term (0 when they are 0.1 s or more apart: not one
+/// capture), or the configured value alone.
 double depth_time_offset_s(const DepthOptions& options, int64_t rgb_utime, int64_t depth_utime);
 
 /// Depth in metres at raw pixel (u, v) (nearest pixel), or 0 when there is no reliable reading:

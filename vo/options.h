@@ -42,10 +42,11 @@ struct DepthOptions {
   double sigma_z_coeff = 1.4e-3;        ///< depth noise sigma_z = coeff * z^2 (metres; Khoshelham 2011)
   bool compensate_time_offset = false;  ///< look depth up where the point was at depth time
   /// The offset compensated (depth capture minus colour capture time) is the frame's depth
-  /// stamp minus its RGB stamp; when false, time_offset_s, for a source whose stamps are
-  /// arrival times rather than capture times (a TUM recording: with_tum_sensor()).
+  /// stamp minus its RGB stamp plus time_offset_s: for a source whose stamps are arrival
+  /// times, time_offset_s is minus the depth image's extra latency (a Kinect:
+  /// with_sensor()). When false, time_offset_s alone, whatever the stamps say.
   bool time_offset_from_stamps = true;
-  double time_offset_s = 0.0;           ///< seconds, used when time_offset_from_stamps is false
+  double time_offset_s = 0.0;           ///< seconds
   bool undistort = true;                ///< use the camera's lens distortion for rays and reprojection
   /// Colour rolling shutter, first-to-last row time; 0 = global shutter (the simulator's camera).
   /// A freiburg1 TUM run uses the Kinect's (with_tum_sensor(), vo/sequence_run.h).

@@ -6,8 +6,8 @@ VoOptions with_sensor(SensorProfile profile, VoOptions options) {
   if (profile == SensorProfile::kSimulator) return options;
   options.depth.rolling_shutter_readout_s = kKinect1RollingShutterReadoutS;
   options.depth.compensate_time_offset = true;
-  options.depth.time_offset_from_stamps = false;
-  options.depth.time_offset_s = kKinect1DepthTimeOffsetS;
+  options.depth.time_offset_from_stamps = true;
+  options.depth.time_offset_s = -kKinect1DepthExtraLatencyS;
   options.covariance.translation_floor_m = kKinect1TranslationFloorM;
   options.covariance.rotation_floor_rad = kKinect1RotationFloorRad;
   options.validate();

@@ -77,14 +77,19 @@ TEST(DepthTimeOffset, CompensatedLookupReadsTheDepthAtRgbTime) {
   EXPECT_LT(e_compensated, 0.15 * e_plain);
 }
 
-// Which offset is compensated: the stamps' difference (a capture 0.1 s or more away is not one
-// capture: none), or, for a source whose stamps are arrival times, the configured value.
+// Which offset is compensated: the stamps' difference plus the configured latency term (a
+// capture 0.1 s or more away is not one capture: none), or the configured value alone.
 TEST(DepthTimeOffset, TakenFromTheStampsOrTheConfiguredValue) {
   DepthOptions options;
   EXPECT_DOUBLE_EQ(depth_time_offset_s(options, 1'000'000, 988'000), -0.012);
   EXPECT_DOUBLE_EQ(depth_time_offset_s(options, 1'000'000, 1'007'500), 0.0075);
   EXPECT_DOUBLE_EQ(depth_time_offset_s(options, 1'000'000, 1'100'000), 0.0);
   EXPECT_DOUBLE_EQ(depth_time_offset_s(options, 1'000'000, 850'000), 0.0);
+
+  options.time_offset_s = -0.015;  // the depth image arrives 15 ms later after its capture
+  EXPECT_NEAR(depth_time_offset_s(options, 1'000'000, 988'000), -0.027, 1e-12);
+  EXPECT_NEAR(depth_time_offset_s(options, 1'000'000, 1'007'500), -0.0075, 1e-12);
+  EXPECT_DOUBLE_EQ(depth_time_offset_s(options, 1'000'000, 1'100'000), 0.0);
 
   options.time_offset_from_stamps = false;
   options.time_offset_s = -0.012;
@@ -103,8 +108,8 @@ TEST(DepthTimeOffset, TheKinectTimingIsForFreiburg1RecordingsOnly) {
   EXPECT_EQ(tum_sensor("../data/tum/rgbd_dataset_freiburg1_rpy"), SensorProfile::kKinect1);
   const VoOptions fr1 = with_tum_sensor("../data/tum/rgbd_dataset_freiburg1_rpy", given);
   EXPECT_TRUE(fr1.depth.compensate_time_offset);
-  EXPECT_FALSE(fr1.depth.time_offset_from_stamps);
-  EXPECT_DOUBLE_EQ(fr1.depth.time_offset_s, kKinect1DepthTimeOffsetS);
+  EXPECT_TRUE(fr1.depth.time_offset_from_stamps);
+  EXPECT_DOUBLE_EQ(fr1.depth.time_offset_s, -kKinect1DepthExtraLatencyS);
   EXPECT_DOUBLE_EQ(fr1.depth.rolling_shutter_readout_s, kKinect1RollingShutterReadoutS);
   EXPECT_DOUBLE_EQ(fr1.covariance.translation_floor_m, kKinect1TranslationFloorM);
   EXPECT_DOUBLE_EQ(fr1.covariance.rotation_floor_rad, kKinect1RotationFloorRad);
