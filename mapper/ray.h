@@ -169,106 +169,83 @@ void continue_index_walk(IndexWalk& w, Visit&& visit) {
 /// Walks walks[0..count) (each at its first cell, which is not visited again) to their ends:
 /// visit(index, k) for every further cell walk k clears, in order for each walk; the walks are
 /// interleaved (two at a time in SSE2 lanes, so that one walk's dependent steps overlap the
-/// other's), each with the same steps as continue_index_walk(). Changes the walks.
+/// other's), each with the same steps as continue_index_walk(). `visit` is taken and returned
+/// by value (kept in registers: its stores cannot alias it). Changes the walks.
 template <class Visit>
-void walk_index_walks(IndexWalk* walks, size_t count, Visit&& visit) {
-  size_t next = 0;
+Visit walk_index_walks(IndexWalk* walks, size_t count, Visit visit) {
 #ifdef __SSE2__
-  if (count >= 2) {
-    // Lane 0 walks walks[a], lane 1 walks[b]; a finished lane takes the next walk.
-    size_t a = 0, b = 1;
-    next = 2;
-    __m128d tx = _mm_set_pd(walks[b].t[0], walks[a].t[0]), ty = _mm_set_pd(walks[b].t[1], walks[a].t[1]),
-            tz = _mm_set_pd(walks[b].t[2], walks[a].t[2]);
-    __m128d dx = _mm_set_pd(walks[b].delta[0], walks[a].delta[0]),
-            dy = _mm_set_pd(walks[b].delta[1], walks[a].delta[1]),
-            dz = _mm_set_pd(walks[b].delta[2], walks[a].delta[2]);
-    __m128d length = _mm_set_pd(walks[b].length, walks[a].length);
-    int index_a = walks[a].index, index_b = walks[b].index;
-    for (;;) {
-      const __m128d x_below_y = _mm_cmplt_pd(tx, ty);
-      const __m128d step_x = _mm_and_pd(x_below_y, _mm_cmplt_pd(tx, tz));
-      const __m128d step_y = _mm_andnot_pd(x_below_y, _mm_cmplt_pd(ty, tz));
-      tx = _mm_add_pd(tx, _mm_and_pd(step_x, dx));
-      ty = _mm_add_pd(ty, _mm_and_pd(step_y, dy));
-      tz = _mm_add_pd(tz, _mm_andnot_pd(_mm_or_pd(step_x, step_y), dz));
-      const int bits_x = _mm_movemask_pd(step_x), bits_y = _mm_movemask_pd(step_y);
-      index_a += walks[a].move[(bits_x & 1) | (bits_y & 1) << 1];
-      index_b += walks[b].move[(bits_x >> 1) | (bits_y & 2)];
-      const int past = _mm_movemask_pd(_mm_cmpgt_pd(_mm_min_pd(_mm_min_pd(tx, ty), tz), length));
-      const bool done_a = index_a == walks[a].end || (past & 1);
-      const bool done_b = index_b == walks[b].end || (past & 2);
-      if (!(done_a | done_b)) {
-        visit(index_a, a);
-        visit(index_b, b);
-        continue;
-      }
-      if (!done_a) visit(index_a, a);
-      if (!done_b) visit(index_b, b);
-      if (next >= count) {
-        // No walk left to start: the unfinished lane (if any) goes on alone.
-        double t[2][3];
-        _mm_storeu_pd(t[0], tx);  // (lane 0, lane 1) of x
-        _mm_storeu_pd(t[1], ty);
-        double tzs[2];
-        _mm_storeu_pd(tzs, tz);
-        if (!done_a || !done_b) {
-          const int lane = done_a ? 1 : 0;
-          IndexWalk& w = walks[lane == 0 ? a : b];
-          w.t[0] = t[0][lane];
-          w.t[1] = t[1][lane];
-          w.t[2] = tzs[lane];
-          w.index = lane == 0 ? index_a : index_b;
-          const size_t k = lane == 0 ? a : b;
-          continue_index_walk(w, [&](int index) { visit(index, k); });
-        }
-        return;
-      }
-      // A finished lane takes the next walk (at its first cell, already visited).
-      if (done_a) {
-        a = next++;
-        const IndexWalk& w = walks[a];
-        tx = _mm_move_sd(tx, _mm_set_sd(w.t[0]));
-        ty = _mm_move_sd(ty, _mm_set_sd(w.t[1]));
-        tz = _mm_move_sd(tz, _mm_set_sd(w.t[2]));
-        dx = _mm_move_sd(dx, _mm_set_sd(w.delta[0]));
-        dy = _mm_move_sd(dy, _mm_set_sd(w.delta[1]));
-        dz = _mm_move_sd(dz, _mm_set_sd(w.delta[2]));
-        length = _mm_move_sd(length, _mm_set_sd(w.length));
-        index_a = w.index;
-      }
-      if (done_b) {
-        if (next >= count) {
-          // Lane 0 goes on alone.
-          double t[3][2];
-          _mm_storeu_pd(t[0], tx);
-          _mm_storeu_pd(t[1], ty);
-          _mm_storeu_pd(t[2], tz);
-          IndexWalk& w = walks[a];
-          for (int axis = 0; axis < 3; ++axis) w.t[axis] = t[axis][0];
-          w.index = index_a;
-          const size_t k = a;
-          continue_index_walk(w, [&](int index) { visit(index, k); });
-          return;
-        }
-        b = next++;
-        const IndexWalk& w = walks[b];
-        tx = _mm_shuffle_pd(tx, _mm_set_sd(w.t[0]), 0);
-        ty = _mm_shuffle_pd(ty, _mm_set_sd(w.t[1]), 0);
-        tz = _mm_shuffle_pd(tz, _mm_set_sd(w.t[2]), 0);
-        dx = _mm_shuffle_pd(dx, _mm_set_sd(w.delta[0]), 0);
-        dy = _mm_shuffle_pd(dy, _mm_set_sd(w.delta[1]), 0);
-        dz = _mm_shuffle_pd(dz, _mm_set_sd(w.delta[2]), 0);
-        length = _mm_shuffle_pd(length, _mm_set_sd(w.length), 0);
-        index_b = w.index;
-      }
+  if (count == 0) return visit;
+  // Lane 0 walks walks[a], lane 1 walks[b]; a finished lane takes the next walk, or goes dead
+  // (crossing times 0 past a negative length: finished at every step, never visited).
+  constexpr size_t kDead = ~size_t{0};
+  static constexpr int kNoMove[4] = {0, 0, 0, 0};
+  size_t a = 0, b = count >= 2 ? 1 : kDead;
+  size_t next = count >= 2 ? 2 : 1;
+  const IndexWalk dead = {{0.0, 0.0, 0.0}, {0.0, 0.0, 0.0}, -1.0, 0, 0, {0, 0, 0, 0}};
+  const IndexWalk& wb = b == kDead ? dead : walks[b];
+  __m128d tx = _mm_set_pd(wb.t[0], walks[a].t[0]), ty = _mm_set_pd(wb.t[1], walks[a].t[1]),
+          tz = _mm_set_pd(wb.t[2], walks[a].t[2]);
+  __m128d dx = _mm_set_pd(wb.delta[0], walks[a].delta[0]), dy = _mm_set_pd(wb.delta[1], walks[a].delta[1]),
+          dz = _mm_set_pd(wb.delta[2], walks[a].delta[2]);
+  __m128d length = _mm_set_pd(wb.length, walks[a].length);
+  int index_a = walks[a].index, index_b = wb.index;
+  int end_a = walks[a].end, end_b = b == kDead ? 0 : wb.end;
+  const int* move_a = walks[a].move;
+  const int* move_b = b == kDead ? kNoMove : wb.move;
+  for (;;) {
+    const __m128d x_below_y = _mm_cmplt_pd(tx, ty);
+    const __m128d step_x = _mm_and_pd(x_below_y, _mm_cmplt_pd(tx, tz));
+    const __m128d step_y = _mm_andnot_pd(x_below_y, _mm_cmplt_pd(ty, tz));
+    tx = _mm_add_pd(tx, _mm_and_pd(step_x, dx));
+    ty = _mm_add_pd(ty, _mm_and_pd(step_y, dy));
+    tz = _mm_add_pd(tz, _mm_andnot_pd(_mm_or_pd(step_x, step_y), dz));
+    const int bits_x = _mm_movemask_pd(step_x), bits_y = _mm_movemask_pd(step_y);
+    index_a += move_a[(bits_x & 1) | (bits_y & 1) << 1];
+    index_b += move_b[(bits_x >> 1) | (bits_y & 2)];
+    const int past = _mm_movemask_pd(_mm_cmpgt_pd(_mm_min_pd(_mm_min_pd(tx, ty), tz), length));
+    const bool done_a = index_a == end_a || (past & 1);
+    const bool done_b = index_b == end_b || (past & 2);
+    if (!(done_a | done_b)) {
+      visit(index_a, a);
+      visit(index_b, b);
+      continue;
     }
+    if (!done_a) visit(index_a, a);
+    if (!done_b) visit(index_b, b);
+    if (done_a && a != kDead) {
+      const IndexWalk& w = next < count ? walks[next] : dead;
+      a = next < count ? next++ : kDead;
+      tx = _mm_move_sd(tx, _mm_set_sd(w.t[0]));
+      ty = _mm_move_sd(ty, _mm_set_sd(w.t[1]));
+      tz = _mm_move_sd(tz, _mm_set_sd(w.t[2]));
+      dx = _mm_move_sd(dx, _mm_set_sd(w.delta[0]));
+      dy = _mm_move_sd(dy, _mm_set_sd(w.delta[1]));
+      dz = _mm_move_sd(dz, _mm_set_sd(w.delta[2]));
+      length = _mm_move_sd(length, _mm_set_sd(w.length));
+      index_a = w.index;
+      end_a = w.end;
+      move_a = a == kDead ? kNoMove : w.move;
+    }
+    if (done_b && b != kDead) {
+      const IndexWalk& w = next < count ? walks[next] : dead;
+      b = next < count ? next++ : kDead;
+      tx = _mm_shuffle_pd(tx, _mm_set_sd(w.t[0]), 0);
+      ty = _mm_shuffle_pd(ty, _mm_set_sd(w.t[1]), 0);
+      tz = _mm_shuffle_pd(tz, _mm_set_sd(w.t[2]), 0);
+      dx = _mm_shuffle_pd(dx, _mm_set_sd(w.delta[0]), 0);
+      dy = _mm_shuffle_pd(dy, _mm_set_sd(w.delta[1]), 0);
+      dz = _mm_shuffle_pd(dz, _mm_set_sd(w.delta[2]), 0);
+      length = _mm_shuffle_pd(length, _mm_set_sd(w.length), 0);
+      index_b = w.index;
+      end_b = w.end;
+      move_b = b == kDead ? kNoMove : w.move;
+    }
+    if (a == kDead && b == kDead) return visit;
   }
+#else
+  for (size_t k = 0; k < count; ++k) continue_index_walk(walks[k], [&](int index) { visit(index, k); });
+  return visit;
 #endif
-  for (; next < count; ++next) {
-    const size_t k = next;
-    continue_index_walk(walks[k], [&](int index) { visit(index, k); });
-  }
 }
 
 /// trace_indexed() for a ray whose end cell lies in the index's grid (end_index is its index),

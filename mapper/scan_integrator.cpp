@@ -557,16 +557,18 @@ void ScanIntegrator::walk_rays() {
   if (touched_idx_.size() < most) touched_idx_.resize(most);
   // The touched list is appended without a branch: the entry is written always and kept when
   // the cell was untouched.
-  uint8_t* const cells = cells_.data();
-  int* const touched = touched_idx_.data();
-  size_t count = touched_count_;
-  walk_index_walks(walks_.data(), walks_.size(), [&](int idx, size_t) {
-    uint8_t& f = cells[static_cast<size_t>(idx)];
-    touched[count] = idx;
-    count += f == 0;
-    f = static_cast<uint8_t>(f | kCleared);
-  });
-  touched_count_ = count;
+  struct Mark {
+    uint8_t* cells;
+    int* touched;
+    size_t count;
+    void operator()(int idx, size_t) {
+      uint8_t& f = cells[static_cast<size_t>(idx)];
+      touched[count] = idx;
+      count += f == 0;
+      f = static_cast<uint8_t>(f | kCleared);
+    }
+  };
+  touched_count_ = walk_index_walks(walks_.data(), walks_.size(), Mark{cells_.data(), touched_idx_.data(), touched_count_}).count;
   walks_.clear();
 }
 
@@ -646,8 +648,12 @@ void ScanIntegrator::compute_discretized() {
     }
     if (cells_[static_cast<size_t>(idx)] & kEndpoint) continue;
     touch(idx, kEndpoint);
-    trace_cell_centre(k);
+    endpoints_.push_back(k);
   }
+  // The rays are made after the pass (their divisions and roots then overlap from ray to ray
+  // instead of stalling the pass at every new cell).
+  for (const Key& k : endpoints_) trace_cell_centre(k);
+  endpoints_.clear();
   std::sort(far_endpoints_.begin(), far_endpoints_.end());
   far_endpoints_.erase(std::unique(far_endpoints_.begin(), far_endpoints_.end()), far_endpoints_.end());
   for (const uint64_t packed : far_endpoints_) {

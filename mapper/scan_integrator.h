@@ -170,6 +170,7 @@ class ScanIntegrator {
   // key follows from the index), the first touched_count_ entries.
   std::vector<int> touched_idx_;
   size_t touched_count_ = 0;
+  std::vector<Key> endpoints_;             // kDiscretized: the distinct endpoint cells in the grid
   std::vector<IndexWalk> walks_;           // kDiscretized: the rays to walk, at their first cell
   // kDiscretized: per axis, first_float() of every grid coordinate 0..side_ (for base
   // float_base_[a]), so that a point is placed in its cell by float comparisons.
