@@ -75,6 +75,10 @@ int main(int argc, char** argv) {
   app.add_option("--neighbours", base.roadmap.max_neighbours,
                  "Each node tries its nearest this many within the connect radius (0, the default: all)")
       ->check(CLI::NonNegativeNumber);
+  std::vector<double> laser_ranges{1.5, 5.0};
+  app.add_option("--laser-ranges", laser_ranges, "The laser experiment's short and long range (m)")
+      ->expected(2)
+      ->check(cli::Positive);
   app.add_option("--out", out_path, "Also write the Markdown to this file");
   app.add_option("--png-dir", png_dir, "Draw <world>_paths.png (PRM red, BRM-SU blue, all five pairs) here");
   return app.run(argc, argv, [&]() -> int {
@@ -129,7 +133,7 @@ int main(int argc, char** argv) {
         return eval::fig12_sample_counts(kinect, pairs, o, {10, 30, 100, 300});
       });
       section("laser", "Laser validation: shorter range, longer but localisable paths",
-              [&] { return eval::laser_experiment(sc, pairs, o, 1.5, 5.0, 1.0); });
+              [&] { return eval::laser_experiment(sc, pairs, o, laser_ranges[0], laser_ranges[1], 1.0); });
       section("precision", "Transfer precision on every roadmap edge (relative tr(Σ) error vs step-by-step EKF)",
               [&] { return eval::transfer_precision(sc, pairs, o); });
       if (!png_dir.empty()) {

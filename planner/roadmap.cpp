@@ -32,6 +32,18 @@ std::vector<BeliefStep> BeliefModel::steps(const Config& a, const Config& b) con
   return out;
 }
 
+double peak_trace_along(const BeliefModel& model, const Config& a, const Config& b, const Mat4& sigma) {
+  Mat4 S = sigma;
+  const std::vector<BeliefStep> steps = model.steps(a, b);
+  if (steps.empty()) return S.trace();
+  double peak = 0.0;
+  for (const BeliefStep& s : steps) {
+    S = propagate_ekf(S, {s});
+    peak = std::max(peak, S.trace());
+  }
+  return peak;
+}
+
 int Roadmap::add_node(const Config& q) {
   nodes_.push_back(q);
   adjacency_.emplace_back();

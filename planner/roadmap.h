@@ -87,6 +87,11 @@ class Roadmap {
   std::vector<std::vector<Edge>> adjacency_;
 };
 
+/// The largest tr(Sigma) at the ends of the steps of the edge a -> b flown from `sigma`
+/// (step-by-step EKF, as the experiments fly a plan): the edge's end included, its start
+/// (a node, checked on its own) not; tr(sigma) for an edge of no steps.
+double peak_trace_along(const BeliefModel& model, const Config& a, const Config& b, const Mat4& sigma);
+
 /// Node 0 = start, node 1 = goal, then up to options.samples samples (more, up to
 /// options.max_samples, while start and goal are not connected); each node is joined to its
 /// nearest max_neighbours within the radius whose motion is valid (the union of both

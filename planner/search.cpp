@@ -100,6 +100,8 @@ PlanResult belief_search(const Roadmap& map, int start, int goal, const BrmQuery
         const Mat4 sigma = e.transfer.apply(labels[l].sigma);
         const double tr = sigma.trace();
         if (!(tr < best[e.to]) || !(tr < query.max_trace)) continue;
+        if (query.edge_peak_trace && !(query.edge_peak_trace(labels[l].node, e.to, labels[l].sigma) < query.max_trace))
+          continue;
         best[e.to] = tr;
         labels.push_back({e.to, l, labels[l].length + e.length_m, sigma});
         best_label[e.to] = static_cast<int>(labels.size()) - 1;
@@ -131,6 +133,8 @@ PlanResult belief_search(const Roadmap& map, int start, int goal, const BrmQuery
       if (!(tr < query.max_trace)) continue;
       auto& f = front[e.to];
       if (std::any_of(f.begin(), f.end(), [&](const auto& p) { return p.first <= len && p.second <= tr; }))
+        continue;
+      if (query.edge_peak_trace && !(query.edge_peak_trace(labels[l].node, e.to, labels[l].sigma) < query.max_trace))
         continue;
       f.erase(std::remove_if(f.begin(), f.end(), [&](const auto& p) { return p.first >= len && p.second >= tr; }),
               f.end());

@@ -8,8 +8,10 @@
 //    order of tr(Sigma) (the paper uses FIFO) and skipped once superseded at their node.
 //  * kShortestBounded — shortest path with tr(Sigma) < max_trace at every node: labels in order
 //    of length, dropped when over the bound or dominated at their node by a label that is both
-//    shorter and better localised (tr). The bound is checked at nodes, as in the paper.
+//    shorter and better localised (tr). The bound is checked at nodes, as in the paper,
+//    and along edges too when the query gives `edge_peak_trace`.
 
+#include <functional>
 #include <limits>
 #include <vector>
 
@@ -35,6 +37,11 @@ struct BrmQuery {
   Mat4 start_covariance = Mat4::Identity();
   BrmObjective objective = BrmObjective::kMinGoalUncertainty;
   double max_trace = std::numeric_limits<double>::infinity();
+  /// Unset: max_trace is checked at nodes only (the paper's Algorithm 1). Set: also along
+  /// each edge, from -> to entered with `sigma`: it returns the largest tr(Sigma) on the way
+  /// (e.g. peak_trace_along with the roadmap's BeliefModel), and a label whose edge peaks at
+  /// or over max_trace is dropped. Called only for labels that pass every other test.
+  std::function<double(int from, int to, const Mat4& sigma)> edge_peak_trace;
 };
 
 PlanResult belief_search(const Roadmap& map, int start, int goal, const BrmQuery& query);

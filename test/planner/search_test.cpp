@@ -68,6 +68,56 @@ TEST(Brm, ShortestBoundedObjectiveTradesLengthForTheBound) {
   EXPECT_FALSE(belief_search(map, 0, 1, q).found);
 }
 
+// Start (0,0) and goal (10,0) are observed (|x| within 0.5 m of either end), the straight
+// 10 m between them is blind; the detour 0 -> (0,3) -> (10,3) -> goal runs along an observed
+// wall (y > 2.5). The blind leg's noise peaks mid-edge (0.4 + 1.15 /m x ~9 m) but the goal's
+// features bring it back under 0.1, so only a check along the edge sees it.
+TEST(Brm, BoundAlongEdgesRejectsAnEdgeThatPeaksBetweenWellLocalisedNodes) {
+  const auto information = [](const Config& q) -> Mat4 {
+    const bool seen = q[0] < 0.5 || q[0] > 9.5 || q[1] > 2.5;
+    return seen ? Mat4(100.0 * Mat4::Identity()) : Mat4(Mat4::Zero());
+  };
+  const BeliefModel model(MotionOptions{}, information);
+  Roadmap map;
+  map.add_node(Config(0, 0, 1, 0));   // start
+  map.add_node(Config(10, 0, 1, 0));  // goal
+  map.add_node(Config(0, 3, 1, 0));
+  map.add_node(Config(10, 3, 1, 0));
+  map.connect(0, 1, &model);
+  map.connect(0, 2, &model);
+  map.connect(2, 3, &model);
+  map.connect(3, 1, &model);
+  BrmQuery q;
+  q.start_covariance = 0.1 * Mat4::Identity();
+  q.objective = BrmObjective::kShortestBounded;
+  q.max_trace = 1.0;
+  // Nodes only: the straight edge ends well localised, so it is taken.
+  const PlanResult nodes_only = belief_search(map, 0, 1, q);
+  ASSERT_TRUE(nodes_only.found);
+  EXPECT_EQ(nodes_only.nodes, (std::vector<int>{0, 1}));
+  EXPECT_LT(nodes_only.traces.back(), 0.1);
+  const double blind_peak = peak_trace_along(model, map.node(0), map.node(1), q.start_covariance);
+  EXPECT_GT(blind_peak, 8.0);  // 0.4 + 1.15 x 9 minus what the first 0.5 m see
+  EXPECT_LT(blind_peak, 0.4 + 1.15 * 10.0);
+  // Along edges: the detour, every step of it under the bound.
+  q.edge_peak_trace = [&](int from, int to, const Mat4& sigma) {
+    return peak_trace_along(model, map.node(from), map.node(to), sigma);
+  };
+  const PlanResult along = belief_search(map, 0, 1, q);
+  ASSERT_TRUE(along.found);
+  EXPECT_EQ(along.nodes, (std::vector<int>{0, 2, 3, 1}));
+  EXPECT_DOUBLE_EQ(along.length_m, 16.0);
+  Mat4 sigma = q.start_covariance;
+  for (size_t i = 1; i < along.nodes.size(); ++i) {
+    const Config &a = map.node(along.nodes[i - 1]), &b = map.node(along.nodes[i]);
+    EXPECT_LT(peak_trace_along(model, a, b, sigma), 1.0);
+    sigma = propagate_ekf(sigma, model.steps(a, b));
+  }
+  // The same check applies to the min-tr(Sigma_goal) objective's bound.
+  q.objective = BrmObjective::kMinGoalUncertainty;
+  EXPECT_EQ(belief_search(map, 0, 1, q).nodes, (std::vector<int>{0, 2, 3, 1}));
+}
+
 TEST(Search, ReportsUnreachableGoalsAndRejectsBadNodes) {
   Roadmap map;
   map.add_node(Config(0, 0, 1, 0));
