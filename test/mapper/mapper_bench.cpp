@@ -75,10 +75,18 @@ std::vector<Scan> scans(int stride) {
   return out;
 }
 
-void BM_Insert(benchmark::State& state, bool discretize) {
+// Mapper::insert as a mapper calls it per frame: the scan, the cells, the log-odds and, when
+// the camera moved far enough (about every third frame here), the keyframe's decimated copy
+// (colour and depth, kept for rebuilds). /no_keyframes: the same with keyframe storage off (only
+// the first frame is stored), to show what the copy costs.
+void BM_Insert(benchmark::State& state, bool discretize, bool keyframes = true) {
   MapperOptions o;
   o.scan.stride = static_cast<int>(state.range(0));
   o.scan.discretize = discretize;
+  if (!keyframes) {
+    o.keyframe_translation_m = 1e9;
+    o.keyframe_rotation_deg = 180.0;
+  }
   Mapper mapper(o);
   const Frames& f = frames();
   size_t i = 0;
@@ -88,6 +96,7 @@ void BM_Insert(benchmark::State& state, bool discretize) {
   }
   state.SetLabel(f.source);
   state.counters["occupied"] = static_cast<double>(mapper.map().num_occupied());
+  state.counters["keyframes"] = static_cast<double>(mapper.keyframes().size()) / static_cast<double>(i);
 }
 
 void BM_Cells(benchmark::State& state, ScanIntegrator::Method method) {
@@ -161,6 +170,8 @@ void BM_Rebuild(benchmark::State& state) {
 
 BENCHMARK_CAPTURE(BM_Insert, exact, false)->Arg(5)->Arg(1)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_Insert, discretized, true)->Arg(5)->Arg(1)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Insert, exact_no_keyframes, false, false)->Arg(5)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Insert, discretized_no_keyframes, true, false)->Arg(5)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_Cells, cell_search, ScanIntegrator::Method::kCellSearch)->Arg(5)->Arg(1)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_Cells, ray_trace, ScanIntegrator::Method::kRayTrace)->Arg(5)->Arg(1)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_Cells, discretized, ScanIntegrator::Method::kDiscretized)->Arg(5)->Arg(1)->Unit(benchmark::kMillisecond);
