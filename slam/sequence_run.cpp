@@ -37,7 +37,11 @@ SlamRun run_slam_sequence(size_t count, const std::function<RgbdFrame(size_t)>& 
     m.new_reference = r.new_reference;
     m.T_reference_current = r.T_reference_current;
     m.T_body_camera = frame.T_body_camera;
-    if (m.ok) m.covariance = r.covariance;
+    if (m.ok) {
+      m.covariance = r.covariance;
+      m.translation_floor_m = r.translation_floor_m;
+      m.rotation_floor_rad = r.rotation_floor_rad;
+    }
     const std::optional<OdometryPose> pose = chain.add(m);
     if (!pose) continue;
     const OdometryLink link = pose->broken ? OdometryLink::kBroken : OdometryLink::kContinuous;

@@ -15,6 +15,8 @@ VoMotion motion_from_message(const kestrel::vo_update_t& m, const char* channel)
   if (motion.ok) {
     motion.T_reference_current = transport::from_message(m.T_reference_current, channel);
     motion.covariance = transport::covariance_from(m.covariance);
+    motion.translation_floor_m = m.translation_floor;
+    motion.rotation_floor_rad = m.rotation_floor;
   }
   return motion;
 }

@@ -132,8 +132,11 @@ MotionEstimate MotionEstimator::estimate(const Frame& ref, const Frame& cur,
   out.pixel_sigma_px = refined.pixel_sigma;
   const CovarianceOptions& co = options.covariance;
   out.covariance *= co.model_scale;
-  out.covariance.diagonal().head<3>().array() += co.translation_floor_m * co.translation_floor_m;
-  out.covariance.diagonal().tail<3>().array() += co.rotation_floor_rad * co.rotation_floor_rad;
+  const double angle = Eigen::AngleAxisd(T.linear()).angle();
+  const double st = std::hypot(co.translation_floor_m, co.translation_per_rad_m * angle);
+  const double sr = std::hypot(co.rotation_floor_rad, co.rotation_per_rad * angle);
+  out.covariance.diagonal().head<3>().array() += st * st;
+  out.covariance.diagonal().tail<3>().array() += sr * sr;
   out.status = VoStatus::kOk;
   return out;
 }

@@ -245,6 +245,8 @@ VoResult VisualOdometry::process(const RgbdFrame& input) {
   result.reference_utime = attempt.reference->utime;
   result.T_reference_current = e.T_ref_cur;
   result.covariance = e.covariance;
+  result.translation_floor_m = options_.covariance.translation_floor_m;
+  result.rotation_floor_rad = options_.covariance.rotation_floor_rad;
   const bool against_previous = attempt.reference == previous_;
   T_prev_cur_last_ = against_previous ? e.T_ref_cur : Eigen::Isometry3d(T_key_prev_.inverse() * e.T_ref_cur);
   last_dt_s_ = dt;

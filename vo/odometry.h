@@ -45,6 +45,11 @@ struct VoResult {
   bool fell_back_to_previous = false;
   Eigen::Isometry3d T_reference_current = Eigen::Isometry3d::Identity();
   Matrix6d covariance = Matrix6d::Zero();  ///< of [dp; dtheta], see motion_refinement.h
+  /// The covariance floors included in `covariance` (per-axis standard deviations added in
+  /// quadrature, CovarianceOptions): noise of each frame's pose (timing, misregistration)
+  /// rather than of this motion, so a chain of motions should count it once, not per motion.
+  double translation_floor_m = 0.0;
+  double rotation_floor_rad = 0.0;
   int num_features = 0;            ///< FAST detections over all levels
   int num_features_with_depth = 0;
   int num_matches = 0;

@@ -72,6 +72,8 @@ std::vector<std::pair<std::string, Field>> fields(VoOptions& o) {
       {"covariance.model_scale", &o.covariance.model_scale},
       {"covariance.translation_floor_m", &o.covariance.translation_floor_m},
       {"covariance.rotation_floor_rad", &o.covariance.rotation_floor_rad},
+      {"covariance.translation_per_rad_m", &o.covariance.translation_per_rad_m},
+      {"covariance.rotation_per_rad", &o.covariance.rotation_per_rad},
       {"keyframe.min_inliers_to_keep", &o.keyframe.min_inliers_to_keep},
       {"keyframe.min_inlier_fraction_to_keep", &o.keyframe.min_inlier_fraction_to_keep},
       {"keyframe.fall_back_to_previous", &o.keyframe.fall_back_to_previous},

@@ -64,6 +64,8 @@ void VoOptions::validate() const {
   require(covariance.model_scale > 0.0, "covariance.model_scale", "must be > 0");
   require(covariance.translation_floor_m >= 0.0, "covariance.translation_floor_m", "must be >= 0");
   require(covariance.rotation_floor_rad >= 0.0, "covariance.rotation_floor_rad", "must be >= 0");
+  require(covariance.translation_per_rad_m >= 0.0, "covariance.translation_per_rad_m", "must be >= 0");
+  require(covariance.rotation_per_rad >= 0.0, "covariance.rotation_per_rad", "must be >= 0");
   require(keyframe.min_inliers_to_keep >= 0, "keyframe.min_inliers_to_keep", "must be >= 0");
   require(keyframe.min_inlier_fraction_to_keep >= 0.0 && keyframe.min_inlier_fraction_to_keep <= 1.0,
           "keyframe.min_inlier_fraction_to_keep", "must be in [0, 1]");

@@ -119,15 +119,23 @@ struct DenseOptions {
 };
 
 /// What the reported covariance adds to the refinement's own (whose noise model only holds
-/// independent pixel and depth noise): the per-estimate error the model does not contain, a
-/// property of the sensor. The defaults are the simulator's camera (global shutter, one capture
-/// time; its errors are correlated over a frame: depth quantised on whole surfaces, rendering),
-/// fitted so the mean NEES is near 6 on the room figure-eight and checked on two other flights
-/// (vo/README.md, "Covariance"); a Kinect's are larger (the freiburg1 profile, sequence_run.h).
+/// independent pixel and depth noise): the error the model does not contain, a property of
+/// the sensor, in two parts that behave differently along a chain of motions:
+///  * floors: noise of each frame's pose (misregistration, a frame's own timing), the same
+///    for every motion; between consecutive motions it cancels, so a chain counts it once
+///    (VoResult's floors, slam's OdometryChain);
+///  * a part proportional to the motion's rotation angle (timing and rolling-shutter errors
+///    scale with how far the camera turned), which is the motion's own and adds up.
+/// The defaults are the simulator's camera (global shutter, one capture time; its errors are
+/// correlated over a frame: depth quantised on whole surfaces, rendering), fitted so the mean
+/// NEES is near 6 on the room figure-eight and checked on two other flights (vo/README.md,
+/// "Covariance"); a Kinect's are larger (sensor_profile.h).
 struct CovarianceOptions {
   double model_scale = 1.0;              ///< multiplies the refinement's covariance
   double translation_floor_m = 0.0006;   ///< per-axis sigma added in quadrature, metres
   double rotation_floor_rad = 0.0002;    ///< per-axis sigma added in quadrature, radians
+  double translation_per_rad_m = 0.0;    ///< per-axis sigma per radian of the motion's rotation, metres
+  double rotation_per_rad = 0.0;         ///< per-axis sigma per radian of the motion's rotation, radians
 };
 
 /// Reference (key) frame policy.

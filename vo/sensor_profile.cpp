@@ -10,6 +10,8 @@ VoOptions with_sensor(SensorProfile profile, VoOptions options) {
   options.depth.time_offset_s = -kKinect1DepthExtraLatencyS;
   options.covariance.translation_floor_m = kKinect1TranslationFloorM;
   options.covariance.rotation_floor_rad = kKinect1RotationFloorRad;
+  options.covariance.translation_per_rad_m = kKinect1TranslationPerRadM;
+  options.covariance.rotation_per_rad = kKinect1RotationPerRad;
   options.validate();
   return options;
 }

@@ -19,7 +19,7 @@ namespace kestrel::vo {
 
 enum class SensorProfile {
   kSimulator,  ///< VoOptions{} as they are
-  kKinect1,    ///< the freiburg1 Kinect: rolling shutter, depth before colour, larger floors
+  kKinect1,    ///< the freiburg1 Kinect: rolling shutter, depth latency, larger covariance
 };
 
 /// The Kinect's model:
@@ -29,13 +29,18 @@ enum class SensorProfile {
 ///   colour image does (fr1_xyz's stamps put depth 8 to 16 ms before colour, fr1_rpy's 0 to
 ///   14 ms after; the best fixed offsets of the two recordings differ by a similar 20 ms:
 ///   about -25 ms on fr1_xyz, -5 ms on fr1_rpy), and 15 ms fits both (vo/README.md);
-/// - covariance floors for what the odometry's noise model leaves out on this sensor (mean
-///   NEES against the ground truth 3.3 / 7.5 on fr1_xyz / fr1_rpy; the rotation floor also
-///   absorbs the ground truth's own orientation jitter, ~0.1 degrees).
+/// - what the odometry's noise model leaves out on this sensor (CovarianceOptions): per-frame
+///   floors 1.0 mm / 0.002 rad (they also absorb the ground truth's own orientation jitter,
+///   ~0.1 degrees) and 0.10 m / 0.085 rad per radian the camera turned, fitted to how the
+///   error of fr1's motions grows with the rotation summed over 1 to 32 frames (the same
+///   factors on both recordings within 25 %); mean NEES against the ground truth 5.4 / 6.6 on
+///   fr1_xyz / fr1_rpy (vo/README.md, "Covariance").
 constexpr double kKinect1RollingShutterReadoutS = 0.015;
 constexpr double kKinect1DepthExtraLatencyS = 0.015;
-constexpr double kKinect1TranslationFloorM = 0.002;
-constexpr double kKinect1RotationFloorRad = 0.0045;
+constexpr double kKinect1TranslationFloorM = 0.001;
+constexpr double kKinect1RotationFloorRad = 0.002;
+constexpr double kKinect1TranslationPerRadM = 0.10;
+constexpr double kKinect1RotationPerRad = 0.085;
 
 /// `options` with the profile's timing and floors set (kSimulator: unchanged).
 VoOptions with_sensor(SensorProfile profile, VoOptions options);

@@ -26,6 +26,8 @@ kestrel::vo_update_t to_message(const VoResult& r, const Eigen::Isometry3d& T_bo
   const bool ok = r.status == VoStatus::kOk;
   m.T_reference_current = transport::to_message(ok ? r.T_reference_current : Eigen::Isometry3d::Identity());
   transport::covariance_to(ok ? r.covariance : Matrix6d::Zero(), m.covariance);
+  m.translation_floor = ok ? r.translation_floor_m : 0.0;
+  m.rotation_floor = ok ? r.rotation_floor_rad : 0.0;
   m.T_body_camera = transport::to_message(T_body_camera);
   m.num_features = r.num_features;
   m.num_features_with_depth = r.num_features_with_depth;

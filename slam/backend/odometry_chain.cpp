@@ -1,5 +1,6 @@
 #include "slam/backend/odometry_chain.h"
 
+#include <cmath>
 #include <string>
 
 #include "common/error.h"
@@ -33,10 +34,19 @@ std::optional<OdometryPose> OdometryChain::add(const VoMotion& m) {
       out.reference_utime = m.reference_utime;
       out.T_reference_camera = m.T_reference_current;
       if (m.covariance.allFinite() && !m.covariance.isZero(0.0)) {
+        // Per-axis floors: isotropic in each block, so the same in any frame. Floors the
+        // covariance cannot contain (negative, not finite, above its diagonal) are not taken
+        // out: the whole covariance then counts per motion.
+        out.floor.diagonal() << Eigen::Vector3d::Constant(m.translation_floor_m * m.translation_floor_m),
+            Eigen::Vector3d::Constant(m.rotation_floor_rad * m.rotation_floor_rad);
+        const bool floors_ok = std::isfinite(m.translation_floor_m) && std::isfinite(m.rotation_floor_rad) &&
+                               m.translation_floor_m >= 0.0 && m.rotation_floor_rad >= 0.0 &&
+                               (m.covariance.diagonal() - out.floor.diagonal()).minCoeff() >= 0.0;
+        if (!floors_ok) out.floor.setZero();
         // [dp; dtheta] with dp in the reference frame -> right perturbation: rho = R^T dp.
         Matrix6d J = Matrix6d::Identity();
         J.topLeftCorner<3, 3>() = m.T_reference_current.linear().transpose();
-        out.covariance = J * m.covariance * J.transpose();
+        out.covariance = J * (m.covariance - out.floor) * J.transpose();
         out.covariance = 0.5 * (out.covariance + out.covariance.transpose()).eval();
         out.has_covariance = true;
       }
@@ -103,6 +113,8 @@ std::optional<Matrix6d> OdometryChain::relative_covariance(const OdometryPose& a
     const Matrix6d Aa = se3::adjoint(T_a_b.inverse());
     cov += Aa * a.covariance * Aa.transpose();
   }
+  // The per-frame pose noise of the span's two ends, as much as one motion carries.
+  cov += b.floor;
   return Matrix6d(0.5 * (cov + cov.transpose()));
 }
 

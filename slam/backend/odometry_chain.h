@@ -11,7 +11,10 @@
 // reference (relative to the reference it was measured from), so that relative_covariance()
 // gives the covariance of the motion between two frames of one segment: the frames' own
 // motions from their references plus the references' motions between them, carried to the
-// later frame (first order; the terms are taken as independent).
+// later frame (first order; the terms are taken as independent). The part of each reported
+// covariance that the VO calls per-frame pose noise (its floors: timing, misregistration) is
+// taken out of every motion and counted once for the span: that noise belongs to each frame's
+// pose, so along a chain it cancels between consecutive motions instead of adding up.
 
 #include <Eigen/Geometry>
 #include <cstdint>
@@ -33,6 +36,10 @@ struct VoMotion {
   /// Of T_reference_current, [dp; dtheta] as in vo_update_t (dp in the reference frame,
   /// dtheta in the current frame); all zero when the VO gave none.
   Matrix6d covariance = Matrix6d::Zero();
+  /// Per-axis standard deviations of the per-frame pose noise included in `covariance` (the
+  /// VO's floors, vo_update_t); 0 = none.
+  double translation_floor_m = 0.0;
+  double rotation_floor_rad = 0.0;
 };
 
 struct OdometryPose {
@@ -40,11 +47,12 @@ struct OdometryPose {
   bool broken = false;              ///< the odometry restarted since the previous pose
   /// How the pose was chained, for relative_covariance(): the reference it was measured from
   /// (0: none, the start of a segment), the motion from it, and that motion's covariance as a
-  /// right perturbation xi = [rho; phi] of T_reference_camera (T * Exp(xi)); has_covariance
-  /// when the VO reported one.
+  /// right perturbation xi = [rho; phi] of T_reference_camera (T * Exp(xi)) without the
+  /// per-frame pose noise, which is `floor`; has_covariance when the VO reported one.
   int64_t reference_utime = 0;
   Eigen::Isometry3d T_reference_camera = Eigen::Isometry3d::Identity();
   Matrix6d covariance = Matrix6d::Zero();
+  Matrix6d floor = Matrix6d::Zero();
   bool has_covariance = false;
   int64_t utime = 0;
 };

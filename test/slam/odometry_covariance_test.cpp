@@ -11,6 +11,7 @@
 
 #include <cmath>
 #include <iostream>
+#include <vector>
 
 #include "common/geometry/se3.h"
 #include "slam/backend/odometry_chain.h"
@@ -43,6 +44,34 @@ Matrix6d translation_covariance(double sx, double sy, double sz) {
   Matrix6d C = Matrix6d::Zero();
   C.diagonal().head<3>() << sx * sx, sy * sy, sz * sz;
   return C;
+}
+
+// The VO's floors are each frame's pose noise: a chain of re-keyed motions counts them once,
+// not once per motion; floors the covariance cannot contain are not taken out.
+TEST(OdometryChainCovariance, CountsThePerFramePoseNoiseOncePerSpan) {
+  const double ft = 0.002, fr = 0.004;  // floors
+  Matrix6d F = Matrix6d::Zero();
+  F.diagonal() << ft * ft, ft * ft, ft * ft, fr * fr, fr * fr, fr * fr;
+  const Matrix6d M = translation_covariance(0.001, 0.0005, 0.0002);  // the motion's own
+  for (const bool valid : {true, false}) {
+    OdometryChain chain;
+    std::vector<OdometryPose> poses;
+    poses.push_back(*chain.add(motion(10, 0, true, Eigen::Isometry3d::Identity(), Matrix6d::Zero())));
+    for (int k = 1; k <= 20; ++k) {  // every frame re-keys: each measured from the one before
+      VoMotion m = motion(10 + 10 * k, 10 * k, true, Eigen::Isometry3d::Identity(), M + F);
+      m.translation_floor_m = valid ? ft : 0.1;  // 0.1 m does not fit in the covariance
+      m.rotation_floor_rad = fr;
+      poses.push_back(*chain.add(m));
+    }
+    const auto c = chain.relative_covariance(poses.front(), poses.back());
+    ASSERT_TRUE(c.has_value());
+    const Matrix6d expected = valid ? Matrix6d(20.0 * M + F) : Matrix6d(20.0 * (M + F));
+    EXPECT_TRUE(c->isApprox(expected, 1e-12)) << (valid ? "valid" : "invalid") << " floors\n" << *c;
+    // One motion: its whole reported covariance, as before.
+    const auto one = chain.relative_covariance(poses[4], poses[5]);
+    ASSERT_TRUE(one.has_value());
+    EXPECT_TRUE(one->isApprox(M + F, 1e-12));
+  }
 }
 
 TEST(OdometryChainCovariance, SumsTheMotionsBetweenTwoFramesThroughTheirReferences) {

@@ -161,7 +161,7 @@ TEST(Options, SetByNameAndRejectedByName) {
   set_option(o, "refinement.pixel_sigma_from_residuals", "false");
   EXPECT_FALSE(o.refinement.pixel_sigma_from_residuals);
   EXPECT_THROW(set_option(o, "refinement.min_pixel_sigma", "0"), std::invalid_argument);
-  EXPECT_EQ(describe_options(o).size(), 67u);
+  EXPECT_EQ(describe_options(o).size(), 69u);
 }
 
 }  // namespace

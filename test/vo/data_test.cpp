@@ -32,11 +32,9 @@ void check(const std::filesystem::path& folder, const Expected& measured) {
   EXPECT_LE(f.gross, measured.max_gross);
   EXPECT_GE(f.ok + 2, f.frames) << "at most the first frame and one more without a motion";
   // The reported covariance against the ground truth: the mean NEES of the frames near 6 (the
-  // dimension), not over-confident by more than a third, and most frames inside the 95 %
-  // chi-square bound (the errors are heavier-tailed than Gaussian). One sensor profile serves
-  // both recordings, whose errors against the noise model differ by about 2x: fr1_rpy sits at
-  // 7.5, fr1_xyz over-cautious at 3.3, hence the wider lower side.
-  EXPECT_GE(f.mean_nees, 3.0);
+  // dimension), neither over- nor under-confident by more than a third, and most frames
+  // inside the 95 % chi-square bound (the errors are heavier-tailed than Gaussian).
+  EXPECT_GE(f.mean_nees, 4.0);
   EXPECT_LE(f.mean_nees, 8.0);
   EXPECT_GE(f.nees_within_95, 0.8);
 }

@@ -113,6 +113,8 @@ TEST(DepthTimeOffset, TheKinectTimingIsForFreiburg1RecordingsOnly) {
   EXPECT_DOUBLE_EQ(fr1.depth.rolling_shutter_readout_s, kKinect1RollingShutterReadoutS);
   EXPECT_DOUBLE_EQ(fr1.covariance.translation_floor_m, kKinect1TranslationFloorM);
   EXPECT_DOUBLE_EQ(fr1.covariance.rotation_floor_rad, kKinect1RotationFloorRad);
+  EXPECT_DOUBLE_EQ(fr1.covariance.translation_per_rad_m, kKinect1TranslationPerRadM);
+  EXPECT_DOUBLE_EQ(fr1.covariance.rotation_per_rad, kKinect1RotationPerRad);
   for (const char* other : {"/tmp/sim_room_export", "rgbd_dataset_freiburg2_desk", "rgbd_dataset_freiburg3_office"}) {
     EXPECT_EQ(tum_sensor(other), SensorProfile::kSimulator) << other;
     const VoOptions o = with_tum_sensor(other, given);

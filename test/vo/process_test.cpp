@@ -13,6 +13,7 @@
 #include "kestrel/vo_update_t.hpp"
 #include "test/support/test_support.h"
 #include "test/vo/synthetic_scene.h"
+#include "vo/options.h"
 
 namespace kestrel::vo {
 namespace {
@@ -76,6 +77,10 @@ TEST(VoProcess, LockStepReplayGivesOneUpdatePerFrameAndRepeats) {
       EXPECT_EQ(u.reference_utime, 1000000);
       EXPECT_LT(se3::translation_distance(T, T_true), 0.003) << "frame " << k;
       EXPECT_GT(u.covariance[0], 0.0);
+      // The floors the covariance includes, for a chain to count once (the process's defaults).
+      EXPECT_DOUBLE_EQ(u.translation_floor, VoOptions{}.covariance.translation_floor_m);
+      EXPECT_DOUBLE_EQ(u.rotation_floor, VoOptions{}.covariance.rotation_floor_rad);
+      EXPECT_GE(u.covariance[0], u.translation_floor * u.translation_floor);
       EXPECT_GT(u.num_reprojection_inliers, 50);
       EXPECT_GE(u.elapsed_ms, 0.0f);
     }
