@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "common/geometry/align.h"
+#include "common/geometry/so3.h"
 #include "vo/ransac.h"
 
 namespace kestrel::vo {
@@ -132,7 +133,7 @@ MotionEstimate MotionEstimator::estimate(const Frame& ref, const Frame& cur,
   out.pixel_sigma_px = refined.pixel_sigma;
   const CovarianceOptions& co = options.covariance;
   out.covariance *= co.model_scale;
-  const double angle = Eigen::AngleAxisd(T.linear()).angle();
+  const double angle = so3::angle(T.linear());
   const double st = std::hypot(co.translation_floor_m, co.translation_per_rad_m * angle);
   const double sr = std::hypot(co.rotation_floor_rad, co.rotation_per_rad * angle);
   out.covariance.diagonal().head<3>().array() += st * st;

@@ -42,6 +42,23 @@ inline Projection project(const Eigen::Vector3d& X, const PinholeCamera& cam,
   return p;
 }
 
+// An image residual: point X (in the frame of the measured pixel) projected against the
+// measured pixel, and g, the image motion per metre of X's depth in its own frame (dX_dz, the
+// point's motion per metre of that depth). linearise() and the pixel-noise estimate share it.
+struct ImageResidual {
+  Projection pr;
+  Eigen::Vector2d r, g;
+};
+
+inline ImageResidual image_residual(const Eigen::Vector3d& X, const Eigen::Vector3d& dX_dz,
+                                    const Eigen::Vector2d& measured, const PinholeCamera& cam, bool esm) {
+  ImageResidual ir;
+  ir.pr = project(X, cam, measured, esm);
+  ir.r = ir.pr.pixel - measured;
+  ir.g = ir.pr.J * dX_dz;
+  return ir;
+}
+
 // The normal equations, upper triangles only. The image and depth residuals are kept apart
 // because their information shares differ (see add()): information = share * H_image + H_depth.
 struct Accumulator {
@@ -270,14 +287,13 @@ Accumulator linearise(const std::vector<Correspondence>& cs, const std::vector<i
       // Reference point into the current image: Y = R^T (P - p).
       const Eigen::Vector3d Y = Rt * (c.ref_point - p);
       if (Y.z() > 1e-6) {
-        const Projection pr = project(Y, cam, c.cur_pixel, esm);
+        const ImageResidual ir = image_residual(Y, Rt * (c.ref_point / c.ref_point.z()), c.cur_pixel, cam, esm);
         RawResidual& q = block[count++];
         q.kind = RawResidual::kImage;
-        q.J.leftCols<3>() = -pr.J * Rt;
-        q.J.rightCols<3>() = pr.J * skew(Y);
-        const Eigen::Vector3d dY_dz = Rt * (c.ref_point / c.ref_point.z());
-        q.r = pr.pixel - c.cur_pixel;
-        q.g = pr.J * dY_dz;
+        q.J.leftCols<3>() = -ir.pr.J * Rt;
+        q.J.rightCols<3>() = ir.pr.J * skew(Y);
+        q.r = ir.r;
+        q.g = ir.g;
         q.sigma = c.ref_sigma_z;
       }
       // Current point in the reference frame: X = R Q + p.
@@ -295,14 +311,13 @@ Accumulator linearise(const std::vector<Correspondence>& cs, const std::vector<i
       }
       if (!o.bidirectional) continue;
       if (X.z() > 1e-6) {
-        const Projection pr = project(X, cam, c.ref_pixel, esm);
+        const ImageResidual ir = image_residual(X, R * (c.cur_point / c.cur_point.z()), c.ref_pixel, cam, esm);
         RawResidual& q = block[count++];
         q.kind = RawResidual::kImage;
-        q.J.leftCols<3>() = pr.J;
-        q.J.rightCols<3>() = -pr.J * R * skew(c.cur_point);
-        const Eigen::Vector3d dX_dz = R * (c.cur_point / c.cur_point.z());
-        q.r = pr.pixel - c.ref_pixel;
-        q.g = pr.J * dX_dz;
+        q.J.leftCols<3>() = ir.pr.J;
+        q.J.rightCols<3>() = -ir.pr.J * R * skew(c.cur_point);
+        q.r = ir.r;
+        q.g = ir.g;
         q.sigma = c.cur_sigma_z;
       }
     }
@@ -319,7 +334,7 @@ Accumulator linearise(const std::vector<Correspondence>& cs, const std::vector<i
 }
 
 // The pixel noise the image residuals at T show. Each residual's component across its depth
-// direction g (the image residuals and g exactly as linearise() forms them) is the difference of
+// direction g (image_residual(), as linearise() forms them) is the difference of
 // two noisy feature positions (variance 2 sigma^2 per axis), and the median of a squared
 // standard normal is 0.4549. The median keeps the few bad matches that survive the outlier
 // removal from inflating it. 0 when there are too few residuals to tell. A pass of its own,
@@ -333,13 +348,11 @@ double pixel_sigma_from_residuals(const std::vector<Correspondence>& cs, const s
   const bool esm = o.solver == Solver::kEsm;
   auto collect = [&](const Eigen::Vector3d& X, const Eigen::Vector3d& dX_dz, const Eigen::Vector2d& measured) {
     if (X.z() <= 1e-6) return;
-    const Projection pr = project(X, cam, measured, esm);
-    const Eigen::Vector2d r = pr.pixel - measured;
-    const Eigen::Vector2d g = pr.J * dX_dz;
-    const double gn2 = g.squaredNorm();
+    const ImageResidual ir = image_residual(X, dX_dz, measured, cam, esm);
+    const double gn2 = ir.g.squaredNorm();
     if (gn2 <= 1e-18) return;
-    const double along_g = r.dot(g);
-    across_sq.push_back(static_cast<float>(std::max(r.squaredNorm() - along_g * along_g / gn2, 0.0)));
+    const double along_g = ir.r.dot(ir.g);
+    across_sq.push_back(static_cast<float>(std::max(ir.r.squaredNorm() - along_g * along_g / gn2, 0.0)));
   };
   const Eigen::Matrix3d R = T.linear();
   const Eigen::Matrix3d Rt = R.transpose();
