@@ -27,6 +27,13 @@ class Environment {
   virtual bool segment_is_free(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double radius) const = 0;
   /// Nothing opaque between a and b (b itself may lie on a surface).
   virtual bool line_of_sight(const Eigen::Vector3d& a, const Eigen::Vector3d& b) const = 0;
+  /// line_of_sight(a, b) for every b of `targets`: out[i] = 1 when seen, else 0. An
+  /// environment may answer many rays from one point faster than one by one, never differently.
+  virtual void lines_of_sight(const Eigen::Vector3d& a, const std::vector<Eigen::Vector3d>& targets,
+                              std::vector<char>& out) const {
+    out.resize(targets.size());
+    for (size_t i = 0; i < targets.size(); ++i) out[i] = line_of_sight(a, targets[i]) ? 1 : 0;
+  }
   /// Landmarks for the feature sensors (may be empty).
   const std::vector<Feature>& features() const { return features_; }
   void set_features(std::vector<Feature> features) { features_ = std::move(features); }

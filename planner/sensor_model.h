@@ -47,10 +47,15 @@ class FeatureSensor {
   const FeatureSensorOptions& options() const { return options_; }
   /// Indices of the features visible from q.
   std::vector<int> visible(const Config& q) const;
+  /// The same by the definition alone (atan2 for every field-of-view test): the reference the
+  /// fast path above is tested against (test FastVisibilityEqualsTheDefinition).
+  std::vector<int> visible_reference(const Config& q) const;
   /// The measurement of feature `index` from q (no visibility check).
   FeatureMeasurement measure(const Config& q, int index) const;
   /// Predicted measurement of feature `index` from q, azimuth wrapped near `reference`.
   Eigen::Vector3d predict(const Config& q, int index, double reference_azimuth) const;
+  /// One feature's H^T Q^-1 H: estimator::measurement_information's values, for the diagonal Q.
+  static Mat4 information_term(const FeatureMeasurement& m);
   /// EKF information M(q) = sum over visible features of H^T Q^-1 H.
   Mat4 information(const Config& q) const;
   /// UKF information gain I(q) = 1/2 log det(prior) - 1/2 log det(posterior) of one update of
@@ -62,11 +67,31 @@ class FeatureSensor {
  private:
   const Environment& env_;
   FeatureSensorOptions options_;
-  // Features bucketed in square cells of max_range_m over x-y, so a query looks at 3 x 3 cells.
+  // Features bucketed in square cells of max_range_m over x-y, so a query looks at 3 x 3 cells
+  // (visible_reference).
   double cell_m_ = 1.0;
   Eigen::Vector2d cell_origin_ = Eigen::Vector2d::Zero();
   int nx_ = 0, ny_ = 0;
   std::vector<std::vector<int>> cells_;
+  // visible(): cells of a quarter of the range, each a run of fine_ (feature index, position,
+  // normal), so a query reads only the cells that meet the range's disc and the field of view's
+  // wedge, and those contiguously.
+  struct CellFeature {
+    Eigen::Vector3d position;
+    Eigen::Vector3d normal;
+    int index;
+  };
+  double fine_m_ = 1.0;
+  int fine_nx_ = 0, fine_ny_ = 0;
+  std::vector<int> fine_start_;
+  std::vector<CellFeature> fine_;
+  // Field-of-view bounds a hair (kFovMargin_rad) outside and inside the edges: a feature
+  // clearly outside or inside is decided by a dot product, only the band between by atan2.
+  bool fast_azimuth_ = false, fast_elevation_ = false;
+  double cos_h_out_ = 0.0, cos_h_in_ = 0.0, tan_v_out_ = 0.0, tan_v_in_ = 0.0;
+
+  // H and Q of feature `index` from q without the predicted z (what M needs).
+  void jacobian_and_noise(const Config& q, int index, FeatureMeasurement& m) const;
 };
 
 }  // namespace kestrel::planner

@@ -1,6 +1,8 @@
 // Speed of the planner in the sim's `floor` world (Release, one core): roadmap build with 100
-// samples per sampler (BRM: with transfer functions), BRM search, the two sensor-uncertainty
-// weights per candidate (EKF tr(M), UKF I(x)), and one edge transfer.
+// samples per sampler (BRM: with transfer functions; the paper camera and the Kinect model,
+// whose 4 m range makes line of sight the cost), BRM search, the two sensor-uncertainty
+// weights per candidate (EKF tr(M), UKF I(x)), the Kinect's M at one pose, and one edge
+// transfer.
 #include <benchmark/benchmark.h>
 
 #include "planner/eval/experiment.h"
@@ -15,10 +17,10 @@ const ExperimentWorld& floor() {
   return w;
 }
 
-void BM_BuildBrm(benchmark::State& state, const char* sampler_name) {
+void BM_BuildBrm(benchmark::State& state, const char* sampler_name, bool kinect) {
   const Environment& env = *floor().env;
   const ConfigurationSpace space(env, {});
-  const FeatureSensor sensor(env, FeatureSensorOptions::paper_camera());
+  const FeatureSensor sensor(env, kinect ? FeatureSensorOptions::kinect() : FeatureSensorOptions::paper_camera());
   const BeliefModel model(MotionOptions{}, [&](const Config& q) { return sensor.information(q); });
   const auto pair = floor().pairs[0];
   uint64_t seed = 1;
@@ -28,8 +30,10 @@ void BM_BuildBrm(benchmark::State& state, const char* sampler_name) {
     benchmark::DoNotOptimize(build_roadmap(space, *sampler, pair.first, pair.second, RoadmapOptions::all_pairs(), &model, rng));
   }
 }
-BENCHMARK_CAPTURE(BM_BuildBrm, su, "su")->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_BuildBrm, uniform, "uniform")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_BuildBrm, su, "su", false)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_BuildBrm, uniform, "uniform", false)->Unit(benchmark::kMillisecond);
+// Fig. 13's build: BRM-SU, 100 samples, all pairs, the Kinect model.
+BENCHMARK_CAPTURE(BM_BuildBrm, su_kinect, "su", true)->Unit(benchmark::kMillisecond);
 
 void BM_SearchBrm(benchmark::State& state) {
   const Environment& env = *floor().env;
@@ -66,6 +70,22 @@ void BM_Weight(benchmark::State& state, bool ukf) {
 }
 BENCHMARK_CAPTURE(BM_Weight, ekf_trace, false)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(BM_Weight, ukf_gain, true)->Unit(benchmark::kMicrosecond);
+
+// The Kinect's M(q) at valid uniform poses (what every edge step evaluates in Fig. 13).
+void BM_KinectInformation(benchmark::State& state) {
+  const Environment& env = *floor().env;
+  const ConfigurationSpace space(env, {});
+  const FeatureSensor sensor(env, FeatureSensorOptions::kinect());
+  Rng rng(5);
+  std::vector<Config> qs;
+  while (qs.size() < 256) {
+    const Config q = space.uniform(rng);
+    if (space.is_valid(q)) qs.push_back(q);
+  }
+  size_t i = 0;
+  for (auto _ : state) benchmark::DoNotOptimize(sensor.information(qs[i++ % qs.size()]));
+}
+BENCHMARK(BM_KinectInformation)->Unit(benchmark::kMicrosecond);
 
 void BM_TransferApply(benchmark::State& state) {
   BeliefStep s;

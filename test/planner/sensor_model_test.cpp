@@ -145,6 +145,87 @@ TEST(FeatureSensor, UkfInformationEqualsTheGenericUkf) {
   }
 }
 
+TEST(FeatureSensor, InformationTermEqualsTheEstimators) {
+  // The diagonal-Q form of H^T Q^-1 H against estimator::measurement_information (LLT of Q):
+  // the same values, not merely close, for Jacobians of every scale and the presets' noise.
+  Rng rng(19);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int t = 0; t < 20000; ++t) {
+    FeatureMeasurement m;
+    for (int i = 0; i < 12; ++i) m.H(i) = u(rng) * std::pow(10.0, 2.0 * u(rng));
+    m.H(0, 3) = 0.0;
+    m.H(1, 2) = 0.0;
+    m.H(1, 3) = -1.0;
+    const double r2 = 0.25 + 16.0 * std::abs(u(rng));
+    const double sr = t % 3 == 0 ? 1.4e-3 * r2 : t % 3 == 1 ? 1.0 : 0.01, sb = t % 3 == 0 ? 1e-3 : t % 3 == 1 ? 1.0 : 0.0087;
+    m.variances = {sr * sr, sb * sb, sb * sb};
+    const Mat4 expected = estimator::measurement_information(m.H, Eigen::Matrix3d(m.variances.asDiagonal()));
+    ASSERT_TRUE((FeatureSensor::information_term(m).array() == expected.array()).all()) << "case " << t;
+  }
+  FeatureMeasurement bad;
+  bad.H.setOnes();
+  bad.variances = {1.0, 0.0, 1.0};
+  EXPECT_THROW(FeatureSensor::information_term(bad), std::invalid_argument);
+}
+
+TEST(FeatureSensor, FastVisibilityEqualsTheDefinition) {
+  // visible() decides the fields of view by dot products away from their edges and by atan2
+  // only within 1e-9 rad of them; visible_reference() asks atan2 always. Features exactly on,
+  // 1e-12 rad and 1e-6 rad either side of each edge, straight above and below, and a random
+  // cloud, for the three presets and many yaws: the same features, and M bit for bit the sum
+  // of measure()'s H^T Q^-1 H over them.
+  PredicateEnvironment env = open_space();
+  Rng rng(17);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const std::vector<FeatureSensorOptions> presets = {FeatureSensorOptions::paper_camera(), FeatureSensorOptions::kinect(),
+                                                     FeatureSensorOptions::planar_laser(4.0)};
+  const std::vector<double> yaws = {0.0, 0.3, -1.2, M_PI, -M_PI, 2.5};
+  std::vector<Feature> features;
+  for (const FeatureSensorOptions& o : presets)
+    for (double yaw : yaws)
+      for (double range : {0.7, 1.5, 1.9})
+        for (double dh : {-1e-6, -1e-12, 0.0, 1e-12, 1e-6})
+          for (double side : {-1.0, 1.0}) {
+            // On the horizontal edge (level), and on the vertical edge (straight ahead).
+            const double az = yaw + side * (0.5 * o.horizontal_fov_rad + dh);
+            features.push_back(feature(range * std::cos(az), range * std::sin(az), 1.0, {-std::cos(az), -std::sin(az), 0}));
+            const double el = side * (0.5 * o.vertical_fov_rad + dh);
+            features.push_back(feature(range * std::cos(el) * std::cos(yaw), range * std::cos(el) * std::sin(yaw),
+                                       1.0 + range * std::sin(el), {-std::cos(yaw), -std::sin(yaw), 0}));
+          }
+  features.push_back(feature(0.0, 0.0, 2.5, {0, 0, -1}));  // straight above: rho = 0
+  features.push_back(feature(0.0, 0.0, 0.2, {0, 0, 1}));   // straight below
+  for (int i = 0; i < 400; ++i) {
+    const Eigen::Vector3d n(u(rng), u(rng), 0.2 * u(rng));
+    features.push_back(feature(4.0 * u(rng), 4.0 * u(rng), 1.0 + 1.5 * u(rng), n));
+  }
+  env.set_features(features);
+  size_t seen_total = 0;
+  for (const FeatureSensorOptions& o : presets) {
+    const FeatureSensor sensor(env, o);
+    std::vector<Config> poses;
+    for (double yaw : yaws) poses.emplace_back(0.0, 0.0, 1.0, yaw);
+    for (int i = 0; i < 50; ++i) poses.emplace_back(0.3 * u(rng), 0.3 * u(rng), 1.0 + 0.2 * u(rng), M_PI * u(rng));
+    for (const Config& q : poses) {
+      const std::vector<int> seen = sensor.visible(q);
+      ASSERT_EQ(seen, sensor.visible_reference(q)) << "yaw " << q[3];
+      seen_total += seen.size();
+      Mat4 M = Mat4::Zero();
+      for (int i : seen) {
+        const FeatureMeasurement m = sensor.measure(q, i);
+        M += estimator::measurement_information(m.H, Eigen::Matrix3d(m.variances.asDiagonal()));
+      }
+      EXPECT_TRUE((sensor.information(q).array() == M.array()).all()) << "yaw " << q[3];
+    }
+  }
+  EXPECT_GT(seen_total, 500u);
+  // The edges themselves, from the pose they were placed for: on the edge and 1e-12 inside
+  // or outside it atan2 decides (either way, the same as the definition), 1e-6 outside is out.
+  const FeatureSensor kinect(env, FeatureSensorOptions::kinect());
+  const std::vector<int> ahead = kinect.visible(Config(0.0, 0.0, 1.0, 0.3));
+  EXPECT_EQ(ahead, kinect.visible_reference(Config(0.0, 0.0, 1.0, 0.3)));
+}
+
 TEST(FeatureSensor, RejectsNonsenseOptions) {
   PredicateEnvironment env = open_space();
   FeatureSensorOptions o;

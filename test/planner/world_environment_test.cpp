@@ -6,6 +6,7 @@
 #include <fstream>
 
 #include "common/error.h"
+#include "planner/configuration_space.h"
 #include "planner/experiment_worlds.h"
 #include "planner/sensor_model.h"
 #include "test/support/test_support.h"
@@ -85,6 +86,79 @@ TEST(WorldEnvironment, FeaturesFollowTheWallsTexturesAndAreSeenFromTheirSide) {
   for (int i : seen) EXPECT_NEAR(dense.features()[i].position.x(), 7.425, 1e-6);
   EXPECT_GT(camera.information(Config(6.2, 9.0, 1.0, 0.0)).trace(), 0.0);
   for (int i : camera.visible(Config(8.7, 9.0, 1.0, M_PI))) EXPECT_GT(dense.features()[i].position.x(), 7.5);
+}
+
+// line_of_sight (the fine grid and the sim's ray tests, stopping at the first hit) and
+// lines_of_sight (all rays from one point against the obstacles gathered once) against the
+// sim's ray cast, from poses all over `env`'s world to every feature within 6 m, to random
+// points, along and across the axes (rays in one fine column), onto the walls' corners.
+void expect_fast_sight_equals_raycast(const WorldEnvironment& env, int poses, uint64_t seed) {
+  Rng rng(seed);
+  const Eigen::AlignedBox3d b = env.bounds();
+  std::uniform_real_distribution<double> ux(b.min().x(), b.max().x()), uy(b.min().y(), b.max().y()), uz(0.1, 2.9);
+  std::vector<Eigen::Vector3d> corners;
+  for (const sim::Surface& s : env.world().surfaces())
+    if (s.is_vertical())
+      for (const auto& c : s.corners()) corners.push_back(c);
+  int clear = 0, blocked = 0;
+  std::vector<Eigen::Vector3d> targets;
+  std::vector<char> expected, batch;
+  const auto check = [&](const Eigen::Vector3d& a, const Eigen::Vector3d& p) {
+    const bool fast = env.line_of_sight(a, p), plain = env.line_of_sight_by_raycast(a, p);
+    ASSERT_EQ(fast, plain) << a.transpose() << " -> " << p.transpose();
+    ++(fast ? clear : blocked);
+    targets.push_back(p);
+    expected.push_back(plain ? 1 : 0);
+  };
+  for (int k = 0; k < poses; ++k) {
+    targets.clear();
+    expected.clear();
+    Eigen::Vector3d a(ux(rng), uy(rng), 1.0);
+    if (k % 3 == 0) a.z() = uz(rng);
+    if (k % 7 == 0) a.x() = std::round(a.x() * 2.0) / 2.0;  // on a fine cell's edge
+    for (const Feature& f : env.features())
+      if ((f.position - a).norm() < 6.0) check(a, f.position);
+    for (int i = 0; i < 40; ++i) check(a, Eigen::Vector3d(ux(rng), uy(rng), uz(rng)));
+    for (const Eigen::Vector3d& step : {Eigen::Vector3d(3, 0, 0), Eigen::Vector3d(0, 3, 0), Eigen::Vector3d(0, -4, 0),
+                                        Eigen::Vector3d(-4, 0, 0), Eigen::Vector3d(1e-4, 3, 0), Eigen::Vector3d(0, 0, 1.5),
+                                        Eigen::Vector3d(2e-3, 4, 0.2)})
+      check(a, a + step);
+    for (int i = 0; i < 20; ++i) check(a, corners[static_cast<size_t>(rng() % corners.size())]);
+    env.lines_of_sight(a, targets, batch);
+    ASSERT_EQ(batch, expected) << "from " << a.transpose();
+    // Only the features: a smaller gathering box.
+    const size_t n_features = targets.size() - 40 - 7 - 20;
+    targets.resize(n_features);
+    env.lines_of_sight(a, targets, batch);
+    ASSERT_EQ(batch, std::vector<char>(expected.begin(), expected.begin() + static_cast<long>(n_features)));
+  }
+  EXPECT_GT(clear, 100);
+  EXPECT_GT(blocked, 100);
+}
+
+TEST(WorldEnvironment, FastLineOfSightEqualsTheSimsRaycast) {
+  expect_fast_sight_equals_raycast(*floor_experiment().env, 300, 21);
+  // And the Kinect's visibility through it equals the definition's (features and M).
+  const ExperimentWorld& w = floor_experiment();
+  const FeatureSensor kinect(*w.env, FeatureSensorOptions::kinect());
+  const ConfigurationSpace space(*w.env, {});
+  Rng rng(4);
+  size_t seen = 0;
+  for (int k = 0; k < 200; ++k) {
+    const Config q = space.uniform(rng);
+    if (!space.is_valid(q)) continue;
+    const std::vector<int> fast = kinect.visible(q);
+    ASSERT_EQ(fast, kinect.visible_reference(q));
+    seen += fast.size();
+  }
+  EXPECT_GT(seen, 1000u);
+}
+
+TEST(WorldEnvironment, FastLineOfSightEqualsTheSimsRaycastInStata) {
+  const auto map = kestrel::test::shared_data() / "maps" / "stata_basement.yaml";
+  auto stata = stata_experiment_world(map.string(), {4.0, 1}, 0.3);
+  if (!stata) GTEST_SKIP() << map << " is absent";
+  expect_fast_sight_equals_raycast(*stata->env, 300, 22);
 }
 
 TEST(ExperimentWorlds, StataIsSkippedWithoutItsMapAndBadMapsAreNamed) {
