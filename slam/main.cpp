@@ -18,6 +18,7 @@
 #include "slam/memory_policy.h"
 #include "slam/place/builtin_vocabulary.h"
 #include "slam/slam_adapter.h"
+#include "vo/sensor_profile.h"
 #if KESTREL_SLAM_OFFLINE
 #include "slam/sequence_run.h"
 #include "drivers/tum/tum_sequence.h"
@@ -33,6 +34,7 @@ using namespace kestrel::slam;
 struct Options {
   std::string vocabulary = "builtin";
   std::string kernel = "dcs";
+  std::string sensor;  // a vo::SensorProfile name; empty: the TUM folder's, else the simulator's
   // Offline.
   std::string tum, out, vo_out;
   // Process.
@@ -71,6 +73,11 @@ void add_options(cli::App& app, Options& o, SlamOptions& s) {
       ->capture_default_str();
   app.add_option("--kernel", o.kernel, "Robust kernel on loop closures: none, huber, cauchy or dcs")
       ->check(CLI::IsMember({"none", "huber", "cauchy", "dcs"}))->capture_default_str();
+  app.add_option("--sensor", o.sensor,
+                 "Camera profile, as kestrel-vo's (its timing corrects the keyframes' features): simulator "
+                 "(global shutter; the default live) or kinect1 (rolling shutter, depth before colour); with "
+                 "--tum the default is the folder's (kinect1 for freiburg1)")
+      ->check(CLI::IsMember({vo::to_string(vo::SensorProfile::kSimulator), vo::to_string(vo::SensorProfile::kKinect1)}));
   app.add_option("--tum", o.tum, "Offline: run VO + SLAM over this TUM RGB-D folder");
   app.add_option("--out", o.out, "Offline: write the optimised camera trajectory here (TUM format)");
   app.add_option("--vo-out", o.vo_out, "Offline: write the odometry-only trajectory here too");
@@ -94,9 +101,12 @@ int run_offline(const Options& o, const SlamOptions& options, std::shared_ptr<co
 #else
   // Frames are decoded one at a time: a long sequence (e.g. a sim flight) need not fit in memory.
   const tum::TumSequence sequence(o.tum);
+  // The camera's profile: as told, else the folder's (as kestrel-vo --tum).
+  const vo::SensorProfile sensor = o.sensor.empty() ? vo::tum_sensor(o.tum) : *vo::parse_sensor_profile(o.sensor);
+  std::cout << "camera profile: " << vo::to_string(sensor) << "\n";
   const SlamRun run = run_slam_sequence(
-      sequence.size(), [&sequence](size_t i) { return sequence.frame(i); }, vo::with_tum_sensor(o.tum, vo::VoOptions{}), options,
-      std::move(vocabulary));
+      sequence.size(), [&sequence](size_t i) { return sequence.frame(i); }, vo::with_sensor(sensor, vo::VoOptions{}),
+      options, std::move(vocabulary));
   write_tum_trajectory(o.out, run.slam);
   if (!o.vo_out.empty()) write_tum_trajectory(o.vo_out, run.vo);
   std::vector<double> ms = run.keyframe_ms;
@@ -126,7 +136,12 @@ int run_offline(const Options& o, const SlamOptions& options, std::shared_ptr<co
 
 int serve(const Options& o, const SlamOptions& options, std::shared_ptr<const Vocabulary> vocabulary) {
   if (!o.out.empty() || !o.vo_out.empty()) throw CLI::ValidationError("--out/--vo-out", "only with --tum");
-  SlamAdapter adapter(options, std::move(vocabulary), o.adapter);
+  AdapterOptions adapter_options = o.adapter;
+  const vo::SensorProfile sensor =
+      o.sensor.empty() ? vo::SensorProfile::kSimulator : *vo::parse_sensor_profile(o.sensor);
+  adapter_options.timing = vo::with_sensor(sensor, vo::VoOptions{}).depth;
+  spdlog::info("camera profile: {}", vo::to_string(sensor));
+  SlamAdapter adapter(options, std::move(vocabulary), adapter_options);
   std::unique_ptr<transport::Node> node;
   node = std::make_unique<transport::Node>(o.name, o.lcm_url);  // UnavailableError: exit 4
   node->advertise(o.graph_channel);

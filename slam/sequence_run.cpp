@@ -27,6 +27,7 @@ SlamRun run_slam_sequence(size_t count, const std::function<RgbdFrame(size_t)>& 
   };
   std::vector<Placed> placed;
   std::optional<OdometryPose> keyframe_pose;  // the chain's pose of the newest keyframe
+  std::optional<OdometryPose> previous_pose;  // the chain's pose of the previous frame with one
   for (size_t i = 0; i < count; ++i) {
     const RgbdFrame frame = frame_at(i);
     const vo::VoResult r = odometry.process(frame);
@@ -45,13 +46,22 @@ SlamRun run_slam_sequence(size_t count, const std::function<RgbdFrame(size_t)>& 
     const std::optional<OdometryPose> pose = chain.add(m);
     if (!pose) continue;
     const OdometryLink link = pose->broken ? OdometryLink::kBroken : OdometryLink::kContinuous;
+    // The keyframe's features' timing: the odometry's motion from the previous frame
+    // (frame_features.h); none across a restart.
+    std::optional<OdometryPose> before = previous_pose;
+    previous_pose = *pose;
     if (slam.wants_keyframe(pose->T_odom_camera, link)) {
+      vo::FrameMotion motion;
+      if (before && !pose->broken) {
+        motion = keyframe_motion(vo_options.depth, frame.utime, frame.depth_utime, before->utime,
+                                 before->T_odom_camera.inverse() * pose->T_odom_camera);
+      }
       const auto t0 = std::chrono::steady_clock::now();
       std::optional<Matrix6d> odometry_covariance;
       if (link == OdometryLink::kContinuous && keyframe_pose) {
         odometry_covariance = chain.relative_covariance(*keyframe_pose, *pose);
       }
-      const SlamStep step = slam.add(frame, pose->T_odom_camera, link, odometry_covariance);
+      const SlamStep step = slam.add(frame, pose->T_odom_camera, link, odometry_covariance, motion);
       if (step.keyframe) keyframe_pose = *pose;
       run.keyframe_ms.push_back(
           std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());

@@ -2,6 +2,9 @@
 // VO + SLAM in one process over decoded frames (the offline `kestrel slam --tum`, the data
 // tests): each frame through the visual odometry, the chained odometry pose to SLAM, and at
 // the end every frame's pose both as the odometry had it and as the optimised graph puts it.
+// Keyframes' features get the odometry's timing correction (place/frame_features.h): the
+// camera's timing is vo_options.depth's (the sensor profile: with_tum_sensor() for a TUM folder),
+// the motion the odometry's from the previous frame to the keyframe.
 
 #include <functional>
 #include <memory>

@@ -29,6 +29,7 @@ void SlamAdapter::reset() {
   recent_.clear();
   odometry_fix_ = Eigen::Isometry3d::Identity();
   last_pose_.reset();
+  previous_chained_.reset();
   keyframe_pose_.reset();
   bridges_ = 0;
 }
@@ -37,8 +38,8 @@ void SlamAdapter::trim_frames() {
   while (static_cast<int>(frames_.size()) > options_.buffer_frames) frames_.erase(frames_.begin());
 }
 
-void SlamAdapter::drop_poses(std::map<int64_t, OdometryPose>::iterator end) {
-  for (auto it = poses_.begin(); it != end; ++it) lost_break_ |= it->second.broken;
+void SlamAdapter::drop_poses(std::map<int64_t, ChainedPose>::iterator end) {
+  for (auto it = poses_.begin(); it != end; ++it) lost_break_ |= it->second.pose.broken;
   poses_.erase(poses_.begin(), end);
 }
 
@@ -53,7 +54,7 @@ AdapterOutputs SlamAdapter::on_frame(const kestrel::rgbd_frame_t& frame) {
     trim_frames();
     return {};
   }
-  const OdometryPose p = pose->second;
+  const ChainedPose p = pose->second;
   poses_.erase(pose);
   drop_poses(poses_.lower_bound(frame.utime));  // older poses will get no frame now
   return process(frame, p);
@@ -68,15 +69,21 @@ AdapterOutputs SlamAdapter::on_vo_update(const kestrel::vo_update_t& update) {
     throw InputError(options_.vo_channel + ": " + e.what());
   }
   if (!pose) return {};
+  ChainedPose chained{*pose};
+  if (previous_chained_ && !pose->broken) {
+    chained.previous_utime = previous_chained_->utime;
+    chained.T_previous_current = previous_chained_->T_odom_camera.inverse() * pose->T_odom_camera;
+  }
+  previous_chained_ = *pose;
   const auto frame = frames_.find(update.utime);
   if (frame == frames_.end()) {
-    poses_[update.utime] = *pose;
+    poses_[update.utime] = chained;
     if (static_cast<int>(poses_.size()) > options_.buffer_frames) drop_poses(std::next(poses_.begin()));
     return {};
   }
   const kestrel::rgbd_frame_t message = std::move(frame->second);
   frames_.erase(frames_.begin(), std::next(frame));  // older frames will get no pose now
-  return process(message, *pose);
+  return process(message, chained);
 }
 
 AdapterOutputs SlamAdapter::on_state(const kestrel::state_t& state) {
@@ -164,7 +171,8 @@ void SlamAdapter::try_anchor(AdapterOutputs& out) {
   }
 }
 
-AdapterOutputs SlamAdapter::process(const kestrel::rgbd_frame_t& message, const OdometryPose& chained) {
+AdapterOutputs SlamAdapter::process(const kestrel::rgbd_frame_t& message, const ChainedPose& waiting) {
+  const OdometryPose& chained = waiting.pose;
   AdapterOutputs out;
   last_processed_utime_ = message.utime;
   const Eigen::Isometry3d T_body_camera =
@@ -199,7 +207,13 @@ AdapterOutputs SlamAdapter::process(const kestrel::rgbd_frame_t& message, const 
   if (link == OdometryLink::kContinuous && keyframe_pose_) {
     odometry_covariance = chain_.relative_covariance(*keyframe_pose_, chained);
   }
-  const SlamStep step = slam_.add(frame, pose.T_odom_camera, link, odometry_covariance);
+  // The features' timing: the odometry's motion from the previous update (not across a restart).
+  vo::FrameMotion motion;
+  if (link == OdometryLink::kContinuous && waiting.previous_utime != 0) {
+    motion = keyframe_motion(options_.timing, frame.utime, frame.depth_utime, waiting.previous_utime,
+                             waiting.T_previous_current);
+  }
+  const SlamStep step = slam_.add(frame, pose.T_odom_camera, link, odometry_covariance, motion);
   if (step.keyframe) keyframe_pose_ = chained;
   lost_break_ = false;
   remember(*last_pose_, step.keyframe);

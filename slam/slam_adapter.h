@@ -24,7 +24,13 @@
 //
 // A frame and its VO update are paired by utime. Frames wait (encoded) in a bounded buffer and
 // are decoded only when their pose makes them a keyframe; an update whose frame has not come
-// yet waits likewise. Invariants: at most `buffer_frames` frames and updates wait; a frame is
+// yet waits likewise.
+//
+// Timing: a keyframe's features get the odometry's timing correction (place/frame_features.h)
+// with the camera's timing `timing` (the VO's DepthOptions of the sensor profile; the
+// default, the simulator's, corrects nothing) and the motion the chained VO_UPDATEs give from
+// the frame before the keyframe (the previous update, whether or not its frame came) to it.
+// Invariants: at most `buffer_frames` frames and updates wait; a frame is
 // given to SLAM at most once, in increasing utime.
 
 #include <deque>
@@ -36,6 +42,7 @@
 #include "kestrel/rgbd_frame_t.hpp"
 #include "kestrel/state_t.hpp"
 #include "slam/slam_messages.h"
+#include "vo/options.h"
 
 namespace kestrel::slam {
 
@@ -50,6 +57,9 @@ struct AdapterOptions {
   double anchor_max_tilt_sigma_rad = 0.01;  ///< anchor only on a STATE whose roll/pitch sigma is below this
   double max_state_extrapolation_s = 0.02;  ///< a frame after the newest STATE: carried on by its velocities
   double max_bridge_s = 10.0;             ///< longest VO outage the estimator's motion may bridge
+  /// The camera's timing (depth offset, rolling shutter) as the VO takes it: with_sensor()'s
+  /// DepthOptions of the camera's profile (kestrel-slam --sensor).
+  vo::DepthOptions timing;
 };
 
 struct AdapterOutputs {
@@ -85,13 +95,18 @@ class SlamAdapter {
     int64_t utime;
     Eigen::Isometry3d T_odom_camera, T_body_camera;
   };
-  AdapterOutputs process(const kestrel::rgbd_frame_t& frame, const OdometryPose& chained);
+  struct ChainedPose {  ///< a VO_UPDATE chained, and the motion from the update before it
+    OdometryPose pose;
+    int64_t previous_utime = 0;  ///< 0: none (the first, or after a restart)
+    Eigen::Isometry3d T_previous_current = Eigen::Isometry3d::Identity();
+  };
+  AdapterOutputs process(const kestrel::rgbd_frame_t& frame, const ChainedPose& chained);
   /// The estimator's T_world_body at utime: interpolated between two states, or carried on
   /// from the newest by its velocities; nothing when the states do not cover it.
   std::optional<Eigen::Isometry3d> state_at(int64_t utime, bool ok_only) const;
   void trim_frames();
   /// Drops waiting poses [begin, end), remembering an odometry break among them.
-  void drop_poses(std::map<int64_t, OdometryPose>::iterator end);
+  void drop_poses(std::map<int64_t, ChainedPose>::iterator end);
   /// Keeps a processed frame for anchoring (frames since the newest keyframe).
   void remember(const FramePose& frame, bool keyframe);
   /// Anchors the graph at the newest remembered frame that STATE brackets; fills `out`.
@@ -101,7 +116,8 @@ class SlamAdapter {
   Slam slam_;
   OdometryChain chain_;
   std::map<int64_t, kestrel::rgbd_frame_t> frames_;  ///< utime -> waiting frame
-  std::map<int64_t, OdometryPose> poses_;            ///< utime -> waiting pose
+  std::map<int64_t, ChainedPose> poses_;             ///< utime -> waiting pose
+  std::optional<OdometryPose> previous_chained_;     ///< the chain's newest pose
   int64_t last_processed_utime_ = 0;
   bool lost_break_ = false;  ///< a pose flagged broken was dropped: flag the next one
   bool anchored_ = false;

@@ -130,7 +130,7 @@ void Slam::add_odometry_edge(const Keyframe& previous, const Keyframe& current, 
 }
 
 SlamStep Slam::add(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera, OdometryLink link,
-                   const std::optional<Matrix6d>& odometry_covariance) {
+                   const std::optional<Matrix6d>& odometry_covariance, const vo::FrameMotion& motion) {
   const bool odometry_broken = link == OdometryLink::kBroken;
   if (have_frame_ && frame.utime <= last_utime_) {
     throw InputError("slam: frame utime " + std::to_string(frame.utime) + " does not follow " +
@@ -150,7 +150,7 @@ SlamStep Slam::add(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camer
   kf.utime = frame.utime;
   kf.T_odom_camera = T_odom_camera;
   kf.T_body_camera = frame.T_body_camera;
-  kf.features = extractor_.extract(frame);
+  kf.features = extractor_.extract(frame, motion);
   const Eigen::Isometry3d T_world_camera =
       keyframes_.empty() ? T_odom_camera
                          : (odometry_broken ? graph_.poses.back() : world_pose(T_odom_camera));

@@ -25,6 +25,7 @@
 #include "common/rgbd_frame.h"
 #include "slam/backend/slam_options.h"
 #include "slam/posegraph/pose_graph.h"
+#include "vo/frame_motion.h"
 
 namespace kestrel::slam {
 
@@ -79,9 +80,12 @@ class Slam {
   /// (continuous link only), is the odometry's own covariance of the motion from the previous
   /// keyframe to this frame (right perturbation [rho; phi], OdometryChain::relative_covariance):
   /// the odometry edge then takes it (OdometryNoise::use_reported) instead of the constant model.
+  /// `motion`: the camera's motion around the frame, for its features' timing correction
+  /// (keyframe_motion(), place/frame_features.h); unknown = no correction.
   SlamStep add(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera,
                OdometryLink link = OdometryLink::kContinuous,
-               const std::optional<Matrix6d>& odometry_covariance = std::nullopt);
+               const std::optional<Matrix6d>& odometry_covariance = std::nullopt,
+               const vo::FrameMotion& motion = {});
 
   const std::vector<Keyframe>& keyframes() const { return keyframes_; }
   /// Vertices are keyframes (poses T_world_camera); edges odometry and loop closures.

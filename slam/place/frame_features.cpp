@@ -6,6 +6,10 @@
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
+#include "common/geometry/se3.h"
+#include "vo/depth_lookup.h"
+#include "vo/lens.h"
+
 namespace kestrel::slam {
 
 size_t FrameFeatures::num_points() const {
@@ -25,7 +29,7 @@ FeatureExtractor::FeatureExtractor(const FeatureOptions& options) : options_(opt
                          options.fast_threshold);
 }
 
-FrameFeatures FeatureExtractor::extract(const RgbdFrame& frame) const {
+FrameFeatures FeatureExtractor::extract(const RgbdFrame& frame, const vo::FrameMotion& motion) const {
   cv::Mat grey;
   if (frame.rgb.empty()) {
     FrameFeatures none;
@@ -35,11 +39,47 @@ FrameFeatures FeatureExtractor::extract(const RgbdFrame& frame) const {
   }
   cv::cvtColor(frame.rgb, grey, cv::COLOR_RGB2GRAY);
   const cv::Mat depth = frame.depth_mm.empty() ? cv::Mat() : depth_to_metres(frame.depth_mm);
-  return extract(grey, depth, frame.camera);
+  return extract(grey, depth, frame.camera, motion);
+}
+
+double FeatureExtractor::reliable_depth(const cv::Mat& depth_m, double u_px, double v_px) const {
+  const int u = static_cast<int>(std::lround(u_px));
+  const int v = static_cast<int>(std::lround(v_px));
+  if (u < 1 || v < 1 || u >= depth_m.cols - 1 || v >= depth_m.rows - 1) return 0.0;
+  // The depth at the pixel, unless the 3x3 neighbourhood straddles a depth edge (the point
+  // would be on the background or the foreground by chance).
+  float lo = std::numeric_limits<float>::infinity(), hi = 0.0f;
+  int valid = 0;
+  for (int dv = -1; dv <= 1; ++dv) {
+    for (int du = -1; du <= 1; ++du) {
+      const float z = depth_m.at<float>(v + dv, u + du);
+      if (!(z > 0.0f)) continue;
+      lo = std::min(lo, z);
+      hi = std::max(hi, z);
+      ++valid;
+    }
+  }
+  const double z = static_cast<double>(depth_m.at<float>(v, u));
+  if (valid < 5 || !(z >= options_.min_depth_m && z <= options_.max_depth_m)) return 0.0;
+  if (static_cast<double>(hi - lo) > options_.max_depth_spread * z) return 0.0;
+  return z;
+}
+
+vo::FrameMotion keyframe_motion(const vo::DepthOptions& timing, int64_t utime, int64_t depth_utime,
+                                int64_t previous_utime, const Eigen::Isometry3d& T_previous_current) {
+  vo::FrameMotion motion;
+  const double dt = 1e-6 * static_cast<double>(utime - previous_utime);
+  if (!(dt > 0.0)) return motion;
+  motion.known = true;
+  motion.twist_per_s = se3::log(T_previous_current) / dt;
+  motion.depth_offset_s =
+      timing.compensate_time_offset ? vo::depth_time_offset_s(timing, utime, depth_utime) : 0.0;
+  motion.readout_s = timing.rolling_shutter_readout_s;
+  return motion;
 }
 
 FrameFeatures FeatureExtractor::extract(const cv::Mat& grey, const cv::Mat& depth_m,
-                                        const PinholeCamera& camera) const {
+                                        const PinholeCamera& camera, const vo::FrameMotion& motion) const {
   FrameFeatures f;
   f.camera = camera;
   orb_->detectAndCompute(grey, cv::noArray(), f.keypoints, f.descriptors);
@@ -47,27 +87,41 @@ FrameFeatures FeatureExtractor::extract(const cv::Mat& grey, const cv::Mat& dept
   const double nan = std::numeric_limits<double>::quiet_NaN();
   f.points.assign(f.keypoints.size(), Eigen::Vector3d(nan, nan, nan));
   if (depth_m.empty()) return f;
+  // The timing correction (top of frame_features.h); none for a global shutter without a
+  // depth offset, whose points stay exactly as read at the keypoint.
+  const bool timed = motion.known && (motion.depth_offset_s != 0.0 || motion.readout_s > 0.0);
+  const bool depth_time = motion.known && motion.depth_offset_s != 0.0;
+  const Eigen::Isometry3d T_rgb_depth =
+      depth_time ? se3::exp(motion.twist_per_s * motion.depth_offset_s) : Eigen::Isometry3d::Identity();
+  const Eigen::Isometry3d T_depth_rgb = T_rgb_depth.inverse();
+  vo::Lens pinhole;  // SLAM's pixels are ideal: the identity map
+  if (timed) pinhole.reset(camera, false);
   for (size_t i = 0; i < f.keypoints.size(); ++i) {
-    const int u = static_cast<int>(std::lround(f.keypoints[i].pt.x));
-    const int v = static_cast<int>(std::lround(f.keypoints[i].pt.y));
-    if (u < 1 || v < 1 || u >= depth_m.cols - 1 || v >= depth_m.rows - 1) continue;
-    // The depth at the keypoint, unless the 3x3 neighbourhood straddles a depth edge (the
-    // point would be on the background or the foreground by chance).
-    float lo = std::numeric_limits<float>::infinity(), hi = 0.0f;
-    int valid = 0;
-    for (int dv = -1; dv <= 1; ++dv) {
-      for (int du = -1; du <= 1; ++du) {
-        const float z = depth_m.at<float>(v + dv, u + du);
-        if (!(z > 0.0f)) continue;
-        lo = std::min(lo, z);
-        hi = std::max(hi, z);
-        ++valid;
-      }
+    const cv::Point2f pt = f.keypoints[i].pt;
+    double z = reliable_depth(depth_m, pt.x, pt.y);
+    if (!(z > 0.0)) continue;
+    if (!timed) {
+      f.points[i] = camera.backproject(pt.x, pt.y, z);
+      continue;
     }
-    const double z = static_cast<double>(depth_m.at<float>(v, u));
-    if (valid < 5 || !(z >= options_.min_depth_m && z <= options_.max_depth_m)) continue;
-    if (static_cast<double>(hi - lo) > options_.max_depth_spread * z) continue;
-    f.points[i] = camera.backproject(f.keypoints[i].pt.x, f.keypoints[i].pt.y, z);
+    if (depth_time) {
+      // Where the point seen now at this pixel was at depth time; read the depth there and
+      // bring that point back to RGB time (its depth along this keypoint's ray).
+      const Eigen::Vector3d p_depth = T_depth_rgb * camera.backproject(pt.x, pt.y, z);
+      if (!(p_depth.z() > 0.0)) continue;
+      const Eigen::Vector2d at_depth = camera.project(p_depth);
+      const double z_depth = reliable_depth(depth_m, at_depth.x(), at_depth.y());
+      if (!(z_depth > 0.0)) continue;
+      z = (T_rgb_depth * camera.backproject(at_depth.x(), at_depth.y(), z_depth)).z();
+      if (!(z >= options_.min_depth_m && z <= options_.max_depth_m)) continue;
+    }
+    // Carried from its row's time to the middle row's (rolling shutter).
+    Eigen::Vector2f pixel;
+    const Eigen::Vector3d p =
+        vo::point_at_frame_time(pinhole, motion, pt.x, pt.y, static_cast<float>(z), &pixel).cast<double>();
+    if (!(p.z() >= options_.min_depth_m && p.z() <= options_.max_depth_m)) continue;
+    f.points[i] = p;
+    f.keypoints[i].pt = cv::Point2f(pixel.x(), pixel.y());
   }
   return f;
 }

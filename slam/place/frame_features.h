@@ -6,14 +6,37 @@
 // Invariants: keypoints, descriptor rows and points are parallel arrays; descriptors are
 // CV_8UC1 with 32 bytes per row; a point without depth is NaN; valid points have
 // min_depth_m <= z <= max_depth_m.
+//
+// Timing (a Kinect: its depth image is captured at another time than the colour image, and
+// the colour image is read row by row): given the camera's motion around the keyframe
+// (vo::FrameMotion), each keypoint's depth is read where its point was at depth time and the
+// point is then carried to the frame's time (the middle row's), exactly as the odometry does
+// (vo/depth_lookup.h: T_rgb_depth = exp(depth_offset_s * twist), vo::point_at_frame_time);
+// the keypoint's pixel becomes that point's projection (its descriptor stays the one
+// computed at the raw pixel). Without a known motion, or with a global shutter and no depth
+// offset (the simulator's camera), points are read at the keypoint as they always were.
+// SLAM takes pixels as ideal pinhole pixels (no lens distortion), with or without timing.
+//
+// Where the motion comes from (keyframe_motion()): the odometry's own estimate of the motion
+// from the frame before the keyframe to the keyframe, over their stamps' interval -- the
+// frame-to-frame motion the VO itself uses for this correction (it predicts it; SLAM, later,
+// has it measured), available when the keyframe is made (no waiting for the next frame),
+// both offline (sequence_run.cpp) and in the process (slam_adapter.cpp, from consecutive
+// VO_UPDATEs). Depth offset and readout are the VO's (vo::DepthOptions of the camera's
+// profile, vo/sensor_profile.h): depth_time_offset_s() of the frame's stamps when
+// compensate_time_offset, else none; rolling_shutter_readout_s.
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <cstdint>
 #include <opencv2/core.hpp>
 #include <opencv2/features2d.hpp>
 #include <vector>
 
 #include "common/camera.h"
 #include "common/rgbd_frame.h"
+#include "vo/frame_motion.h"
+#include "vo/options.h"
 
 namespace kestrel::slam {
 
@@ -43,13 +66,26 @@ class FeatureExtractor {
   /// Throws std::invalid_argument naming the field if an option is unusable.
   explicit FeatureExtractor(const FeatureOptions& options = {});
   /// Features of a frame; a frame without colour gives none, without depth gives no points.
-  FrameFeatures extract(const RgbdFrame& frame) const;
+  /// `motion`: the camera's motion around the frame's time (see the top of this file).
+  FrameFeatures extract(const RgbdFrame& frame, const vo::FrameMotion& motion = {}) const;
   /// Features of a grey image with an optional depth image in metres (CV_32FC1, NaN = none).
-  FrameFeatures extract(const cv::Mat& grey, const cv::Mat& depth_m, const PinholeCamera& camera) const;
+  FrameFeatures extract(const cv::Mat& grey, const cv::Mat& depth_m, const PinholeCamera& camera,
+                        const vo::FrameMotion& motion = {}) const;
 
  private:
+  /// Depth in metres at pixel (u, v) (nearest), or 0 when it is outside the image (one pixel
+  /// of border), out of range or on a depth edge (3x3 neighbourhood).
+  double reliable_depth(const cv::Mat& depth_m, double u, double v) const;
+
   FeatureOptions options_;
   cv::Ptr<cv::ORB> orb_;
 };
+
+/// The motion for a keyframe's features (see the top of this file): `T_previous_current` is
+/// the odometry's motion from the previous frame (stamped `previous_utime`) to this one
+/// (`utime`, depth stamped `depth_utime`); `timing` the camera's (the VO's DepthOptions).
+/// Unknown when the interval is not positive.
+vo::FrameMotion keyframe_motion(const vo::DepthOptions& timing, int64_t utime, int64_t depth_utime,
+                                int64_t previous_utime, const Eigen::Isometry3d& T_previous_current);
 
 }  // namespace kestrel::slam

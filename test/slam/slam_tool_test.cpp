@@ -18,7 +18,7 @@ using ::kestrel::test::tool;
 TEST(SlamTool, HelpListsTheOptions) {
   const auto help = run({tool("slam"), "--help"});
   EXPECT_EQ(help.exit_code, kExitOk);
-  for (const char* option : {"--keyframe-distance", "--loop-min-age", "--candidates", "--kernel", "--tum", "--vocabulary"}) {
+  for (const char* option : {"--keyframe-distance", "--loop-min-age", "--candidates", "--kernel", "--tum", "--vocabulary", "--sensor"}) {
     EXPECT_NE(help.out.find(option), std::string::npos) << option;
   }
 }
@@ -27,6 +27,7 @@ TEST(SlamTool, BadOptionsAreExitCode2) {
   EXPECT_EQ(run({tool("slam"), "--kernel", "tukey"}).exit_code, kExitUsage);
   EXPECT_EQ(run({tool("slam"), "--keyframe-distance", "-1"}).exit_code, kExitUsage);
   EXPECT_EQ(run({tool("slam"), "--candidates", "0"}).exit_code, kExitUsage);
+  EXPECT_EQ(run({tool("slam"), "--sensor", "kinect2"}).exit_code, kExitUsage) << "simulator or kinect1";
   EXPECT_EQ(run({tool("slam"), "--out", "x.txt"}).exit_code, kExitUsage) << "--out only with --tum";
   EXPECT_EQ(run({tool("slam"), "--tum", "somewhere"}).exit_code, kExitUsage) << "--tum needs --out";
 }

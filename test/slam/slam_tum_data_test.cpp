@@ -1,5 +1,5 @@
-// VO + SLAM on the real TUM sequences (label data; skips without ../shared/data), the VO with
-// the recordings' camera profile (kinect1): on each, the ATE of the optimised trajectory is no
+// VO + SLAM on the real TUM sequences (label data; skips without ../shared/data), the VO and
+// the keyframe features' timing with the recordings' camera profile (kinect1): on each, the ATE of the optimised trajectory is no
 // worse than the odometry's (issue 6; but for fr1_xyz's one imprecise loop, see below), and on fr1_rpy,
 // where the camera sweeps back over the desk, loops are closed and the ATE drops; with the
 // built-in (trained) vocabulary and the online one alike, and no loop closure is false.
@@ -53,16 +53,19 @@ TEST_P(SlamOnTum, AteIsNoWorseThanTheOdometrys) {
   std::cout << name << (builtin ? " (built-in vocabulary)" : " (online vocabulary)") << ": ATE VO " << vo_ate << " m, SLAM " << slam_ate << " m, " << run.keyframes
             << " keyframes, " << run.loop_closures << " loop closures\n";
   // fr1_xyz has almost no drift to correct (the VO's 0.89 cm is mostly noise), and the one
-  // loop the built-in vocabulary finds there is itself 2.4 cm / 1.25 deg off, worse than the
-  // odometry over its span (slam/README.md, "Missing": the two-view adjustment does not model
-  // the Kinect's timing as the VO does): SLAM then ends at 1.11 cm, above the VO. That case
-  // is held to its measured figure plus 10 %; everywhere else SLAM may not be worse.
+  // loop the built-in vocabulary finds there is itself off: 2.4 cm / 1.25 deg (SLAM 1.11 cm)
+  // before the keyframe features had the VO's timing correction, 1.27 cm / 0.78 deg with it,
+  // still more than the odometry over its span in rotation (0.59 deg) and weighted above it
+  // (slam/README.md, "Missing"). SLAM then ends at 0.98 cm, still above the VO's 0.89: that
+  // case is held to its measured figure plus 10 %; everywhere else SLAM may not be worse.
   if (name == "rgbd_dataset_freiburg1_xyz" && run.loop_closures > 0)
-    EXPECT_LE(slam_ate, 1.1 * 0.0111);
+    EXPECT_LE(slam_ate, 1.1 * 0.00977);
   else
     EXPECT_LE(slam_ate, vo_ate + 1e-9);
   for (const LoopError& e : loop_errors(run, sequence.ground_truth)) {
     ASSERT_TRUE(e.has_truth);
+    std::cout << "  loop " << e.edge.from_utime << " -> " << e.edge.to_utime << ": " << e.translation_m * 100.0
+              << " cm, " << e.rotation_rad * 180.0 / M_PI << " deg\n";
     EXPECT_LT(e.translation_m, 0.10) << "a false loop closure";
     EXPECT_LT(e.rotation_rad, 3.0 * M_PI / 180.0) << "a false loop closure";
   }
