@@ -76,7 +76,8 @@ int launch(const Options& o) {
   ProcessSet set = select(read_process_sets(o.sets_file), o.set, o.only, o.without);
   if (!o.source.empty()) {
     const std::vector<std::string> source = split_command(o.source);
-    if (const auto profile = camera_profile_of_source(source)) set_camera_profile(set, *profile);
+    if (const auto profile = camera_profile_of_source(source))
+      set_camera_profile(set, *profile, kCameraProfileTools);
     set.push_back({"source", source, "source"});
   }
   if (set.empty()) throw CLI::ValidationError("SET", "selects no process");

@@ -129,9 +129,15 @@ std::optional<std::string> camera_profile_of_source(const std::vector<std::strin
 }
 
 void set_camera_profile(ProcessSet& set, const std::string& profile) {
+  set_camera_profile(set, profile, {"vo"});
+}
+
+void set_camera_profile(ProcessSet& set, const std::string& profile, const std::vector<std::string>& tools) {
   for (ProcessSpec& p : set) {
     const std::string tool = std::filesystem::path(p.argv[0]).filename().string();
-    if (tool != "vo" && tool != "kestrel-vo") continue;
+    if (std::none_of(tools.begin(), tools.end(),
+                     [&](const std::string& t) { return tool == t || tool == "kestrel-" + t; }))
+      continue;
     if (std::find(p.argv.begin(), p.argv.end(), "--sensor") != p.argv.end()) continue;
     p.argv.push_back("--sensor");
     p.argv.push_back(profile);

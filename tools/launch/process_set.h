@@ -47,5 +47,11 @@ std::optional<std::string> camera_profile_of_source(const std::vector<std::strin
 
 /// Adds `--sensor profile` to every `vo` process of `set` whose command does not name one.
 void set_camera_profile(ProcessSet& set, const std::string& profile);
+/// The same for every process running one of `tools` (bare names: "vo" also matches
+/// "kestrel-vo"). `kestrel launch` gives the profile to the processes that model the camera's
+/// timing, kCameraProfileTools.
+void set_camera_profile(ProcessSet& set, const std::string& profile, const std::vector<std::string>& tools);
+/// vo (its odometry) and slam (its keyframe features' timing correction, slam/README.md).
+inline const std::vector<std::string> kCameraProfileTools = {"vo", "slam"};
 
 }  // namespace kestrel::launch
