@@ -1,7 +1,8 @@
 #pragma once
 // The worlds of the paper's planning experiments, loaded through the simulator's world
 // library (drivers/sim): the shipped `floor` world (13 x 23 m, the size of the paper's Stata
-// ground floor) and `stata`, extruded from the real Stata basement map when it is present.
+// ground floor, as rooms and corridors), the shipped `atrium` (the same size, open, as the
+// paper describes its floor) and `stata`, extruded from the real Stata basement map when it is present.
 // Each comes with its five start/goal pairs (>= 8.53 m apart, as in the paper), checked to be
 // free for the vehicle when the world is loaded.
 
@@ -26,6 +27,10 @@ struct ExperimentWorld {
 
 /// The shipped `floor` world. Throws std::runtime_error if a pair is not free for `radius_m`.
 ExperimentWorld floor_experiment_world(const WorldFeatureOptions& features, double radius_m);
+
+/// The shipped `atrium` world (13 x 23 m, the paper's open kind of floor). Throws
+/// std::runtime_error if a pair is not free for `radius_m`.
+ExperimentWorld atrium_experiment_world(const WorldFeatureOptions& features, double radius_m);
 
 /// `stata` from `map_yaml`, or nullopt when that file does not exist. Bad map files throw
 /// InputError naming the file.

@@ -53,7 +53,7 @@ cv::Mat draw_paths(const ExperimentWorld& w, const eval::Scenario& sc, const eva
 
 int main(int argc, char** argv) {
   cli::App app("plan-experiments",
-               "Reproduces the paper's planner tables (BRM vs PRM, samplers) in the sim's floor and stata worlds");
+               "Reproduces the paper's planner tables (BRM vs PRM, samplers) in the sim's floor, atrium and stata worlds");
   eval::ExperimentOptions o;
   std::string only = "all", out_path, which = "all", map_yaml = KESTREL_DEFAULT_STATA_MAP, png_dir;
   WorldFeatureOptions features;
@@ -61,7 +61,8 @@ int main(int argc, char** argv) {
   app.add_option("--trials", o.trials, "Trials per start/goal pair and setting")->check(cli::Positive);
   app.add_option("--samples", o.samples, "Samples per roadmap")->check(cli::Positive);
   app.add_option("--seed", o.seed, "Seed of every random draw (features, samplers)");
-  app.add_option("--world", which, "floor, stata or all")->check(CLI::IsMember({"all", "floor", "stata"}));
+  app.add_option("--world", which, "floor, atrium, stata or all")
+      ->check(CLI::IsMember({"all", "floor", "atrium", "stata"}));
   app.add_option("--map", map_yaml, "ROS map the stata world is built from (skipped with a message when absent)");
   app.add_option("--feature-density", features.mean_density_per_m2,
                  "Mean features per square metre over the walls (each wall's share follows its texture)")
@@ -100,8 +101,9 @@ int main(int argc, char** argv) {
             [&] { return eval::table3_weight_cost(o.seed); });
 
     std::vector<ExperimentWorld> worlds;
-    if (which != "stata") worlds.push_back(floor_experiment_world(features, base.space.radius_m));
-    if (which != "floor") {
+    if (which == "all" || which == "floor") worlds.push_back(floor_experiment_world(features, base.space.radius_m));
+    if (which == "all" || which == "atrium") worlds.push_back(atrium_experiment_world(features, base.space.radius_m));
+    if (which == "all" || which == "stata") {
       auto stata = stata_experiment_world(map_yaml, features, base.space.radius_m);
       if (stata) worlds.push_back(std::move(*stata));
       else emit("## World stata\n\nSkipped: the map " + map_yaml + " is absent.\n\n");
