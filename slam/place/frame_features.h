@@ -22,7 +22,8 @@
 // frame-to-frame motion the VO itself uses for this correction (it predicts it; SLAM, later,
 // has it measured), available when the keyframe is made (no waiting for the next frame),
 // both offline (sequence_run.cpp) and in the process (slam_adapter.cpp, from consecutive
-// VO_UPDATEs). Depth offset and readout are the VO's (vo::DepthOptions of the camera's
+// VO_UPDATEs); on fr1 the next frame's motion or the previous-to-next one did no better
+// (slam/README.md, "Missing"). Depth offset and readout are the VO's (vo::DepthOptions of the camera's
 // profile, vo/sensor_profile.h): depth_time_offset_s() of the frame's stamps when
 // compensate_time_offset, else none; rolling_shutter_readout_s.
 
