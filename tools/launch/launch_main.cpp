@@ -77,7 +77,7 @@ int launch(const Options& o) {
   if (!o.source.empty()) {
     const std::vector<std::string> source = split_command(o.source);
     if (const auto profile = camera_profile_of_source(source))
-      set_camera_profile(set, *profile, kCameraProfileTools);
+      set_camera_profile(set, *profile);
     set.push_back({"source", source, "source"});
   }
   if (set.empty()) throw CLI::ValidationError("SET", "selects no process");

@@ -129,10 +129,7 @@ std::optional<std::string> camera_profile_of_source(const std::vector<std::strin
 }
 
 void set_camera_profile(ProcessSet& set, const std::string& profile) {
-  set_camera_profile(set, profile, {"vo"});
-}
-
-void set_camera_profile(ProcessSet& set, const std::string& profile, const std::vector<std::string>& tools) {
+  const std::vector<std::string>& tools = kCameraProfileTools;
   for (ProcessSpec& p : set) {
     const std::string tool = std::filesystem::path(p.argv[0]).filename().string();
     if (std::none_of(tools.begin(), tools.end(),

@@ -45,13 +45,12 @@ std::filesystem::path resolve_executable(const std::string& command,
 /// and nothing for any other source (the simulator, a replay), which leaves vo's default.
 std::optional<std::string> camera_profile_of_source(const std::vector<std::string>& source_argv);
 
-/// Adds `--sensor profile` to every `vo` process of `set` whose command does not name one.
-void set_camera_profile(ProcessSet& set, const std::string& profile);
-/// The same for every process running one of `tools` (bare names: "vo" also matches
-/// "kestrel-vo"). `kestrel launch` gives the profile to the processes that model the camera's
-/// timing, kCameraProfileTools.
-void set_camera_profile(ProcessSet& set, const std::string& profile, const std::vector<std::string>& tools);
-/// vo (its odometry) and slam (its keyframe features' timing correction, slam/README.md).
+/// The processes that model the camera's timing: vo (its odometry) and slam (its keyframe
+/// features' timing correction, slam/README.md). Bare names: "vo" also matches "kestrel-vo".
 inline const std::vector<std::string> kCameraProfileTools = {"vo", "slam"};
+
+/// Adds `--sensor profile` to every process of `set` running one of kCameraProfileTools whose
+/// command does not name a profile already.
+void set_camera_profile(ProcessSet& set, const std::string& profile);
 
 }  // namespace kestrel::launch
