@@ -1,9 +1,12 @@
 #pragma once
 // The pinhole model of an RGB-D camera whose depth is registered to its colour image.
 //
-// Invariant: pixel coordinates are of undistorted images; (0, 0) is the centre of the
-// top-left pixel. `distortion` is carried for completeness (a source may report it) but
-// project()/backproject() do not apply it: sources either undistort or report zeros.
+// Invariant: (0, 0) is the centre of the top-left pixel; `distortion` is the lens model of the
+// images as the source delivers them (zero when it undistorted them or its lens has none;
+// TUM's freiburg1 reports its calibration with raw images). project()/backproject() are the
+// pinhole model of ideal (undistorted) pixels and do not apply it: a consumer of raw pixels
+// maps them to ideal ones first (vo::Lens, which the VO uses; SLAM and the mapper take raw
+// pixels as ideal, an error of a few pixels on freiburg1 -- their READMEs say so).
 
 #include <Eigen/Core>
 #include <array>

@@ -12,6 +12,7 @@ VoOptions with_sensor(SensorProfile profile, VoOptions options) {
   options.covariance.rotation_floor_rad = kKinect1RotationFloorRad;
   options.covariance.translation_per_rad_m = kKinect1TranslationPerRadM;
   options.covariance.rotation_per_rad = kKinect1RotationPerRad;
+  options.dense.weight = kKinect1DenseWeight;
   options.validate();
   return options;
 }

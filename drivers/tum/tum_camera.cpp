@@ -18,7 +18,11 @@ TumCamera detect_camera(const std::string& folder) {
 PinholeCamera camera_intrinsics(TumCamera camera) {
   switch (camera) {
     case TumCamera::kFreiburg1:
-      return PinholeCamera::vga(517.3, 516.5, 318.6, 255.3);
+    {
+      PinholeCamera c = PinholeCamera::vga(517.3, 516.5, 318.6, 255.3);
+      c.distortion = {0.2624, -0.9531, -0.0054, 0.0026, 1.1633};
+      return c;
+    }
     case TumCamera::kFreiburg2:
       return PinholeCamera::vga(520.9, 521.0, 325.1, 249.7);
     case TumCamera::kFreiburg3:

@@ -7,9 +7,10 @@
 // "Intrinsic Camera Calibration of the Kinect"); for any other folder the ROS default
 // 525/525/319.5/239.5 is used, as TUM advises for uncalibrated use. Images are 640x480.
 //
-// Distortion is reported as zero: the images are not undistorted here (TUM's registered depth
-// cannot be undistorted exactly), and PinholeCamera's invariant is that the source either
-// undistorts or reports zeros. For fr1 the residual distortion is a few pixels at the corners.
+// The images are not undistorted here (TUM's registered depth cannot be undistorted exactly):
+// freiburg1 reports TUM's calibrated lens distortion with its raw images (2-3 % radial over
+// most of the image, 5-8 px; up to ~25 px in the corners), for consumers that map raw pixels
+// to ideal ones (vo::Lens); freiburg2/3 and unknown folders report none (not measured here).
 
 #include <string>
 
@@ -22,7 +23,8 @@ enum class TumCamera { kFreiburg1, kFreiburg2, kFreiburg3, kUnknown };
 /// The camera named in the last component of `folder` ("freiburg1" .. "freiburg3").
 TumCamera detect_camera(const std::string& folder);
 
-/// TUM's calibrated intrinsics for `camera` (ROS default for kUnknown), 640x480, no distortion.
+/// TUM's calibrated intrinsics for `camera` (ROS default for kUnknown), 640x480; distortion
+/// for freiburg1 only.
 PinholeCamera camera_intrinsics(TumCamera camera);
 
 /// "freiburg1", ..., "unknown (ROS default intrinsics)".
