@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <mutex>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
@@ -17,7 +18,13 @@ size_t FrameFeatures::num_points() const {
                                            [](const Eigen::Vector3d& p) { return !std::isnan(p.z()); }));
 }
 
-FeatureExtractor::FeatureExtractor(const FeatureOptions& options) : options_(options) {
+struct FeatureExtractor::LensCache {
+  std::mutex mutex;
+  std::shared_ptr<const vo::Lens> lens;  // the last camera's
+};
+
+FeatureExtractor::FeatureExtractor(const FeatureOptions& options)
+    : options_(options), lens_cache_(std::make_shared<LensCache>()) {
   if (options.max_features < 1) throw std::invalid_argument("features: max_features must be >= 1");
   if (options.pyramid_levels < 1) throw std::invalid_argument("features: pyramid_levels must be >= 1");
   if (!(options.scale_factor > 1.0)) throw std::invalid_argument("features: scale_factor must be > 1");
@@ -65,6 +72,16 @@ double FeatureExtractor::reliable_depth(const cv::Mat& depth_m, double u_px, dou
   return z;
 }
 
+std::shared_ptr<const vo::Lens> FeatureExtractor::lens_for(const PinholeCamera& camera) const {
+  const std::lock_guard<std::mutex> lock(lens_cache_->mutex);
+  if (!lens_cache_->lens || !lens_cache_->lens->prepared_for(camera, true)) {
+    auto lens = std::make_shared<vo::Lens>();
+    lens->reset(camera, true);
+    lens_cache_->lens = std::move(lens);
+  }
+  return lens_cache_->lens;
+}
+
 vo::FrameMotion keyframe_motion(const vo::DepthOptions& timing, int64_t utime, int64_t depth_utime,
                                 int64_t previous_utime, const Eigen::Isometry3d& T_previous_current) {
   vo::FrameMotion motion;
@@ -94,31 +111,42 @@ FrameFeatures FeatureExtractor::extract(const cv::Mat& grey, const cv::Mat& dept
   const Eigen::Isometry3d T_rgb_depth =
       depth_time ? se3::exp(motion.twist_per_s * motion.depth_offset_s) : Eigen::Isometry3d::Identity();
   const Eigen::Isometry3d T_depth_rgb = T_rgb_depth.inverse();
-  vo::Lens pinhole;  // SLAM's pixels are ideal: the identity map
-  if (timed) pinhole.reset(camera, false);
+  // The lens (top of frame_features.h): without distortion ideal pixels are the raw ones and
+  // the untimed path below is the one keyframes always took.
+  const bool distorted = std::any_of(camera.distortion.begin(), camera.distortion.end(),
+                                     [](double d) { return d != 0.0; });
+  const std::shared_ptr<const vo::Lens> lens = (timed || distorted) ? lens_for(camera) : nullptr;
   for (size_t i = 0; i < f.keypoints.size(); ++i) {
-    const cv::Point2f pt = f.keypoints[i].pt;
+    const cv::Point2f pt = f.keypoints[i].pt;  // raw: depth is read here
+    Eigen::Vector2d ideal(pt.x, pt.y);
+    if (distorted) {
+      ideal = lens->ideal(pt.x, pt.y).cast<double>();
+      f.keypoints[i].pt = cv::Point2f(static_cast<float>(ideal.x()), static_cast<float>(ideal.y()));
+    }
     double z = reliable_depth(depth_m, pt.x, pt.y);
     if (!(z > 0.0)) continue;
     if (!timed) {
-      f.points[i] = camera.backproject(pt.x, pt.y, z);
+      f.points[i] = camera.backproject(ideal.x(), ideal.y(), z);
       continue;
     }
     if (depth_time) {
-      // Where the point seen now at this pixel was at depth time; read the depth there and
-      // bring that point back to RGB time (its depth along this keypoint's ray).
-      const Eigen::Vector3d p_depth = T_depth_rgb * camera.backproject(pt.x, pt.y, z);
+      // Where the point seen now at this pixel was at depth time; read the depth there (at
+      // that ideal pixel's raw one) and bring that point back to RGB time (its depth along
+      // this keypoint's ray).
+      const Eigen::Vector3d p_depth = T_depth_rgb * camera.backproject(ideal.x(), ideal.y(), z);
       if (!(p_depth.z() > 0.0)) continue;
       const Eigen::Vector2d at_depth = camera.project(p_depth);
-      const double z_depth = reliable_depth(depth_m, at_depth.x(), at_depth.y());
+      const Eigen::Vector2d raw_at_depth =
+          distorted ? vo::distort_pixel(camera, true, at_depth.x(), at_depth.y()) : at_depth;
+      const double z_depth = reliable_depth(depth_m, raw_at_depth.x(), raw_at_depth.y());
       if (!(z_depth > 0.0)) continue;
       z = (T_rgb_depth * camera.backproject(at_depth.x(), at_depth.y(), z_depth)).z();
       if (!(z >= options_.min_depth_m && z <= options_.max_depth_m)) continue;
     }
-    // Carried from its row's time to the middle row's (rolling shutter).
+    // Carried from its (raw) row's time to the middle row's (rolling shutter).
     Eigen::Vector2f pixel;
     const Eigen::Vector3d p =
-        vo::point_at_frame_time(pinhole, motion, pt.x, pt.y, static_cast<float>(z), &pixel).cast<double>();
+        vo::point_at_frame_time(*lens, motion, pt.x, pt.y, static_cast<float>(z), &pixel).cast<double>();
     if (!(p.z() >= options_.min_depth_m && p.z() <= options_.max_depth_m)) continue;
     f.points[i] = p;
     f.keypoints[i].pt = cv::Point2f(pixel.x(), pixel.y());

@@ -15,7 +15,14 @@
 // the keypoint's pixel becomes that point's projection (its descriptor stays the one
 // computed at the raw pixel). Without a known motion, or with a global shutter and no depth
 // offset (the simulator's camera), points are read at the keypoint as they always were.
-// SLAM takes pixels as ideal pinhole pixels (no lens distortion), with or without timing.
+//
+// Lens (common/camera.h: a source may report the distortion of its raw images, as freiburg1
+// does): keypoints are detected and described on the raw image, and depth is read at the raw
+// pixel (the registered depth shares its grid), but the point lies on the ray of the ideal
+// pixel (vo::Lens with the camera's distortion) and the keypoint's pixel becomes that ideal
+// pixel (with timing, the point's projection): every pixel in FrameFeatures is an ideal
+// pinhole pixel of `camera`, which is what the loop verifier's two-frame adjustment projects
+// with. Without distortion (the simulator) nothing changes, bit for bit.
 //
 // Where the motion comes from (keyframe_motion()): the odometry's own estimate of the motion
 // from the frame before the keyframe to the keyframe, over their stamps' interval -- the
@@ -30,6 +37,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <cstdint>
+#include <memory>
 #include <opencv2/core.hpp>
 #include <opencv2/features2d.hpp>
 #include <vector>
@@ -37,6 +45,7 @@
 #include "common/camera.h"
 #include "common/rgbd_frame.h"
 #include "vo/frame_motion.h"
+#include "vo/lens.h"
 #include "vo/options.h"
 
 namespace kestrel::slam {
@@ -53,7 +62,7 @@ struct FeatureOptions {
 
 struct FrameFeatures {
   PinholeCamera camera;
-  std::vector<cv::KeyPoint> keypoints;
+  std::vector<cv::KeyPoint> keypoints; ///< detected on the raw image; pt: ideal pixel (see the top)
   cv::Mat descriptors;                 ///< CV_8UC1, one 32-byte row per keypoint
   std::vector<Eigen::Vector3d> points; ///< p_in_camera, NaN without depth
 
@@ -77,9 +86,14 @@ class FeatureExtractor {
   /// Depth in metres at pixel (u, v) (nearest), or 0 when it is outside the image (one pixel
   /// of border), out of range or on a depth edge (3x3 neighbourhood).
   double reliable_depth(const cv::Mat& depth_m, double u, double v) const;
+  /// The lens map of `camera` with its distortion, built once per camera and shared by
+  /// copies of this extractor (thread-safe; building one is a 640 x 480 table).
+  std::shared_ptr<const vo::Lens> lens_for(const PinholeCamera& camera) const;
 
+  struct LensCache;
   FeatureOptions options_;
   cv::Ptr<cv::ORB> orb_;
+  std::shared_ptr<LensCache> lens_cache_;
 };
 
 /// The motion for a keyframe's features (see the top of this file): `T_previous_current` is
