@@ -5,8 +5,9 @@
 // images as the source delivers them (zero when it undistorted them or its lens has none;
 // TUM's freiburg1 reports its calibration with raw images). project()/backproject() are the
 // pinhole model of ideal (undistorted) pixels and do not apply it: a consumer of raw pixels
-// maps them to ideal ones first (vo::Lens, which the VO uses; SLAM and the mapper take raw
-// pixels as ideal, an error of a few pixels on freiburg1 -- their READMEs say so).
+// maps them to ideal ones first (vo::Lens, which the VO and SLAM's keyframe features use;
+// the mapper takes raw pixels as ideal, an error of a few pixels on freiburg1 -- its README
+// says so).
 
 #include <Eigen/Core>
 #include <array>
