@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <opencv2/calib3d.hpp>
 
 namespace kestrel::vo {
 
@@ -15,21 +14,36 @@ void Lens::reset(const PinholeCamera& camera, bool use_distortion) {
                                [](double d) { return d != 0.0; });
   if (!use_distortion || !any) return;
 
+  // Each raw pixel's ideal one by Newton's method on the forward model (distort_pixel), in
+  // normalised coordinates, started from the row's previous solution: 2-4 iterations a pixel
+  // (a fixed-point inversion needs tens in the corners of a strongly distorted lens), so the
+  // table costs milliseconds, not a stall of the first frame.
   const int w = camera.width, h = camera.height;
-  cv::Mat raw(w * h, 1, CV_32FC2);
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) raw.at<cv::Vec2f>(y * w + x) = cv::Vec2f(float(x), float(y));
-  const cv::Matx33d K(camera.fx, 0, camera.cx, 0, camera.fy, camera.cy, 0, 0, 1);
-  const cv::Mat D(1, 5, CV_64F, const_cast<double*>(camera.distortion.data()));
-  cv::Mat ideal;
-  // Many iterations: the fixed-point inversion converges slowly in the corners of a strongly
-  // distorted lens, and this table is built once per camera.
-  cv::undistortPoints(raw, ideal, K, D, cv::noArray(), K,
-                      cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 100, 1e-10));
+  const double k1 = camera.distortion[0], k2 = camera.distortion[1], p1 = camera.distortion[2],
+               p2 = camera.distortion[3], k3 = camera.distortion[4];
   table_.resize(static_cast<size_t>(w) * static_cast<size_t>(h));
-  for (size_t i = 0; i < table_.size(); ++i) {
-    const cv::Vec2f p = ideal.at<cv::Vec2f>(static_cast<int>(i));
-    table_[i] = Eigen::Vector2f(p[0], p[1]);
+  for (int y = 0; y < h; ++y) {
+    const double yd = (double(y) - camera.cy) / camera.fy;
+    double xu = (0.0 - camera.cx) / camera.fx, yu = yd;  // the guess for the row's first pixel
+    for (int x = 0; x < w; ++x) {
+      const double xd = (double(x) - camera.cx) / camera.fx;
+      for (int it = 0; it < 30; ++it) {
+        const double r2 = xu * xu + yu * yu;
+        const double radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3));
+        const double dradial = k1 + r2 * (2.0 * k2 + 3.0 * r2 * k3);  // d radial / d r2
+        const double fx = xu * radial + 2.0 * p1 * xu * yu + p2 * (r2 + 2.0 * xu * xu) - xd;
+        const double fy = yu * radial + p1 * (r2 + 2.0 * yu * yu) + 2.0 * p2 * xu * yu - yd;
+        if (std::abs(fx) < 1e-13 && std::abs(fy) < 1e-13) break;
+        const double jxx = radial + 2.0 * xu * xu * dradial + 2.0 * p1 * yu + 6.0 * p2 * xu;
+        const double jxy = 2.0 * xu * yu * dradial + 2.0 * p1 * xu + 2.0 * p2 * yu;
+        const double jyy = radial + 2.0 * yu * yu * dradial + 6.0 * p1 * yu + 2.0 * p2 * xu;
+        const double det = jxx * jyy - jxy * jxy;  // the Jacobian is symmetric
+        xu -= (jyy * fx - jxy * fy) / det;
+        yu -= (jxx * fy - jxy * fx) / det;
+      }
+      table_[static_cast<size_t>(y) * static_cast<size_t>(w) + static_cast<size_t>(x)] =
+          Eigen::Vector2f(float(camera.fx * xu + camera.cx), float(camera.fy * yu + camera.cy));
+    }
   }
 }
 
