@@ -21,12 +21,14 @@ void Lens::reset(const PinholeCamera& camera, bool use_distortion) {
   const int w = camera.width, h = camera.height;
   const double k1 = camera.distortion[0], k2 = camera.distortion[1], p1 = camera.distortion[2],
                p2 = camera.distortion[3], k3 = camera.distortion[4];
-  table_.resize(static_cast<size_t>(w) * static_cast<size_t>(h));
-  for (int y = 0; y < h; ++y) {
-    const double yd = (double(y) - camera.cy) / camera.fy;
-    double xu = (0.0 - camera.cx) / camera.fx, yu = yd;  // the guess for the row's first pixel
-    for (int x = 0; x < w; ++x) {
-      const double xd = (double(x) - camera.cx) / camera.fx;
+  cols_ = (w - 1) / kStep + 2;
+  rows_ = (h - 1) / kStep + 2;
+  table_.resize(static_cast<size_t>(cols_) * static_cast<size_t>(rows_));
+  for (int gy = 0; gy < rows_; ++gy) {
+    const double yd = (double(gy * kStep) - camera.cy) / camera.fy;
+    double xu = (0.0 - camera.cx) / camera.fx, yu = yd;  // the guess for the row's first node
+    for (int gx = 0; gx < cols_; ++gx) {
+      const double xd = (double(gx * kStep) - camera.cx) / camera.fx;
       for (int it = 0; it < 30; ++it) {
         const double r2 = xu * xu + yu * yu;
         const double radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3));
@@ -41,7 +43,7 @@ void Lens::reset(const PinholeCamera& camera, bool use_distortion) {
         xu -= (jyy * fx - jxy * fy) / det;
         yu -= (jxx * fy - jxy * fx) / det;
       }
-      table_[static_cast<size_t>(y) * static_cast<size_t>(w) + static_cast<size_t>(x)] =
+      table_[static_cast<size_t>(gy) * static_cast<size_t>(cols_) + static_cast<size_t>(gx)] =
           Eigen::Vector2f(float(camera.fx * xu + camera.cx), float(camera.fy * yu + camera.cy));
     }
   }
@@ -56,15 +58,16 @@ bool Lens::prepared_for(const PinholeCamera& c, bool use_distortion) const {
 Eigen::Vector2f Lens::ideal(float u, float v) const {
   if (table_.empty()) return {u, v};
   const int w = camera_.width, h = camera_.height;
-  const float uc = std::clamp(u, 0.0f, float(w - 1) - 1e-3f);
-  const float vc = std::clamp(v, 0.0f, float(h - 1) - 1e-3f);
-  const int x = static_cast<int>(uc), y = static_cast<int>(vc);
-  const float fx = uc - float(x), fy = vc - float(y);
-  const size_t i = static_cast<size_t>(y) * static_cast<size_t>(w) + static_cast<size_t>(x);
-  const size_t ws = static_cast<size_t>(w);
+  const float uc = std::clamp(u, 0.0f, float(w - 1));
+  const float vc = std::clamp(v, 0.0f, float(h - 1));
+  const float gu = uc * (1.0f / kStep), gv = vc * (1.0f / kStep);
+  const int x = std::min(static_cast<int>(gu), cols_ - 2), y = std::min(static_cast<int>(gv), rows_ - 2);
+  const float fx = gu - float(x), fy = gv - float(y);
+  const size_t i = static_cast<size_t>(y) * static_cast<size_t>(cols_) + static_cast<size_t>(x);
+  const size_t c = static_cast<size_t>(cols_);
   const Eigen::Vector2f top = (1 - fx) * table_[i] + fx * table_[i + 1];
-  const Eigen::Vector2f bottom = (1 - fx) * table_[i + ws] + fx * table_[i + ws + 1];
-  // Outside the table (a coordinate clamped above) the map continues with unit slope.
+  const Eigen::Vector2f bottom = (1 - fx) * table_[i + c] + fx * table_[i + c + 1];
+  // Outside the image (a coordinate clamped above) the map continues with unit slope.
   return (1 - fy) * top + fy * bottom + Eigen::Vector2f(u - uc, v - vc);
 }
 

@@ -4,9 +4,10 @@
 // reports. Depth images registered to the colour image share its raw pixel grid, which is why
 // depth is looked up at raw pixels while rays come from ideal ones.
 //
-// Invariant: after reset(camera), ideal(u, v) is within 1e-3 px of the exact inverse of the
-// Brown-Conrady model with camera.distortion, over the whole image; with zero distortion it is
-// the identity.
+// Invariant: after reset(camera), ideal(u, v) is within 0.01 px of the exact inverse of the
+// Brown-Conrady model with camera.distortion over the image (bilinear between nodes of the
+// exact inverse every 4 px; on freiburg1's lens: median 3e-4, 99 % within 5e-3 px, a tenth of
+// a percent of the features' pixel noise); with zero distortion it is the identity.
 
 #include <Eigen/Core>
 #include <vector>
@@ -38,7 +39,12 @@ class Lens {
   PinholeCamera camera_;
   bool use_distortion_ = false;
   bool prepared_ = false;
-  std::vector<Eigen::Vector2f> table_;  // ideal coordinates of each raw pixel, row-major
+  // Ideal coordinates of every kStep-th raw pixel in both directions (one node past the last
+  // pixel), row-major, cols_ x rows_ nodes: 150 kB for VGA, so that the features' lookups
+  // stay in cache (a table of every pixel, 2.4 MB, missed it on most of them).
+  static constexpr int kStep = 4;
+  int cols_ = 0, rows_ = 0;
+  std::vector<Eigen::Vector2f> table_;
 };
 
 /// Raw (distorted) level-0 pixel of the ideal pinhole pixel (u, v) under the camera's

@@ -80,10 +80,10 @@ TEST(KeyframeLens, PointOnTheIdealRayWithDepthReadAtTheRawPixel) {
     if (plain.has_point(i)) {
       EXPECT_EQ(plain.points[i], raw_camera.backproject(raw.x, raw.y, plain.points[i].z()));
     }
-    // The ideal pixel is the one the lens maps to the raw keypoint (vo::Lens: within 1e-3 px).
+    // The ideal pixel is the one the lens maps to the raw keypoint (vo::Lens: within 0.01 px).
     const Eigen::Vector2d back = raw_of(camera, ideal.x, ideal.y);
-    EXPECT_NEAR(back.x(), raw.x, 2e-3) << "keypoint " << i;
-    EXPECT_NEAR(back.y(), raw.y, 2e-3) << "keypoint " << i;
+    EXPECT_NEAR(back.x(), raw.x, 1e-2) << "keypoint " << i;
+    EXPECT_NEAR(back.y(), raw.y, 1e-2) << "keypoint " << i;
     largest_shift_px = std::max(largest_shift_px, double(std::hypot(ideal.x - raw.x, ideal.y - raw.y)));
     ASSERT_EQ(plain.has_point(i), f.has_point(i));  // depth validity is the raw pixel's
     if (!f.has_point(i)) continue;
