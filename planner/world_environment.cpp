@@ -7,13 +7,13 @@
 #include <random>
 #include <stdexcept>
 
+#include "drivers/sim/collision.h"
 #include "planner/types.h"
 
 namespace kestrel::planner {
 
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
 // The last millimetre is the target's own surface: a feature on a wall sees its viewer.
 constexpr double kTargetMargin_m = 1e-3;
 // Slack of the fine grid's bookkeeping (obstacle boxes and the segment's cells): far above
@@ -115,39 +115,12 @@ WorldEnvironment::WorldEnvironment(const sim::World& world) : world_(world) {
 
 bool WorldEnvironment::hits(const Obstacle& o, const Eigen::Vector3d& origin, const Eigen::Vector3d& dir,
                             double max_distance) const {
-  // The sim's ray_rectangle / ray_box (collision.cpp), the same arithmetic in the same order,
-  // then the sim's acceptance: a hit no farther than max_distance.
-  double t = kInf;
-  if (!o.is_box) {
-    const sim::Surface& s = world_.surfaces()[o.index];
-    const double denom = s.normal.dot(dir);
-    if (std::abs(denom) < 1e-15) return false;
-    t = s.normal.dot(s.origin - origin) / denom;
-    if (t <= 0.0) return false;
-    const Eigen::Vector3d q = origin + t * dir - s.origin;
-    const double u = q.dot(s.axis_s), v = q.dot(s.axis_t);
-    if (!(u >= 0 && u <= s.width && v >= 0 && v <= s.height)) return false;
-  } else {
-    const sim::Box& box = world_.boxes()[o.index];
-    const Eigen::Vector3d lo = o.T_box_world * origin;
-    const Eigen::Vector3d d = o.T_box_world.linear() * dir;
-    double t_near = -kInf, t_far = kInf;
-    int axis = -1;
-    for (int i = 0; i < 3; ++i) {
-      const double h = box.half_extent[i];
-      if (std::abs(d[i]) < 1e-15) {
-        if (std::abs(lo[i]) > h) return false;
-        continue;
-      }
-      double t0 = (-h - lo[i]) / d[i], t1 = (h - lo[i]) / d[i];
-      if (t0 > t1) std::swap(t0, t1);
-      if (t0 > t_near) t_near = t0, axis = i;
-      t_far = std::min(t_far, t1);
-    }
-    if (t_near > t_far || t_near <= 0.0 || axis < 0) return false;
-    t = t_near;
-  }
-  return t <= max_distance;
+  // The sim's own ray tests (drivers/sim/collision.h), the box's inverse pose kept per
+  // obstacle, then the sim's acceptance: a hit no farther than max_distance.
+  if (!o.is_box) return sim::ray_rectangle(origin, dir, world_.surfaces()[o.index]) <= max_distance;
+  int axis = -1;
+  return sim::ray_box_local(o.T_box_world * origin, o.T_box_world.linear() * dir,
+                            world_.boxes()[o.index].half_extent, &axis) <= max_distance;
 }
 
 bool WorldEnvironment::sim_tests(const Obstacle& o, const Eigen::Vector3d& a, const Eigen::Vector3d& end) const {

@@ -29,41 +29,6 @@ double minimize_convex(F f) {
   return std::min({f1, f2, f(0.0), f(1.0)});
 }
 
-// Entry distance of the ray into the box along `dir` (unit), with the face it enters by
-// (0..5 as Box::faces), or infinity if it misses or starts inside.
-double ray_box(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, const Box& box, int* face) {
-  const Eigen::Isometry3d T_box_world = box.T_world_box.inverse();
-  const Eigen::Vector3d o = T_box_world * origin;
-  const Eigen::Vector3d d = T_box_world.linear() * dir;
-  double t_near = -kInf, t_far = kInf;
-  int axis = -1;
-  for (int i = 0; i < 3; ++i) {
-    const double h = box.half_extent[i];
-    if (std::abs(d[i]) < 1e-15) {
-      if (std::abs(o[i]) > h) return kInf;
-      continue;
-    }
-    double t0 = (-h - o[i]) / d[i], t1 = (h - o[i]) / d[i];
-    if (t0 > t1) std::swap(t0, t1);
-    if (t0 > t_near) t_near = t0, axis = i;
-    t_far = std::min(t_far, t1);
-  }
-  if (t_near > t_far || t_near <= 0.0 || axis < 0) return kInf;
-  // Entering through the face whose normal opposes the direction.
-  *face = 2 * axis + (d[axis] < 0 ? 0 : 1);
-  return t_near;
-}
-
-double ray_rectangle(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, const Surface& s) {
-  const double denom = s.normal.dot(dir);
-  if (std::abs(denom) < 1e-15) return kInf;
-  const double t = s.normal.dot(s.origin - origin) / denom;
-  if (t <= 0.0) return kInf;
-  const Eigen::Vector3d q = origin + t * dir - s.origin;
-  const double u = q.dot(s.axis_s), v = q.dot(s.axis_t);
-  return (u >= 0 && u <= s.width && v >= 0 && v <= s.height) ? t : kInf;
-}
-
 bool segment_crosses_rectangle(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Surface& s) {
   const double da = s.plane_distance(a), db = s.plane_distance(b);
   if ((da > 0) == (db > 0) && da != 0 && db != 0) return false;
@@ -90,6 +55,46 @@ Eigen::AlignedBox3d bounds_of(const Box& box) {
 }
 
 }  // namespace
+
+double ray_box_local(const Eigen::Vector3d& o, const Eigen::Vector3d& d, const Eigen::Vector3d& half_extent,
+                     int* axis) {
+  double t_near = -kInf, t_far = kInf;
+  int entry = -1;
+  for (int i = 0; i < 3; ++i) {
+    const double h = half_extent[i];
+    if (std::abs(d[i]) < 1e-15) {
+      if (std::abs(o[i]) > h) return kInf;
+      continue;
+    }
+    double t0 = (-h - o[i]) / d[i], t1 = (h - o[i]) / d[i];
+    if (t0 > t1) std::swap(t0, t1);
+    if (t0 > t_near) t_near = t0, entry = i;
+    t_far = std::min(t_far, t1);
+  }
+  if (t_near > t_far || t_near <= 0.0 || entry < 0) return kInf;
+  *axis = entry;
+  return t_near;
+}
+
+double ray_box(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, const Box& box, int* face) {
+  const Eigen::Isometry3d T_box_world = box.T_world_box.inverse();
+  const Eigen::Vector3d d = T_box_world.linear() * dir;
+  int axis = -1;
+  const double t = ray_box_local(T_box_world * origin, d, box.half_extent, &axis);
+  // Entering through the face whose normal opposes the direction.
+  if (t < kInf) *face = 2 * axis + (d[axis] < 0 ? 0 : 1);
+  return t;
+}
+
+double ray_rectangle(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, const Surface& s) {
+  const double denom = s.normal.dot(dir);
+  if (std::abs(denom) < 1e-15) return kInf;
+  const double t = s.normal.dot(s.origin - origin) / denom;
+  if (t <= 0.0) return kInf;
+  const Eigen::Vector3d q = origin + t * dir - s.origin;
+  const double u = q.dot(s.axis_s), v = q.dot(s.axis_t);
+  return (u >= 0 && u <= s.width && v >= 0 && v <= s.height) ? t : kInf;
+}
 
 double distance_to_rectangle(const Eigen::Vector3d& p, const Surface& s) {
   const Eigen::Vector3d d = p - s.origin;

@@ -23,6 +23,16 @@ double distance_to_box(const Eigen::Vector3d& p, const Box& box);
 double segment_distance_to_rectangle(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Surface& s);
 double segment_distance_to_box(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Box& box);
 
+/// Entry distance along the unit direction `d` into the box of half extents `half_extent`
+/// centred at the origin, for a ray from `o` (both in the box's frame), and the axis of the
+/// entry face; infinity (axis untouched) if it misses or starts inside.
+double ray_box_local(const Eigen::Vector3d& o, const Eigen::Vector3d& d, const Eigen::Vector3d& half_extent,
+                     int* axis);
+/// The same for a ray in world coordinates, with the face it enters by (0..5 as Box::faces).
+double ray_box(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, const Box& box, int* face);
+/// Distance along the unit direction to the rectangle of s, or infinity if the ray misses it.
+double ray_rectangle(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, const Surface& s);
+
 struct RayHit {
   double distance = 0.0;  ///< along the unit direction, metres
   int surface = -1;       ///< the surface hit
