@@ -24,22 +24,6 @@ constexpr double kSlack_m = 1e-5;
 constexpr double kSimCell_m = 1.0;
 constexpr int kSimGlobalCells = 256;
 
-Eigen::AlignedBox3d bounds_of(const sim::Surface& s) {
-  Eigen::AlignedBox3d b;
-  for (const auto& c : s.corners()) b.extend(c);
-  return b;
-}
-
-Eigen::AlignedBox3d bounds_of(const sim::Box& box) {
-  Eigen::AlignedBox3d b;
-  for (int i = 0; i < 8; ++i) {
-    const Eigen::Vector3d corner((i & 1 ? 1 : -1) * box.half_extent.x(), (i & 2 ? 1 : -1) * box.half_extent.y(),
-                                 (i & 4 ? 1 : -1) * box.half_extent.z());
-    b.extend(box.T_world_box * corner);
-  }
-  return b;
-}
-
 }  // namespace
 
 WorldEnvironment::WorldEnvironment(const sim::World& world) : world_(world) {
@@ -51,7 +35,7 @@ WorldEnvironment::WorldEnvironment(const sim::World& world) : world_(world) {
       Obstacle o;
       o.index = s.id;
       obstacles_.push_back(o);
-      boxes.push_back(bounds_of(s));
+      boxes.push_back(sim::bounds_of(s));
     }
   for (size_t i = 0; i < world_.boxes().size(); ++i) {
     Obstacle o;
@@ -59,7 +43,7 @@ WorldEnvironment::WorldEnvironment(const sim::World& world) : world_(world) {
     o.index = static_cast<int>(i);
     o.T_box_world = world_.boxes()[i].T_world_box.inverse();
     obstacles_.push_back(o);
-    boxes.push_back(bounds_of(world_.boxes()[i]));
+    boxes.push_back(sim::bounds_of(world_.boxes()[i]));
   }
   if (obstacles_.empty()) return;
   Eigen::AlignedBox3d all;

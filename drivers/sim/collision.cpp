@@ -38,6 +38,8 @@ bool segment_crosses_rectangle(const Eigen::Vector3d& a, const Eigen::Vector3d& 
   return x >= 0 && x <= s.width && y >= 0 && y <= s.height;
 }
 
+}  // namespace
+
 Eigen::AlignedBox3d bounds_of(const Surface& s) {
   Eigen::AlignedBox3d b;
   for (const auto& c : s.corners()) b.extend(c);
@@ -53,8 +55,6 @@ Eigen::AlignedBox3d bounds_of(const Box& box) {
   }
   return b;
 }
-
-}  // namespace
 
 double ray_box_local(const Eigen::Vector3d& o, const Eigen::Vector3d& d, const Eigen::Vector3d& half_extent,
                      int* axis) {

@@ -23,6 +23,9 @@ double distance_to_box(const Eigen::Vector3d& p, const Box& box);
 double segment_distance_to_rectangle(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Surface& s);
 double segment_distance_to_box(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Box& box);
 
+/// Axis-aligned bounds of the rectangle of s / of the solid box (its eight corners).
+Eigen::AlignedBox3d bounds_of(const Surface& s);
+Eigen::AlignedBox3d bounds_of(const Box& box);
 /// Entry distance along the unit direction `d` into the box of half extents `half_extent`
 /// centred at the origin, for a ray from `o` (both in the box's frame), and the axis of the
 /// entry face; infinity (axis untouched) if it misses or starts inside.
