@@ -18,6 +18,25 @@ PinholeCamera PinholeCamera::scaled(double s) const {
   return c;
 }
 
+bool PinholeCamera::distorted() const {
+  for (double k : distortion) {
+    if (k != 0.0) return true;
+  }
+  return false;
+}
+
+Eigen::Vector2d PinholeCamera::distort(double u, double v) const {
+  if (!distorted()) return {u, v};  // exactly, not through the normalised coordinates
+  const double k1 = distortion[0], k2 = distortion[1], p1 = distortion[2], p2 = distortion[3],
+               k3 = distortion[4];
+  const double x = (u - cx) / fx, y = (v - cy) / fy;
+  const double r2 = x * x + y * y;
+  const double radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3));
+  const double xd = x * radial + 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x);
+  const double yd = y * radial + p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y;
+  return {fx * xd + cx, fy * yd + cy};
+}
+
 void PinholeCamera::validate(const char* what) const {
   const bool ok = width > 0 && height > 0 && width <= 16384 && height <= 16384 &&
                   std::isfinite(fx) && std::isfinite(fy) && std::isfinite(cx) &&
@@ -26,6 +45,9 @@ void PinholeCamera::validate(const char* what) const {
     throw InputError(std::string(what) + ": invalid camera (" + std::to_string(width) + "x" +
                      std::to_string(height) + ", fx=" + std::to_string(fx) +
                      ", fy=" + std::to_string(fy) + ")");
+  }
+  for (double k : distortion) {
+    if (!std::isfinite(k)) throw InputError(std::string(what) + ": non-finite lens distortion coefficient");
   }
 }
 

@@ -5,9 +5,8 @@
 // images as the source delivers them (zero when it undistorted them or its lens has none;
 // TUM's freiburg1 reports its calibration with raw images). project()/backproject() are the
 // pinhole model of ideal (undistorted) pixels and do not apply it: a consumer of raw pixels
-// maps them to ideal ones first (vo::Lens, which the VO and SLAM's keyframe features use;
-// the mapper takes raw pixels as ideal, an error of a few pixels on freiburg1 -- its README
-// says so).
+// maps them to ideal ones first (vo::Lens, which the VO and SLAM's keyframe features use), or
+// reads each ideal pixel's value at its raw pixel, distort() (the mapper's decimated grid).
 
 #include <Eigen/Core>
 #include <array>
@@ -41,6 +40,11 @@ struct PinholeCamera {
   Eigen::Vector2d project(const Eigen::Vector3d& p) const {
     return {fx * p.x() / p.z() + cx, fy * p.y() / p.z() + cy};
   }
+  /// True if the images carry lens distortion (any coefficient non-zero).
+  bool distorted() const;
+  /// Raw (distorted) pixel of the ideal pinhole pixel (u, v) under `distortion` (OpenCV's
+  /// Brown-Conrady model, k1 k2 p1 p2 k3); (u, v) itself without distortion.
+  Eigen::Vector2d distort(double u, double v) const;
   /// True if (u, v) lies inside the image, `border` pixels away from its edges.
   bool contains(double u, double v, double border = 0.0) const {
     return u >= border - 0.5 && v >= border - 0.5 && u <= width - 0.5 - border &&

@@ -7,8 +7,14 @@
 // OcTree::insertPointCloud be fed exactly the same rays (the equality test and the benchmark do
 // that). The pixel grid is kept, so the integrator can go from a cell to the rays through it.
 //
+// A source with lens distortion (common/camera.h) is read on the ideal pinhole grid: each
+// node takes the reading of the raw pixel nearest to where the lens images the node's ray
+// (at most half a raw pixel from it; a node imaged outside the image has no reading), so
+// rays follow the lens and everything downstream stays a pinhole grid.
+//
 // Invariants: points.size() == valid.size() == cols * rows (row-major); points[i] is meaningful
-// only where valid[i]; camera describes the grid the points came from (after decimation).
+// only where valid[i]; camera describes the grid the points came from (after decimation) and
+// has no distortion.
 
 #include <Eigen/Geometry>
 #include <cstdint>
@@ -37,7 +43,9 @@ struct Scan {
 };
 
 /// `frame` with every `stride`-th pixel of its colour and depth images (a grid centred in the
-/// image) and the camera re-scaled to match; stride 1 returns a shallow copy.
+/// image) and the camera re-scaled to match, on the ideal grid when the camera reports
+/// distortion (see above; the result's camera has none); stride 1 of an undistorted frame
+/// returns a shallow copy.
 RgbdFrame decimate(const RgbdFrame& frame, int stride);
 
 /// The rays of `frame` (every pixel; decimate first) seen from T_world_camera. Depth 0 (no

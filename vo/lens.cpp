@@ -10,11 +10,9 @@ void Lens::reset(const PinholeCamera& camera, bool use_distortion) {
   use_distortion_ = use_distortion;
   prepared_ = true;
   table_.clear();
-  const bool any = std::any_of(camera.distortion.begin(), camera.distortion.end(),
-                               [](double d) { return d != 0.0; });
-  if (!use_distortion || !any) return;
+  if (!use_distortion || !camera.distorted()) return;
 
-  // Each raw pixel's ideal one by Newton's method on the forward model (distort_pixel), in
+  // Each raw pixel's ideal one by Newton's method on the forward model (PinholeCamera::distort), in
   // normalised coordinates, started from the row's previous solution: 2-4 iterations a pixel
   // (a fixed-point inversion needs tens in the corners of a strongly distorted lens), so the
   // table costs milliseconds, not a stall of the first frame.
@@ -75,18 +73,6 @@ Eigen::Vector3f Lens::ray(float u, float v) const {
   const Eigen::Vector2f p = ideal(u, v);
   return {(p.x() - float(camera_.cx)) / float(camera_.fx),
           (p.y() - float(camera_.cy)) / float(camera_.fy), 1.0f};
-}
-
-Eigen::Vector2d distort_pixel(const PinholeCamera& c, bool use_distortion, double u, double v) {
-  if (!use_distortion) return {u, v};
-  const double k1 = c.distortion[0], k2 = c.distortion[1], p1 = c.distortion[2], p2 = c.distortion[3],
-               k3 = c.distortion[4];
-  const double x = (u - c.cx) / c.fx, y = (v - c.cy) / c.fy;
-  const double r2 = x * x + y * y;
-  const double radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3));
-  const double xd = x * radial + 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x);
-  const double yd = y * radial + p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y;
-  return {c.fx * xd + c.cx, c.fy * yd + c.cy};
 }
 
 }  // namespace kestrel::vo

@@ -47,8 +47,4 @@ class Lens {
   std::vector<Eigen::Vector2f> table_;
 };
 
-/// Raw (distorted) level-0 pixel of the ideal pinhole pixel (u, v) under the camera's
-/// Brown-Conrady distortion (OpenCV's model); the identity without distortion.
-Eigen::Vector2d distort_pixel(const PinholeCamera& camera, bool use_distortion, double u, double v);
-
 }  // namespace kestrel::vo

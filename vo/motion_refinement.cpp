@@ -218,7 +218,7 @@ DenseQuadratic linearise_dense(const DenseTerm& d, const PinholeCamera& cam, con
       if (!(X.z() > 1e-3f)) continue;
       float u = fx * X.x() / X.z() + cx, v = fy * X.y() / X.z() + cy;
       if (d.use_distortion) {
-        const Eigen::Vector2d raw = distort_pixel(cam, true, u, v);
+        const Eigen::Vector2d raw = cam.distort(u, v);
         u = static_cast<float>(raw.x());
         v = static_cast<float>(raw.y());
       }

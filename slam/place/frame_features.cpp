@@ -113,8 +113,7 @@ FrameFeatures FeatureExtractor::extract(const cv::Mat& grey, const cv::Mat& dept
   const Eigen::Isometry3d T_depth_rgb = T_rgb_depth.inverse();
   // The lens (top of frame_features.h): without distortion ideal pixels are the raw ones and
   // the untimed path below is the one keyframes always took.
-  const bool distorted = std::any_of(camera.distortion.begin(), camera.distortion.end(),
-                                     [](double d) { return d != 0.0; });
+  const bool distorted = camera.distorted();
   const std::shared_ptr<const vo::Lens> lens = (timed || distorted) ? lens_for(camera) : nullptr;
   for (size_t i = 0; i < f.keypoints.size(); ++i) {
     const cv::Point2f pt = f.keypoints[i].pt;  // raw: depth is read here
@@ -137,7 +136,7 @@ FrameFeatures FeatureExtractor::extract(const cv::Mat& grey, const cv::Mat& dept
       if (!(p_depth.z() > 0.0)) continue;
       const Eigen::Vector2d at_depth = camera.project(p_depth);
       const Eigen::Vector2d raw_at_depth =
-          distorted ? vo::distort_pixel(camera, true, at_depth.x(), at_depth.y()) : at_depth;
+          distorted ? camera.distort(at_depth.x(), at_depth.y()) : at_depth;
       const double z_depth = reliable_depth(depth_m, raw_at_depth.x(), raw_at_depth.y());
       if (!(z_depth > 0.0)) continue;
       z = (T_rgb_depth * camera.backproject(at_depth.x(), at_depth.y(), z_depth)).z();

@@ -3,6 +3,8 @@
 // boundaries, camera centres on cell corners, rays cut at max range.
 #include <gtest/gtest.h>
 
+#include <array>
+#include <cmath>
 #include <random>
 
 #include "common/error.h"
@@ -163,6 +165,9 @@ TEST(ScanIntegrator, CellSearchTracesOnlyAFewRays) {
   EXPECT_GT(update.free.size(), 100u);
 }
 
+// freiburg1's calibrated lens (drivers/tum/tum_camera.cpp): 5-8 px over most of the image.
+constexpr std::array<double, 5> kFr1Distortion{0.2624, -0.9531, -0.0054, 0.0026, 1.1633};
+
 TEST(Scan, DecimatedScanEqualsMakeScanOfTheDecimatedFrame) {
   std::mt19937 rng(11);
   const Scene scene = random_scene(rng);
@@ -170,27 +175,80 @@ TEST(Scan, DecimatedScanEqualsMakeScanOfTheDecimatedFrame) {
   RgbdFrame frame = scene.render(test::kinect_camera(), T, 5);
   frame.depth_mm.at<uint16_t>(237, 322) = 0;   // a hole and a too-near reading on the stride-5 grid
   frame.depth_mm.at<uint16_t>(242, 327) = 50;
-  for (const int stride : {1, 2, 3, 5, 7}) {
-    ScanOptions options;
-    options.stride = stride;
-    options.min_range_m = 0.1;
-    const Scan expected = make_scan(decimate(frame, stride), T, options, "test");
-    Scan scan;
-    make_decimated_scan(frame, T, options, "test", scan);
-    ASSERT_EQ(scan.cols, expected.cols) << "stride " << stride;
-    ASSERT_EQ(scan.rows, expected.rows);
-    EXPECT_EQ(scan.camera.fx, expected.camera.fx);
-    EXPECT_EQ(scan.camera.cx, expected.camera.cx);
-    EXPECT_EQ(scan.camera.cy, expected.camera.cy);
-    EXPECT_EQ(scan.num_points, expected.num_points);
-    EXPECT_GT(scan.num_points, 0u);
-    EXPECT_EQ(scan.valid, expected.valid);
-    for (size_t i = 0; i < scan.points.size(); ++i) {
-      if (!expected.valid[i]) continue;
-      ASSERT_EQ(scan.points[i], expected.points[i]) << "stride " << stride << " pixel " << i;
+  for (const bool distorted : {false, true}) {
+    // The rendered image is the same either way: with distortion the frame claims a lens, so
+    // both paths read it through the same lens grid.
+    frame.camera.distortion = distorted ? kFr1Distortion : std::array<double, 5>{};
+    for (const int stride : {1, 2, 3, 5, 7}) {
+      ScanOptions options;
+      options.stride = stride;
+      options.min_range_m = 0.1;
+      const Scan expected = make_scan(decimate(frame, stride), T, options, "test");
+      Scan scan;
+      make_decimated_scan(frame, T, options, "test", scan);
+      ASSERT_EQ(scan.cols, expected.cols) << "stride " << stride;
+      ASSERT_EQ(scan.rows, expected.rows);
+      EXPECT_EQ(scan.camera.fx, expected.camera.fx);
+      EXPECT_EQ(scan.camera.cx, expected.camera.cx);
+      EXPECT_EQ(scan.camera.cy, expected.camera.cy);
+      EXPECT_FALSE(scan.camera.distorted());
+      EXPECT_EQ(scan.num_points, expected.num_points);
+      EXPECT_GT(scan.num_points, 0u);
+      EXPECT_EQ(scan.valid, expected.valid);
+      for (size_t i = 0; i < scan.points.size(); ++i) {
+        if (!expected.valid[i]) continue;
+        ASSERT_EQ(scan.points[i], expected.points[i]) << "stride " << stride << " pixel " << i;
+      }
     }
   }
+  frame.camera.distortion = {};
   EXPECT_EQ(decimate(frame, 5).depth_mm.at<uint16_t>(47, 64), 0);  // the hole is on the grid
+}
+
+// A distorted source: each node of the (ideal) grid reads the raw pixel where the lens images
+// its ray, so a single reading lands on the node whose ray it was taken along.
+TEST(Scan, DistortedDepthIsReadWhereTheLensImagesEachNode) {
+  RgbdFrame frame;
+  frame.camera = test::kinect_camera();
+  frame.camera.distortion = kFr1Distortion;
+  frame.utime = 1;
+  frame.depth_mm = cv::Mat(frame.camera.height, frame.camera.width, CV_16UC1, cv::Scalar(0));
+  ScanOptions options;
+  options.stride = 5;  // grid 128 x 96, node (c, r) at full-size ideal pixel (2 + 5c, 2 + 5r)
+  const int c = 10, r = 8;
+  const Eigen::Vector2d raw = frame.camera.distort(2 + 5 * c, 2 + 5 * r);
+  ASSERT_GT((raw - Eigen::Vector2d(2 + 5 * c, 2 + 5 * r)).norm(), 5.0) << "the lens must matter here";
+  frame.depth_mm.at<uint16_t>(int(std::lround(raw.y())), int(std::lround(raw.x()))) = 2000;
+  const Eigen::Isometry3d T = test::look_at({0.3, -0.2, 1.0}, {2.0, 0.5, 1.2});
+  Scan scan;
+  make_decimated_scan(frame, T, options, "test", scan);
+  ASSERT_EQ(scan.num_points, 1u);
+  const size_t node = static_cast<size_t>(r * scan.cols + c);
+  ASSERT_TRUE(scan.valid[node]);
+  const Eigen::Vector3d expected = T * scan.camera.backproject(c, r, 2.0);
+  EXPECT_NEAR(scan.points[node].x(), expected.x(), 1e-5);
+  EXPECT_NEAR(scan.points[node].y(), expected.y(), 1e-5);
+  EXPECT_NEAR(scan.points[node].z(), expected.z(), 1e-5);
+  // Read as ideal (no lens), the same reading is a different ray, centimetres away at 2 m.
+  frame.camera.distortion = {};
+  make_decimated_scan(frame, T, options, "test", scan);
+  EXPECT_EQ(scan.num_points, 0u) << "the raw pixel is not on the plain stride-5 grid";
+
+  // Readings everywhere: the corners' rays leave the raw image (this lens pulls them outwards),
+  // so those nodes have none; the centre has one, at full resolution too.
+  frame.camera.distortion = kFr1Distortion;
+  frame.depth_mm.setTo(1500);
+  for (const int stride : {5, 1}) {
+    options.stride = stride;
+    make_decimated_scan(frame, T, options, "test", scan);
+    EXPECT_FALSE(scan.valid[0]) << "stride " << stride;
+    EXPECT_TRUE(scan.valid[static_cast<size_t>(scan.rows / 2 * scan.cols + scan.cols / 2)]);
+    EXPECT_LT(scan.num_points, static_cast<size_t>(scan.cols * scan.rows));
+    EXPECT_GT(scan.num_points, static_cast<size_t>(scan.cols * scan.rows) * 9 / 10);
+  }
+  const RgbdFrame full = decimate(frame, 1);  // resampled, not a copy, when the lens distorts
+  EXPECT_FALSE(full.camera.distorted());
+  EXPECT_EQ(full.depth_mm.at<uint16_t>(0, 0), 0);
 }
 
 TEST(Scan, MinRangeKeepsReadingsAtOrBeyondIt) {

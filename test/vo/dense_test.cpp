@@ -96,13 +96,12 @@ TEST(DenseDepth, DistortionInvertsTheLensTable) {
   lens.reset(cam, true);
   for (double v = 20; v < cam.height - 20; v += 37) {
     for (double u = 20; u < cam.width - 20; u += 41) {
-      const Eigen::Vector2d raw = distort_pixel(cam, true, u, v);
+      const Eigen::Vector2d raw = cam.distort(u, v);
       const Eigen::Vector2f back = lens.ideal(float(raw.x()), float(raw.y()));
       EXPECT_NEAR(back.x(), u, 1e-2) << u << ", " << v;
       EXPECT_NEAR(back.y(), v, 1e-2) << u << ", " << v;
     }
   }
-  EXPECT_EQ(distort_pixel(cam, false, 100.25, 50.5), Eigen::Vector2d(100.25, 50.5));
 }
 
 // Two views of the synthetic room (walls, floor, block: every direction constrained); the
