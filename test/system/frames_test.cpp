@@ -4,6 +4,10 @@
 // map the mapper and the planner use) must lie where the estimator's STATE puts the body at
 // their times, and the SLAM corrections must not pull the estimator away from the truth.
 //
+// With the mapper in the set (the first configuration), the map it builds from SLAM_GRAPH --
+// keyframes inserted at SLAM's poses, rebuilt when loop closures move them -- must agree with
+// the map of the same frames at their true poses.
+//
 // This caught SLAM's map being kept in its odometry frame (the body at the first frame) while
 // the estimator's world is fixed when the filter starts, a second later on this flight: every
 // correction then pulled the estimator by the body's motion in between (8-14 cm), and its ATE
@@ -23,15 +27,22 @@
 #include <vector>
 
 #include "common/geometry/align.h"
+#include "common/trajectory.h"
 #include "common/transport/channels.h"
 #include "common/transport/convert.h"
 #include "common/transport/log_file.h"
 #include "common/transport/message.h"
+#include "common/transport/rgbd_codec.h"
 #include "kestrel/ground_truth_t.hpp"
+#include "kestrel/octomap_t.hpp"
+#include "kestrel/rgbd_frame_t.hpp"
 #include "kestrel/slam_correction_t.hpp"
 #include "kestrel/slam_graph_t.hpp"
 #include "kestrel/state_t.hpp"
 #include "kestrel/vo_update_t.hpp"
+#include "mapper/map_compare.h"
+#include "mapper/mapper.h"
+#include "mapper/octree_io.h"
 #include "test/support/test_support.h"
 
 namespace kestrel {
@@ -42,6 +53,7 @@ struct Recording {
   std::optional<kestrel::slam_graph_t> graph;   ///< the last one
   std::optional<Eigen::Isometry3d> T_body_camera;
   int corrections = 0;
+  int64_t last_map_revision = -1;  ///< MAP_OCTOMAP's (jumps to the next thousand after a rebuild)
 };
 
 Recording read_recording(const std::string& path) {
@@ -57,6 +69,8 @@ Recording read_recording(const std::string& path) {
       r.graph = transport::decode_message<kestrel::slam_graph_t>(d.data(), d.size(), "SLAM_GRAPH");
     } else if (e->channel == channel::kSlamCorrection) {
       ++r.corrections;
+    } else if (e->channel == channel::kMapOctomap) {
+      r.last_map_revision = transport::decode_message<kestrel::octomap_t>(d.data(), d.size(), "MAP_OCTOMAP").revision;
     } else if (e->channel == channel::kVoUpdate && !r.T_body_camera) {
       const auto m = transport::decode_message<kestrel::vo_update_t>(d.data(), d.size(), "VO_UPDATE");
       r.T_body_camera = transport::from_message(m.T_body_camera, "VO_UPDATE");
@@ -65,17 +79,68 @@ Recording read_recording(const std::string& path) {
   return r;
 }
 
-// Body positions of the truth, by utime.
-std::map<int64_t, Eigen::Vector3d> read_truth(const std::string& path) {
-  std::map<int64_t, Eigen::Vector3d> truth;
+// Body poses of the truth, by utime.
+std::map<int64_t, Eigen::Isometry3d> read_truth(const std::string& path) {
+  std::map<int64_t, Eigen::Isometry3d> truth;
   transport::LogReader log(path);
   while (auto e = log.next()) {
     if (e->channel != channel::kGroundTruth) continue;
     const auto m = transport::decode_message<kestrel::ground_truth_t>(e->data.data(), e->data.size(), "GROUND_TRUTH");
     if (m.frame == kestrel::ground_truth_t::FRAME_BODY)
-      truth[m.utime] = transport::from_message(m.T_world_frame, "GROUND_TRUTH").translation();
+      truth[m.utime] = transport::from_message(m.T_world_frame, "GROUND_TRUTH");
   }
   return truth;
+}
+
+// The camera frames of the log whose utimes are in `utimes`.
+std::map<int64_t, RgbdFrame> read_frames(const std::string& path, const std::map<int64_t, Eigen::Isometry3d>& utimes) {
+  std::map<int64_t, RgbdFrame> frames;
+  transport::LogReader log(path);
+  while (auto e = log.next()) {
+    if (e->channel != channel::kCameraRgbd) continue;
+    const auto m = transport::decode_message<kestrel::rgbd_frame_t>(e->data.data(), e->data.size(), "CAMERA_RGBD");
+    if (utimes.count(m.utime)) frames.emplace(m.utime, transport::decode_rgbd(m, "CAMERA_RGBD"));
+  }
+  return frames;
+}
+
+// The mapper's map (saved at exit) against the map of SLAM's keyframe frames at their true
+// poses, carried into SLAM's world by the rigid fit of the keyframes' positions.
+void expect_map_agrees_with_truth(const Recording& rec, const std::map<int64_t, Eigen::Isometry3d>& truth,
+                                  const std::string& source, const std::string& map_file) {
+  EXPECT_GE(rec.last_map_revision, 1000) << "no MAP_OCTOMAP after a rebuild (the revision jumps then)";
+  Trajectory true_body;  // the truth comes at its own rate: interpolated at the frames' times
+  for (const auto& [utime, T] : truth) true_body.push_back(utime, T);
+  std::map<int64_t, Eigen::Isometry3d> slam_poses, true_poses;  // T_world_camera by keyframe utime
+  for (const auto& kf : rec.graph->keyframes) {
+    const std::optional<Eigen::Isometry3d> T = true_body.at(kf.utime, 20'000);
+    if (!T) continue;
+    slam_poses[kf.utime] = transport::from_message(kf.T_world_camera, "SLAM_GRAPH");
+    true_poses[kf.utime] = *T * *rec.T_body_camera;
+  }
+  ASSERT_EQ(true_poses.size(), rec.graph->keyframes.size()) << "keyframes without a true pose";
+  Eigen::Matrix3Xd a(3, static_cast<Eigen::Index>(true_poses.size())), b(3, a.cols());
+  Eigen::Index i = 0;
+  for (const auto& [utime, T] : true_poses) {
+    a.col(i) = T.translation();
+    b.col(i++) = slam_poses.at(utime).translation();
+  }
+  const std::optional<Eigen::Isometry3d> T_slam_true = align_rigid(a, b);
+  ASSERT_TRUE(T_slam_true.has_value());
+
+  const std::map<int64_t, RgbdFrame> frames = read_frames(source, true_poses);
+  ASSERT_EQ(frames.size(), true_poses.size()) << "keyframes whose frame is not in the log";
+  mapper::Mapper reference;  // the process's defaults
+  for (const auto& [utime, frame] : frames) reference.insert(frame, *T_slam_true * true_poses.at(utime));
+  const mapper::VoxelMap flown = mapper::read_map_file(map_file);
+  const mapper::MapAgreement agree = mapper::compare_maps(flown, reference.map());
+  std::cout << "map: " << flown.num_occupied() << " occupied cells, at true poses " << reference.map().num_occupied()
+            << "; class agreement " << agree.class_agreement() << " on " << agree.known_both << " cells, "
+            << agree.occupied_a_matched << " of the occupied within a cell of the truth's\n";
+  EXPECT_GT(flown.num_occupied(), 500u);
+  EXPECT_GT(agree.class_agreement(), 0.95);
+  EXPECT_GT(double(agree.occupied_a_matched), 0.95 * double(agree.occupied_a));
+  EXPECT_GT(double(agree.occupied_b_matched), 0.95 * double(agree.occupied_b));
 }
 
 // RMS position error after the best rigid alignment (the ATE).
@@ -91,7 +156,7 @@ double aligned_rmse(const std::vector<Eigen::Vector3d>& est, const std::vector<E
 }
 
 // The flight through the processes; `vo_options` are added to kestrel-vo's command line.
-void fly_figure_eight(const std::string& vo_options) {
+void fly_figure_eight(const std::string& vo_options, bool with_mapper) {
   test::TempDir dir;
   const std::string source = (dir / "source.lcmlog").string();
   const std::string recorded = (dir / "system.lcmlog").string();
@@ -100,11 +165,14 @@ void fly_figure_eight(const std::string& vo_options) {
                              300.0);
   ASSERT_EQ(sim.exit_code, 0) << sim.err;
 
+  const std::string map_file = (dir / "map.bt").string();
+  const std::string mapper = with_mapper ? test::tool("mapper").string() + " -q --save " + map_file + " & M=$!; " : "";
   const std::string script = test::tool("vo").string() + " -q " + vo_options + " & V=$!; " + test::tool("estimator").string() +
-                             " -q & E=$!; " + test::tool("slam").string() + " -q & S=$!; " +
-                             test::tool("replay").string() + " " + source +
-                             " --expect vo,estimator,slam --ack-timeout 60 --record " + recorded +
-                             "; R=$?; kill -INT $V $E $S; wait $V $E $S; exit $R";
+                             " -q & E=$!; " + test::tool("slam").string() + " -q & S=$!; " + mapper +
+                             test::tool("replay").string() + " " + source + " --expect vo,estimator,slam" +
+                             (with_mapper ? ",mapper" : "") + " --ack-timeout 60 --record " + recorded +
+                             "; R=$?; kill -INT $V $E $S " + (with_mapper ? "$M" : "") + "; wait $V $E $S " +
+                             (with_mapper ? "$M" : "") + "; exit $R";
   const auto r = test::run({test::tool("isolated").string(), "--", "sh", "-c", script}, 600.0);
   ASSERT_EQ(r.exit_code, 0) << r.err;
 
@@ -136,17 +204,18 @@ void fly_figure_eight(const std::string& vo_options) {
     const auto g = truth.find(utime);
     if (g == truth.end()) continue;
     est.push_back(T.translation());
-    gt.push_back(g->second);
+    gt.push_back(g->second.translation());
   }
   ASSERT_GE(est.size(), 2000u);
   const double ate = aligned_rmse(est, gt);
   EXPECT_LT(ate, 0.02);
   std::cout << "estimator ATE " << ate << " m\n";
+  if (with_mapper) expect_map_agrees_with_truth(rec, truth, source, map_file);
 }
 
 TEST(System, SlamKeyframesAndCorrectionsAreInTheEstimatorsWorld) {
   if (!test::can_isolate_network()) GTEST_SKIP() << "no network namespace available";
-  fly_figure_eight("");
+  fly_figure_eight("", /*with_mapper=*/true);
 }
 
 // The VO's dense depth term is on by default; the same flight without it. With it, before
@@ -154,7 +223,7 @@ TEST(System, SlamKeyframesAndCorrectionsAreInTheEstimatorsWorld) {
 // last keyframes 6.1 cm from STATE (slam/README.md, odometry): both configurations stay tested.
 TEST(System, SlamKeyframesAreInTheEstimatorsWorldWithoutTheVoDenseTerm) {
   if (!test::can_isolate_network()) GTEST_SKIP() << "no network namespace available";
-  fly_figure_eight("--set dense.enabled=false");
+  fly_figure_eight("--set dense.enabled=false", /*with_mapper=*/false);
 }
 
 }  // namespace
