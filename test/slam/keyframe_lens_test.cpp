@@ -11,6 +11,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "slam/place/frame_features.h"
+#include "test/slam/keyframe_scenes.h"
 
 namespace kestrel::slam {
 namespace {
@@ -22,27 +23,7 @@ PinholeCamera fr1(bool with_distortion) {
   return c;
 }
 
-// The raw pixel of ideal pixel (u, v), written out from the Brown-Conrady model.
-Eigen::Vector2d raw_of(const PinholeCamera& c, double u, double v) {
-  const double k1 = c.distortion[0], k2 = c.distortion[1], p1 = c.distortion[2], p2 = c.distortion[3];
-  const double k3 = c.distortion[4];
-  const double x = (u - c.cx) / c.fx, y = (v - c.cy) / c.fy, r2 = x * x + y * y;
-  const double radial = 1.0 + k1 * r2 + k2 * r2 * r2 + k3 * r2 * r2 * r2;
-  const double xd = x * radial + 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x);
-  const double yd = y * radial + p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y;
-  return {c.fx * xd + c.cx, c.fy * yd + c.cy};
-}
-
-/// A grey texture with sharp 8 x 8 pixel cells (fixed seed): corners all over the image.
-cv::Mat texture(const PinholeCamera& camera) {
-  cv::Mat noise(camera.height, camera.width, CV_8UC1);
-  cv::RNG rng(11);
-  rng.fill(noise, cv::RNG::UNIFORM, 0, 256);
-  cv::Mat grey;
-  cv::resize(noise(cv::Rect(0, 0, camera.width / 8, camera.height / 8)), grey, noise.size(), 0, 0,
-             cv::INTER_NEAREST);
-  return grey;
-}
+cv::Mat texture(const PinholeCamera& camera) { return test::texture(camera, 11); }
 
 /// Depth that changes with the raw column (1 mm a pixel, under the edge test's 3 %), so a
 /// reading taken at the ideal pixel instead of the raw one would show.
@@ -56,8 +37,8 @@ cv::Mat column_ramp(const PinholeCamera& camera) {
 // Hand-worked: at ideal pixel (418.6, 255.3), x = 100 / 517.3 = 0.193311, y = 0, r^2 = 0.037369;
 // radial = 1 + 0.2624 r^2 - 0.9531 r^4 + 1.1633 r^6 = 1.008535; p2 (r^2 + 2 x^2) = 0.000291; so
 // the raw pixel is 318.6 + 517.3 (0.193311 * 1.008535 + 0.000291) = 419.604 (1.0 px further out).
-TEST(KeyframeLens, TheModelWrittenOutHereIsTheHandWorkedOne) {
-  const Eigen::Vector2d raw = raw_of(fr1(true), 418.6, 255.3);
+TEST(KeyframeLens, Fr1sLensMapsTheHandWorkedPixel) {
+  const Eigen::Vector2d raw = fr1(true).distort(418.6, 255.3);
   EXPECT_NEAR(raw.x(), 419.604, 0.001);
   // y: p1 (r^2 + 2 y^2) = -0.0054 * 0.037370 -> -0.104 px; 2 p2 x y = 0.
   EXPECT_NEAR(raw.y(), 255.3 - 0.104, 0.001);
@@ -81,7 +62,7 @@ TEST(KeyframeLens, PointOnTheIdealRayWithDepthReadAtTheRawPixel) {
       EXPECT_EQ(plain.points[i], raw_camera.backproject(raw.x, raw.y, plain.points[i].z()));
     }
     // The ideal pixel is the one the lens maps to the raw keypoint (vo::Lens: within 0.01 px).
-    const Eigen::Vector2d back = raw_of(camera, ideal.x, ideal.y);
+    const Eigen::Vector2d back = camera.distort(ideal.x, ideal.y);
     EXPECT_NEAR(back.x(), raw.x, 1e-2) << "keypoint " << i;
     EXPECT_NEAR(back.y(), raw.y, 1e-2) << "keypoint " << i;
     largest_shift_px = std::max(largest_shift_px, double(std::hypot(ideal.x - raw.x, ideal.y - raw.y)));
@@ -109,10 +90,7 @@ TEST(KeyframeLens, RollingShutterTakesTheRawRowsTime) {
   const double Z = 2.0, w = 1.0, readout = 0.015;
   const cv::Mat depth(camera.height, camera.width, CV_32FC1, cv::Scalar(Z));
   const cv::Mat grey = texture(camera);
-  vo::FrameMotion motion;
-  motion.known = true;
-  motion.twist_per_s << 0, 0, 0, 0, w, 0;
-  motion.readout_s = readout;
+  const vo::FrameMotion motion = test::moving({0, 0, 0}, {0, w, 0}, 0.0, readout);
   const FeatureExtractor extractor;
   const FrameFeatures plain = extractor.extract(grey, depth, raw_camera);
   const FrameFeatures still = extractor.extract(grey, depth, camera);
@@ -123,9 +101,8 @@ TEST(KeyframeLens, RollingShutterTakesTheRawRowsTime) {
   for (size_t i = 0; i < timed.size(); ++i) {
     ASSERT_EQ(still.has_point(i), timed.has_point(i));
     if (!timed.has_point(i)) continue;
-    const Eigen::Vector3d p = still.points[i];
-    const double s = (double(plain.keypoints[i].pt.y) - 239.5) * readout / 480.0;
-    const Eigen::Vector3d expected(p.x() + s * w * p.z(), p.y(), p.z() - s * w * p.x());
+    const Eigen::Vector3d expected =
+        test::carried_to_middle_row(still.points[i], plain.keypoints[i].pt.y, camera.height, readout, w);
     EXPECT_NEAR((timed.points[i] - expected).norm(), 0.0, 5e-6) << "keypoint " << i;
     const Eigen::Vector2d pixel = camera.project(expected);
     EXPECT_NEAR(timed.keypoints[i].pt.x, pixel.x(), 2e-3);

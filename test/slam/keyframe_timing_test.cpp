@@ -11,32 +11,17 @@
 
 #include "common/geometry/se3.h"
 #include "slam/place/frame_features.h"
+#include "test/slam/keyframe_scenes.h"
 #include "test/slam/synthetic_room.h"
 #include "vo/sensor_profile.h"
 
 namespace kestrel::slam {
 namespace {
 
-/// A grey texture ORB finds a few hundred corners on (fixed seed).
-cv::Mat texture(const PinholeCamera& camera) {
-  cv::Mat noise(camera.height, camera.width, CV_8UC1);
-  cv::RNG rng(7);
-  rng.fill(noise, cv::RNG::UNIFORM, 0, 256);
-  cv::Mat grey;
-  cv::resize(noise(cv::Rect(0, 0, camera.width / 8, camera.height / 8)), grey, noise.size(), 0, 0,
-             cv::INTER_NEAREST);  // 8 x 8 pixel cells: sharp corners
-  return grey;
-}
+using test::carried_to_middle_row;
+using test::moving;
 
-vo::FrameMotion moving(const Eigen::Vector3d& rho, const Eigen::Vector3d& phi, double depth_offset_s,
-                       double readout_s) {
-  vo::FrameMotion m;
-  m.known = true;
-  m.twist_per_s << rho, phi;
-  m.depth_offset_s = depth_offset_s;
-  m.readout_s = readout_s;
-  return m;
-}
+cv::Mat texture(const PinholeCamera& camera) { return test::texture(camera, 7); }
 
 // Camera sliding along +x at 4 m/s, its depth image 30 ms older than the colour, over a plane
 // tilted about the y axis: in the camera at depth time z = Z0 + k x (Z0 = 2 m, k = 0.25). At
@@ -94,9 +79,8 @@ TEST(KeyframeTiming, RollingShutterCarriesPointAndPixelToTheMiddleRow) {
   for (size_t i = 0; i < timed.size(); ++i) {
     ASSERT_EQ(still.has_point(i), timed.has_point(i));
     if (!timed.has_point(i)) continue;
-    const Eigen::Vector3d p = still.points[i];
-    const double s = (double(still.keypoints[i].pt.y) - 119.5) * readout / 240.0;
-    const Eigen::Vector3d expected(p.x() + s * w * p.z(), p.y(), p.z() - s * w * p.x());
+    const Eigen::Vector3d expected =
+        carried_to_middle_row(still.points[i], still.keypoints[i].pt.y, camera.height, readout, w);
     EXPECT_NEAR((timed.points[i] - expected).norm(), 0.0, 2e-6) << "keypoint " << i;
     const Eigen::Vector2d pixel = camera.project(expected);
     EXPECT_NEAR(timed.keypoints[i].pt.x, pixel.x(), 2e-3);
