@@ -25,16 +25,25 @@ bool PinholeCamera::distorted() const {
   return false;
 }
 
-Eigen::Vector2d PinholeCamera::distort(double u, double v) const {
-  if (!distorted()) return {u, v};  // exactly, not through the normalised coordinates
+Eigen::Vector2d PinholeCamera::distort_normalized(double x, double y, Eigen::Matrix2d* jacobian) const {
   const double k1 = distortion[0], k2 = distortion[1], p1 = distortion[2], p2 = distortion[3],
                k3 = distortion[4];
-  const double x = (u - cx) / fx, y = (v - cy) / fy;
   const double r2 = x * x + y * y;
   const double radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3));
-  const double xd = x * radial + 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x);
-  const double yd = y * radial + p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y;
-  return {fx * xd + cx, fy * yd + cy};
+  if (jacobian) {
+    const double dradial = k1 + r2 * (2.0 * k2 + 3.0 * r2 * k3);  // d radial / d r2
+    const double jxy = 2.0 * x * y * dradial + 2.0 * p1 * x + 2.0 * p2 * y;  // symmetric
+    *jacobian << radial + 2.0 * x * x * dradial + 2.0 * p1 * y + 6.0 * p2 * x, jxy,  //
+        jxy, radial + 2.0 * y * y * dradial + 6.0 * p1 * y + 2.0 * p2 * x;
+  }
+  return {x * radial + 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x),
+          y * radial + p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y};
+}
+
+Eigen::Vector2d PinholeCamera::distort(double u, double v) const {
+  if (!distorted()) return {u, v};  // exactly, not through the normalised coordinates
+  const Eigen::Vector2d d = distort_normalized((u - cx) / fx, (v - cy) / fy);
+  return {fx * d.x() + cx, fy * d.y() + cy};
 }
 
 void PinholeCamera::validate(const char* what) const {

@@ -45,6 +45,9 @@ struct PinholeCamera {
   /// Raw (distorted) pixel of the ideal pinhole pixel (u, v) under `distortion` (OpenCV's
   /// Brown-Conrady model, k1 k2 p1 p2 k3); (u, v) itself without distortion.
   Eigen::Vector2d distort(double u, double v) const;
+  /// The same model on normalised coordinates (x / z, y / z): the distorted normalised point,
+  /// and d(distorted) / d(x, y) in `jacobian` when one is given (for inverting the model).
+  Eigen::Vector2d distort_normalized(double x, double y, Eigen::Matrix2d* jacobian = nullptr) const;
   /// True if (u, v) lies inside the image, `border` pixels away from its edges.
   bool contains(double u, double v, double border = 0.0) const {
     return u >= border - 0.5 && v >= border - 0.5 && u <= width - 0.5 - border &&

@@ -12,13 +12,11 @@ void Lens::reset(const PinholeCamera& camera, bool use_distortion) {
   table_.clear();
   if (!use_distortion || !camera.distorted()) return;
 
-  // Each raw pixel's ideal one by Newton's method on the forward model (PinholeCamera::distort), in
+  // Each raw pixel's ideal one by Newton's method on the forward model (PinholeCamera::distort_normalized), in
   // normalised coordinates, started from the row's previous solution: 2-4 iterations a pixel
   // (a fixed-point inversion needs tens in the corners of a strongly distorted lens), so the
   // table costs milliseconds, not a stall of the first frame.
   const int w = camera.width, h = camera.height;
-  const double k1 = camera.distortion[0], k2 = camera.distortion[1], p1 = camera.distortion[2],
-               p2 = camera.distortion[3], k3 = camera.distortion[4];
   cols_ = (w - 1) / kStep + 2;
   rows_ = (h - 1) / kStep + 2;
   table_.resize(static_cast<size_t>(cols_) * static_cast<size_t>(rows_));
@@ -28,18 +26,13 @@ void Lens::reset(const PinholeCamera& camera, bool use_distortion) {
     for (int gx = 0; gx < cols_; ++gx) {
       const double xd = (double(gx * kStep) - camera.cx) / camera.fx;
       for (int it = 0; it < 30; ++it) {
-        const double r2 = xu * xu + yu * yu;
-        const double radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3));
-        const double dradial = k1 + r2 * (2.0 * k2 + 3.0 * r2 * k3);  // d radial / d r2
-        const double fx = xu * radial + 2.0 * p1 * xu * yu + p2 * (r2 + 2.0 * xu * xu) - xd;
-        const double fy = yu * radial + p1 * (r2 + 2.0 * yu * yu) + 2.0 * p2 * xu * yu - yd;
+        Eigen::Matrix2d J;
+        const Eigen::Vector2d d = camera.distort_normalized(xu, yu, &J);
+        const double fx = d.x() - xd, fy = d.y() - yd;
         if (std::abs(fx) < 1e-13 && std::abs(fy) < 1e-13) break;
-        const double jxx = radial + 2.0 * xu * xu * dradial + 2.0 * p1 * yu + 6.0 * p2 * xu;
-        const double jxy = 2.0 * xu * yu * dradial + 2.0 * p1 * xu + 2.0 * p2 * yu;
-        const double jyy = radial + 2.0 * yu * yu * dradial + 6.0 * p1 * yu + 2.0 * p2 * xu;
-        const double det = jxx * jyy - jxy * jxy;  // the Jacobian is symmetric
-        xu -= (jyy * fx - jxy * fy) / det;
-        yu -= (jxx * fy - jxy * fx) / det;
+        const double det = J(0, 0) * J(1, 1) - J(0, 1) * J(0, 1);  // the Jacobian is symmetric
+        xu -= (J(1, 1) * fx - J(0, 1) * fy) / det;
+        yu -= (J(0, 0) * fy - J(0, 1) * fx) / det;
       }
       table_[static_cast<size_t>(gy) * static_cast<size_t>(cols_) + static_cast<size_t>(gx)] =
           Eigen::Vector2f(float(camera.fx * xu + camera.cx), float(camera.fy * yu + camera.cy));

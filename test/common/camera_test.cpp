@@ -45,6 +45,23 @@ TEST(PinholeCamera, DistortMatchesHandComputedBrownConrady) {
   EXPECT_NEAR(raw.y(), 1.25, 1e-12);
 }
 
+TEST(PinholeCamera, NormalisedDistortionJacobianMatchesCentralDifferences) {
+  PinholeCamera c = simple_camera();
+  c.distortion = {0.2624, -0.9531, -0.0054, 0.0026, 1.1633};  // freiburg1's
+  for (const double x : {-0.6, -0.1, 0.0, 0.35}) {
+    for (const double y : {-0.45, 0.05, 0.4}) {
+      Eigen::Matrix2d J;
+      const Eigen::Vector2d d = c.distort_normalized(x, y, &J);
+      EXPECT_EQ(d, c.distort_normalized(x, y));  // the Jacobian changes nothing
+      const double h = 1e-6;
+      const Eigen::Vector2d dx = (c.distort_normalized(x + h, y) - c.distort_normalized(x - h, y)) / (2 * h);
+      const Eigen::Vector2d dy = (c.distort_normalized(x, y + h) - c.distort_normalized(x, y - h)) / (2 * h);
+      EXPECT_NEAR((J.col(0) - dx).norm(), 0.0, 1e-8) << x << ", " << y;
+      EXPECT_NEAR((J.col(1) - dy).norm(), 0.0, 1e-8) << x << ", " << y;
+    }
+  }
+}
+
 TEST(PinholeCamera, NonFiniteDistortionIsAnInputError) {
   PinholeCamera c = simple_camera();
   c.validate("camera");
