@@ -32,11 +32,18 @@ int main(int argc, char** argv) {
   sc.roadmap = RoadmapOptions{};  // 6 m / 20 neighbours: the grown roadmap reaches 3000 samples
   sc.roadmap.max_samples = 3000;
   uint64_t seed = 1;
-  double density = 4.0, laser_range = 5.0, z_max = 3.0, start_trace = 0.4;
+  double density = 4.0, laser_range = 5.0, z_max = 3.0, start_trace = 0.4, dominance_slack = 0.01;
   app.add_option("--map", map, "A sim world ('floor', 'room', 'office' or a .world file) or a ROS map YAML");
   app.add_option("--start", start, "Start x y z yaw (m, rad)")->expected(4);
   app.add_option("--goal", goal, "Goal x y z yaw (m, rad)")->expected(4);
-  app.add_option("--planner", planner, "brm or prm")->check(CLI::IsMember({"brm", "prm"}));
+  app.add_option("--planner", planner,
+                 "brm (Algorithm 1), brm-dominance (keeps every label no covariance beats: slower, better localised) "
+                 "or prm")
+      ->check(CLI::IsMember({"brm", "brm-dominance", "prm"}));
+  app.add_option("--dominance-slack", dominance_slack,
+                 "brm-dominance: drop a label within this fraction of a kept one (0: exact, can take minutes)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   app.add_option("--sampler", sampler, "uniform, su, su-ukf, gaussian, bridge")
       ->check(CLI::IsMember({"uniform", "su", "su-ukf", "gaussian", "bridge"}));
   app.add_option("--sensor", sensor, "camera (the paper's), kinect, laser")->check(CLI::IsMember({"camera", "kinect", "laser"}));
@@ -81,7 +88,7 @@ int main(int argc, char** argv) {
     const ConfigurationSpace space(env, sc.space);
     if (!space.is_valid(q0)) throw CLI::ValidationError("--start", "start is not in free space");
     if (!space.is_valid(q1)) throw CLI::ValidationError("--goal", "goal is not in free space");
-    const eval::Trial t = eval::run_trial(sc, eval::Setting{planner, sampler, samples}, q0, q1, seed);
+    const eval::Trial t = eval::run_trial(sc, eval::Setting{planner, sampler, samples, dominance_slack}, q0, q1, seed);
     spdlog::info("{} features, build {:.3f} s, search {:.2f} ms", env.features().size(), t.build_s, 1e3 * t.search_s);
     if (!t.found) {
       std::cerr << "kestrel-plan: no path found with " << t.samples.size() << " samples\n";
@@ -98,7 +105,7 @@ int main(int argc, char** argv) {
       std::cout << t.path[i][0] << " " << t.path[i][1] << " " << t.path[i][2] << " " << t.path[i][3] << " "
                 << covariances[i].trace() << "\n";
     if (!png.empty()) {
-      eval::DrawnPath drawn{t.path, covariances, planner == "brm" ? cv::Scalar(200, 0, 0) : cv::Scalar(0, 0, 220)};
+      eval::DrawnPath drawn{t.path, covariances, planner != "prm" ? cv::Scalar(200, 0, 0) : cv::Scalar(0, 0, 220)};
       if (!cv::imwrite(png, eval::draw_plans(env, t.samples, {drawn}, sc.space.z_min_m))) throw InputError(png + ": cannot write");
     }
     return kExitOk;

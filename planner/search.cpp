@@ -1,6 +1,7 @@
 // PRM Dijkstra and the BRM label search.
 #include "planner/search.h"
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <functional>
 #include <queue>
@@ -14,7 +15,19 @@ struct Label {
   int parent;  // index into the label store, -1 for the root
   double length;
   Mat4 sigma;
+  double trace;
+  bool superseded;  // another label at its node beats it: never expanded
 };
+
+// a <= b in the Loewner order (b - a positive semi-definite), to rounding: every direction's
+// variance under a is at most b's.
+bool loewner_leq(const Mat4& a, const Mat4& b) {
+  const Mat4 d = b - a;
+  const double tolerance = 1e-12 * std::max(a.trace(), b.trace());
+  for (int i = 0; i < 4; ++i)
+    if (d(i, i) < -tolerance) return false;
+  return Eigen::SelfAdjointEigenSolver<Mat4>(d, Eigen::EigenvaluesOnly).eigenvalues()(0) >= -tolerance;
+}
 
 bool on_path(const std::vector<Label>& labels, int label, int node) {
   for (int l = label; l >= 0; l = labels[l].parent)
@@ -76,50 +89,33 @@ PlanResult shortest_path(const Roadmap& map, int start, int goal) {
 
 PlanResult belief_search(const Roadmap& map, int start, int goal, const BrmQuery& query) {
   check_nodes(map, start, goal);
-  std::vector<Label> labels{{start, -1, 0.0, query.start_covariance}};
-  long expansions = 0;
-  if (query.objective == BrmObjective::kMinGoalUncertainty) {
-    std::vector<double> best(map.size(), std::numeric_limits<double>::infinity());
-    std::vector<int> best_label(map.size(), -1);
-    best[start] = query.start_covariance.trace();
-    best_label[start] = 0;
-    // Algorithm 1's acceptance rule, expanded best-first by tr(Sigma) rather than in FIFO order,
-    // and skipping labels superseded at their node before their turn: far fewer re-expansions.
-    // Like the FIFO original this is a heuristic (pruning by tr at a node can drop a label that
-    // would do better later), so the two may return different, equally plausible paths.
-    using Item = std::pair<double, int>;
-    std::priority_queue<Item, std::vector<Item>, std::greater<>> open;
-    open.push({best[start], 0});
-    while (!open.empty()) {
-      const auto [tr_l, l] = open.top();
-      open.pop();
-      if (tr_l > best[labels[l].node]) continue;  // a better label reached this node since
-      ++expansions;
-      for (const Edge& e : map.edges(labels[l].node)) {
-        if (on_path(labels, l, e.to)) continue;
-        const Mat4 sigma = e.transfer.apply(labels[l].sigma);
-        const double tr = sigma.trace();
-        if (!(tr < best[e.to]) || !(tr < query.max_trace)) continue;
-        if (query.edge_peak_trace && !(query.edge_peak_trace(labels[l].node, e.to, labels[l].sigma) < query.max_trace))
-          continue;
-        best[e.to] = tr;
-        labels.push_back({e.to, l, labels[l].length + e.length_m, sigma});
-        best_label[e.to] = static_cast<int>(labels.size()) - 1;
-        if (e.to != goal) open.push({tr, best_label[e.to]});
-      }
-    }
-    PlanResult r = best_label[goal] >= 0 ? unwind(labels, best_label[goal]) : PlanResult{};
-    r.expansions = expansions;
-    return r;
-  }
-  // Shortest with a bound: best-first on length over Pareto-optimal (length, trace) labels.
-  std::vector<std::vector<std::pair<double, double>>> front(map.size());
+  const bool shortest = query.objective == BrmObjective::kShortestBounded;
+  const bool by_matrix = query.pruning == BrmPruning::kCovarianceDominance;
+  std::vector<Label> labels{{start, -1, 0.0, query.start_covariance, query.start_covariance.trace(), false}};
+  std::vector<std::vector<int>> front(map.size());  // labels alive at each node
+  front[start].push_back(0);
+  // `a` makes `b` redundant at their node: no longer (when length counts) and no worse
+  // localised: by trace (Algorithm 1's rule) or in every direction (the exact rule).
+  // The slack widens only the rejection of a newcomer; a label already kept is superseded only
+  // by exact dominance, so a dropped label is within (1 + slack) of one that survives, never
+  // of a chain of them.
+  const auto beats = [&](const Label& a, const Label& b, double slack) {
+    if (shortest && a.length > b.length) return false;
+    if (!by_matrix) return a.trace <= b.trace;
+    const double scale = 1.0 + slack;
+    return a.trace <= scale * b.trace && loewner_leq(a.sigma, scale * b.sigma);  // tr: cheap, necessary
+  };
+  // Best-first: by length for the bounded shortest path (the goal's first label is the answer),
+  // by tr(Sigma) otherwise (Algorithm 1 is FIFO; this order re-expands far less). A label
+  // superseded at its node before its turn is skipped.
   using Item = std::pair<double, int>;
   std::priority_queue<Item, std::vector<Item>, std::greater<>> open;
-  open.push({0.0, 0});
+  open.push({shortest ? 0.0 : labels[0].trace, 0});
+  long expansions = 0;
   while (!open.empty()) {
     const int l = open.top().second;
     open.pop();
+    if (labels[l].superseded || (!shortest && labels[l].node == goal)) continue;
     ++expansions;
     if (labels[l].node == goal) {
       PlanResult r = unwind(labels, l);
@@ -128,22 +124,25 @@ PlanResult belief_search(const Roadmap& map, int start, int goal, const BrmQuery
     }
     for (const Edge& e : map.edges(labels[l].node)) {
       if (on_path(labels, l, e.to)) continue;
-      const Mat4 sigma = e.transfer.apply(labels[l].sigma);
-      const double tr = sigma.trace(), len = labels[l].length + e.length_m;
-      if (!(tr < query.max_trace)) continue;
-      auto& f = front[e.to];
-      if (std::any_of(f.begin(), f.end(), [&](const auto& p) { return p.first <= len && p.second <= tr; }))
-        continue;
+      Label next{e.to, l, labels[l].length + e.length_m, e.transfer.apply(labels[l].sigma), 0.0, false};
+      next.trace = next.sigma.trace();
+      if (!(next.trace < query.max_trace)) continue;
+      std::vector<int>& here = front[e.to];
+      if (std::any_of(here.begin(), here.end(), [&](int k) { return beats(labels[k], next, query.dominance_slack); })) continue;
       if (query.edge_peak_trace && !(query.edge_peak_trace(labels[l].node, e.to, labels[l].sigma) < query.max_trace))
         continue;
-      f.erase(std::remove_if(f.begin(), f.end(), [&](const auto& p) { return p.first >= len && p.second >= tr; }),
-              f.end());
-      f.push_back({len, tr});
-      labels.push_back({e.to, l, len, sigma});
-      open.push({len, static_cast<int>(labels.size()) - 1});
+      for (int k : here) labels[k].superseded = beats(next, labels[k], 0.0);
+      here.erase(std::remove_if(here.begin(), here.end(), [&](int k) { return labels[k].superseded; }), here.end());
+      labels.push_back(std::move(next));
+      const int id = static_cast<int>(labels.size()) - 1;
+      here.push_back(id);
+      open.push({shortest ? labels[id].length : labels[id].trace, id});
     }
   }
   PlanResult r;
+  if (!shortest && !front[goal].empty())
+    r = unwind(labels, *std::min_element(front[goal].begin(), front[goal].end(),
+                                         [&](int a, int b) { return labels[a].trace < labels[b].trace; }));
   r.expansions = expansions;
   return r;
 }

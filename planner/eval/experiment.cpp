@@ -46,8 +46,8 @@ std::vector<double> fly(const std::vector<Config>& path, const BeliefModel& mode
 }
 
 Trial run_trial(const Scenario& sc, const Setting& setting, const Config& start, const Config& goal, uint64_t seed) {
-  if (setting.planner != "brm" && setting.planner != "prm")
-    throw std::invalid_argument("unknown planner '" + setting.planner + "' (brm, prm)");
+  if (setting.planner != "brm" && setting.planner != "brm-dominance" && setting.planner != "prm")
+    throw std::invalid_argument("unknown planner '" + setting.planner + "' (brm, brm-dominance, prm)");
   const ConfigurationSpace space(*sc.env, sc.space);
   const FeatureSensor sensor(*sc.env, sc.sensor);
   const BeliefModel model(sc.motion, [&sensor](const Config& q) { return sensor.information(q); });
@@ -55,7 +55,7 @@ Trial run_trial(const Scenario& sc, const Setting& setting, const Config& start,
   auto sampler = make_sampler(setting.sampler, space, sensor, sc.ukf_prior);
   RoadmapOptions options = sc.roadmap;
   options.samples = setting.samples;
-  const bool brm = setting.planner == "brm";
+  const bool brm = setting.planner != "prm";
 
   Trial t;
   const auto t0 = std::chrono::steady_clock::now();
@@ -68,6 +68,10 @@ Trial run_trial(const Scenario& sc, const Setting& setting, const Config& start,
   if (brm) {
     BrmQuery q;
     q.start_covariance = sc.start_covariance;
+    if (setting.planner == "brm-dominance") {
+      q.pruning = BrmPruning::kCovarianceDominance;
+      q.dominance_slack = setting.dominance_slack;
+    }
     r = belief_search(map, 0, 1, q);
   } else {
     r = shortest_path(map, 0, 1);

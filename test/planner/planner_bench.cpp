@@ -1,6 +1,7 @@
 // Speed of the planner in the sim's `floor` world (Release, one core): roadmap build with 100
 // samples per sampler (BRM: with transfer functions; the paper camera and the Kinect model,
-// whose 4 m range makes line of sight the cost), BRM search, the two sensor-uncertainty
+// whose 4 m range makes line of sight the cost), BRM search (Algorithm 1's trace rule and
+// covariance dominance, exact and with 1 % slack), the two sensor-uncertainty
 // weights per candidate (EKF tr(M), UKF I(x)), the Kinect's M at one pose, and one edge
 // transfer.
 #include <benchmark/benchmark.h>
@@ -35,7 +36,7 @@ BENCHMARK_CAPTURE(BM_BuildBrm, uniform, "uniform", false)->Unit(benchmark::kMill
 // Fig. 13's build: BRM-SU, 100 samples, all pairs, the Kinect model.
 BENCHMARK_CAPTURE(BM_BuildBrm, su_kinect, "su", true)->Unit(benchmark::kMillisecond);
 
-void BM_SearchBrm(benchmark::State& state) {
+void BM_SearchBrm(benchmark::State& state, BrmPruning pruning, double slack) {
   const Environment& env = *floor().env;
   const ConfigurationSpace space(env, {});
   const FeatureSensor sensor(env, FeatureSensorOptions::paper_camera());
@@ -46,9 +47,14 @@ void BM_SearchBrm(benchmark::State& state) {
   const Roadmap map = build_roadmap(space, *sampler, pair.first, pair.second, RoadmapOptions::all_pairs(), &model, rng);
   BrmQuery q;
   q.start_covariance = 0.1 * Mat4::Identity();
+  q.pruning = pruning;
+  q.dominance_slack = slack;
   for (auto _ : state) benchmark::DoNotOptimize(belief_search(map, 0, 1, q));
 }
-BENCHMARK(BM_SearchBrm)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_SearchBrm, trace, BrmPruning::kTrace, 0.0)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_SearchBrm, dominance_exact, BrmPruning::kCovarianceDominance, 0.0)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_SearchBrm, dominance_slack_1pct, BrmPruning::kCovarianceDominance, 0.01)
+    ->Unit(benchmark::kMicrosecond);
 
 // The sampler's weight at valid uniform candidates: tr(M) (EKF) and I(x) (UKF, eq. 27).
 void BM_Weight(benchmark::State& state, bool ukf) {

@@ -1,6 +1,11 @@
 // PRM and BRM on graphs whose answers are known by construction.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <functional>
+#include <iostream>
+#include <limits>
+
 #include "planner/grid_environment.h"
 #include "planner/search.h"
 
@@ -116,6 +121,127 @@ TEST(Brm, BoundAlongEdgesRejectsAnEdgeThatPeaksBetweenWellLocalisedNodes) {
   // The same check applies to the min-tr(Sigma_goal) objective's bound.
   q.objective = BrmObjective::kMinGoalUncertainty;
   EXPECT_EQ(belief_search(map, 0, 1, q).nodes, (std::vector<int>{0, 2, 3, 1}));
+}
+
+// An edge of `length` m in 0.25 m steps whose features see only `seen` (information 50 per
+// step along it).
+ScatteringTransfer seeing(double length, const Eigen::Vector4d& seen) {
+  BeliefStep s;
+  s.R = (0.25 * Eigen::Vector4d(0.1, 0.1, 0.02, 0.01)).asDiagonal();
+  s.M = 50.0 * seen * seen.transpose();
+  return ScatteringTransfer::from_steps(std::vector<BeliefStep>(static_cast<size_t>(length / 0.25), s));
+}
+
+// Two ways to node 4: 0-4 (2 m seeing y) arrives with the smaller tr(Sigma), 0-3-4 (2 x 2 m,
+// the first seeing x) with a small x variance and a large y variance. The last edge 4-1 sees
+// y only, so y's variance at 4 does not matter and x's does: the goal is better from 0-3-4.
+// Algorithm 1 keeps only 0-4 at node 4 (smaller trace); the dominance rule keeps both.
+Roadmap trace_trap() {
+  Roadmap map;
+  for (int i = 0; i < 5; ++i) map.add_node(Config(i, 0, 1, 0));
+  const Eigen::Vector4d x(1, 0, 0, 0), y(0, 1, 0, 0);
+  map.add_edge(0, 4, 2.0, seeing(2.0, y));
+  map.add_edge(0, 3, 2.0, seeing(2.0, x));
+  map.add_edge(3, 4, 2.0, seeing(2.0, Eigen::Vector4d::Zero()));
+  map.add_edge(4, 1, 2.0, seeing(2.0, y));
+  return map;
+}
+
+TEST(Brm, TracePruningMissesTheOptimumThatCovarianceDominanceKeeps) {
+  const Roadmap map = trace_trap();
+  BrmQuery q;
+  q.start_covariance = Mat4::Identity();
+  PlanResult direct, detour;
+  direct.nodes = {0, 4, 1};
+  detour.nodes = {0, 3, 4, 1};
+  predict_along(map, q.start_covariance, direct);
+  predict_along(map, q.start_covariance, detour);
+  ASSERT_LT(direct.traces[1], detour.traces[2]);  // at node 4 the direct label looks better...
+  ASSERT_LT(detour.goal_covariance.trace(), direct.goal_covariance.trace() - 0.5);  // ...and is not
+
+  const PlanResult trace_rule = belief_search(map, 0, 1, q);
+  EXPECT_EQ(trace_rule.nodes, direct.nodes);
+  q.pruning = BrmPruning::kCovarianceDominance;
+  const PlanResult exact = belief_search(map, 0, 1, q);
+  EXPECT_EQ(exact.nodes, detour.nodes);
+  EXPECT_NEAR(exact.goal_covariance.trace(), detour.goal_covariance.trace(), 1e-12);
+}
+
+// Every simple path from 0 to 1, by depth-first enumeration: the least goal tr(Sigma).
+double best_by_enumeration(const Roadmap& map, const Mat4& sigma0) {
+  double best = std::numeric_limits<double>::infinity();
+  std::vector<bool> on(map.size(), false);
+  std::function<void(int, const Mat4&)> visit = [&](int n, const Mat4& sigma) {
+    if (n == 1) {
+      best = std::min(best, sigma.trace());
+      return;
+    }
+    on[n] = true;
+    for (const Edge& e : map.edges(n))
+      if (!on[e.to]) visit(e.to, e.transfer.apply(sigma));
+    on[n] = false;
+  };
+  visit(0, sigma0);
+  return best;
+}
+
+// Random roadmaps of 7 nodes, each edge's features seeing a random direction: both rules
+// against every simple path. Neither is exact (the no-revisit rule: a kept label cannot take
+// a continuation through its own path), but dominance misses far less often.
+TEST(Brm, CovarianceDominanceMissesTheBestSimplePathFarLessOftenThanTracePruning) {
+  Rng rng(7);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::normal_distribution<double> n01(0.0, 1.0);
+  int trace_missed = 0, dominance_missed = 0, dominance_worse = 0, slack_far = 0, trials = 0;
+  for (int g = 0; g < 200; ++g) {
+    Roadmap map;
+    for (int i = 0; i < 7; ++i) map.add_node(Config(i, 0, 1, 0));
+    for (int a = 0; a < 7; ++a)
+      for (int b = a + 1; b < 7; ++b) {
+        if (u(rng) > 0.5) continue;
+        const double length = 1.0 + std::floor(4.0 * u(rng));
+        const Eigen::Vector4d d(n01(rng), n01(rng), n01(rng), n01(rng));
+        const Eigen::Vector4d seen = u(rng) < 0.3 ? Eigen::Vector4d::Zero() : Eigen::Vector4d(0.3 * d.normalized());
+        map.add_edge(a, b, length, seeing(length, seen));
+        map.add_edge(b, a, length, seeing(length, seen));
+      }
+    const Mat4 sigma0 = 0.5 * Mat4::Identity();
+    const double best = best_by_enumeration(map, sigma0);
+    BrmQuery q;
+    q.start_covariance = sigma0;
+    const PlanResult trace_rule = belief_search(map, 0, 1, q);
+    q.pruning = BrmPruning::kCovarianceDominance;
+    const PlanResult dominance = belief_search(map, 0, 1, q);
+    q.dominance_slack = 0.05;
+    const PlanResult slack = belief_search(map, 0, 1, q);
+    ASSERT_EQ(trace_rule.found, std::isfinite(best)) << "roadmap " << g;
+    ASSERT_EQ(dominance.found, std::isfinite(best)) << "roadmap " << g;
+    ASSERT_EQ(slack.found, std::isfinite(best)) << "roadmap " << g;
+    if (!std::isfinite(best)) continue;
+    ++trials;
+    // Each answer is a real path: its tr(Sigma), re-predicted along it, is never below the best.
+    for (const PlanResult* r : {&trace_rule, &dominance, &slack}) {
+      PlanResult again;
+      again.nodes = r->nodes;
+      predict_along(map, sigma0, again);
+      ASSERT_NEAR(again.goal_covariance.trace(), r->goal_covariance.trace(), 1e-12 * best) << "roadmap " << g;
+      ASSERT_GE(r->goal_covariance.trace(), best * (1.0 - 1e-12)) << "roadmap " << g;
+    }
+    trace_missed += trace_rule.goal_covariance.trace() > best * (1.0 + 1e-9);
+    dominance_missed += dominance.goal_covariance.trace() > best * (1.0 + 1e-9);
+    dominance_worse += dominance.goal_covariance.trace() > trace_rule.goal_covariance.trace() * (1.0 + 1e-9);
+    // A newcomer within 5 % of a kept label in every direction is dropped; phi(c Sigma) <=
+    // c phi(Sigma) for c >= 1 bounds what that costs per edge (6 edges at most here).
+    slack_far += slack.goal_covariance.trace() > dominance.goal_covariance.trace() * std::pow(1.05, 6);
+  }
+  std::cout << "of " << trials << " random roadmaps the best simple path was missed by trace pruning on "
+            << trace_missed << ", by covariance dominance on " << dominance_missed << "; dominance worse than trace on "
+            << dominance_worse << "\n";
+  EXPECT_GT(trials, 150);
+  EXPECT_GT(trace_missed, trials / 4) << "the roadmaps should include many where trace pruning misses the best";
+  EXPECT_LT(dominance_missed * 5, trace_missed);
+  EXPECT_LE(dominance_worse, trials / 50);
+  EXPECT_EQ(slack_far, 0);
 }
 
 TEST(Search, ReportsUnreachableGoalsAndRejectsBadNodes) {

@@ -1,5 +1,5 @@
 // `kestrel plan` and `kestrel plan-experiments` as a user runs them: a plan in the shipped
-// floor world (a roadmap that grows until it connects), bad world and map files named in the
+// floor world (a roadmap that grows until it connects; both BRM label rules), bad world and map files named in the
 // error, and the experiments' tables and plot from one command.
 #include <gtest/gtest.h>
 
@@ -54,6 +54,29 @@ TEST(PlanTool, ARoadmapThatDoesNotConnectGrowsUntilItDoes) {
   EXPECT_NE(yes.out.find("length"), std::string::npos);
 }
 
+double goal_trace(const std::string& out) {
+  const std::string key = "goal tr(Sigma) ";
+  const size_t at = out.find(key);
+  return at == std::string::npos ? -1.0 : std::stod(out.substr(at + key.size()));
+}
+
+TEST(PlanTool, CovarianceDominanceEndsNoWorseLocalisedThanAlgorithm1) {
+  // The default query (the floor's two far rooms, 300 samples): the same roadmap searched
+  // with both label rules; dominance keeps the trace rule's labels and more.
+  std::vector<double> trace;
+  for (const char* planner : {"brm", "brm-dominance"}) {
+    const test::RunResult r = test::run({test::tool("plan").string(), "--planner", planner, "--seed", "1"});
+    ASSERT_EQ(r.exit_code, 0) << planner << ": " << r.err;
+    const auto path = waypoints(r.out);
+    ASSERT_GE(path.size(), 2u) << r.out;
+    EXPECT_EQ(path.front(), (std::vector<double>{2.5, 2.5, 1, 0, 0.4}));
+    trace.push_back(goal_trace(r.out));
+    ASSERT_GT(trace.back(), 0.0) << r.out;
+    EXPECT_NEAR(path.back()[4], trace.back(), 1e-6 * trace.back()) << "the header's tr(Sigma) is the goal's";
+  }
+  EXPECT_LE(trace[1], trace[0]);
+}
+
 TEST(PlanTool, BadWorldAndMapFilesAreNamedWithExitCode3) {
   test::TempDir dir;
   std::ofstream(dir / "bad.world") << "wall nonsense\n";
@@ -75,7 +98,8 @@ TEST(PlanExperimentsTool, OneCommandWritesTheTableAndThePlot) {
   const std::string md = test::read_file(dir / "tables.md");
   EXPECT_EQ(md, r.out);  // --out holds what was printed
   EXPECT_NE(md.find("### Table 5"), std::string::npos) << md;
-  for (const char* row : {"| prm | uniform |", "| brm | su |", "| brm | su-ukf |", "| brm | gaussian |", "| brm | bridge |"})
+  for (const char* row : {"| prm | uniform |", "| brm | su |", "| brm | su-ukf |", "| brm | gaussian |", "| brm | bridge |",
+                          "| brm-dominance | su |"})
     EXPECT_NE(md.find(row), std::string::npos) << row << "\n" << md;
   const cv::Mat png = cv::imread((dir / "floor_paths.png").string());
   ASSERT_FALSE(png.empty());
