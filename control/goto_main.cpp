@@ -66,7 +66,9 @@ int run(const Options& o) {
       r.request_id = request_id;
       r.start_mode = kestrel::plan_request_t::START_FROM_STATE;
       for (int i = 0; i < 4; ++i) r.goal[i] = o.goal[static_cast<size_t>(i)];
-      r.planner = o.planner == "prm" ? kestrel::plan_request_t::PLANNER_PRM : kestrel::plan_request_t::PLANNER_BRM;
+      r.planner = o.planner == "prm"             ? kestrel::plan_request_t::PLANNER_PRM
+                  : o.planner == "brm-dominance" ? kestrel::plan_request_t::PLANNER_BRM_DOMINANCE
+                                                 : kestrel::plan_request_t::PLANNER_BRM;
       r.objective = o.max_trace > 0.0 ? kestrel::plan_request_t::OBJECTIVE_SHORTEST_BOUNDED
                                       : kestrel::plan_request_t::OBJECTIVE_MIN_GOAL_UNCERTAINTY;
       r.max_covariance_trace = o.max_trace;
@@ -121,7 +123,9 @@ int main(int argc, char** argv) {
   Options o;
   app.add_option("--lcm-url", o.lcm_url, "LCM URL (default: $LCM_DEFAULT_URL or kestrel's)");
   app.add_option("--goal", o.goal, "Goal x y z yaw (world frame: the estimator's, m and rad)")->expected(4)->required();
-  app.add_option("--planner", o.planner, "brm or prm")->check(CLI::IsMember({"brm", "prm"}))->capture_default_str();
+  app.add_option("--planner", o.planner, "brm (Algorithm 1), brm-dominance (covariance dominance) or prm")
+      ->check(CLI::IsMember({"brm", "brm-dominance", "prm"}))
+      ->capture_default_str();
   app.add_option("--max-trace", o.max_trace, "Shortest path with tr(Sigma) below this (0: least uncertain goal)")
       ->check(CLI::NonNegativeNumber)->capture_default_str();
   app.add_flag("--wait", o.wait, "Wait until the vehicle is at the goal");

@@ -96,11 +96,12 @@ int main(int argc, char** argv) {
         q.start_trace = r.start_covariance_trace;
       }
       q.goal = Config(r.goal[0], r.goal[1], r.goal[2], r.goal[3]);
-      q.brm = r.planner == kestrel::plan_request_t::PLANNER_BRM;
+      q.brm = r.planner != kestrel::plan_request_t::PLANNER_PRM;
+      if (r.planner == kestrel::plan_request_t::PLANNER_BRM_DOMINANCE) q.pruning = BrmPruning::kCovarianceDominance;
       q.objective = r.objective == kestrel::plan_request_t::OBJECTIVE_SHORTEST_BOUNDED ? BrmObjective::kShortestBounded
                                                                                        : BrmObjective::kMinGoalUncertainty;
       if (r.objective == kestrel::plan_request_t::OBJECTIVE_SHORTEST_BOUNDED) q.max_trace = r.max_covariance_trace;
-      const bool known = (r.start_mode == 0 || r.start_mode == 1) && (r.planner == 0 || r.planner == 1) &&
+      const bool known = (r.start_mode == 0 || r.start_mode == 1) && (r.planner >= 0 && r.planner <= 2) &&
                          (r.objective == 0 || r.objective == 1);
       const auto t0 = std::chrono::steady_clock::now();
       PlanAnswer a;

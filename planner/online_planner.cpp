@@ -112,6 +112,8 @@ PlanAnswer OnlinePlanner::plan(const PlanQuery& query) const {
     q.start_covariance = sigma0;
     q.objective = query.objective;
     q.max_trace = query.max_trace;
+    q.pruning = query.pruning;
+    q.dominance_slack = query.dominance_slack;
     r = belief_search(map, 0, 1, q);
   } else {
     r = shortest_path(map, 0, 1);

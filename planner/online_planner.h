@@ -47,6 +47,8 @@ struct PlanQuery {
   double start_trace = 0.0;     ///< with `start`: tr(Sigma), spread evenly
   Config goal = Config::Zero();
   bool brm = true;
+  BrmPruning pruning = BrmPruning::kTrace;  ///< BRM only
+  double dominance_slack = 0.01;            ///< kCovarianceDominance only (BrmQuery)
   BrmObjective objective = BrmObjective::kMinGoalUncertainty;
   double max_trace = std::numeric_limits<double>::infinity();
 };

@@ -1,6 +1,9 @@
 // The process's planner without LCM: request validation, statuses and reproducible plans.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <iostream>
+
 #include "planner/floor_plan.h"
 #include "planner/online_planner.h"
 
@@ -53,6 +56,29 @@ TEST(OnlinePlanner, PlansReproduciblyAndPredictsCovariances) {
   EXPECT_TRUE(a.waypoints.back().isApprox(q.goal));
   EXPECT_NEAR(a.traces.front(), 0.4, 1e-12);
   EXPECT_GE(a.length_m, (q.goal - *q.start).head<3>().norm());
+}
+
+TEST(OnlinePlanner, CovarianceDominanceSearchesTheSameRoadmapExactlyOrWithinItsSlack) {
+  const OnlinePlanner p = floor_planner();
+  PlanQuery q;
+  q.request_id = 7;  // the same id: the same roadmap
+  q.start = Config(2.5, 2.5, 1.0, 0.0);
+  q.start_trace = 0.4;
+  q.goal = Config(10.5, 20.0, 1.0, 0.0);
+  const PlanAnswer trace_rule = p.plan(q);
+  q.pruning = BrmPruning::kCovarianceDominance;
+  const PlanAnswer slack = p.plan(q);  // the default 1 %
+  q.dominance_slack = 0.0;
+  const PlanAnswer exact = p.plan(q);
+  for (const PlanAnswer* a : {&trace_rule, &slack, &exact}) {
+    ASSERT_EQ(a->status, PlanAnswer::kOk) << a->message;
+    EXPECT_TRUE(a->waypoints.back().isApprox(q.goal));
+  }
+  EXPECT_LE(exact.traces.back(), trace_rule.traces.back() * (1.0 + 1e-12));
+  // At most 1 % per edge above what the exact rule finds (and it may be above the trace rule).
+  EXPECT_LE(slack.traces.back(), exact.traces.back() * std::pow(1.01, static_cast<double>(slack.waypoints.size() - 1)));
+  std::cout << "goal tr(Sigma): trace rule " << trace_rule.traces.back() << ", dominance " << exact.traces.back()
+            << ", at 1 % " << slack.traces.back() << "\n";
 }
 
 // A 6 x 3 m free room whose cells around the vehicle at (1, 1.5) the camera never saw (all

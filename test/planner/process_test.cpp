@@ -1,6 +1,6 @@
 // kestrel-planner as a process, in a private network namespace under lock-step replay: a log
-// with an OctoMap of a room split by a wall with one gap, a STATE and five PLAN_REQUESTs goes
-// through the running planner twice (RESET between). Each request gets one PLAN with the
+// with an OctoMap of a room split by a wall with one gap, a STATE and six PLAN_REQUESTs (BRM
+// by both label rules, PRM, bad ones) goes through the running planner twice (RESET between). Each request gets one PLAN with the
 // right status; the plans run from their start to their goal through the gap, clear of the
 // known walls, with the predicted tr(Sigma) starting at the request's (or the state's); the
 // second replay answers identically.
@@ -81,6 +81,9 @@ void write_input_log(const std::string& path) {
   kestrel::plan_request_t bad = request(5, 6.5, 1.0);
   bad.planner = 7;
   log.write_message(channel::kPlanRequest, 2005, bad);
+  kestrel::plan_request_t dominance = request(6, 6.5, 1.0);
+  dominance.planner = kestrel::plan_request_t::PLANNER_BRM_DOMINANCE;
+  log.write_message(channel::kPlanRequest, 2006, dominance);
   log.close();
 }
 
@@ -124,22 +127,22 @@ TEST(PlannerProcess, AnswersEveryRequestOverLcmAndRepeatsAfterReset) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
 
   const auto a = plans((dir / "a.lcmlog").string()), b = plans((dir / "b.lcmlog").string());
-  ASSERT_EQ(a.size(), 5u);
+  ASSERT_EQ(a.size(), 6u);
   ASSERT_EQ(b.size(), a.size());
   for (size_t i = 0; i < a.size(); ++i) EXPECT_EQ(a[i].request_id, static_cast<int64_t>(i + 1));
   EXPECT_EQ(a[0].status, kestrel::plan_t::STATUS_NO_MAP);
   EXPECT_EQ(a[3].status, kestrel::plan_t::STATUS_GOAL_IN_COLLISION);
   EXPECT_EQ(a[4].status, kestrel::plan_t::STATUS_BAD_REQUEST);
-  for (int k : {1, 2}) {
+  for (int k : {1, 2, 5}) {
     const kestrel::plan_t& p = a[k];
     ASSERT_EQ(p.status, kestrel::plan_t::STATUS_OK) << p.message;
     ASSERT_GE(p.num_waypoints, 2);
-    const double sx = k == 1 ? 1.0 : 3.0, gy = k == 1 ? 1.0 : 3.2;
+    const double sx = k == 2 ? 3.0 : 1.0, gy = k == 2 ? 3.2 : 1.0;
     EXPECT_NEAR(p.waypoints[0][0], 1.5, 1e-9);
     EXPECT_NEAR(p.waypoints[0][1], sx, 1e-9);
     EXPECT_NEAR(p.waypoints.back()[0], 6.5, 1e-9);
     EXPECT_NEAR(p.waypoints.back()[1], gy, 1e-9);
-    EXPECT_NEAR(p.covariance_trace[0], k == 1 ? 0.4 : 0.05, 1e-9);
+    EXPECT_NEAR(p.covariance_trace[0], k == 2 ? 0.05 : 0.4, 1e-9);
     for (double tr : p.covariance_trace) EXPECT_GT(tr, 0.0);
     // Clear of the walls by the vehicle radius less the map's half-cell rounding.
     EXPECT_GT(check_path(p, 0.3 - 0.05), kGapY) << "plan " << k + 1 << " does not go through the gap";

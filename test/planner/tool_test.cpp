@@ -60,9 +60,10 @@ double goal_trace(const std::string& out) {
   return at == std::string::npos ? -1.0 : std::stod(out.substr(at + key.size()));
 }
 
-TEST(PlanTool, CovarianceDominanceEndsNoWorseLocalisedThanAlgorithm1) {
-  // The default query (the floor's two far rooms, 300 samples): the same roadmap searched
-  // with both label rules; dominance keeps the trace rule's labels and more.
+TEST(PlanTool, CovarianceDominanceEndsBetterLocalisedThanAlgorithm1OnTheDefaultQuery) {
+  // The default query (the floor's two far rooms, grown roadmap): the same roadmap searched
+  // with both label rules. At the tools' 1 % slack dominance is not always below the trace
+  // rule; here it is (0.9307 against 0.9318 when written).
   std::vector<double> trace;
   for (const char* planner : {"brm", "brm-dominance"}) {
     const test::RunResult r = test::run({test::tool("plan").string(), "--planner", planner, "--seed", "1"});
