@@ -95,7 +95,7 @@ PlanResult belief_search(const Roadmap& map, int start, int goal, const BrmQuery
   std::vector<std::vector<int>> front(map.size());  // labels alive at each node
   front[start].push_back(0);
   // `a` makes `b` redundant at their node: no longer (when length counts) and no worse
-  // localised: by trace (Algorithm 1's rule) or in every direction (the exact rule).
+  // localised: by trace (Algorithm 1's rule) or in every direction (covariance dominance).
   // The slack widens only the rejection of a newcomer; a label already kept is superseded only
   // by exact dominance, so a dropped label is within (1 + slack) of one that survives, never
   // of a chain of them.
@@ -128,7 +128,8 @@ PlanResult belief_search(const Roadmap& map, int start, int goal, const BrmQuery
       next.trace = next.sigma.trace();
       if (!(next.trace < query.max_trace)) continue;
       std::vector<int>& here = front[e.to];
-      if (std::any_of(here.begin(), here.end(), [&](int k) { return beats(labels[k], next, query.dominance_slack); })) continue;
+      const auto kept_beats_next = [&](int k) { return beats(labels[k], next, query.dominance_slack); };
+      if (std::any_of(here.begin(), here.end(), kept_beats_next)) continue;
       if (query.edge_peak_trace && !(query.edge_peak_trace(labels[l].node, e.to, labels[l].sigma) < query.max_trace))
         continue;
       for (int k : here) labels[k].superseded = beats(next, labels[k], 0.0);
