@@ -48,7 +48,7 @@ struct PlanQuery {
   Config goal = Config::Zero();
   bool brm = true;
   BrmPruning pruning = BrmPruning::kTrace;  ///< BRM only
-  double dominance_slack = 0.01;            ///< kCovarianceDominance only (BrmQuery)
+  double dominance_slack = kToolsDominanceSlack;  ///< kCovarianceDominance only (BrmQuery)
   BrmObjective objective = BrmObjective::kMinGoalUncertainty;
   double max_trace = std::numeric_limits<double>::infinity();
 };

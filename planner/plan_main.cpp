@@ -32,7 +32,8 @@ int main(int argc, char** argv) {
   sc.roadmap = RoadmapOptions{};  // 6 m / 20 neighbours: the grown roadmap reaches 3000 samples
   sc.roadmap.max_samples = 3000;
   uint64_t seed = 1;
-  double density = 4.0, laser_range = 5.0, z_max = 3.0, start_trace = 0.4, dominance_slack = 0.01;
+  double density = 4.0, laser_range = 5.0, z_max = 3.0, start_trace = 0.4;
+  double dominance_slack = kToolsDominanceSlack;
   app.add_option("--map", map, "A sim world ('floor', 'room', 'office' or a .world file) or a ROS map YAML");
   app.add_option("--start", start, "Start x y z yaw (m, rad)")->expected(4);
   app.add_option("--goal", goal, "Goal x y z yaw (m, rad)")->expected(4);

@@ -31,7 +31,7 @@ struct Setting {
   int samples = 100;
   /// brm-dominance's BrmQuery::dominance_slack: 0 is exact up to the no-revisit rule but can
   /// take minutes on a grown 3000-sample roadmap; 1 % costs ~1 % and ~45x less time.
-  double dominance_slack = 0.01;
+  double dominance_slack = kToolsDominanceSlack;
 };
 
 struct Trial {

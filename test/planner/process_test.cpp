@@ -1,9 +1,9 @@
 // kestrel-planner as a process, in a private network namespace under lock-step replay: a log
 // with an OctoMap of a room split by a wall with one gap, a STATE and six PLAN_REQUESTs (BRM
-// by both label rules, PRM, bad ones) goes through the running planner twice (RESET between). Each request gets one PLAN with the
-// right status; the plans run from their start to their goal through the gap, clear of the
-// known walls, with the predicted tr(Sigma) starting at the request's (or the state's); the
-// second replay answers identically.
+// by both label rules, PRM, bad ones) goes through the running planner twice (RESET
+// between). Each request gets one PLAN with the right status; the plans run from their start
+// to their goal through the gap, clear of the known walls, with the predicted tr(Sigma)
+// starting at the request's (or the state's); the second replay answers identically.
 #include <gtest/gtest.h>
 #include <octomap/OcTree.h>
 

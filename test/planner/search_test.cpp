@@ -12,12 +12,28 @@
 namespace kestrel::planner {
 namespace {
 
-// An edge of `length` m in 0.25 m steps; `observed` edges see the position well.
-ScatteringTransfer edge(double length, bool observed) {
+// An edge of `length` m in 0.25 m steps, each with information M.
+ScatteringTransfer edge(double length, const Mat4& M) {
   BeliefStep s;
   s.R = (0.25 * Eigen::Vector4d(0.1, 0.1, 0.02, 0.01)).asDiagonal();
-  if (observed) s.M = Eigen::Vector4d(20.0, 20.0, 20.0, 20.0).asDiagonal();
+  s.M = M;
   return ScatteringTransfer::from_steps(std::vector<BeliefStep>(static_cast<size_t>(length / 0.25), s));
+}
+
+// `observed` edges see the position well.
+ScatteringTransfer edge(double length, bool observed) {
+  return edge(length, observed ? Mat4(20.0 * Mat4::Identity()) : Mat4(Mat4::Zero()));
+}
+
+// Features that see only `seen` (information 50 per step in that direction).
+ScatteringTransfer seeing(double length, const Eigen::Vector4d& seen) {
+  return edge(length, Mat4(50.0 * seen * seen.transpose()));
+}
+
+// a <-> b, the same transfer both ways.
+void join(Roadmap& map, int a, int b, double length, const ScatteringTransfer& transfer) {
+  map.add_edge(a, b, length, transfer);
+  map.add_edge(b, a, length, transfer);
 }
 
 // start 0 -> goal 1. Short route 0-2-1 (2 x 5 m) crosses a featureless hall; the long route
@@ -25,15 +41,11 @@ ScatteringTransfer edge(double length, bool observed) {
 Roadmap two_routes() {
   Roadmap map;
   for (int i = 0; i < 5; ++i) map.add_node(Config(i, 0, 1, 0));
-  auto both = [&](int a, int b, double len, bool obs) {
-    map.add_edge(a, b, len, edge(len, obs));
-    map.add_edge(b, a, len, edge(len, obs));
-  };
-  both(0, 2, 5.0, false);
-  both(2, 1, 5.0, false);
-  both(0, 3, 5.0, true);
-  both(3, 4, 5.0, true);
-  both(4, 1, 5.0, true);
+  join(map, 0, 2, 5.0, edge(5.0, false));
+  join(map, 2, 1, 5.0, edge(5.0, false));
+  join(map, 0, 3, 5.0, edge(5.0, true));
+  join(map, 3, 4, 5.0, edge(5.0, true));
+  join(map, 4, 1, 5.0, edge(5.0, true));
   return map;
 }
 
@@ -123,15 +135,6 @@ TEST(Brm, BoundAlongEdgesRejectsAnEdgeThatPeaksBetweenWellLocalisedNodes) {
   EXPECT_EQ(belief_search(map, 0, 1, q).nodes, (std::vector<int>{0, 2, 3, 1}));
 }
 
-// An edge of `length` m in 0.25 m steps whose features see only `seen` (information 50 per
-// step along it).
-ScatteringTransfer seeing(double length, const Eigen::Vector4d& seen) {
-  BeliefStep s;
-  s.R = (0.25 * Eigen::Vector4d(0.1, 0.1, 0.02, 0.01)).asDiagonal();
-  s.M = 50.0 * seen * seen.transpose();
-  return ScatteringTransfer::from_steps(std::vector<BeliefStep>(static_cast<size_t>(length / 0.25), s));
-}
-
 // Two ways to node 4: 0-4 (2 m seeing y) arrives with the smaller tr(Sigma), 0-3-4 (2 x 2 m,
 // the first seeing x) with a small x variance and a large y variance. The last edge 4-1 sees
 // y only, so y's variance at 4 does not matter and x's does: the goal is better from 0-3-4.
@@ -162,9 +165,9 @@ TEST(Brm, TracePruningMissesTheOptimumThatCovarianceDominanceKeeps) {
   const PlanResult trace_rule = belief_search(map, 0, 1, q);
   EXPECT_EQ(trace_rule.nodes, direct.nodes);
   q.pruning = BrmPruning::kCovarianceDominance;
-  const PlanResult exact = belief_search(map, 0, 1, q);
-  EXPECT_EQ(exact.nodes, detour.nodes);
-  EXPECT_NEAR(exact.goal_covariance.trace(), detour.goal_covariance.trace(), 1e-12);
+  const PlanResult dominance = belief_search(map, 0, 1, q);
+  EXPECT_EQ(dominance.nodes, detour.nodes);
+  EXPECT_NEAR(dominance.goal_covariance.trace(), detour.goal_covariance.trace(), 1e-12);
 }
 
 // Every simple path from 0 to 1, by depth-first enumeration: the least goal tr(Sigma).
@@ -202,8 +205,7 @@ TEST(Brm, CovarianceDominanceMissesTheBestSimplePathFarLessOftenThanTracePruning
         const double length = 1.0 + std::floor(4.0 * u(rng));
         const Eigen::Vector4d d(n01(rng), n01(rng), n01(rng), n01(rng));
         const Eigen::Vector4d seen = u(rng) < 0.3 ? Eigen::Vector4d::Zero() : Eigen::Vector4d(0.3 * d.normalized());
-        map.add_edge(a, b, length, seeing(length, seen));
-        map.add_edge(b, a, length, seeing(length, seen));
+        join(map, a, b, length, seeing(length, seen));
       }
     const Mat4 sigma0 = 0.5 * Mat4::Identity();
     const double best = best_by_enumeration(map, sigma0);

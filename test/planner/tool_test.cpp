@@ -1,6 +1,6 @@
 // `kestrel plan` and `kestrel plan-experiments` as a user runs them: a plan in the shipped
-// floor world (a roadmap that grows until it connects; both BRM label rules), bad world and map files named in the
-// error, and the experiments' tables and plot from one command.
+// floor world (a roadmap that grows until it connects; both BRM label rules), bad world
+// and map files named in the error, and the experiments' tables and plot from one command.
 #include <gtest/gtest.h>
 
 #include <fstream>
