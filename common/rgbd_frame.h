@@ -10,16 +10,26 @@
 #include <Eigen/Geometry>
 #include <cstdint>
 #include <opencv2/core/mat.hpp>
+#include <string>
 
 #include "common/camera.h"
 
 namespace kestrel {
+
+/// The sensor models a source names in RgbdFrame::sensor. Consumers key their timing and
+/// noise profiles by them (vo/sensor_profile.h); the name travels with every frame, so a log
+/// replays with the model of the camera that recorded it.
+namespace sensor_model {
+inline constexpr const char* kSimulator = "simulator";  ///< kestrel-sim's rendered camera
+inline constexpr const char* kKinect1 = "kinect1";      ///< Kinect v1: libfreenect, TUM freiburg1
+}  // namespace sensor_model
 
 struct RgbdFrame {
   int64_t utime = 0;        ///< RGB exposure time, microseconds
   int64_t depth_utime = 0;  ///< depth image time, microseconds
   int64_t seq = 0;          ///< source frame counter
   PinholeCamera camera;
+  std::string sensor;       ///< the sensor's model (sensor_model::k*), "" when the source does not know
   Eigen::Isometry3d T_body_camera = Eigen::Isometry3d::Identity();
   cv::Mat rgb;       ///< CV_8UC3, R,G,B
   cv::Mat depth_mm;  ///< CV_16UC1, millimetres, 0 = none

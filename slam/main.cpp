@@ -34,7 +34,7 @@ using namespace kestrel::slam;
 struct Options {
   std::string vocabulary = "builtin";
   std::string kernel = "dcs";
-  std::string sensor;  // a vo::SensorProfile name; empty: the TUM folder's, else the simulator's
+  std::string sensor;  // a vo::SensorProfile name; empty: the TUM folder's, else each frame's
   // Offline.
   std::string tum, out, vo_out;
   // Process.
@@ -75,8 +75,8 @@ void add_options(cli::App& app, Options& o, SlamOptions& s) {
       ->check(CLI::IsMember({"none", "huber", "cauchy", "dcs"}))->capture_default_str();
   app.add_option("--sensor", o.sensor,
                  "Camera profile, as kestrel-vo's (its timing corrects the keyframes' features): simulator "
-                 "(global shutter; the default live) or kinect1 (rolling shutter, depth before colour); with "
-                 "--tum the default is the folder's (kinect1 for freiburg1)")
+                 "(global shutter) or kinect1 (rolling shutter, depth before colour); by default the one "
+                 "each frame's sensor model names (with --tum the folder's: kinect1 for freiburg1)")
       ->check(CLI::IsMember({vo::to_string(vo::SensorProfile::kSimulator), vo::to_string(vo::SensorProfile::kKinect1)}));
   app.add_option("--tum", o.tum, "Offline: run VO + SLAM over this TUM RGB-D folder");
   app.add_option("--out", o.out, "Offline: write the optimised camera trajectory here (TUM format)");
@@ -137,10 +137,8 @@ int run_offline(const Options& o, const SlamOptions& options, std::shared_ptr<co
 int serve(const Options& o, const SlamOptions& options, std::shared_ptr<const Vocabulary> vocabulary) {
   if (!o.out.empty() || !o.vo_out.empty()) throw CLI::ValidationError("--out/--vo-out", "only with --tum");
   AdapterOptions adapter_options = o.adapter;
-  const vo::SensorProfile sensor =
-      o.sensor.empty() ? vo::SensorProfile::kSimulator : *vo::parse_sensor_profile(o.sensor);
-  adapter_options.timing = vo::with_sensor(sensor, vo::VoOptions{}).depth;
-  spdlog::info("camera profile: {}", vo::to_string(sensor));
+  if (!o.sensor.empty()) adapter_options.sensor = vo::parse_sensor_profile(o.sensor);
+  spdlog::info("camera profile: {}", o.sensor.empty() ? "each frame's sensor model" : o.sensor);
   SlamAdapter adapter(options, std::move(vocabulary), adapter_options);
   std::unique_ptr<transport::Node> node;
   node = std::make_unique<transport::Node>(o.name, o.lcm_url);  // UnavailableError: exit 4

@@ -27,9 +27,10 @@
 // yet waits likewise.
 //
 // Timing: a keyframe's features get the odometry's timing correction (place/frame_features.h)
-// with the camera's timing `timing` (the VO's DepthOptions of the sensor profile; the
-// default, the simulator's, corrects nothing) and the motion the chained VO_UPDATEs give from
-// the frame before the keyframe (the previous update, whether or not its frame came) to it.
+// with the camera's timing (the VO's DepthOptions of the sensor profile: `sensor` if set, else
+// the one the frame's sensor model names; the simulator's corrects nothing) and the motion the
+// chained VO_UPDATEs give from the frame before the keyframe (the previous update, whether or
+// not its frame came) to it.
 // Invariants: at most `buffer_frames` frames and updates wait; a frame is
 // given to SLAM at most once, in increasing utime.
 
@@ -43,6 +44,7 @@
 #include "kestrel/state_t.hpp"
 #include "slam/slam_messages.h"
 #include "vo/options.h"
+#include "vo/sensor_profile.h"
 
 namespace kestrel::slam {
 
@@ -57,9 +59,10 @@ struct AdapterOptions {
   double anchor_max_tilt_sigma_rad = 0.01;  ///< anchor only on a STATE whose roll/pitch sigma is below this
   double max_state_extrapolation_s = 0.02;  ///< a frame after the newest STATE: carried on by its velocities
   double max_bridge_s = 10.0;             ///< longest VO outage the estimator's motion may bridge
-  /// The camera's timing (depth offset, rolling shutter) as the VO takes it: with_sensor()'s
-  /// DepthOptions of the camera's profile (kestrel-slam --sensor).
-  vo::DepthOptions timing;
+  /// The camera's profile, whose timing (depth offset, rolling shutter) the keyframes'
+  /// features are corrected with as the VO corrects them (kestrel-slam --sensor); unset: each
+  /// frame's sensor model names it (vo::profile_of_sensor).
+  std::optional<vo::SensorProfile> sensor;
 };
 
 struct AdapterOutputs {

@@ -10,6 +10,7 @@
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -33,7 +34,7 @@ using namespace kestrel;
 struct Options {
   std::string variant = "default";
   std::vector<std::string> settings;  // KEY=VALUE over the variant
-  std::string sensor;                 // a SensorProfile name; empty: the TUM folder's, else the simulator's
+  std::string sensor;                 // a SensorProfile name; empty: the TUM folder's, else the frames'
   // Offline.
   std::string tum;
   std::string out;
@@ -44,6 +45,27 @@ struct Options {
   std::string in_channel = channel::kCameraRgbd;
   std::string out_channel = channel::kVoUpdate;
 };
+
+// The pipeline's options for camera profile `sensor`: the variant's, then the profile's, then
+// each --set (which may change what the profile set).
+vo::VoOptions configured(const Options& o, vo::SensorProfile sensor) {
+  vo::VoOptions options;
+  try {
+    options = vo::with_sensor(sensor, vo::variant(o.variant).options);
+  } catch (const std::invalid_argument& e) {
+    throw CLI::ValidationError("--variant", e.what());
+  }
+  for (const std::string& kv : o.settings) {
+    const auto eq = kv.find('=');
+    if (eq == std::string::npos) throw CLI::ValidationError("--set", "'" + kv + "' is not KEY=VALUE");
+    try {
+      vo::set_option(options, kv.substr(0, eq), kv.substr(eq + 1));
+    } catch (const std::invalid_argument& e) {
+      throw CLI::ValidationError("--set", e.what());
+    }
+  }
+  return options;
+}
 
 int run_offline(const Options& o, const vo::VoOptions& options) {
   if (o.out.empty()) throw CLI::RequiredError("--out (with --tum)");
@@ -69,13 +91,34 @@ int run_offline(const Options& o, const vo::VoOptions& options) {
   return kExitOk;
 }
 
-int serve(const Options& o, const vo::VoOptions& options) {
+// The process's odometry runs with the camera's profile: --sensor's, else the one the frames'
+// sensor model names (a log keeps it, so a replay runs as the live camera did). It is made at
+// the first frame and made again when the model changes (another source: the motion cannot be
+// chained across it, so the odometry restarts, as after a lost frame).
+int serve(const Options& o, std::optional<vo::SensorProfile> forced) {
   if (!o.out.empty() || !o.stats.empty()) throw CLI::ValidationError("--out/--stats", "only with --tum");
-  vo::VisualOdometry odometry(options);
+  std::optional<vo::SensorProfile> profile;
+  std::unique_ptr<vo::VisualOdometry> odometry;
+  auto odometry_for = [&](const RgbdFrame& frame) -> vo::VisualOdometry& {
+    const vo::SensorProfile wanted = forced.value_or(vo::profile_of_sensor(frame.sensor));
+    if (odometry && wanted == *profile) return *odometry;
+    const std::string why = forced ? "--sensor" : "the frames' sensor '" + frame.sensor + "'";
+    if (odometry) {
+      spdlog::warn("{}: frame {}: the camera is now {} ({}): the odometry restarts", o.in_channel, frame.utime,
+                   vo::to_string(wanted), why);
+    } else {
+      spdlog::info("camera profile: {} ({})", vo::to_string(wanted), why);
+    }
+    odometry = std::make_unique<vo::VisualOdometry>(configured(o, wanted));
+    profile = wanted;
+    return *odometry;
+  };
   std::unique_ptr<transport::Node> node;
   node = std::make_unique<transport::Node>(o.name, o.lcm_url);  // UnavailableError: exit 4
   node->advertise(o.out_channel);
-  node->on_reset([&] { odometry.reset(); });
+  node->on_reset([&] {
+    if (odometry) odometry->reset();
+  });
   int64_t frames = 0, ok = 0;
   node->subscribe<rgbd_frame_t>(o.in_channel, [&](const rgbd_frame_t& message) {
     RgbdFrame frame;
@@ -87,7 +130,7 @@ int serve(const Options& o, const vo::VoOptions& options) {
       throw;
     }
     const auto t0 = std::chrono::steady_clock::now();
-    const vo::VoResult r = odometry.process(frame);
+    const vo::VoResult r = odometry_for(frame).process(frame);
     const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     node->publish(o.out_channel, vo::to_message(r, frame.T_body_camera, ms));
     ++frames;
@@ -117,9 +160,9 @@ int main(int argc, char** argv) {
                  "Change one option of the variant, KEY=VALUE (repeatable; --list-options shows them)");
   bool list = false;
   app.add_option("--sensor", o.sensor,
-                 "Camera profile: simulator (global shutter; the default live) or kinect1 (rolling "
-                 "shutter, depth before colour, larger covariance floors); with --tum the default "
-                 "is the folder's (kinect1 for freiburg1)")
+                 "Camera profile: simulator (global shutter) or kinect1 (rolling shutter, depth before "
+                 "colour, larger covariance floors); by default the one each frame's sensor model "
+                 "names (with --tum the folder's: kinect1 for freiburg1)")
       ->check(CLI::IsMember({vo::to_string(vo::SensorProfile::kSimulator), vo::to_string(vo::SensorProfile::kKinect1)}));
   app.add_flag("--list-options", list, "Print every pipeline option of the variant with its value and exit");
   app.add_option("--tum", o.tum, "Offline: TUM RGB-D sequence folder to run over");
@@ -130,35 +173,25 @@ int main(int argc, char** argv) {
   app.add_option("--in", o.in_channel, "Channel of rgbd_frame_t")->capture_default_str();
   app.add_option("--out-channel", o.out_channel, "Channel of vo_update_t")->capture_default_str();
   return app.run(argc, argv, [&]() -> int {
-    vo::VoOptions options;
-    try {
-      options = vo::variant(o.variant).options;
-      // The camera's profile (before --set, which may change it): as told, else the TUM
-      // folder's, else the simulator's.
-      vo::SensorProfile sensor = vo::SensorProfile::kSimulator;
-      if (!o.sensor.empty()) {
-        sensor = *vo::parse_sensor_profile(o.sensor);
-      } else if (!o.tum.empty()) {
-        sensor = vo::tum_sensor(o.tum);
-      }
-      options = vo::with_sensor(sensor, options);
-      spdlog::info("camera profile: {}", vo::to_string(sensor));
-    } catch (const std::invalid_argument& e) {
-      throw CLI::ValidationError("--variant", e.what());
+    // The camera's profile: as told, else the TUM folder's; live, else each frame's (serve()).
+    std::optional<vo::SensorProfile> forced;
+    if (!o.sensor.empty()) {
+      forced = *vo::parse_sensor_profile(o.sensor);
+    } else if (!o.tum.empty()) {
+      forced = vo::tum_sensor(o.tum);
     }
-    for (const std::string& kv : o.settings) {
-      const auto eq = kv.find('=');
-      if (eq == std::string::npos) throw CLI::ValidationError("--set", "'" + kv + "' is not KEY=VALUE");
-      try {
-        vo::set_option(options, kv.substr(0, eq), kv.substr(eq + 1));
-      } catch (const std::invalid_argument& e) {
-        throw CLI::ValidationError("--set", e.what());
-      }
-    }
+    // Every profile the run may take is checked now, so a bad --set is a usage error at the start.
+    for (const vo::SensorProfile p : {vo::SensorProfile::kSimulator, vo::SensorProfile::kKinect1})
+      if (!forced || p == *forced) configured(o, p);
+    const vo::VoOptions options = configured(o, forced.value_or(vo::SensorProfile::kSimulator));
     if (list) {
       for (const std::string& line : vo::describe_options(options)) std::cout << line << "\n";
       return kExitOk;
     }
-    return o.tum.empty() ? serve(o, options) : run_offline(o, options);
+    if (!o.tum.empty()) {
+      spdlog::info("camera profile: {}", vo::to_string(*forced));
+      return run_offline(o, options);
+    }
+    return serve(o, forced);
   });
 }

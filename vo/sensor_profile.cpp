@@ -1,5 +1,7 @@
 #include "vo/sensor_profile.h"
 
+#include "common/rgbd_frame.h"
+
 namespace kestrel::vo {
 
 VoOptions with_sensor(SensorProfile profile, VoOptions options) {
@@ -18,7 +20,11 @@ VoOptions with_sensor(SensorProfile profile, VoOptions options) {
 }
 
 std::string to_string(SensorProfile profile) {
-  return profile == SensorProfile::kKinect1 ? "kinect1" : "simulator";
+  return profile == SensorProfile::kKinect1 ? sensor_model::kKinect1 : sensor_model::kSimulator;
+}
+
+SensorProfile profile_of_sensor(const std::string& sensor_model) {
+  return parse_sensor_profile(sensor_model).value_or(SensorProfile::kSimulator);
 }
 
 std::optional<SensorProfile> parse_sensor_profile(const std::string& name) {

@@ -7,8 +7,9 @@
 //
 // The Kinect's values were measured on TUM's freiburg1 recordings (vo/README.md, "Sensor
 // timing" and "Covariance"); they are one calibration of the sensor, chosen by sweeps scored
-// on both sequences, not per sequence. Who knows the source applies the profile: `kestrel vo
-// --tum` from the folder's name, `kestrel vo --sensor`, `kestrel launch` from its --source.
+// on both sequences, not per sequence. Every frame names its sensor's model (RgbdFrame::sensor,
+// set by the source and kept in logs), and profile_of_sensor() maps it to a profile; `kestrel
+// vo --sensor` and `kestrel slam --sensor` override it.
 
 #include <optional>
 #include <string>
@@ -52,8 +53,12 @@ constexpr double kKinect1DenseWeight = 2.0;
 /// `options` with the profile's timing and floors set (kSimulator: unchanged).
 VoOptions with_sensor(SensorProfile profile, VoOptions options);
 
-/// "simulator" or "kinect1".
+/// "simulator" or "kinect1" (sensor_model::k*, the names frames carry).
 std::string to_string(SensorProfile profile);
+
+/// The profile for frames of `sensor_model` (RgbdFrame::sensor): kinect1's for "kinect1", the
+/// simulator's for any other name, "" (unknown) included.
+SensorProfile profile_of_sensor(const std::string& sensor_model);
 /// The profile named `name` (as to_string() writes it), or nothing.
 std::optional<SensorProfile> parse_sensor_profile(const std::string& name);
 

@@ -54,7 +54,7 @@ LoadedSequence load_tum_sequence(const std::string& folder) {
 }
 
 SensorProfile tum_sensor(const std::string& folder) {
-  return tum::detect_camera(folder) == tum::TumCamera::kFreiburg1 ? SensorProfile::kKinect1 : SensorProfile::kSimulator;
+  return profile_of_sensor(tum::sensor_model_of(tum::detect_camera(folder)));
 }
 
 VoOptions with_tum_sensor(const std::string& folder, VoOptions options) {

@@ -74,6 +74,7 @@ rgbd_frame_t encode_rgbd(const RgbdFrame& frame, const RgbdEncoding& encoding) {
   m.depth_utime = frame.depth_utime;
   m.seq = frame.seq;
   m.camera = to_message(frame.camera, frame.T_body_camera);
+  m.camera.sensor = frame.sensor;
 
   m.rgb_encoding = frame.rgb.empty() ? rgbd_frame_t::RGB_NONE : encoding.rgb;
   if (m.rgb_encoding == rgbd_frame_t::RGB_RGB8) {
@@ -110,6 +111,7 @@ RgbdFrame decode_rgbd(const rgbd_frame_t& m, const char* what) {
   f.seq = m.seq;
   f.camera = from_message(m.camera, what);
   f.T_body_camera = from_message(m.camera.T_body_camera, what);
+  f.sensor = m.camera.sensor;
   const int w = f.camera.width;
   const int h = f.camera.height;
   const size_t pixels = static_cast<size_t>(w) * static_cast<size_t>(h);

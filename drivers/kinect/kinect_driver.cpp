@@ -52,6 +52,7 @@ void KinectDriver::publish_frame(const PairedFrame& pair, const DriverSink& sink
   f.depth_utime = pair.depth.host_utime;
   f.seq = result_.frames;
   f.camera = registration_.calibration().rgb;
+  f.sensor = sensor_model::kKinect1;
   f.T_body_camera = options_.T_body_camera;
   f.rgb = pair.rgb.image;
   f.depth_mm = registration_.register_raw(pair.depth.image);

@@ -90,6 +90,7 @@ RgbdFrame Renderer::render(const std::vector<Eigen::Isometry3d>& exposure, int64
   frame.depth_utime = utime;
   frame.seq = seq;
   frame.camera = options_.camera;
+  frame.sensor = sensor_model::kSimulator;
   frame.T_body_camera = options_.T_body_camera;
   expose_rgb(planes_, options_.camera, options_.rgb, static_cast<uint32_t>(frame_key), frame.rgb);
   make_kinect_depth(raster_, ir_return_, options_.depth, static_cast<uint32_t>(frame_key >> 32), frame.depth_mm);

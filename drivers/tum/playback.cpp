@@ -36,11 +36,19 @@ std::vector<PlaybackEvent> playback_schedule(const TumSequence& sequence, const 
     }
   }
   if (window.ground_truth) {
+    // From the last pose at or before the first frame to the first at or after the last one,
+    // so that every frame's true pose can be interpolated (the motion capture runs at its own
+    // rate: fr1's first frames come between two of its samples).
     const auto& poses = sequence.ground_truth().poses();
+    size_t begin_pose = 0, end_pose = poses.size();  // [begin_pose, end_pose)
     for (size_t i = 0; i < poses.size(); ++i) {
-      if (poses[i].utime >= first && poses[i].utime <= last)
-        events.push_back({poses[i].utime, EventKind::kGroundTruth, i});
+      if (poses[i].utime <= first) begin_pose = i;
+      if (poses[i].utime >= last) {
+        end_pose = i + 1;
+        break;
+      }
     }
+    for (size_t i = begin_pose; i < end_pose; ++i) events.push_back({poses[i].utime, EventKind::kGroundTruth, i});
   }
   std::stable_sort(events.begin(), events.end(), [](const PlaybackEvent& a, const PlaybackEvent& b) {
     return std::make_tuple(a.utime, static_cast<int>(a.kind), a.index) <

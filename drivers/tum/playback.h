@@ -5,8 +5,10 @@
 // Invariants of playback_schedule(): events are sorted by utime; at equal utime, IMU comes
 // before ground truth and ground truth before a frame (an estimator integrates the IMU up to
 // a frame before it sees the frame). The window holds the frames whose RGB time lies in
-// [first + start, first + start + duration] (first = the sequence's first frame), and the IMU
-// samples and poses between the window's first and last frame times, inclusive.
+// [first + start, first + start + duration] (first = the sequence's first frame), the IMU
+// samples between the window's first and last frame times, inclusive, and the poses from the
+// last at or before the first frame to the first at or after the last frame (so that every
+// frame's true pose can be interpolated).
 
 #include <cstddef>
 #include <cstdint>

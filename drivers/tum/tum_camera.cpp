@@ -47,4 +47,8 @@ const char* camera_name(TumCamera camera) {
   return "unknown (ROS default intrinsics)";
 }
 
+const char* sensor_model_of(TumCamera camera) {
+  return camera == TumCamera::kFreiburg1 ? sensor_model::kKinect1 : "";
+}
+
 }  // namespace kestrel::tum

@@ -15,6 +15,7 @@
 #include <string>
 
 #include "common/camera.h"
+#include "common/rgbd_frame.h"
 
 namespace kestrel::tum {
 
@@ -29,5 +30,9 @@ PinholeCamera camera_intrinsics(TumCamera camera);
 
 /// "freiburg1", ..., "unknown (ROS default intrinsics)".
 const char* camera_name(TumCamera camera);
+
+/// The sensor model the frames name (RgbdFrame::sensor): kinect1 for freiburg1, whose Kinect
+/// the profile was measured on; "" for the others (their timing is not measured here).
+const char* sensor_model_of(TumCamera camera);
 
 }  // namespace kestrel::tum

@@ -78,6 +78,7 @@ RgbdFrame TumSequence::frame(size_t i) const {
   f.depth_utime = depth.utime;
   f.seq = static_cast<int64_t>(ref.rgb);
   f.camera = camera_;
+  f.sensor = sensor_model_of(camera_model_);
   f.rgb = load_rgb(path_of(rgb), camera_.width, camera_.height, {rgb_list_, rgb.line});
   f.depth_mm = to_mm_(
       load_depth_raw(path_of(depth), camera_.width, camera_.height, {depth_list_, depth.line}));

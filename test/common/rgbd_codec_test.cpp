@@ -14,6 +14,7 @@ RgbdFrame test_frame() {
   f.utime = 1305031229528784;
   f.depth_utime = f.utime + 7000;
   f.seq = 42;
+  f.sensor = "kinect1";
   f.camera.fx = 517.3;
   f.camera.fy = 516.5;
   f.camera.cx = 318.6;
@@ -42,6 +43,7 @@ TEST(RgbdCodec, RawRoundTripIsExact) {
   EXPECT_EQ(g.utime, f.utime);
   EXPECT_EQ(g.depth_utime, f.depth_utime);
   EXPECT_EQ(g.seq, 42);
+  EXPECT_EQ(g.sensor, "kinect1");  // the consumers' profile is keyed by it
   EXPECT_DOUBLE_EQ(g.camera.fx, 517.3);
   EXPECT_EQ(cv::norm(g.rgb, f.rgb, cv::NORM_INF), 0.0);
   EXPECT_EQ(cv::norm(g.depth_mm, f.depth_mm, cv::NORM_INF), 0.0);

@@ -70,6 +70,7 @@ TEST(KinectTool, IdentityCalibrationRoundTripIsExactWithinQuantisation) {
         transport::decode_message<kestrel::rgbd_frame_t>(e->data.data(), e->data.size(), e->channel), "log");
     EXPECT_EQ(f.seq, frame);
     EXPECT_EQ(f.camera.fx, 517.3);  // the fixture folder names freiburg1
+    EXPECT_EQ(f.sensor, "kinect1");  // the driver's, whatever the replayed folder's name
     EXPECT_EQ(cv::norm(f.rgb, TumFixture::rgb_image(frame), cv::NORM_INF), 0.0) << "frame " << frame;
     for (int v = 0; v < 480; ++v) {
       for (int u = 0; u < 640; ++u) {

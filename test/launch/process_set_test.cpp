@@ -119,28 +119,5 @@ TEST(ResolveExecutable, PrefersKestrelToolsThenPath) {
   EXPECT_THROW(resolve_executable((dir / "missing").string(), dir.path()), InputError);
 }
 
-// A Kinect source gives the odometry and SLAM the Kinect's camera profile; the simulator and
-// replays leave their default; a profile named in the set's own command wins; other processes
-// get none.
-TEST(CameraProfile, FollowsTheSource) {
-  EXPECT_EQ(camera_profile_of_source(split_command("kinect")), "kinect1");
-  EXPECT_EQ(camera_profile_of_source(split_command("/opt/kestrel/bin/kestrel-kinect --fakenect-dir x")), "kinect1");
-  EXPECT_EQ(camera_profile_of_source(split_command("tum-play --rate 0.5 ../data/tum/rgbd_dataset_freiburg1_xyz")),
-            "kinect1");
-  EXPECT_FALSE(camera_profile_of_source(split_command("tum-play /tmp/sim_export")).has_value());
-  EXPECT_FALSE(camera_profile_of_source(split_command("sim --world room")).has_value());
-  EXPECT_FALSE(camera_profile_of_source(split_command("replay flight.lcmlog")).has_value());
-
-  ProcessSet set = {{"vo", {"vo"}, "onboard"},
-                    {"slam", {"/opt/kestrel/bin/kestrel-slam"}, "offboard"},
-                    {"vo2", {"vo", "--sensor", "simulator"}, "onboard"},
-                    {"mapper", {"mapper"}, "offboard"}};
-  set_camera_profile(set, "kinect1");
-  EXPECT_EQ(set[0].argv, (std::vector<std::string>{"vo", "--sensor", "kinect1"}));
-  EXPECT_EQ(set[1].argv, (std::vector<std::string>{"/opt/kestrel/bin/kestrel-slam", "--sensor", "kinect1"}));
-  EXPECT_EQ(set[2].argv, (std::vector<std::string>{"vo", "--sensor", "simulator"}));
-  EXPECT_EQ(set[3].argv, (std::vector<std::string>{"mapper"}));
-}
-
 }  // namespace
 }  // namespace kestrel::launch

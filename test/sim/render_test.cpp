@@ -35,6 +35,7 @@ TEST(RenderTest, DepthOfATiltedPlaneIsAnalytic) {
   // Turned 25 degrees and pitched 10 degrees, so the depth varies across the image.
   const Eigen::Isometry3d T = look({0.0, 0.2, 1.5}, 0.44, 0.17);
   const RgbdFrame frame = renderer.render(T, 0, 0);
+  EXPECT_EQ(frame.sensor, "simulator");  // consumers take the simulator's profile by it
   const PinholeCamera& c = options.camera;
   int valid = 0, expected = 0;
   for (int v = 0; v < c.height; v += 3)

@@ -243,37 +243,49 @@ TEST_F(AdapterTest, PairsFramesAndUpdatesInEitherOrderAndPublishesTheGraph) {
 // With a Kinect's timing, a keyframe's features get the correction with the motion the VO
 // updates give from the frame before it (frame 2 -> 3: 1 m/s along the optical axis), here with
 // frame 2's update in and its frame never decoded; the first keyframe, with no frame before
-// it, gets none. With the default timing (the simulator's) nothing is corrected.
+// it, gets none. The timing is the one the frames' sensor model names, or the adapter's own
+// profile when it has one; frames that name no model get the simulator's, which corrects nothing.
 TEST_F(AdapterTest, KeyframeFeaturesTakeTheCamerasTimingAndTheOdometrysMotion) {
   AdapterOptions kinect;
-  kinect.timing = vo::with_sensor(vo::SensorProfile::kKinect1, vo::VoOptions{}).depth;
-  SlamAdapter timed(SlamOptions{}, nullptr, kinect);
+  kinect.sensor = vo::SensorProfile::kKinect1;
+  SlamAdapter timed(SlamOptions{}, nullptr), told(SlamOptions{}, nullptr, kinect);
+  auto kinect_frame = [this](int k) {
+    kestrel::rgbd_frame_t m = frame(k);
+    m.camera.sensor = sensor_model::kKinect1;
+    return m;
+  };
   for (int k = 0; k < 4; ++k) {
-    for (SlamAdapter* a : {&timed, &adapter_}) {
-      if (k != 2) a->on_frame(frame(k));
-      a->on_vo_update(update(k));
+    if (k != 2) {
+      timed.on_frame(kinect_frame(k));
+      told.on_frame(frame(k));
+      adapter_.on_frame(frame(k));
     }
+    for (SlamAdapter* a : {&timed, &told, &adapter_}) a->on_vo_update(update(k));
   }
   ASSERT_EQ(timed.slam().keyframes().size(), 2u);
+  ASSERT_EQ(told.slam().keyframes().size(), 2u);
   ASSERT_EQ(adapter_.slam().keyframes().size(), 2u);
   const FeatureExtractor extractor(SlamOptions{}.features);
   const RgbdFrame f0 = transport::decode_rgbd(frame(0), "test"), f3 = transport::decode_rgbd(frame(3), "test");
   const vo::FrameMotion motion =
-      keyframe_motion(kinect.timing, f3.utime, f3.depth_utime, utime(2), pose(2).inverse() * pose(3));
+      keyframe_motion(vo::with_sensor(vo::SensorProfile::kKinect1, vo::VoOptions{}).depth, f3.utime, f3.depth_utime,
+                      utime(2), pose(2).inverse() * pose(3));
   ASSERT_TRUE(motion.known);
   EXPECT_NEAR(motion.twist_per_s.head<3>().norm(), 1.0, 1e-9);
   EXPECT_NE(motion.depth_offset_s, 0.0);
   const FrameFeatures expected = extractor.extract(f3, motion), plain = extractor.extract(f3);
-  const FrameFeatures& got = timed.slam().keyframes()[1].features;
-  ASSERT_EQ(got.size(), expected.size());
-  size_t moved = 0;
-  for (size_t i = 0; i < got.size(); ++i) {
-    ASSERT_EQ(got.has_point(i), expected.has_point(i));
-    if (!got.has_point(i)) continue;
-    EXPECT_NEAR((got.points[i] - expected.points[i]).norm(), 0.0, 1e-6);
-    if (plain.has_point(i) && (plain.points[i] - got.points[i]).norm() > 5e-3) ++moved;
+  for (const SlamAdapter* a : {&timed, &told}) {
+    const FrameFeatures& got = a->slam().keyframes()[1].features;
+    ASSERT_EQ(got.size(), expected.size());
+    size_t moved = 0;
+    for (size_t i = 0; i < got.size(); ++i) {
+      ASSERT_EQ(got.has_point(i), expected.has_point(i));
+      if (!got.has_point(i)) continue;
+      EXPECT_NEAR((got.points[i] - expected.points[i]).norm(), 0.0, 1e-6);
+      if (plain.has_point(i) && (plain.points[i] - got.points[i]).norm() > 5e-3) ++moved;
+    }
+    EXPECT_GT(moved, got.num_points() / 2) << "the correction moved the points (15 mm of depth at 1 m/s)";
   }
-  EXPECT_GT(moved, got.num_points() / 2) << "the correction moved the points (15 mm of depth at 1 m/s)";
   const FrameFeatures& first = timed.slam().keyframes()[0].features;
   const FrameFeatures plain0 = extractor.extract(f0);
   ASSERT_EQ(first.size(), plain0.size());

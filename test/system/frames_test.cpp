@@ -32,18 +32,14 @@
 #include "common/transport/convert.h"
 #include "common/transport/log_file.h"
 #include "common/transport/message.h"
-#include "common/transport/rgbd_codec.h"
 #include "kestrel/ground_truth_t.hpp"
 #include "kestrel/octomap_t.hpp"
-#include "kestrel/rgbd_frame_t.hpp"
 #include "kestrel/slam_correction_t.hpp"
 #include "kestrel/slam_graph_t.hpp"
 #include "kestrel/state_t.hpp"
 #include "kestrel/vo_update_t.hpp"
-#include "mapper/map_compare.h"
-#include "mapper/mapper.h"
-#include "mapper/octree_io.h"
 #include "test/support/test_support.h"
+#include "test/system/map_check.h"
 
 namespace kestrel {
 namespace {
@@ -90,57 +86,6 @@ std::map<int64_t, Eigen::Isometry3d> read_truth(const std::string& path) {
       truth[m.utime] = transport::from_message(m.T_world_frame, "GROUND_TRUTH");
   }
   return truth;
-}
-
-// The camera frames of the log whose utimes are in `utimes`.
-std::map<int64_t, RgbdFrame> read_frames(const std::string& path, const std::map<int64_t, Eigen::Isometry3d>& utimes) {
-  std::map<int64_t, RgbdFrame> frames;
-  transport::LogReader log(path);
-  while (auto e = log.next()) {
-    if (e->channel != channel::kCameraRgbd) continue;
-    const auto m = transport::decode_message<kestrel::rgbd_frame_t>(e->data.data(), e->data.size(), "CAMERA_RGBD");
-    if (utimes.count(m.utime)) frames.emplace(m.utime, transport::decode_rgbd(m, "CAMERA_RGBD"));
-  }
-  return frames;
-}
-
-// The mapper's map (saved at exit) against the map of SLAM's keyframe frames at their true
-// poses, carried into SLAM's world by the rigid fit of the keyframes' positions.
-void expect_map_agrees_with_truth(const Recording& rec, const std::map<int64_t, Eigen::Isometry3d>& truth,
-                                  const std::string& source, const std::string& map_file) {
-  EXPECT_GE(rec.last_map_revision, 1000) << "no MAP_OCTOMAP after a rebuild (the revision jumps then)";
-  Trajectory true_body;  // the truth comes at its own rate: interpolated at the frames' times
-  for (const auto& [utime, T] : truth) true_body.push_back(utime, T);
-  std::map<int64_t, Eigen::Isometry3d> slam_poses, true_poses;  // T_world_camera by keyframe utime
-  for (const auto& kf : rec.graph->keyframes) {
-    const std::optional<Eigen::Isometry3d> T = true_body.at(kf.utime, 20'000);
-    if (!T) continue;
-    slam_poses[kf.utime] = transport::from_message(kf.T_world_camera, "SLAM_GRAPH");
-    true_poses[kf.utime] = *T * *rec.T_body_camera;
-  }
-  ASSERT_EQ(true_poses.size(), rec.graph->keyframes.size()) << "keyframes without a true pose";
-  Eigen::Matrix3Xd a(3, static_cast<Eigen::Index>(true_poses.size())), b(3, a.cols());
-  Eigen::Index i = 0;
-  for (const auto& [utime, T] : true_poses) {
-    a.col(i) = T.translation();
-    b.col(i++) = slam_poses.at(utime).translation();
-  }
-  const std::optional<Eigen::Isometry3d> T_slam_true = align_rigid(a, b);
-  ASSERT_TRUE(T_slam_true.has_value());
-
-  const std::map<int64_t, RgbdFrame> frames = read_frames(source, true_poses);
-  ASSERT_EQ(frames.size(), true_poses.size()) << "keyframes whose frame is not in the log";
-  mapper::Mapper reference;  // the process's defaults
-  for (const auto& [utime, frame] : frames) reference.insert(frame, *T_slam_true * true_poses.at(utime));
-  const mapper::VoxelMap flown = mapper::read_map_file(map_file);
-  const mapper::MapAgreement agree = mapper::compare_maps(flown, reference.map());
-  std::cout << "map: " << flown.num_occupied() << " occupied cells, at true poses " << reference.map().num_occupied()
-            << "; class agreement " << agree.class_agreement() << " on " << agree.known_both << " cells, "
-            << agree.occupied_a_matched << " of the occupied within a cell of the truth's\n";
-  EXPECT_GT(flown.num_occupied(), 500u);
-  EXPECT_GT(agree.class_agreement(), 0.95);
-  EXPECT_GT(double(agree.occupied_a_matched), 0.95 * double(agree.occupied_a));
-  EXPECT_GT(double(agree.occupied_b_matched), 0.95 * double(agree.occupied_b));
 }
 
 // RMS position error after the best rigid alignment (the ATE).
@@ -210,7 +155,12 @@ void fly_figure_eight(const std::string& vo_options, bool with_mapper) {
   const double ate = aligned_rmse(est, gt);
   EXPECT_LT(ate, 0.02);
   std::cout << "estimator ATE " << ate << " m\n";
-  if (with_mapper) expect_map_agrees_with_truth(rec, truth, source, map_file);
+  if (with_mapper) {
+    EXPECT_GE(rec.last_map_revision, 1000) << "no MAP_OCTOMAP after a rebuild (the revision jumps then)";
+    Trajectory true_camera;  // the truth comes at its own rate: interpolated at the keyframes' times
+    for (const auto& [utime, T] : truth) true_camera.push_back(utime, T * *rec.T_body_camera);
+    test::expect_map_agrees_with_truth(*rec.graph, true_camera, source, map_file, 0.95);
+  }
 }
 
 TEST(System, SlamKeyframesAndCorrectionsAreInTheEstimatorsWorld) {

@@ -51,14 +51,17 @@ TEST(Playback, MergesFramesImuAndGroundTruthInTimeOrder) {
   }
   EXPECT_EQ(frames, 4);
   // Between the first and last frame (0 .. 99999 us after t0), inclusive: the accelerometer
-  // every 5 ms from t0 - 0.1 s hits t0 exactly; ground truth every 10 ms does too.
+  // every 5 ms from t0 - 0.1 s hits t0 exactly; ground truth every 10 ms does too, and its
+  // sample after the last frame comes along so that the last frame's truth can be interpolated.
   EXPECT_EQ(imu, 20);  // t0, t0 + 5 ms, ..., t0 + 95 ms
-  EXPECT_EQ(gt, 10);   // t0, t0 + 10 ms, ..., t0 + 90 ms
+  EXPECT_EQ(gt, 11);   // t0, t0 + 10 ms, ..., t0 + 100 ms
   EXPECT_EQ(events.front().utime, TumFixture::kT0);
   EXPECT_EQ(events.front().kind, EventKind::kImu);  // IMU before ground truth before the frame
   EXPECT_EQ(events[1].kind, EventKind::kGroundTruth);
   EXPECT_EQ(events[2].kind, EventKind::kFrame);
-  EXPECT_EQ(events.back().kind, EventKind::kFrame);
+  EXPECT_EQ(events.back().kind, EventKind::kGroundTruth);  // the pose after the last frame
+  EXPECT_EQ(events.back().utime, TumFixture::kT0 + 100000);
+  EXPECT_EQ(events[events.size() - 2].kind, EventKind::kFrame);
 }
 
 TEST(Playback, WindowSelectsFramesByTimeAndCanDropStreams) {
@@ -71,13 +74,16 @@ TEST(Playback, WindowSelectsFramesByTimeAndCanDropStreams) {
   w.imu = false;
   const auto events = playback_schedule(s, w);
   std::vector<size_t> frames;
+  std::vector<int64_t> poses;
   for (const auto& e : events) {
     ASSERT_NE(e.kind, EventKind::kImu);
     if (e.kind == EventKind::kFrame) frames.push_back(e.index);
-    ASSERT_GE(e.utime, TumFixture::rgb_utime(2));
-    ASSERT_LE(e.utime, TumFixture::rgb_utime(3));
+    if (e.kind == EventKind::kGroundTruth) poses.push_back(e.utime - TumFixture::kT0);
   }
   EXPECT_EQ(frames, (std::vector<size_t>{2, 3}));
+  // The poses (every 10 ms from t0) that bracket frames 2 and 3 (66.7 and 100 ms): none inside
+  // the window left out, none beyond the one on each side.
+  EXPECT_EQ(poses, (std::vector<int64_t>{60000, 70000, 80000, 90000, 100000}));
   w.start_s = 10.0;
   EXPECT_TRUE(playback_schedule(s, w).empty());
   w.start_s = -1.0;
@@ -165,7 +171,8 @@ TEST(Player, LoopingKeepsTimeAndSequenceNumbersIncreasing) {
   EXPECT_EQ(stats.passes, 3);
   ASSERT_EQ(out.size(), 3 * events.size());
   const int64_t period = loop_period_us(s, events);
-  EXPECT_EQ(period, TumFixture::kPeriod * 2);  // span of one frame interval + one interval
+  // The span (t0 to the pose after the last frame, at 40 ms) and one frame interval.
+  EXPECT_EQ(period, 40000 + TumFixture::kPeriod);
   std::vector<int64_t> seqs;
   for (size_t i = 0; i < out.size(); ++i) {
     EXPECT_EQ(out[i].utime, events[i % events.size()].utime + static_cast<int64_t>(i / events.size()) * period);

@@ -81,7 +81,7 @@ TEST(TumSequence, DepthIsRoundedAndScaled) {
   EXPECT_EQ(f.depth_mm.at<uint16_t>(10, 10), scaled(TumFixture::depth_raw_at(0, 10, 10)));
 }
 
-TEST(TumSequence, IntrinsicsFollowTheFolderNameOrTheOverride) {
+TEST(TumSequence, IntrinsicsAndSensorModelFollowTheFolderNameOrTheOverride) {
   test::TempDir dir;
   struct Case {
     const char* name;
@@ -101,6 +101,8 @@ TEST(TumSequence, IntrinsicsFollowTheFolderNameOrTheOverride) {
     EXPECT_EQ(s.camera().cy, c.cy);
     EXPECT_EQ(s.camera().width, 640);
     EXPECT_EQ(s.frame(0).camera.fx, c.fx);
+    // Only freiburg1's Kinect has a measured profile (vo/sensor_profile.h) for its frames to name.
+    EXPECT_EQ(s.frame(0).sensor, c.camera == TumCamera::kFreiburg1 ? "kinect1" : "") << c.name;
   }
   const TumFixture fx(dir.path(), 1, "rgbd_dataset_freiburg1_o");
   SequenceOptions o;

@@ -1,7 +1,8 @@
 // kestrel-vo as a process, in a private network namespace: a log of synthetic frames (one of
 // them corrupt) is replayed in lock-step through it twice; each frame gets one VO_UPDATE with
 // the right status and motion, the corrupt one STATUS_BAD_INPUT, and the two replays (with
-// a RESET between them) give identical answers.
+// a RESET between them) give identical answers. The process takes the camera's profile from
+// the sensor model the frames name, unless --sensor says otherwise.
 
 #include <gtest/gtest.h>
 
@@ -14,6 +15,7 @@
 #include "test/support/test_support.h"
 #include "test/vo/synthetic_scene.h"
 #include "vo/options.h"
+#include "vo/sensor_profile.h"
 
 namespace kestrel::vo {
 namespace {
@@ -88,6 +90,56 @@ TEST(VoProcess, LockStepReplayGivesOneUpdatePerFrameAndRepeats) {
     EXPECT_EQ(b[size_t(k)].status, u.status);
     EXPECT_EQ(b[size_t(k)].reference_utime, u.reference_utime);
     EXPECT_EQ(b[size_t(k)].num_inliers, u.num_inliers);
+  }
+}
+
+// Frames 0-2 name a Kinect, 3-5 the simulator: the updates carry the named profile's floors,
+// and the change of camera restarts the odometry (frame 3 has no reference). With --sensor
+// every frame gets that profile and nothing restarts.
+TEST(VoProcess, TakesTheCameraProfileTheFramesName) {
+  if (!kestrel::test::can_isolate_network()) GTEST_SKIP() << "cannot create a network namespace here";
+  kestrel::test::TempDir dir;
+  const std::string in = (dir / "in.lcmlog").string();
+  {
+    const test::SyntheticScene scene(31);
+    transport::LogWriter log(in);
+    for (int k = 0; k < 6; ++k) {
+      RgbdFrame frame = scene.render(truth(k), test::test_camera(), 1000000 + 33333 * k);
+      frame.sensor = k < 3 ? sensor_model::kKinect1 : sensor_model::kSimulator;
+      log.write_message(channel::kCameraRgbd, frame.utime, transport::encode_rgbd(frame));
+    }
+  }
+  const std::string vo = kestrel::test::tool("vo").string(), replay = kestrel::test::tool("replay").string();
+  const std::string script =
+      "'" + vo + "' -q & VO=$!; "
+      "'" + replay + "' '" + in + "' --expect vo --record '" + (dir / "named.lcmlog").string() + "' >/dev/null; "
+      "R=$?; kill $VO; wait $VO; [ $R = 0 ] || exit $R; "
+      "'" + vo + "' -q --sensor kinect1 & VO=$!; "
+      "'" + replay + "' '" + in + "' --expect vo --record '" + (dir / "told.lcmlog").string() + "' >/dev/null; "
+      "R=$?; kill $VO; wait $VO; exit $R";
+  const kestrel::test::RunResult r =
+      kestrel::test::run({kestrel::test::tool("isolated").string(), "--", "sh", "-c", script}, 120.0);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+
+  const VoOptions simulator, kinect = with_sensor(SensorProfile::kKinect1, VoOptions{});
+  ASSERT_NE(simulator.covariance.translation_floor_m, kinect.covariance.translation_floor_m);
+  const auto named = updates((dir / "named.lcmlog").string()), told = updates((dir / "told.lcmlog").string());
+  ASSERT_EQ(named.size(), 6u);
+  ASSERT_EQ(told.size(), 6u);
+  for (int k = 0; k < 6; ++k) {
+    const auto& u = named[size_t(k)];
+    const bool first_of_camera = k == 0 || k == 3;
+    EXPECT_EQ(u.status, first_of_camera ? kestrel::vo_update_t::STATUS_NO_REFERENCE : kestrel::vo_update_t::STATUS_OK)
+        << "frame " << k;
+    if (!first_of_camera) {
+      EXPECT_DOUBLE_EQ(u.translation_floor, (k < 3 ? kinect : simulator).covariance.translation_floor_m) << k;
+      EXPECT_DOUBLE_EQ(u.rotation_floor, (k < 3 ? kinect : simulator).covariance.rotation_floor_rad) << k;
+    }
+    const auto& v = told[size_t(k)];
+    EXPECT_EQ(v.status, k == 0 ? kestrel::vo_update_t::STATUS_NO_REFERENCE : kestrel::vo_update_t::STATUS_OK) << k;
+    if (k > 0) {
+      EXPECT_DOUBLE_EQ(v.translation_floor, kinect.covariance.translation_floor_m) << k;
+    }
   }
 }
 

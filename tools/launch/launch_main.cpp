@@ -75,10 +75,7 @@ struct HeartbeatListener {
 int launch(const Options& o) {
   ProcessSet set = select(read_process_sets(o.sets_file), o.set, o.only, o.without);
   if (!o.source.empty()) {
-    const std::vector<std::string> source = split_command(o.source);
-    if (const auto profile = camera_profile_of_source(source))
-      set_camera_profile(set, *profile);
-    set.push_back({"source", source, "source"});
+    set.push_back({"source", split_command(o.source), "source"});
   }
   if (set.empty()) throw CLI::ValidationError("SET", "selects no process");
   const fs::path tool_dir = fs::canonical("/proc/self/exe").parent_path();

@@ -9,7 +9,6 @@
 #include <sstream>
 
 #include "common/error.h"
-#include "drivers/tum/tum_camera.h"
 
 namespace kestrel::launch {
 namespace {
@@ -116,29 +115,6 @@ std::filesystem::path resolve_executable(const std::string& command,
   }
   throw InputError("'" + command + "': no kestrel-" + command + " in " + tool_dir.string() +
                    " (is it built?) and no '" + command + "' on PATH");
-}
-
-std::optional<std::string> camera_profile_of_source(const std::vector<std::string>& argv) {
-  if (argv.empty()) return std::nullopt;
-  const std::string tool = std::filesystem::path(argv[0]).filename().string();
-  if (tool == "kinect" || tool == "kestrel-kinect") return "kinect1";
-  if (tool == "tum-play" || tool == "kestrel-tum-play")
-    for (size_t i = 1; i < argv.size(); ++i)
-      if (tum::detect_camera(argv[i]) == tum::TumCamera::kFreiburg1) return "kinect1";
-  return std::nullopt;
-}
-
-void set_camera_profile(ProcessSet& set, const std::string& profile) {
-  const std::vector<std::string>& tools = kCameraProfileTools;
-  for (ProcessSpec& p : set) {
-    const std::string tool = std::filesystem::path(p.argv[0]).filename().string();
-    if (std::none_of(tools.begin(), tools.end(),
-                     [&](const std::string& t) { return tool == t || tool == "kestrel-" + t; }))
-      continue;
-    if (std::find(p.argv.begin(), p.argv.end(), "--sensor") != p.argv.end()) continue;
-    p.argv.push_back("--sensor");
-    p.argv.push_back(profile);
-  }
 }
 
 }  // namespace kestrel::launch

@@ -7,7 +7,6 @@
 // malformed file is an InputError naming the file (and line where yaml-cpp knows it).
 
 #include <filesystem>
-#include <optional>
 #include <string>
 #include <vector>
 
@@ -39,18 +38,5 @@ std::vector<std::string> split_command(const std::string& command);
 /// Throws InputError naming the command when nothing runnable is found.
 std::filesystem::path resolve_executable(const std::string& command,
                                          const std::filesystem::path& tool_dir);
-
-/// The camera profile (`kestrel vo --sensor`) that a source command implies: "kinect1" for a
-/// Kinect -- the driver (`kinect`, live or fakenect) or `tum-play` of a freiburg1 recording --
-/// and nothing for any other source (the simulator, a replay), which leaves vo's default.
-std::optional<std::string> camera_profile_of_source(const std::vector<std::string>& source_argv);
-
-/// The processes that model the camera's timing: vo (its odometry) and slam (its keyframe
-/// features' timing correction, slam/README.md). Bare names: "vo" also matches "kestrel-vo".
-inline const std::vector<std::string> kCameraProfileTools = {"vo", "slam"};
-
-/// Adds `--sensor profile` to every process of `set` running one of kCameraProfileTools whose
-/// command does not name a profile already.
-void set_camera_profile(ProcessSet& set, const std::string& profile);
 
 }  // namespace kestrel::launch

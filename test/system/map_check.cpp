@@ -1,0 +1,67 @@
+#include "test/system/map_check.h"
+
+#include <gtest/gtest.h>
+
+#include <iostream>
+#include <optional>
+
+#include "common/geometry/align.h"
+#include "common/transport/channels.h"
+#include "common/transport/convert.h"
+#include "common/transport/log_file.h"
+#include "common/transport/message.h"
+#include "common/transport/rgbd_codec.h"
+#include "kestrel/rgbd_frame_t.hpp"
+#include "mapper/map_compare.h"
+#include "mapper/mapper.h"
+#include "mapper/octree_io.h"
+
+namespace kestrel::test {
+
+std::map<int64_t, RgbdFrame> read_frames(const std::string& path, const std::map<int64_t, Eigen::Isometry3d>& utimes) {
+  std::map<int64_t, RgbdFrame> frames;
+  transport::LogReader log(path);
+  while (auto e = log.next()) {
+    if (e->channel != channel::kCameraRgbd) continue;
+    const auto m = transport::decode_message<kestrel::rgbd_frame_t>(e->data.data(), e->data.size(), "CAMERA_RGBD");
+    if (utimes.count(m.utime)) frames.emplace(m.utime, transport::decode_rgbd(m, "CAMERA_RGBD"));
+  }
+  return frames;
+}
+
+void expect_map_agrees_with_truth(const kestrel::slam_graph_t& graph, const Trajectory& true_camera,
+                                  const std::string& source_log, const std::string& map_file, double min_agreement) {
+  std::map<int64_t, Eigen::Isometry3d> slam_poses, true_poses;  // T_world_camera by keyframe utime
+  for (const auto& kf : graph.keyframes) {
+    const std::optional<Eigen::Isometry3d> T = true_camera.at(kf.utime, 20'000);
+    if (!T) continue;
+    slam_poses[kf.utime] = transport::from_message(kf.T_world_camera, "SLAM_GRAPH");
+    true_poses[kf.utime] = *T;
+  }
+  ASSERT_EQ(true_poses.size(), graph.keyframes.size()) << "keyframes without a true pose";
+  ASSERT_GE(true_poses.size(), 3u);
+  Eigen::Matrix3Xd a(3, static_cast<Eigen::Index>(true_poses.size())), b(3, a.cols());
+  Eigen::Index i = 0;
+  for (const auto& [utime, T] : true_poses) {
+    a.col(i) = T.translation();
+    b.col(i++) = slam_poses.at(utime).translation();
+  }
+  const std::optional<Eigen::Isometry3d> T_slam_true = align_rigid(a, b);
+  ASSERT_TRUE(T_slam_true.has_value());
+
+  const std::map<int64_t, RgbdFrame> frames = read_frames(source_log, true_poses);
+  ASSERT_EQ(frames.size(), true_poses.size()) << "keyframes whose frame is not in the log";
+  mapper::Mapper reference;  // the process's defaults
+  for (const auto& [utime, frame] : frames) reference.insert(frame, *T_slam_true * true_poses.at(utime));
+  const mapper::VoxelMap flown = mapper::read_map_file(map_file);
+  const mapper::MapAgreement agree = mapper::compare_maps(flown, reference.map());
+  std::cout << "map: " << flown.num_occupied() << " occupied cells, at true poses " << reference.map().num_occupied()
+            << "; class agreement " << agree.class_agreement() << " on " << agree.known_both << " cells, "
+            << agree.occupied_a_matched << " of the occupied within a cell of the truth's\n";
+  EXPECT_GT(flown.num_occupied(), 500u);
+  EXPECT_GT(agree.class_agreement(), min_agreement);
+  EXPECT_GT(double(agree.occupied_a_matched), min_agreement * double(agree.occupied_a));
+  EXPECT_GT(double(agree.occupied_b_matched), min_agreement * double(agree.occupied_b));
+}
+
+}  // namespace kestrel::test
