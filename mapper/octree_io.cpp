@@ -2,6 +2,7 @@
 
 #include <cstring>
 #include <fstream>
+#include <iostream>
 #include <sstream>
 
 #include "common/error.h"
@@ -58,6 +59,22 @@ VoxelMap from_octree(const octomap::OcTree& tree, MapOptions options) {
 
 namespace {
 
+// Debian's liboctomap is built with its debug output on: reading a stream prints "Reading
+// binary octree type OcTree" to std::cerr, a line in the planner's log per map it receives.
+// Its failures come back as return values, which are turned into errors here. (Its " done."
+// after writing goes through stdio's stderr and is left: muting file descriptor 2 would also
+// swallow the process's own log lines.)
+class QuietOctomap {
+ public:
+  QuietOctomap() : saved_(std::cerr.rdbuf(nullptr)) {}
+  ~QuietOctomap() { std::cerr.rdbuf(saved_); }
+  QuietOctomap(const QuietOctomap&) = delete;
+  QuietOctomap& operator=(const QuietOctomap&) = delete;
+
+ private:
+  std::streambuf* saved_;
+};
+
 void write_stream(const VoxelMap& map, OctreeFormat format, std::ostream& out) {
   const auto tree = to_octree(map);
   // writeBinary first turns the tree to maximum likelihood and prunes it again, so a .bt is
@@ -66,8 +83,7 @@ void write_stream(const VoxelMap& map, OctreeFormat format, std::ostream& out) {
   if (!ok) throw std::runtime_error("OctoMap could not write the tree");
 }
 
-VoxelMap read_stream(const std::string& bytes, OctreeFormat format, const std::string& what,
-                     MapOptions options) {
+std::unique_ptr<octomap::OcTree> read_tree(const std::string& bytes, OctreeFormat format, const std::string& what) {
   // Check the first line and the node structure here, so that a wrong file gets our one-line
   // error only, and a corrupt one never reaches OctoMap's unbounded recursion.
   const char* header =
@@ -79,6 +95,7 @@ VoxelMap read_stream(const std::string& bytes, OctreeFormat format, const std::s
   check_octree_stream(bytes, format, what);
   std::istringstream in(bytes, std::ios::binary);
   std::unique_ptr<octomap::OcTree> tree;
+  const QuietOctomap quiet;
   if (format == OctreeFormat::kBinary) {
     tree = std::make_unique<octomap::OcTree>(0.1);
     if (!tree->readBinary(in)) throw InputError(what + ": not a readable OctoMap binary (.bt) tree");
@@ -92,10 +109,15 @@ VoxelMap read_stream(const std::string& bytes, OctreeFormat format, const std::s
   if (!(tree->getResolution() >= 0.005 && tree->getResolution() <= 10.0)) {
     throw InputError(what + ": unusable resolution " + std::to_string(tree->getResolution()));
   }
-  return from_octree(*tree, options);
+  return tree;
 }
 
 }  // namespace
+
+std::unique_ptr<octomap::OcTree> read_octree(const uint8_t* data, size_t size, OctreeFormat format,
+                                             const std::string& what) {
+  return read_tree(std::string(reinterpret_cast<const char*>(data), size), format, what);
+}
 
 std::vector<uint8_t> encode_octree(const VoxelMap& map, OctreeFormat format) {
   std::ostringstream out(std::ios::binary);
@@ -106,7 +128,7 @@ std::vector<uint8_t> encode_octree(const VoxelMap& map, OctreeFormat format) {
 
 VoxelMap decode_octree(const uint8_t* data, size_t size, OctreeFormat format, const char* what,
                        MapOptions options) {
-  return read_stream(std::string(reinterpret_cast<const char*>(data), size), format, what, options);
+  return from_octree(*read_octree(data, size, format, what), options);
 }
 
 OctreeFormat format_of(const std::string& path) {
@@ -135,7 +157,7 @@ VoxelMap read_map_file(const std::string& path, MapOptions options) {
   std::ostringstream all;
   all << in.rdbuf();
   if (!in) throw InputError(path + ": cannot read map file");
-  return read_stream(all.str(), format, path, options);
+  return from_octree(*read_tree(all.str(), format, path), options);
 }
 
 }  // namespace kestrel::mapper

@@ -32,8 +32,14 @@ VoxelMap from_octree(const octomap::OcTree& tree, MapOptions options = {});
 
 /// The map as an OctoMap stream in `format`.
 std::vector<uint8_t> encode_octree(const VoxelMap& map, OctreeFormat format);
-/// Reads a stream written by encode_octree (or by OctoMap); throws InputError naming `what`
-/// when it is not a readable OcTree of that format.
+/// The OcTree in an OctoMap stream of `format` (encode_octree's, OctoMap's own, a
+/// MAP_OCTOMAP message's). The stream's structure is checked first (octree_stream_check.h:
+/// OctoMap's readers recurse without bound on a corrupt one); throws InputError naming `what`
+/// when it is not a readable OcTree of that format or its resolution is unusable.
+std::unique_ptr<octomap::OcTree> read_octree(const uint8_t* data, size_t size, OctreeFormat format,
+                                             const std::string& what);
+/// Reads a stream written by encode_octree (or by OctoMap) into a map: read_octree, then
+/// from_octree.
 VoxelMap decode_octree(const uint8_t* data, size_t size, OctreeFormat format, const char* what,
                        MapOptions options = {});
 

@@ -15,6 +15,7 @@
 #include "kestrel/plan_t.hpp"
 #include "kestrel/process_status_t.hpp"
 #include "kestrel/state_t.hpp"
+#include "mapper/octree_io.h"
 #include "planner/map_sources.h"
 #include "planner/online_planner.h"
 
@@ -80,7 +81,10 @@ int main(int argc, char** argv) {
     node.set_health(kestrel::process_status_t::STATE_DEGRADED, "no map yet");
     node.subscribe<kestrel::octomap_t>(channel::kMapOctomap, [&](const kestrel::octomap_t& m) {
       if (m.size != static_cast<int32_t>(m.data.size())) throw InputError("MAP_OCTOMAP: size disagrees with data");
-      const auto tree = decode_octomap(m.data, m.format == kestrel::octomap_t::FORMAT_BINARY, "MAP_OCTOMAP");
+      const auto tree = mapper::read_octree(
+          m.data.data(), m.data.size(),
+          m.format == kestrel::octomap_t::FORMAT_BINARY ? mapper::OctreeFormat::kBinary : mapper::OctreeFormat::kFull,
+          "MAP_OCTOMAP");
       planner.set_map(project_octomap(*tree, o.map_z_min_m, o.map_z_max_m, "MAP_OCTOMAP"));
       node.set_health(kestrel::process_status_t::STATE_RUNNING, "map revision " + std::to_string(m.revision));
     }, 2);

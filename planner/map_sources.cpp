@@ -4,8 +4,6 @@
 #include <octomap/OcTree.h>
 
 #include <cmath>
-#include <memory>
-#include <sstream>
 
 #include "common/error.h"
 #include "drivers/sim/occupancy_map.h"
@@ -61,21 +59,6 @@ OccupancyGrid project_octomap(const octomap::OcTree& tree, double z_min, double 
       }
   }
   return g;
-}
-
-std::unique_ptr<octomap::OcTree> decode_octomap(const std::vector<uint8_t>& bytes, bool binary,
-                                                const std::string& source) {
-  std::istringstream in(std::string(bytes.begin(), bytes.end()));
-  if (binary) {
-    auto tree = std::make_unique<octomap::OcTree>(0.1);
-    if (!tree->readBinary(in)) throw InputError(source + ": not a binary OctoMap stream");
-    return tree;
-  }
-  std::unique_ptr<octomap::AbstractOcTree> any(octomap::AbstractOcTree::read(in));
-  auto* tree = dynamic_cast<octomap::OcTree*>(any.get());
-  if (!tree) throw InputError(source + ": not an OcTree stream");
-  any.release();
-  return std::unique_ptr<octomap::OcTree>(tree);
 }
 
 }  // namespace kestrel::planner

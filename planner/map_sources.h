@@ -28,9 +28,5 @@ OccupancyGrid read_ros_map(const std::string& yaml_path);
 /// `source`) for an empty tree.
 OccupancyGrid project_octomap(const octomap::OcTree& tree, double z_min, double z_max, const std::string& source);
 
-/// Decodes an OctoMap stream (binary .bt or full .ot as in octomap_t) into a tree. Throws
-/// InputError naming `source` when the bytes are not a readable OcTree.
-std::unique_ptr<octomap::OcTree> decode_octomap(const std::vector<uint8_t>& bytes, bool binary,
-                                                const std::string& source);
 
 }  // namespace kestrel::planner

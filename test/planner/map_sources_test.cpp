@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "common/error.h"
+#include "mapper/octree_io.h"
 #include "planner/map_sources.h"
 #include "test/support/test_support.h"
 
@@ -80,10 +81,22 @@ TEST(OctoMap, ProjectsTheHeightBandOntoTheGrid) {
   EXPECT_EQ(cell(1.55, 1.05), OccupancyGrid::kUnknown);  // never observed
 }
 
+// MAP_OCTOMAP streams are read through the mapper's checked reader (the planner process does):
+// junk, and a stream whose nodes claim children 200,000 levels deep -- on which OctoMap's own
+// readBinary recurses until the stack overflows (a 400 kB message crashed the planner
+// before) -- are errors naming the source.
 TEST(OctoMap, CorruptStreamsAndEmptyTreesAreErrorsNamingTheSource) {
+  using mapper::OctreeFormat;
   const std::vector<uint8_t> junk{1, 2, 3, 4, 5};
-  EXPECT_NE(error_of([&] { decode_octomap(junk, true, "MAP_OCTOMAP"); }).find("MAP_OCTOMAP"), std::string::npos);
-  EXPECT_NE(error_of([&] { decode_octomap(junk, false, "MAP_OCTOMAP"); }).find("MAP_OCTOMAP"), std::string::npos);
+  for (const OctreeFormat format : {OctreeFormat::kBinary, OctreeFormat::kFull})
+    EXPECT_NE(error_of([&] { mapper::read_octree(junk.data(), junk.size(), format, "MAP_OCTOMAP"); }).find("MAP_OCTOMAP"),
+              std::string::npos);
+  std::string deep = "# Octomap OcTree binary file\nid OcTree\nsize 40\nres 0.1\ndata\n";
+  for (int i = 0; i < 200000; ++i) deep += std::string("\x03\x00", 2);  // child 0 an inner node, again and again
+  const auto* bytes = reinterpret_cast<const uint8_t*>(deep.data());
+  EXPECT_NE(error_of([&] { mapper::read_octree(bytes, deep.size(), OctreeFormat::kBinary, "MAP_OCTOMAP"); })
+                .find("MAP_OCTOMAP"),
+            std::string::npos);
   octomap::OcTree empty(0.1);
   EXPECT_NE(error_of([&] { project_octomap(empty, 0.0, 1.0, "MAP_OCTOMAP"); }).find("MAP_OCTOMAP"), std::string::npos);
   // A real stream round-trips.
@@ -92,7 +105,8 @@ TEST(OctoMap, CorruptStreamsAndEmptyTreesAreErrorsNamingTheSource) {
   std::ostringstream out;
   tree.writeBinary(out);
   const std::string s = out.str();
-  const auto back = decode_octomap(std::vector<uint8_t>(s.begin(), s.end()), true, "MAP_OCTOMAP");
+  const auto back = mapper::read_octree(reinterpret_cast<const uint8_t*>(s.data()), s.size(),
+                                       mapper::OctreeFormat::kBinary, "MAP_OCTOMAP");
   EXPECT_EQ(back->size(), tree.size());
 }
 
