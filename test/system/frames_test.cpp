@@ -33,47 +33,11 @@
 #include "common/transport/log_file.h"
 #include "common/transport/message.h"
 #include "kestrel/ground_truth_t.hpp"
-#include "kestrel/octomap_t.hpp"
-#include "kestrel/slam_correction_t.hpp"
-#include "kestrel/slam_graph_t.hpp"
-#include "kestrel/state_t.hpp"
-#include "kestrel/vo_update_t.hpp"
 #include "test/support/test_support.h"
-#include "test/system/map_check.h"
+#include "test/system/recording.h"
 
 namespace kestrel {
 namespace {
-
-struct Recording {
-  std::map<int64_t, Eigen::Isometry3d> states;  ///< utime -> T_world_body (OK states)
-  std::optional<kestrel::slam_graph_t> graph;   ///< the last one
-  std::optional<Eigen::Isometry3d> T_body_camera;
-  int corrections = 0;
-  int64_t last_map_revision = -1;  ///< MAP_OCTOMAP's (jumps to the next thousand after a rebuild)
-};
-
-Recording read_recording(const std::string& path) {
-  Recording r;
-  transport::LogReader log(path);
-  while (auto e = log.next()) {
-    const auto& d = e->data;
-    if (e->channel == channel::kState) {
-      const auto m = transport::decode_message<kestrel::state_t>(d.data(), d.size(), "STATE");
-      if (m.status == kestrel::state_t::STATUS_OK)
-        r.states[m.utime] = transport::from_message(m.T_world_body, "STATE");
-    } else if (e->channel == channel::kSlamGraph) {
-      r.graph = transport::decode_message<kestrel::slam_graph_t>(d.data(), d.size(), "SLAM_GRAPH");
-    } else if (e->channel == channel::kSlamCorrection) {
-      ++r.corrections;
-    } else if (e->channel == channel::kMapOctomap) {
-      r.last_map_revision = transport::decode_message<kestrel::octomap_t>(d.data(), d.size(), "MAP_OCTOMAP").revision;
-    } else if (e->channel == channel::kVoUpdate && !r.T_body_camera) {
-      const auto m = transport::decode_message<kestrel::vo_update_t>(d.data(), d.size(), "VO_UPDATE");
-      r.T_body_camera = transport::from_message(m.T_body_camera, "VO_UPDATE");
-    }
-  }
-  return r;
-}
 
 // Body poses of the truth, by utime.
 std::map<int64_t, Eigen::Isometry3d> read_truth(const std::string& path) {
@@ -121,7 +85,7 @@ void fly_figure_eight(const std::string& vo_options, bool with_mapper) {
   const auto r = test::run({test::tool("isolated").string(), "--", "sh", "-c", script}, 600.0);
   ASSERT_EQ(r.exit_code, 0) << r.err;
 
-  const Recording rec = read_recording(recorded);
+  const test::Recording rec = test::read_recording(recorded);
   ASSERT_TRUE(rec.graph.has_value()) << "SLAM published no graph";
   ASSERT_TRUE(rec.T_body_camera.has_value());
   ASSERT_GE(rec.states.size(), 2000u);

@@ -14,68 +14,20 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
-#include <cmath>
 #include <iostream>
-#include <limits>
 #include <optional>
 #include <string>
 
-#include "common/geometry/align.h"
 #include "common/trajectory.h"
 #include "common/transport/channels.h"
-#include "common/transport/log_file.h"
-#include "common/transport/message.h"
-#include "kestrel/octomap_t.hpp"
 #include "kestrel/slam_edge_t.hpp"
-#include "kestrel/slam_graph_t.hpp"
+#include "tools/eval/evaluate.h"
 #include "tools/eval/log_input.h"
 #include "test/support/test_support.h"
-#include "test/system/map_check.h"
+#include "test/system/recording.h"
 
 namespace kestrel {
 namespace {
-
-struct Recording {
-  std::optional<kestrel::slam_graph_t> graph;  ///< the last one
-  int states = 0;
-  int64_t last_map_revision = -1;  ///< MAP_OCTOMAP's (jumps to the next thousand after a rebuild)
-};
-
-Recording read_recording(const std::string& path) {
-  Recording r;
-  transport::LogReader log(path);
-  while (auto e = log.next()) {
-    const auto& d = e->data;
-    if (e->channel == channel::kSlamGraph) {
-      r.graph = transport::decode_message<kestrel::slam_graph_t>(d.data(), d.size(), "SLAM_GRAPH");
-    } else if (e->channel == channel::kState) {
-      ++r.states;
-    } else if (e->channel == channel::kMapOctomap) {
-      r.last_map_revision = transport::decode_message<kestrel::octomap_t>(d.data(), d.size(), "MAP_OCTOMAP").revision;
-    }
-  }
-  return r;
-}
-
-// RMS position error of `est` against `truth` (both T_world_camera) after the best rigid fit.
-double ate(const Trajectory& est, const Trajectory& truth) {
-  std::vector<Eigen::Vector3d> a, b;
-  for (const StampedPose& p : est.poses()) {
-    if (const auto T = truth.at(p.utime, 20'000)) {
-      a.push_back(p.T.translation());
-      b.push_back(T->translation());
-    }
-  }
-  if (a.size() < 3) return std::numeric_limits<double>::infinity();
-  Eigen::Matrix3Xd A(3, static_cast<Eigen::Index>(a.size())), B(3, A.cols());
-  for (size_t i = 0; i < a.size(); ++i) {
-    A.col(static_cast<Eigen::Index>(i)) = a[i];
-    B.col(static_cast<Eigen::Index>(i)) = b[i];
-  }
-  const std::optional<Eigen::Isometry3d> T = align_rigid(A, B);
-  if (!T) return std::numeric_limits<double>::infinity();
-  return std::sqrt(((*T * A) - B).colwise().squaredNorm().mean());
-}
 
 TEST(System, ReplayedTumRecordingRunsWithItsCamerasProfileAndMapsTheScene) {
   KESTREL_REQUIRE_TUM(folder, "rgbd_dataset_freiburg1_xyz");
@@ -113,13 +65,17 @@ TEST(System, ReplayedTumRecordingRunsWithItsCamerasProfileAndMapsTheScene) {
   }
   EXPECT_LT(worst_m, 1e-6) << "the replayed odometry is not the offline run's";
   EXPECT_LT(worst_rad, 1e-6);
+  // Scored as `kestrel eval --gt source --est recorded` scores it; every frame has its truth
+  // (tum-play brackets the frames with the motion capture's samples).
   const Trajectory truth = eval::read_log_input(source, {channel::kGroundTruth}).trajectory;  // T_world_camera
-  const double vo_ate = ate(replayed, truth);
-  std::cout << "VO ATE " << vo_ate << " m (offline run's trajectory to " << worst_m << " m)\n";
-  EXPECT_LT(vo_ate, 0.0125) << "the Kinect's profile gives 1.13 cm, the simulator's 1.68";
+  const eval::Evaluation scored = eval::evaluate(eval::frame_times(replayed), replayed, truth, eval::EvalOptions{});
+  EXPECT_EQ(scored.association.no_gt_before_start + scored.association.no_gt_after_end, 0u);
+  std::cout << "VO ATE " << scored.ate.error_m.rmse << " m over " << scored.ate.error_m.count << " frames (offline run's trajectory to "
+            << worst_m << " m)\n";
+  EXPECT_LT(scored.ate.error_m.rmse, 0.0125) << "the Kinect's profile gives 1.13 cm, the simulator's 1.68";
 
-  const Recording rec = read_recording(recorded);
-  EXPECT_EQ(rec.states, 0) << "no gyro in the recording: the estimator has nothing to propagate with";
+  const test::Recording rec = test::read_recording(recorded);
+  EXPECT_TRUE(rec.states.empty()) << "no gyro in the recording: the estimator has nothing to propagate with";
   ASSERT_TRUE(rec.graph.has_value()) << "SLAM published no graph";
   const auto loops = std::count_if(rec.graph->edges.begin(), rec.graph->edges.end(),
                                    [](const auto& e) { return e.kind == kestrel::slam_edge_t::KIND_LOOP_CLOSURE; });

@@ -1,4 +1,4 @@
-#include "test/system/map_check.h"
+#include "test/system/recording.h"
 
 #include <gtest/gtest.h>
 
@@ -11,12 +11,38 @@
 #include "common/transport/log_file.h"
 #include "common/transport/message.h"
 #include "common/transport/rgbd_codec.h"
+#include "kestrel/octomap_t.hpp"
 #include "kestrel/rgbd_frame_t.hpp"
+#include "kestrel/state_t.hpp"
+#include "kestrel/vo_update_t.hpp"
 #include "mapper/map_compare.h"
 #include "mapper/mapper.h"
 #include "mapper/octree_io.h"
 
 namespace kestrel::test {
+
+Recording read_recording(const std::string& path) {
+  Recording r;
+  transport::LogReader log(path);
+  while (auto e = log.next()) {
+    const auto& d = e->data;
+    if (e->channel == channel::kState) {
+      const auto m = transport::decode_message<kestrel::state_t>(d.data(), d.size(), "STATE");
+      if (m.status == kestrel::state_t::STATUS_OK)
+        r.states[m.utime] = transport::from_message(m.T_world_body, "STATE");
+    } else if (e->channel == channel::kSlamGraph) {
+      r.graph = transport::decode_message<kestrel::slam_graph_t>(d.data(), d.size(), "SLAM_GRAPH");
+    } else if (e->channel == channel::kSlamCorrection) {
+      ++r.corrections;
+    } else if (e->channel == channel::kMapOctomap) {
+      r.last_map_revision = transport::decode_message<kestrel::octomap_t>(d.data(), d.size(), "MAP_OCTOMAP").revision;
+    } else if (e->channel == channel::kVoUpdate && !r.T_body_camera) {
+      const auto m = transport::decode_message<kestrel::vo_update_t>(d.data(), d.size(), "VO_UPDATE");
+      r.T_body_camera = transport::from_message(m.T_body_camera, "VO_UPDATE");
+    }
+  }
+  return r;
+}
 
 std::map<int64_t, RgbdFrame> read_frames(const std::string& path, const std::map<int64_t, Eigen::Isometry3d>& utimes) {
   std::map<int64_t, RgbdFrame> frames;
