@@ -22,7 +22,7 @@ kestrel::vehicle_command_t to_message(const FollowerCommand& c, int64_t utime) {
     m.velocity[i] = c.velocity[i];
   }
   m.yaw = c.yaw;
-  m.yaw_rate = 0.0;
+  m.yaw_rate = c.yaw_rate;
   return m;
 }
 

@@ -79,6 +79,13 @@ Eigen::Vector3d PathFollower::point_at(double s) const {
   return path_[at.segment].position + at.t * (path_[at.segment + 1].position - path_[at.segment].position);
 }
 
+double PathFollower::yaw_slope_at(double s) const {
+  if (path_.size() < 2) return 0.0;
+  const size_t i = segment_at(s);
+  const double len = cumulative_[i + 1] - cumulative_[i];
+  return len > 0.0 ? wrap_angle(path_[i + 1].yaw - path_[i].yaw) / len : 0.0;
+}
+
 double PathFollower::yaw_at(double s) const {
   if (path_.size() < 2) return path_.front().yaw;
   const Place at = locate(s);
@@ -144,7 +151,8 @@ FollowerCommand PathFollower::command(const VehicleState& state) {
   const double speed = std::min(options_.cruise_speed_m_s, std::sqrt(2.0 * options_.decel_m_s2 * remaining));
   c.position = on_path;
   c.velocity = aim.norm() > 1e-9 ? Eigen::Vector3d(speed * aim.normalized()) : Eigen::Vector3d::Zero();
-  c.yaw = yaw_at(ahead);
+  c.yaw = yaw_at(progress_m_);
+  c.yaw_rate = speed * yaw_slope_at(progress_m_);
   return c;
 }
 

@@ -10,7 +10,11 @@
 //   velocity  = v(s) * the unit vector from path(s) to path(s + lookahead), which rounds the
 //               corners; v(s) = min(cruise, sqrt(2 a (L - s))), a stop at the end without
 //               overshoot for a vehicle that tracks its velocity;
-//   yaw       = the waypoints' yaw interpolated at s + lookahead (shortest way round).
+//   yaw       = the waypoints' yaw interpolated at s (shortest way round), with the feed-forward
+//               yaw rate v(s) * dyaw/ds, so the camera turns along an edge as the planner's
+//               belief model has it turn (its predicted covariance assumes that yaw).
+// (Until 27 Nov the yaw was the path's at s + lookahead with no feed-forward: 0.19 rad ahead
+// of the path's at the progress on vehicle_loop_test's L; 0.086 rad now.)
 // At the end (within arrive_radius of the last waypoint, s at the end) the command holds the
 // last waypoint. A vehicle farther than max_deviation from the path is off it: the follower
 // commands a hold where it is and stays off the path until it is given a new one (a replan).
@@ -32,7 +36,7 @@ struct Waypoint {
 struct FollowerOptions {
   double cruise_speed_m_s = 0.5;    ///< along the path
   double decel_m_s2 = 0.5;          ///< for the stop at the end
-  double lookahead_m = 0.5;         ///< where the velocity and the yaw aim
+  double lookahead_m = 0.5;         ///< where the velocity aims
   double search_window_m = 1.0;     ///< how far ahead of the progress the nearest point is sought
   double arrive_radius_m = 0.10;    ///< at the end within this: arrived
   double max_deviation_m = 1.0;     ///< farther from the path: off it, hold
@@ -52,6 +56,7 @@ struct FollowerCommand {
   Eigen::Vector3d position = Eigen::Vector3d::Zero();  ///< kPosition: the set point; kHold: where the vehicle is
   double yaw = 0.0;
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();  ///< feed-forward, world, m/s
+  double yaw_rate = 0.0;                               ///< feed-forward, rad/s
 };
 
 enum class FollowStatus { kIdle, kFollowing, kArrived, kOffPath };
@@ -76,10 +81,14 @@ class PathFollower {
   double length_m() const { return cumulative_.empty() ? 0.0 : cumulative_.back(); }
   /// Distance of the vehicle from the path at the last command.
   double deviation_m() const { return deviation_m_; }
+  /// The path's yaw `s` metres along it: the waypoints' yaw interpolated the short way round,
+  /// as the planner's belief model turns the camera along an edge (planner/roadmap.h).
+  double yaw_at(double s) const;
+  /// dyaw/ds there, rad per metre of path (0 on a turn on the spot, which is a step in yaw).
+  double yaw_slope_at(double s) const;
 
  private:
   Eigen::Vector3d point_at(double s) const;
-  double yaw_at(double s) const;
   size_t segment_at(double s) const;
   struct Place {
     size_t segment;  ///< from waypoint `segment` to the next

@@ -65,6 +65,7 @@ VehicleCommand vehicle_command(const kestrel::vehicle_command_t& m) {
       c.position = position;
       c.yaw = m.yaw;
       c.velocity = velocity.allFinite() ? velocity : Eigen::Vector3d::Zero();  // feed-forward is optional
+      c.yaw_rate = std::isfinite(m.yaw_rate) ? m.yaw_rate : 0.0;
       break;
     default:
       throw bad("unknown mode " + std::to_string(static_cast<int>(m.mode)));

@@ -26,7 +26,7 @@ ControlOutput control(const VehicleCommand& command, const VehicleEstimate& esti
     out.yaw_rate = command.yaw_rate;
   } else {  // kPosition (a hold is latched into a position by VehicleLoop)
     v_target = clamp_norm(o.position_gain * (command.position - estimate.p), o.max_speed_m_s) + command.velocity;
-    out.yaw_rate = o.yaw_gain * wrap_angle(command.yaw - estimate.yaw);
+    out.yaw_rate = o.yaw_gain * wrap_angle(command.yaw - estimate.yaw) + command.yaw_rate;
   }
   v_target = clamp_norm(v_target, o.max_speed_m_s);
   out.yaw_rate = std::clamp(out.yaw_rate, -o.max_yaw_rate, o.max_yaw_rate);
@@ -145,6 +145,7 @@ void VehicleLoop::advance_to(double t_s, const VehicleEstimate& estimate) {
     command_.position = estimate.p;
     command_.yaw = estimate.yaw;
     command_.velocity.setZero();
+    command_.yaw_rate = 0.0;
     latch_hold_ = false;
   }
   while (vehicle_.end_s() < t_s + lookahead_s_) vehicle_.step(control(command_, estimate, vehicle_.options()));

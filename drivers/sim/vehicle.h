@@ -37,7 +37,7 @@ struct VehicleCommand {
   Eigen::Vector3d position = Eigen::Vector3d::Zero();
   double yaw = 0.0;
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();  ///< kVelocity: target; kPosition: feed-forward
-  double yaw_rate = 0.0;                               ///< kVelocity only
+  double yaw_rate = 0.0;                               ///< kVelocity: target; kPosition: feed-forward
 };
 
 /// What the controller believes (from STATE, or the truth).

@@ -1,6 +1,6 @@
 // PathFollower (path_follower.h) against hand-worked cases: the command on a straight path,
 // the stop profile at the end, arrival, progress that never goes back (also on a path that
-// passes close to itself), yaw interpolated the short way round, off the path, bad input.
+// passes close to itself), yaw interpolated the short way round with its rate, off the path, bad input.
 
 #include <gtest/gtest.h>
 
@@ -90,16 +90,22 @@ TEST(PathFollower, ProgressNeverGoesBackNorShortCutsAPathThatPassesCloseToItself
   EXPECT_NEAR(f.progress_m(), 1.2, 1e-12);
 }
 
-TEST(PathFollower, YawIsInterpolatedTheShortWayRoundAtTheLookahead) {
-  FollowerOptions o;
-  o.lookahead_m = 0.5;
-  PathFollower f(o);
+// The yaw is the path's where the vehicle is along it (as the planner's belief model turns the
+// camera), with the rate at which it turns there at the commanded speed.
+TEST(PathFollower, YawIsInterpolatedTheShortWayRoundAtTheProgressWithItsRate) {
+  PathFollower f;  // cruise 0.5 m/s
   // From yaw 170 deg to -170 deg over 2 m: the short way is +20 deg through 180.
   const double a = 170.0 * M_PI / 180.0;
   f.set_path({{Eigen::Vector3d(0, 0, 1), a}, {Eigen::Vector3d(2, 0, 1), -a}});
-  const FollowerCommand c = f.command(at(0.5, 0.0));  // aims at s = 1.0, half way: 180 deg
+  const FollowerCommand c = f.command(at(1.0, 0.0));  // half way: 180 deg
   EXPECT_NEAR(std::cos(c.yaw), -1.0, 1e-12);
   EXPECT_NEAR(std::remainder(c.yaw - M_PI, 2 * M_PI), 0.0, 1e-9);
+  EXPECT_NEAR(c.yaw_rate, 0.5 * (20.0 * M_PI / 180.0) / 2.0, 1e-12);  // 0.5 m/s * 10 deg per metre
+  // A turn on the spot (two waypoints at one place) is a step: no rate to feed forward.
+  PathFollower g;
+  g.set_path({{Eigen::Vector3d(0, 0, 1), 0.0}, {Eigen::Vector3d(0, 0, 1), 1.0}, {Eigen::Vector3d(2, 0, 1), 1.0}});
+  EXPECT_EQ(g.yaw_slope_at(0.0), 0.0);
+  EXPECT_NEAR(g.yaw_at(0.5), 1.0, 1e-12);
 }
 
 TEST(PathFollower, FartherThanTheLargestDeviationItHoldsUntilANewPath) {
