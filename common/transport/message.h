@@ -29,8 +29,19 @@ Msg decode_message(const void* data, size_t size, const std::string& what) {
                        ? -1
                        : msg.decode(data, 0, static_cast<int>(size));
   if (used < 0) {
-    throw InputError(what + ": " + std::to_string(size) + " bytes are not a valid " +
-                     Msg::getTypeName() + " (other type, truncated or corrupt)");
+    // LCM starts a message with its type's fingerprint (8 bytes, big-endian), a hash of the
+    // type's fields: tell a message of another type, or of this type as another version of
+    // kestrel defined it (a log recorded before a message changed), from a damaged one.
+    uint64_t fingerprint = 0;
+    for (size_t i = 0; i < 8 && size >= 8; ++i) fingerprint = (fingerprint << 8) | static_cast<const uint8_t*>(data)[i];
+    const std::string bytes = what + ": " + std::to_string(size) + " bytes";
+    if (size < 8) throw InputError(bytes + " are too short for any message");
+    if (fingerprint != static_cast<uint64_t>(Msg::getHash())) {
+      throw InputError(bytes + " are not of type " + Msg::getTypeName() +
+                       " (another fingerprint: another message type, or a version of it from an "
+                       "older or newer kestrel, e.g. a log recorded before the message changed)");
+    }
+    throw InputError(bytes + " are a truncated or corrupt " + Msg::getTypeName() + " message");
   }
   if (static_cast<size_t>(used) != size) {
     throw InputError(what + ": " + Msg::getTypeName() + " of " + std::to_string(used) +

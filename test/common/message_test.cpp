@@ -35,13 +35,25 @@ TEST(Message, WrongTypeNamesTheChannel) {
   } catch (const InputError& e) {
     EXPECT_EQ(std::string(e.what()).rfind("VO_UPDATE: ", 0), 0u) << e.what();
     EXPECT_NE(std::string(e.what()).find("vo_update_t"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("another fingerprint"), std::string::npos) << e.what();
   }
 }
 
+// Each failure says which it is: too short to hold a fingerprint, a truncated message of the
+// right type, extra bytes after one.
 TEST(Message, TruncatedAndOverlongAreRejected) {
   auto bytes = encode_message(sample_imu());
-  EXPECT_THROW(decode_message<kestrel::imu_t>(bytes.data(), bytes.size() - 1, "IMU"), InputError);
-  EXPECT_THROW(decode_message<kestrel::imu_t>(bytes.data(), 0, "IMU"), InputError);
+  auto error = [](const std::vector<uint8_t>& b, size_t n) {
+    try {
+      decode_message<kestrel::imu_t>(b.data(), n, "IMU");
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_NE(error(bytes, bytes.size() - 1).find("truncated or corrupt imu_t message"), std::string::npos)
+      << error(bytes, bytes.size() - 1);
+  EXPECT_NE(error(bytes, 0).find("too short"), std::string::npos) << error(bytes, 0);
   bytes.push_back(0);
   EXPECT_THROW(decode_message<kestrel::imu_t>(bytes.data(), bytes.size(), "IMU"), InputError);
 }

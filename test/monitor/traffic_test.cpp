@@ -60,7 +60,7 @@ TEST(TrafficMonitor, CountsAndChecksKnownChannels) {
   const auto wrong = transport::encode_message(kestrel::vo_update_t{});
   const std::string error = traffic.on_message("IMU", wrong.data(), wrong.size(), 10.5);
   EXPECT_EQ(error.rfind("IMU: ", 0), 0u) << error;
-  EXPECT_NE(error.find("not a valid imu_t"), std::string::npos) << error;
+  EXPECT_NE(error.find("are not of type imu_t (another fingerprint"), std::string::npos) << error;
   auto truncated = good;
   truncated.resize(truncated.size() - 3);
   EXPECT_NE(traffic.on_message("IMU", truncated.data(), truncated.size(), 11.0), "");
