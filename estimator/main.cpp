@@ -51,8 +51,7 @@ int run(const Options& o) {
   node->subscribe<kestrel::imu_t>(channel::kImu, [&](const kestrel::imu_t& m) {
     // A source without a gyro (a TUM recording has only the Kinect's accelerometer) leaves the
     // filter nothing to propagate with: the health says so, rather than "initialising".
-    constexpr int8_t kBoth = kestrel::imu_t::HAS_GYRO | kestrel::imu_t::HAS_ACCEL;
-    if ((m.fields & kBoth) != kBoth)
+    if (!imu_has_gyro_and_accel(m))
       node->set_health(kestrel::process_status_t::STATE_DEGRADED,
                        "IMU samples lack the gyro or the accelerometer: the filter needs both");
     const ImuSample s = imu_from_message(m, channel::kImu);  // throws: Node counts and logs

@@ -13,9 +13,13 @@ void copy3(const Eigen::Vector3d& v, double (&out)[3]) {
 
 }  // namespace
 
-ImuSample imu_from_message(const kestrel::imu_t& m, const std::string& channel) {
+bool imu_has_gyro_and_accel(const kestrel::imu_t& m) {
   constexpr int8_t kBoth = kestrel::imu_t::HAS_GYRO | kestrel::imu_t::HAS_ACCEL;
-  if ((m.fields & kBoth) != kBoth)
+  return (m.fields & kBoth) == kBoth;
+}
+
+ImuSample imu_from_message(const kestrel::imu_t& m, const std::string& channel) {
+  if (!imu_has_gyro_and_accel(m))
     throw InputError(channel + ": IMU sample at utime " + std::to_string(m.utime) +
                      " lacks the gyro or the accelerometer (fields = " +
                      std::to_string(static_cast<int>(m.fields)) + "); the estimator needs both");

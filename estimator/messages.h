@@ -19,6 +19,9 @@
 
 namespace kestrel::estimator {
 
+/// Whether `m` has both the gyro and the accelerometer, which the filter needs.
+bool imu_has_gyro_and_accel(const kestrel::imu_t& m);
+/// The sample of `m`; throws InputError naming `channel` unless imu_has_gyro_and_accel(m).
 ImuSample imu_from_message(const kestrel::imu_t& m, const std::string& channel);
 VoUpdate vo_from_message(const kestrel::vo_update_t& m, const std::string& channel);
 PoseCorrection correction_from_message(const kestrel::slam_correction_t& m,
