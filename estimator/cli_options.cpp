@@ -21,9 +21,30 @@ void add_estimator_options(CLI::App& app, EstimatorOptions& o) {
   static const std::map<std::string, VoNoiseOptions::Source> kSources{
       {"reported", VoNoiseOptions::Source::kReported},
       {"constant", VoNoiseOptions::Source::kConstant}};
+  static const std::map<std::string, EstimatorMode> kModes{
+      {"auto", EstimatorMode::kAuto}, {"imu", EstimatorMode::kImu},
+      {"visual", EstimatorMode::kVisualOnly}};
   const CLI::Range non_negative(0.0, 1e9);
   const CLI::Range positive(1e-12, 1e9);
 
+  app.add_option("--mode", o.mode,
+                 "auto: the IMU filter if the IMU has a gyro, else the visual odometry alone; "
+                 "imu: the IMU filter only; visual: the visual odometry alone")
+      ->transform(CLI::CheckedTransformer(kModes, CLI::ignore_case))
+      ->default_str("auto");
+  app.add_option("--visual-accel-noise", o.visual_only.accel_noise_density,
+                 "Visual only: white acceleration of the constant-velocity model, m/s^2/sqrt(Hz)")
+      ->check(positive)->capture_default_str();
+  app.add_option("--visual-angular-accel-noise", o.visual_only.angular_accel_noise_density,
+                 "Visual only: white angular acceleration, rad/s^2/sqrt(Hz)")
+      ->check(positive)->capture_default_str();
+  app.add_option("--visual-gravity-sigma", o.visual_only.gravity_sigma,
+                 "Visual only: acceleration an accelerometer reading cannot tell from gravity, "
+                 "m/s^2 (0 = level only at the start)")
+      ->check(non_negative)->capture_default_str();
+  app.add_option("--no-imu-after", o.visual_only.no_imu_after_s,
+                 "--mode auto: VO updates this long with no IMU at all select the visual odometry alone, s")
+      ->check(positive)->capture_default_str();
   app.add_option("--filter", o.filter, "State filter: ekf (Appendix A) or ukf (Appendix B)")
       ->transform(CLI::CheckedTransformer(kFilters, CLI::ignore_case))
       ->default_str("ekf");

@@ -28,13 +28,18 @@ int run(const Options& o) {
   if (!r.skips.damage.empty()) spdlog::warn("{}", r.skips.damage);
   if (r.skips.rejected > 0)
     spdlog::warn("{} messages skipped; the first: {}", r.skips.rejected, r.skips.first_reason);
+  const bool visual = r.mode == EstimatorMode::kVisualOnly;
+  if (r.trajectory.empty() && visual)
+    throw InputError(o.log + ": the visual-only estimator never started (no successful VO update "
+                     "among " + std::to_string(r.vo_messages) + ")");
   if (r.trajectory.empty())
     throw InputError(o.log + ": the filter never initialised (" + std::to_string(r.imu_messages) +
                      " IMU messages; it needs " + std::to_string(o.estimator.init.duration_s) +
                      " s of a still IMU, or --init-moving-after)");
   write_tum_trajectory(o.out, r.trajectory);
   const EstimatorCounters& c = r.counters;
-  std::cout << "states written: " << r.trajectory.size() << " to " << o.out << "\n"
+  std::cout << "estimator: " << (visual ? "visual only (the IMU has no gyro)" : "IMU filter") << "\n"
+            << "states written: " << r.trajectory.size() << " to " << o.out << "\n"
             << "IMU messages: " << r.imu_messages << " (" << c.imu_duplicate << " duplicate, "
             << c.imu_out_of_order << " out of order, " << c.imu_gaps << " gaps)\n"
             << "VO updates: " << r.vo_messages << " (" << c.vo_applied << " applied, "
@@ -46,7 +51,7 @@ int run(const Options& o) {
             << " applied, " << c.corrections_too_old << " too old)\n"
             << "messages skipped: " << r.skips.rejected << "\n"
             << "filter restarts: " << c.filter_failures << "\n"
-            << "started: " << (c.moving_starts > 0 ? "on the move" : "still") << " at "
+            << "started: " << (visual ? "on the first VO update" : c.moving_starts > 0 ? "on the move" : "still") << " at "
             << r.trajectory.poses().front().utime << "\n";
   return kExitOk;
 }

@@ -126,7 +126,7 @@ Verdict Estimator::add_vo(const VoUpdate& u) {
       spec.clone_utime = u.utime;
       spec.anchored = true;
       spec.anchor = u.T_refcam_curcam;
-      spec.anchor_covariance = vo_noise(u);
+      spec.anchor_covariance = vo_noise(options_.vo_noise, u);
     }
     clone_specs_[u.reference_utime] = spec;
     Event clone;

@@ -77,6 +77,7 @@ struct EstimatorCounters {
   int64_t corrections_applied = 0, corrections_gated = 0;
   int64_t replays = 0, replayed_steps = 0, resets = 0, filter_failures = 0, init_restarts = 0;
   int64_t moving_starts = 0;  ///< initialisations on the move (no still window)
+  int64_t gravity_updates = 0;  ///< visual only: frames levelled by the accelerometer
 };
 
 class Estimator {
@@ -134,7 +135,6 @@ class Estimator {
   void apply(Event& event, FilterState& s);
   void trim();
   void retire(const Event& event);
-  Matrix6d vo_noise(const VoUpdate& update) const;
   int64_t oldest_utime() const { return history_.front().imu.utime; }
   static int64_t to_utime(double seconds) { return static_cast<int64_t>(std::llround(seconds * 1e6)); }
 

@@ -28,12 +28,6 @@ Matrix6d anchored_covariance(const Eigen::Isometry3d& A, const Matrix6d& cov_A,
 
 }  // namespace
 
-Matrix6d Estimator::vo_noise(const VoUpdate& u) const {
-  if (options_.vo_noise.source == VoNoiseOptions::Source::kConstant)
-    return options_.vo_noise.constant_sigma.array().square().matrix().asDiagonal();
-  return options_.vo_noise.reported_scale * u.covariance;
-}
-
 void Estimator::apply(Event& e, FilterState& s) {
   switch (e.kind) {
     case EventKind::kClone:
@@ -48,7 +42,7 @@ void Estimator::apply(Event& e, FilterState& s) {
         return;
       }
       Eigen::Isometry3d z = e.vo.T_refcam_curcam;
-      Matrix6d Q = vo_noise(e.vo);
+      Matrix6d Q = vo_noise(options_.vo_noise, e.vo);
       if (spec->second.anchored) {
         Q = anchored_covariance(spec->second.anchor, spec->second.anchor_covariance, z, Q);
         z = spec->second.anchor.inverse() * z;

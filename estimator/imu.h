@@ -8,6 +8,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <optional>
 
 namespace kestrel::estimator {
 
@@ -15,6 +16,17 @@ struct ImuSample {
   int64_t utime = 0;
   Eigen::Vector3d gyro = Eigen::Vector3d::Zero();   ///< rad/s, body
   Eigen::Vector3d accel = Eigen::Vector3d::Zero();  ///< specific force, m/s^2, body
+};
+
+/// An IMU message as it comes: either part may be missing (a Kinect has no gyro).
+struct ImuReading {
+  int64_t utime = 0;
+  std::optional<Eigen::Vector3d> gyro;   ///< rad/s, body
+  std::optional<Eigen::Vector3d> accel;  ///< specific force, m/s^2, body
+
+  bool complete() const { return gyro.has_value() && accel.has_value(); }
+  /// The sample of a complete reading.
+  ImuSample sample() const { return {utime, *gyro, *accel}; }
 };
 
 struct ImuNoise {

@@ -9,14 +9,6 @@ namespace {
 
 double sq(double v) { return v * v; }
 
-// Tilt about the horizontal body axes, yaw about world z (R^T e_z in the body frame).
-Eigen::Matrix3d attitude_covariance(const Eigen::Matrix3d& R_world_body, double sigma_tilt,
-                                    double sigma_yaw) {
-  const Eigen::Vector3d up_body = R_world_body.transpose() * Eigen::Vector3d::UnitZ();
-  return sq(sigma_tilt) * (Eigen::Matrix3d::Identity() - up_body * up_body.transpose()) +
-         sq(sigma_yaw) * up_body * up_body.transpose();
-}
-
 // The diagonal prior of a start; still and moving starts differ only in how well they know
 // velocity, tilt and gyro bias.
 Matrix15d start_covariance(const Eigen::Matrix3d& R_world_body, const InitOptions& o,
@@ -31,6 +23,13 @@ Matrix15d start_covariance(const Eigen::Matrix3d& R_world_body, const InitOption
 }
 
 }  // namespace
+
+Eigen::Matrix3d attitude_covariance(const Eigen::Matrix3d& R_world_body, double sigma_tilt,
+                                    double sigma_yaw) {
+  const Eigen::Vector3d up_body = R_world_body.transpose() * Eigen::Vector3d::UnitZ();
+  return sq(sigma_tilt) * (Eigen::Matrix3d::Identity() - up_body * up_body.transpose()) +
+         sq(sigma_yaw) * up_body * up_body.transpose();
+}
 
 Eigen::Matrix3d attitude_from_gravity(const Eigen::Vector3d& f, double yaw) {
   const double roll = std::atan2(f.y(), f.z());

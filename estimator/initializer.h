@@ -57,6 +57,11 @@ class Initializer {
 /// R_world_body with the given yaw whose z axis agrees with a measured specific force.
 Eigen::Matrix3d attitude_from_gravity(const Eigen::Vector3d& specific_force_body, double yaw);
 
+/// Covariance of dtheta (body frame) for an attitude whose tilt is known to sigma_tilt and its
+/// yaw (about world z) to sigma_yaw.
+Eigen::Matrix3d attitude_covariance(const Eigen::Matrix3d& R_world_body, double sigma_tilt,
+                                    double sigma_yaw);
+
 /// The mean of the window's specific forces, each rotated into the body frame of the last
 /// sample by the gyro integrated between them (bias ignored): gravity plus the mean
 /// acceleration, in one frame even when the vehicle turns.

@@ -22,6 +22,12 @@ bool symmetric_psd(const Matrix6d& C, bool allow_zero) {
 
 }  // namespace
 
+Matrix6d vo_noise(const VoNoiseOptions& options, const VoUpdate& u) {
+  if (options.source == VoNoiseOptions::Source::kConstant)
+    return options.constant_sigma.array().square().matrix().asDiagonal();
+  return options.reported_scale * u.covariance;
+}
+
 void validate_imu(const ImuSample& s, const std::string& what) {
   if (!s.gyro.allFinite() || !s.accel.allFinite())
     throw InputError(what + ": non-finite IMU reading at utime " + std::to_string(s.utime));

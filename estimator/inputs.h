@@ -9,6 +9,7 @@
 
 #include "estimator/imu.h"
 #include "estimator/measurements.h"
+#include "estimator/options.h"
 
 namespace kestrel::estimator {
 
@@ -29,6 +30,9 @@ struct PoseCorrection {
   Eigen::Isometry3d T_world_body = Eigen::Isometry3d::Identity();
   Matrix6d covariance = Matrix6d::Zero();  ///< [dp (world); dtheta (body)]; zero = unknown
 };
+
+/// The noise of a VO update's [dp; dtheta] under `options` (reported or constant).
+Matrix6d vo_noise(const VoNoiseOptions& options, const VoUpdate& update);
 
 /// Throws InputError (naming `what`) unless the input is usable: finite values, a proper
 /// rotation, a symmetric positive semi-definite covariance (all zero allowed where noted).

@@ -7,6 +7,7 @@
 #include "common/transport/log_file.h"
 #include "common/transport/message.h"
 #include "estimator/messages.h"
+#include "estimator/state_estimator.h"
 #include "kestrel/ground_truth_t.hpp"
 
 namespace kestrel::estimator {
@@ -29,27 +30,27 @@ bool convert_event(const transport::LogEvent& ev, const Convert& convert, LogSki
 LogRunResult run_log(const std::string& path, const EstimatorOptions& options,
                      const LogChannels& channels, double skip_s) {
   transport::LogReader log(path);
-  Estimator estimator(options);
+  StateEstimator estimator(options);
   LogRunResult r;
   int64_t first_timestamp = -1;
   const auto skip_us = static_cast<int64_t>(skip_s * 1e6);
+  auto record = [&](const StepResult& step) {
+    if (!step.state) return;
+    r.trajectory.push_back(step.state->utime, step.state->nav.T_world_body());
+    r.velocity.push_back(step.state->nav.v_world_body);
+  };
   while (auto ev = log.next()) {
     if (first_timestamp < 0) first_timestamp = ev->timestamp;
     if (ev->timestamp - first_timestamp < skip_us) continue;
     if (ev->channel == channels.imu) {
       ++r.imu_messages;
       convert_event<kestrel::imu_t>(*ev, [&](const kestrel::imu_t& m) {
-        const ImuSample s = imu_from_message(m, ev->channel);
-        if (estimator.add_imu(s) != Verdict::kAccepted) return;
-        if (const auto out = estimator.output(); out && out->utime == s.utime) {
-          r.trajectory.push_back(out->utime, out->nav.T_world_body());
-          r.velocity.push_back(out->nav.v_world_body);
-        }
+        record(estimator.add_imu(imu_from_message(m, ev->channel)));
       }, r.skips);
     } else if (ev->channel == channels.vo) {
       ++r.vo_messages;
       convert_event<kestrel::vo_update_t>(*ev, [&](const kestrel::vo_update_t& m) {
-        estimator.add_vo(vo_from_message(m, ev->channel));
+        record(estimator.add_vo(vo_from_message(m, ev->channel)));
       }, r.skips);
     } else if (ev->channel == channels.correction) {
       ++r.correction_messages;
@@ -59,8 +60,12 @@ LogRunResult run_log(const std::string& path, const EstimatorOptions& options,
     }
   }
   r.skips.damage = log.damage_report();
-  if (r.imu_messages == 0)
-    throw InputError(path + ": no message on " + channels.imu + ": the estimator needs the IMU");
+  if (r.imu_messages == 0 && options.mode == EstimatorMode::kImu)
+    throw InputError(path + ": no message on " + channels.imu + ": --mode imu needs the IMU");
+  if (r.imu_messages == 0 && r.vo_messages == 0)
+    throw InputError(path + ": no message on " + channels.imu + " or " + channels.vo +
+                     ": nothing to estimate from");
+  r.mode = estimator.mode();
   r.counters = estimator.counters();
   return r;
 }

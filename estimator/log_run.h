@@ -31,7 +31,9 @@ struct LogSkips {
 };
 
 struct LogRunResult {
-  Trajectory trajectory;  ///< T_world_body after every IMU sample once initialised
+  /// The estimator that ran (state_estimator.h); kAuto if nothing decided it.
+  EstimatorMode mode = EstimatorMode::kAuto;
+  Trajectory trajectory;  ///< T_world_body of every state published (state_estimator.h)
   std::vector<Eigen::Vector3d> velocity;  ///< v_world_body at the same utimes
   int64_t imu_messages = 0, vo_messages = 0, correction_messages = 0;
   EstimatorCounters counters;
@@ -40,7 +42,7 @@ struct LogRunResult {
 
 /// Runs an estimator with `options` over the log at `path`. Messages logged in the first
 /// skip_s seconds are left out (an estimator started in flight). Throws InputError if the log
-/// cannot be read or holds no IMU message.
+/// cannot be read, holds neither IMU nor VO messages, or no IMU message in mode kImu.
 LogRunResult run_log(const std::string& path, const EstimatorOptions& options,
                      const LogChannels& channels = {}, double skip_s = 0.0);
 

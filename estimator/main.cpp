@@ -1,5 +1,6 @@
 // kestrel-estimator: the onboard state estimator process. IMU, VO_UPDATE and SLAM_CORRECTION
-// in; STATE out after every IMU sample once the filter has a state (README.md). A thin
+// in; STATE out after every IMU sample once the filter has a state, or after every VO update
+// without a gyro (state_estimator.h, README.md). A thin
 // adapter: decode -> estimator library -> encode; lock-step replay resets it through Node.
 
 #include <spdlog/spdlog.h>
@@ -12,7 +13,7 @@
 #include "common/transport/channels.h"
 #include "common/transport/node.h"
 #include "estimator/cli_options.h"
-#include "estimator/estimator.h"
+#include "estimator/state_estimator.h"
 #include "estimator/messages.h"
 
 namespace {
@@ -25,67 +26,79 @@ struct Options {
   EstimatorOptions estimator;
 };
 
-// Health follows the filter: RUNNING while VO is being fused, DEGRADED on the IMU alone.
-void report_health(transport::Node& node, const std::optional<EstimatorOutput>& out) {
-  if (!out) {
-    node.set_health(kestrel::process_status_t::STATE_STARTING, "initialising: waiting for a still IMU (or --init-moving-after)");
+// Health follows the estimator: RUNNING while VO is being fused, DEGRADED without it (the IMU
+// filter on the IMU alone, the visual-only one predicting), or on an IMU the mode cannot use.
+void report_health(transport::Node& node, const StateEstimator& estimator) {
+  const auto out = estimator.output();
+  const bool visual = estimator.mode() == EstimatorMode::kVisualOnly;
+  if (estimator.mode() == EstimatorMode::kImu && !out && estimator.incomplete_imu() > 0) {
+    node.set_health(kestrel::process_status_t::STATE_DEGRADED,
+                    "IMU samples lack the gyro or the accelerometer: --mode imu needs both "
+                    "(--mode auto runs on the visual odometry without a gyro)");
+  } else if (!out) {
+    node.set_health(kestrel::process_status_t::STATE_STARTING,
+                    visual ? "visual only (no gyro): waiting for the first VO update"
+                           : "initialising: waiting for a still IMU (or --init-moving-after)");
   } else if (out->status == Status::kDegraded) {
-    node.set_health(kestrel::process_status_t::STATE_DEGRADED, "no VO fused recently: IMU only");
+    node.set_health(kestrel::process_status_t::STATE_DEGRADED,
+                    visual ? "visual only, no VO fused recently: predicting"
+                           : "no VO fused recently: IMU only");
   } else {
-    node.set_health(kestrel::process_status_t::STATE_RUNNING, "");
+    node.set_health(kestrel::process_status_t::STATE_RUNNING,
+                    visual ? "visual only: the IMU has no gyro" : "");
   }
 }
 
 int run(const Options& o) {
   std::optional<transport::Node> node;
   node.emplace("estimator", o.lcm_url);  // UnavailableError: exit 4
-  Estimator estimator(o.estimator);
+  StateEstimator estimator(o.estimator);
   int64_t seq = 0;
   node->advertise(channel::kState);
   node->on_reset([&] {
     estimator.reset();
     seq = 0;
   });
-  report_health(*node, std::nullopt);
+  report_health(*node, estimator);
+  auto publish = [&](const StepResult& r) {
+    if (r.state)
+      node->publish(channel::kState,
+                    state_to_message(*r.state, estimator.mode(), o.estimator.filter, seq++));
+  };
 
   node->subscribe<kestrel::imu_t>(channel::kImu, [&](const kestrel::imu_t& m) {
-    // A source without a gyro (a TUM recording has only the Kinect's accelerometer) leaves the
-    // filter nothing to propagate with: the health says so, rather than "initialising".
-    if (!imu_has_gyro_and_accel(m))
-      node->set_health(kestrel::process_status_t::STATE_DEGRADED,
-                       "IMU samples lack the gyro or the accelerometer: the filter needs both");
-    const ImuSample s = imu_from_message(m, channel::kImu);  // throws: Node counts and logs
-    const Verdict v = estimator.add_imu(s);
-    if (v != Verdict::kAccepted) {
-      spdlog::debug("IMU: sample at utime {} dropped (duplicate or out of order)", s.utime);
-      return;
-    }
-    const auto out = estimator.output();
-    report_health(*node, out);
-    if (out && out->utime == s.utime)
-      node->publish(channel::kState, state_to_message(*out, o.estimator.filter, seq++));
+    const ImuReading r = imu_from_message(m, channel::kImu);  // throws: Node counts and logs
+    const StepResult step = estimator.add_imu(r);
+    if (step.verdict == Verdict::kDuplicate || step.verdict == Verdict::kOutOfOrder)
+      spdlog::debug("IMU: sample at utime {} dropped (duplicate or out of order)", r.utime);
+    report_health(*node, estimator);
+    publish(step);
   }, 400);
   node->subscribe<kestrel::vo_update_t>(channel::kVoUpdate, [&](const kestrel::vo_update_t& m) {
     const VoUpdate u = vo_from_message(m, channel::kVoUpdate);
     validate_vo(u, o.estimator.vo_noise.source == VoNoiseOptions::Source::kReported,
                 channel::kVoUpdate);
-    const Verdict v = estimator.add_vo(u);
-    if (v == Verdict::kDuplicate || v == Verdict::kOutOfOrder || v == Verdict::kTooOld)
+    const StepResult step = estimator.add_vo(u);
+    if (step.verdict == Verdict::kDuplicate || step.verdict == Verdict::kOutOfOrder ||
+        step.verdict == Verdict::kTooOld)
       spdlog::debug("VO_UPDATE: update at utime {} dropped (duplicate, out of order or too old)", u.utime);
+    if (estimator.mode() == EstimatorMode::kVisualOnly) report_health(*node, estimator);
+    publish(step);
   });
   node->subscribe<kestrel::slam_correction_t>(channel::kSlamCorrection,
                                               [&](const kestrel::slam_correction_t& m) {
     const PoseCorrection c = correction_from_message(m, channel::kSlamCorrection);
     validate_correction(c, channel::kSlamCorrection);
     if (estimator.add_correction(c) == Verdict::kTooOld)
-      spdlog::warn("SLAM_CORRECTION: correction for utime {} is older than the {} s history; dropped",
+      spdlog::warn("SLAM_CORRECTION: correction for utime {} is outside the {} s history; dropped",
                    c.utime, o.estimator.history_s);
   });
 
   const int code = node->spin();
   const EstimatorCounters c = estimator.counters();
-  spdlog::info("IMU {} accepted, {} duplicate, {} out of order, {} gaps; VO {} applied, {} failed, "
+  spdlog::info("{}IMU {} accepted, {} duplicate, {} out of order, {} gaps; VO {} applied, {} failed, "
                "{} gated ({} forced past the gate), {} dropped; corrections {} applied, {} too old; filter restarts {}",
+               estimator.mode() == EstimatorMode::kVisualOnly ? "visual only; " : "",
                c.imu_accepted, c.imu_duplicate, c.imu_out_of_order, c.imu_gaps, c.vo_applied,
                c.vo_failed, c.vo_gated, c.vo_forced, c.vo_duplicate + c.vo_out_of_order + c.vo_too_old,
                c.corrections_applied, c.corrections_too_old, c.filter_failures);

@@ -13,22 +13,19 @@ void copy3(const Eigen::Vector3d& v, double (&out)[3]) {
 
 }  // namespace
 
-bool imu_has_gyro_and_accel(const kestrel::imu_t& m) {
-  constexpr int8_t kBoth = kestrel::imu_t::HAS_GYRO | kestrel::imu_t::HAS_ACCEL;
-  return (m.fields & kBoth) == kBoth;
-}
-
-ImuSample imu_from_message(const kestrel::imu_t& m, const std::string& channel) {
-  if (!imu_has_gyro_and_accel(m))
-    throw InputError(channel + ": IMU sample at utime " + std::to_string(m.utime) +
-                     " lacks the gyro or the accelerometer (fields = " +
-                     std::to_string(static_cast<int>(m.fields)) + "); the estimator needs both");
-  ImuSample s;
-  s.utime = m.utime;
-  s.gyro = vec3(m.angular_velocity);
-  s.accel = vec3(m.linear_acceleration);
-  validate_imu(s, channel);
-  return s;
+ImuReading imu_from_message(const kestrel::imu_t& m, const std::string& channel) {
+  const std::string what = channel + ": IMU sample at utime " + std::to_string(m.utime);
+  ImuReading r;
+  r.utime = m.utime;
+  if (m.fields & kestrel::imu_t::HAS_GYRO) r.gyro = vec3(m.angular_velocity);
+  if (m.fields & kestrel::imu_t::HAS_ACCEL) r.accel = vec3(m.linear_acceleration);
+  if (!r.gyro && !r.accel)
+    throw InputError(what + " has neither a gyro nor an accelerometer reading (fields = " +
+                     std::to_string(static_cast<int>(m.fields)) + ")");
+  if ((r.gyro && !r.gyro->allFinite()) || (r.accel && !r.accel->allFinite()))
+    throw InputError(what + ": non-finite reading");
+  if (m.utime < 0) throw InputError(what + ": negative utime");
+  return r;
 }
 
 VoUpdate vo_from_message(const kestrel::vo_update_t& m, const std::string& channel) {
@@ -55,11 +52,14 @@ PoseCorrection correction_from_message(const kestrel::slam_correction_t& m,
   return c;
 }
 
-kestrel::state_t state_to_message(const EstimatorOutput& out, FilterKind filter, int64_t seq) {
+kestrel::state_t state_to_message(const EstimatorOutput& out, EstimatorMode mode,
+                                  FilterKind filter, int64_t seq) {
   kestrel::state_t m;
   m.utime = out.utime;
   m.seq = seq;
-  m.filter = filter == FilterKind::kUkf ? kestrel::state_t::FILTER_UKF : kestrel::state_t::FILTER_EKF;
+  m.filter = mode == EstimatorMode::kVisualOnly ? kestrel::state_t::FILTER_VISUAL_ONLY
+              : filter == FilterKind::kUkf       ? kestrel::state_t::FILTER_UKF
+                                                 : kestrel::state_t::FILTER_EKF;
   switch (out.status) {
     case Status::kInitializing: m.status = kestrel::state_t::STATUS_INITIALIZING; break;
     case Status::kOk: m.status = kestrel::state_t::STATUS_OK; break;

@@ -5,7 +5,7 @@
 // (kestrel_estimator_messages) so that the filter itself stays free of LCM.
 //
 // Every *_from_message throws InputError naming the channel for a message the estimator
-// cannot use (a missing gyro or accelerometer, a non-finite value, a corrupt pose). A VO
+// cannot use (an IMU reading with nothing in it, a non-finite value, a corrupt pose). A VO
 // failure (status != OK) converts to a VoUpdate with ok = false and its pose ignored.
 
 #include <cstdint>
@@ -19,15 +19,16 @@
 
 namespace kestrel::estimator {
 
-/// Whether `m` has both the gyro and the accelerometer, which the filter needs.
-bool imu_has_gyro_and_accel(const kestrel::imu_t& m);
-/// The sample of `m`; throws InputError naming `channel` unless imu_has_gyro_and_accel(m).
-ImuSample imu_from_message(const kestrel::imu_t& m, const std::string& channel);
+/// The reading of `m`, with the parts its fields say it has; throws InputError naming
+/// `channel` for a reading with neither part, a non-finite value or a negative utime.
+ImuReading imu_from_message(const kestrel::imu_t& m, const std::string& channel);
 VoUpdate vo_from_message(const kestrel::vo_update_t& m, const std::string& channel);
 PoseCorrection correction_from_message(const kestrel::slam_correction_t& m,
                                        const std::string& channel);
 
-/// STATE for an output; `seq` numbers the published states.
-kestrel::state_t state_to_message(const EstimatorOutput& out, FilterKind filter, int64_t seq);
+/// STATE for an output of the estimator `mode` selected (filter says which IMU filter); `seq`
+/// numbers the published states.
+kestrel::state_t state_to_message(const EstimatorOutput& out, EstimatorMode mode,
+                                  FilterKind filter, int64_t seq);
 
 }  // namespace kestrel::estimator

@@ -103,8 +103,13 @@ AdapterOutputs SlamAdapter::on_state(const kestrel::state_t& state) {
   double tilt_variance = 0.0;
   if (state.cov_dim >= 9 && static_cast<int>(state.covariance.size()) >= 9)
     tilt_variance = std::max(state.covariance[6][6], state.covariance[7][7]);
+  // The visual-only estimator (no gyro) is the exception: nothing re-measures its tilt after
+  // its start (the accelerometer levels the start only, by default), so its world is the one
+  // its first states show, however uncertain their tilt.
+  const bool visual_only = state.filter == kestrel::state_t::FILTER_VISUAL_ONLY;
   sample.ok = ok && std::isfinite(tilt_variance) &&
-              tilt_variance <= options_.anchor_max_tilt_sigma_rad * options_.anchor_max_tilt_sigma_rad;
+              (visual_only ||
+               tilt_variance <= options_.anchor_max_tilt_sigma_rad * options_.anchor_max_tilt_sigma_rad);
   sample.T_world_body = transport::from_message(state.T_world_body, options_.state_channel.c_str());
   for (int i = 0; i < 3; ++i) {
     sample.velocity[i] = state.velocity[i];
@@ -223,11 +228,13 @@ AdapterOutputs SlamAdapter::process(const kestrel::rgbd_frame_t& message, const 
     return out;
   }
   out.graph = graph_message(slam_);
-  if (step.optimisation) {
-    out.correction = correction_message(slam_, options_.correction_sigma_m, options_.correction_sigma_rad);
-  }
   out.step = step;
   try_anchor(out);
+  // A correction is a pose in the estimator's world: none before the graph is anchored in it
+  // (in SLAM's odometry frame it would pull the state by the frames' difference).
+  if (step.optimisation && anchored_) {
+    out.correction = correction_message(slam_, options_.correction_sigma_m, options_.correction_sigma_rad);
+  }
   return out;
 }
 

@@ -8,11 +8,14 @@
 // seconds after the first frame). SLAM_CORRECTION poses are applied by the estimator as poses
 // in its own world, and the mapper's map must be in the frame the vehicle flies in, so the
 // first frame since the newest keyframe that the estimator's STATE covers (an OK state with
-// its roll and pitch settled on each side of its utime, at most max_state_gap_s apart, or the
+// its roll and pitch settled, or a visual-only one, whose tilt nothing re-measures, on each
+// side of its utime, at most max_state_gap_s apart, or the
 // newest carried on by its velocities for up to max_state_extrapolation_s) anchors the graph: the graph is moved
 // rigidly so that this frame's pose (the newest keyframe's composed with the odometry since)
 // is the estimator's pose then. A hovering vehicle makes no keyframe after the first, so any
-// frame must do. Without STATE (offline runs) the world stays the odometry frame.
+// frame must do. Without STATE (offline runs) the world stays the odometry frame, and no
+// SLAM_CORRECTION is published until the graph is anchored: the estimator applies one as a
+// pose in its own world.
 //
 // VO restarts: when the visual odometry loses its reference (a blank wall, a fast turn) its
 // new segment is unrelated to the old one, and the heading turned in the gap would be lost for

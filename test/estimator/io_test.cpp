@@ -27,21 +27,35 @@ using test::vo_message;
 using test::write_log;
 
 
-TEST(Messages, ImuWithoutGyroOrWithNanIsRefusedNamingTheChannel) {
+TEST(Messages, ImuReadingKeepsThePartsItHasAndRefusesNanOrNothingNamingTheChannel) {
   ImuSample s;
   s.utime = 5;
+  s.gyro << 0.1, 0.2, 0.3;
+  s.accel << 0.0, 0.5, 9.8;
   kestrel::imu_t m = imu_message(s);
-  EXPECT_NO_THROW(imu_from_message(m, "IMU"));
-  m.fields = kestrel::imu_t::HAS_ACCEL;  // the TUM accelerometer-only IMU
+  const ImuReading both = imu_from_message(m, "IMU");
+  ASSERT_TRUE(both.complete());
+  EXPECT_EQ(both.sample().gyro, s.gyro);
+  EXPECT_EQ(both.sample().accel, s.accel);
+  m.fields = kestrel::imu_t::HAS_ACCEL;  // the Kinect's (and TUM's) accelerometer-only IMU
+  const ImuReading accel_only = imu_from_message(m, "IMU");
+  EXPECT_FALSE(accel_only.gyro.has_value());
+  ASSERT_TRUE(accel_only.accel.has_value());
+  EXPECT_EQ(*accel_only.accel, s.accel);
+  m.fields = 0;
   try {
     imu_from_message(m, "IMU");
-    FAIL() << "no gyro accepted";
+    FAIL() << "a reading with nothing in it accepted";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("IMU"), std::string::npos);
   }
   m = imu_message(s);
   m.linear_acceleration[2] = INFINITY;
   EXPECT_THROW(imu_from_message(m, "IMU"), InputError);
+  m = imu_message(s);
+  m.fields = kestrel::imu_t::HAS_ACCEL;
+  m.angular_velocity[0] = std::nan("");  // not there: not looked at
+  EXPECT_NO_THROW(imu_from_message(m, "IMU"));
 }
 
 TEST(Messages, VoFailureCarriesNoPoseAndACorruptPoseIsRefused) {
@@ -71,7 +85,7 @@ TEST(Messages, StateCarriesTheOutputAndItsCovarianceRowMajor) {
   out.nav.v_world_body << 4, 5, 6;
   for (int r = 0; r < 15; ++r)
     for (int c = 0; c < 15; ++c) out.covariance(r, c) = r * 100 + c;
-  const kestrel::state_t m = state_to_message(out, FilterKind::kUkf, 9);
+  kestrel::state_t m = state_to_message(out, EstimatorMode::kImu, FilterKind::kUkf, 9);
   EXPECT_EQ(m.utime, 77);
   EXPECT_EQ(m.seq, 9);
   EXPECT_EQ(m.filter, kestrel::state_t::FILTER_UKF);
@@ -80,6 +94,8 @@ TEST(Messages, StateCarriesTheOutputAndItsCovarianceRowMajor) {
   EXPECT_EQ(m.velocity[1], 5.0);
   ASSERT_EQ(m.cov_dim, 15);
   EXPECT_EQ(m.covariance[2][7], 207.0);
+  m = state_to_message(out, EstimatorMode::kVisualOnly, FilterKind::kUkf, 10);
+  EXPECT_EQ(m.filter, kestrel::state_t::FILTER_VISUAL_ONLY);
 }
 
 TEST(LogRun, EqualsTheLibraryFedTheSameInputsAndCountsWhatItSkips) {
@@ -127,7 +143,7 @@ TEST(LogRun, EqualsTheLibraryFedTheSameInputsAndCountsWhatItSkips) {
   EXPECT_LT(worst, 0.03);
 }
 
-TEST(LogRun, ALogWithoutImuIsAnInputError) {
+TEST(LogRun, ALogWithoutImuIsAnInputErrorForTheImuFilterAndOneWithoutInputsForAny) {
   kestrel::test::TempDir dir;
   const std::string path = (dir / "no_imu.lcmlog").string();
   {
@@ -135,7 +151,17 @@ TEST(LogRun, ALogWithoutImuIsAnInputError) {
     log.write_message("VO_UPDATE", 1, vo_message(VoUpdate{}));
     log.close();
   }
-  EXPECT_THROW(run_log(path, EstimatorOptions{}), InputError);
+  EstimatorOptions imu_only;
+  imu_only.mode = EstimatorMode::kImu;
+  EXPECT_THROW(run_log(path, imu_only), InputError);
+  EXPECT_NO_THROW(run_log(path, EstimatorOptions{}));  // auto: the visual odometry alone
+  const std::string empty = (dir / "empty.lcmlog").string();
+  {
+    transport::LogWriter log(empty);
+    log.write_message("GROUND_TRUTH", 1, kestrel::ground_truth_t{});
+    log.close();
+  }
+  EXPECT_THROW(run_log(empty, EstimatorOptions{}), InputError);
   EXPECT_THROW(run_log((dir / "missing.lcmlog").string(), EstimatorOptions{}), InputError);
 }
 

@@ -4,13 +4,14 @@
 // recordings, one STATE per accepted IMU sample, and the last state equals the library's
 // (kestrel estimate's) on the same log. This is the whole process path: LCM decode, the
 // message conversions, Node's rejection of bad messages, acks and RESET. An IMU without a gyro
-// is refused sample by sample, and the heartbeat says why.
+// runs the visual-only estimator, or, in --mode imu, is refused with the heartbeat saying why.
 
 #include <gtest/gtest.h>
 
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <cmath>
 #include <sstream>
 
 #include "common/transport/channels.h"
@@ -67,15 +68,19 @@ TEST(EstimatorProcess, LockStepReplayIsDeterministicResetsAndEqualsTheLibrary) {
   EXPECT_EQ(last->cov_dim, 15);
 }
 
-// An IMU without a gyro (a TUM recording: the Kinect's accelerometer only): every sample is
-// refused, no STATE is published, and the heartbeat says why instead of "initialising".
-TEST(EstimatorProcess, AnImuWithoutAGyroIsRefusedAndTheHealthSaysSo) {
+// An IMU without a gyro (a TUM recording, a Kinect: the accelerometer only) and VO. By
+// default the estimator runs on the VO alone: a STATE per VO update, marked visual-only, the
+// heartbeat RUNNING and saying so; the states equal the offline run's (kestrel estimate).
+// With --mode imu every sample is refused, no STATE is published, and the heartbeat says why
+// instead of "initialising".
+TEST(EstimatorProcess, AnImuWithoutAGyroRunsVisualOnlyOrIsRefusedInImuModeAndTheHealthSaysSo) {
   if (!kestrel::test::can_isolate_network()) GTEST_SKIP() << "no network namespace available";
   if (!std::filesystem::exists(kestrel::test::tool("replay")))
     GTEST_SKIP() << kestrel::test::tool("replay") << " is not built (tools/replay)";
   if (std::system("command -v lcm-logger > /dev/null 2>&1") != 0) GTEST_SKIP() << "lcm-logger not found";
   kestrel::test::TempDir dir;
   const std::string in = (dir / "in.lcmlog").string();
+  constexpr int kUpdates = 20;
   {
     transport::LogWriter log(in);
     for (int k = 0; k < 50; ++k) {
@@ -86,20 +91,56 @@ TEST(EstimatorProcess, AnImuWithoutAGyroIsRefusedAndTheHealthSaysSo) {
       m.linear_acceleration[2] = 9.81;
       log.write_message(channel::kImu, m.utime, m);
     }
+    for (int k = 1; k <= kUpdates; ++k) {  // moving 1 cm per frame along x
+      VoUpdate u;
+      u.utime = 1'100'000 + 33'333 * k;
+      u.reference_utime = u.utime - 33'333;
+      u.ok = true;
+      u.T_refcam_curcam.translation() << 0.01, 0.0, 0.0;
+      u.covariance = Matrix6d::Identity() * 1e-6;
+      log.write_message(channel::kVoUpdate, u.utime, test::vo_message(u));
+    }
   }
   const std::string logged = (dir / "heartbeats.lcmlog").string();
+  const std::string estimator = kestrel::test::tool("estimator").string();
+  const std::string replay = kestrel::test::tool("replay").string();
   const std::string script =
       "lcm-logger -q --lcm-url='" + std::string(transport::kDefaultLcmUrl) + "' -f " + logged +
-      " & L=$!; sleep 0.5; " + kestrel::test::tool("estimator").string() + " -q & P=$!; " +
-      kestrel::test::tool("replay").string() + " " + in + " --expect estimator --record " +
-      (dir / "out.lcmlog").string() + " >/dev/null; R=$?; sleep 0.3; kill -INT $P $L; wait $P; wait $L; exit $R";
+      " & L=$!; sleep 0.5; " + estimator + " -q & P=$!; " + replay + " " + in +
+      " --expect estimator --record " + (dir / "visual.lcmlog").string() +
+      " >/dev/null || exit 11; sleep 0.3; kill -INT $P; wait $P; " + estimator + " -q --mode imu & P=$!; " +
+      replay + " " + in + " --expect estimator --record " + (dir / "imu.lcmlog").string() +
+      " >/dev/null; R=$?; sleep 0.3; kill -INT $P $L; wait $P; wait $L; exit $R";
   const auto r = kestrel::test::run({kestrel::test::tool("isolated").string(), "--", "sh", "-c", script}, 120.0);
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_TRUE(transport::read_messages<kestrel::state_t>((dir / "out.lcmlog").string(), channel::kState).empty());
-  std::string last_health;
-  for (const auto& s : transport::read_messages<kestrel::process_status_t>(logged, channel::kProcessStatus))
-    if (s.name == "estimator" && s.state == kestrel::process_status_t::STATE_DEGRADED) last_health = s.message;
-  EXPECT_NE(last_health.find("lack the gyro"), std::string::npos) << "'" << last_health << "'";
+
+  const auto states = transport::read_messages<kestrel::state_t>((dir / "visual.lcmlog").string(), channel::kState);
+  ASSERT_EQ(states.size(), static_cast<size_t>(kUpdates));
+  const LogRunResult offline = run_log(in, EstimatorOptions{});
+  EXPECT_EQ(offline.mode, EstimatorMode::kVisualOnly);
+  ASSERT_EQ(offline.trajectory.size(), states.size());
+  for (size_t i = 0; i < states.size(); ++i) {
+    EXPECT_EQ(states[i].filter, kestrel::state_t::FILTER_VISUAL_ONLY);
+    EXPECT_EQ(states[i].utime, offline.trajectory.poses()[i].utime);
+    EXPECT_NEAR(states[i].T_world_body.position[0], offline.trajectory.poses()[i].T.translation().x(), 1e-12);
+  }
+  // 20 frames of 1 cm along the camera's x, which the accelerometer's gravity (along the
+  // camera's z, body = camera) turns into the world's horizontal plane.
+  const auto& p = states.back().T_world_body.position;
+  EXPECT_NEAR(std::hypot(p[0], p[1]), 0.01 * kUpdates, 1e-6);
+  EXPECT_NEAR(p[2], 0.0, 1e-6);
+
+  EXPECT_TRUE(transport::read_messages<kestrel::state_t>((dir / "imu.lcmlog").string(), channel::kState).empty());
+  bool ran_visual = false;
+  std::string last_degraded;
+  for (const auto& s : transport::read_messages<kestrel::process_status_t>(logged, channel::kProcessStatus)) {
+    if (s.name != "estimator") continue;
+    if (s.state == kestrel::process_status_t::STATE_RUNNING && s.message.find("visual only") != std::string::npos)
+      ran_visual = true;
+    if (s.state == kestrel::process_status_t::STATE_DEGRADED) last_degraded = s.message;
+  }
+  EXPECT_TRUE(ran_visual) << "no RUNNING heartbeat saying 'visual only'";
+  EXPECT_NE(last_degraded.find("lack the gyro"), std::string::npos) << "'" << last_degraded << "'";
 }
 
 }  // namespace

@@ -1,0 +1,88 @@
+#include "estimator/state_estimator.h"
+
+namespace kestrel::estimator {
+
+StateEstimator::StateEstimator(const EstimatorOptions& options)
+    : options_(options), mode_(options.mode), imu_filter_(options), visual_(options) {}
+
+void StateEstimator::reset() {
+  mode_ = options_.mode;
+  imu_filter_.reset();
+  visual_.reset();
+  first_vo_utime_ = -1;
+  imu_seen_ = false;
+}
+
+StepResult StateEstimator::add_imu(const ImuReading& r) {
+  if (mode_ == EstimatorMode::kAuto)
+    mode_ = r.gyro ? EstimatorMode::kImu : EstimatorMode::kVisualOnly;
+  imu_seen_ = true;
+  StepResult result;
+  if (mode_ == EstimatorMode::kVisualOnly) {
+    if (r.accel) visual_.add_accel(r.utime, *r.accel);
+    return result;
+  }
+  if (!r.complete()) {
+    ++incomplete_imu_;
+    result.verdict = Verdict::kInvalid;
+    return result;
+  }
+  result.verdict = imu_filter_.add_imu(r.sample());
+  if (result.verdict == Verdict::kAccepted) {
+    if (auto out = imu_filter_.output(); out && out->utime == r.utime) result.state = std::move(out);
+  }
+  return result;
+}
+
+StepResult StateEstimator::add_vo(const VoUpdate& u) {
+  StepResult result;
+  if (mode_ == EstimatorMode::kAuto && !imu_seen_) {
+    if (first_vo_utime_ < 0) first_vo_utime_ = u.utime;
+    const double span_s = static_cast<double>(u.utime - first_vo_utime_) * 1e-6;
+    if (span_s >= options_.visual_only.no_imu_after_s) mode_ = EstimatorMode::kVisualOnly;
+  }
+  switch (mode_) {
+    case EstimatorMode::kAuto:
+      ++vo_before_decision_;
+      result.verdict = Verdict::kNotInitialized;
+      return result;
+    case EstimatorMode::kImu:
+      result.verdict = imu_filter_.add_vo(u);
+      return result;
+    case EstimatorMode::kVisualOnly:
+      result.verdict = visual_.add_vo(u);
+      if (auto out = visual_.output(); out && out->utime == u.utime &&
+          (result.verdict == Verdict::kAccepted || result.verdict == Verdict::kNoMeasurement))
+        result.state = std::move(out);
+      return result;
+  }
+  return result;
+}
+
+Verdict StateEstimator::add_correction(const PoseCorrection& c) {
+  switch (mode_) {
+    case EstimatorMode::kImu: return imu_filter_.add_correction(c);
+    case EstimatorMode::kVisualOnly: return visual_.add_correction(c);
+    case EstimatorMode::kAuto: break;
+  }
+  return Verdict::kNotInitialized;
+}
+
+std::optional<EstimatorOutput> StateEstimator::output() const {
+  switch (mode_) {
+    case EstimatorMode::kImu: return imu_filter_.output();
+    case EstimatorMode::kVisualOnly: return visual_.output();
+    case EstimatorMode::kAuto: break;
+  }
+  return std::nullopt;
+}
+
+EstimatorCounters StateEstimator::counters() const {
+  EstimatorCounters c = mode_ == EstimatorMode::kVisualOnly ? visual_.counters() : imu_filter_.counters();
+  c.vo_received += vo_before_decision_;
+  c.vo_before_init += vo_before_decision_;
+  c.imu_invalid += incomplete_imu_;
+  return c;
+}
+
+}  // namespace kestrel::estimator

@@ -1,0 +1,58 @@
+#pragma once
+// The estimator a source gets: the IMU filter (estimator.h) when its IMU has a gyro and an
+// accelerometer, the visual-only estimator (visual_only.h) when it has no gyro or no IMU at
+// all. The process kestrel-estimator and the offline run over a log (log_run.h) both go
+// through it, so they choose, and publish, alike.
+//
+// EstimatorMode::kAuto decides once, from the inputs alone (so a replay decides the same):
+// the first IMU reading selects the IMU filter if it has both parts, the visual-only
+// estimator if it lacks the gyro; VO updates spanning visual_only.no_imu_after_s with no IMU
+// reading at all select the visual-only estimator. VO updates before the decision are
+// dropped (counted as vo_before_init). reset() forgets the decision.
+//
+// States to publish: the IMU filter gives one after every IMU sample once initialised, the
+// visual-only estimator one after every VO update (a failed one included) once started.
+
+#include <optional>
+
+#include "estimator/estimator.h"
+#include "estimator/visual_only.h"
+
+namespace kestrel::estimator {
+
+/// What an input did, and the state to publish after it, if any.
+struct StepResult {
+  Verdict verdict = Verdict::kAccepted;
+  std::optional<EstimatorOutput> state;
+};
+
+class StateEstimator {
+ public:
+  explicit StateEstimator(const EstimatorOptions& options);
+
+  /// In the IMU filter's mode a reading without both parts is refused (kInvalid).
+  StepResult add_imu(const ImuReading& reading);
+  StepResult add_vo(const VoUpdate& update);
+  Verdict add_correction(const PoseCorrection& correction);
+  void reset();
+
+  /// kAuto while undecided, else the estimator that runs.
+  EstimatorMode mode() const { return mode_; }
+  /// The newest state; empty while undecided or initialising.
+  std::optional<EstimatorOutput> output() const;
+  EstimatorCounters counters() const;
+  /// IMU readings refused for a missing part (the IMU filter's mode only).
+  int64_t incomplete_imu() const { return incomplete_imu_; }
+
+ private:
+  EstimatorOptions options_;
+  EstimatorMode mode_;
+  Estimator imu_filter_;
+  VisualOnlyEstimator visual_;
+  int64_t first_vo_utime_ = -1;  // while undecided and no IMU reading seen
+  bool imu_seen_ = false;
+  int64_t vo_before_decision_ = 0;
+  int64_t incomplete_imu_ = 0;
+};
+
+}  // namespace kestrel::estimator
