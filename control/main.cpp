@@ -74,7 +74,7 @@ int main(int argc, char** argv) {
   app.add_option("--waypoints", o.waypoints, "Fly these waypoints at once (x y z yaw [tr] per line: `kestrel plan`'s output)");
   app.add_option("--speed", f.cruise_speed_m_s, "Cruise speed along the path (m/s)")->check(cli::Positive)->capture_default_str();
   app.add_option("--decel", f.decel_m_s2, "Deceleration for the stop at the end (m/s^2)")->check(cli::Positive)->capture_default_str();
-  app.add_option("--lookahead", f.lookahead_m, "Where velocity and yaw aim, ahead along the path (m)")->check(cli::Positive)->capture_default_str();
+  app.add_option("--lookahead", f.lookahead_m, "Where the velocity aims, ahead along the path (m)")->check(cli::Positive)->capture_default_str();
   app.add_option("--arrive-radius", f.arrive_radius_m, "Arrived within this of the last waypoint (m)")->check(cli::Positive)->capture_default_str();
   app.add_option("--max-deviation", f.max_deviation_m, "Farther than this from the path: hold and wait for a new plan (m)")->check(cli::Positive)->capture_default_str();
   app.add_option("--period", o.node.command_period_s, "At most one command per this much sensor time (s)")->check(CLI::NonNegativeNumber)->capture_default_str();
