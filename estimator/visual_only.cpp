@@ -66,6 +66,7 @@ void VisualOnlyEstimator::start(const VoUpdate& first) {
   while (!accel_.empty() && accel_.front().first <= first.reference_utime) accel_.pop_front();
   Frame origin;
   origin.utime = first.reference_utime;
+  origin.reference_utime = origin.utime;  // given, not predicted: the first motion measures the rates
   origin.T_world_body = se3::make(R, o.position);
   origin.covariance.topLeftCorner<3, 3>().diagonal().setConstant(sq(o.sigma_position));
   origin.covariance.bottomRightCorner<3, 3>() = attitude_covariance(R, sigma_tilt, o.sigma_yaw);

@@ -80,7 +80,7 @@ class VisualOnlyEstimator {
     Eigen::Isometry3d T_world_body = Eigen::Isometry3d::Identity();
     Matrix6d covariance = Matrix6d::Zero();  ///< [dp (world); dtheta (body)]
     Matrix6d vo_noise = Matrix6d::Zero();    ///< the update's own part of it (B Q B^T)
-    int64_t reference_utime = -1;            ///< -1: predicted, not measured
+    int64_t reference_utime = -1;            ///< -1: predicted, not measured (the start: its own)
   };
 
   void start(const VoUpdate& first);
