@@ -20,6 +20,7 @@ size_t write_ply(const KeyframeStore& keyframes, const std::string& path, double
   const double max_mm = max_range_m * 1000.0;
   for (const StoredKeyframe* kf : keyframes.in_time_order()) {
     const RgbdFrame& f = kf->frame;
+    const Eigen::Isometry3d T_world_depth = kf->T_world_depth();
     const PinholeCamera& c = f.camera;
     const bool colour = !f.rgb.empty();
     for (int v = 0; v < f.depth_mm.rows; ++v) {
@@ -28,7 +29,7 @@ size_t write_ply(const KeyframeStore& keyframes, const std::string& path, double
         if (depth[u] == 0 || depth[u] > max_mm) continue;
         const double z = 0.001 * depth[u];
         const Eigen::Vector3d p =
-            kf->T_world_camera * Eigen::Vector3d((u - c.cx) / c.fx * z, (v - c.cy) / c.fy * z, z);
+            T_world_depth * Eigen::Vector3d((u - c.cx) / c.fx * z, (v - c.cy) / c.fy * z, z);
         Point out{};
         for (int a = 0; a < 3; ++a) out.xyz[a] = static_cast<float>(p[a]);
         if (colour) {

@@ -33,6 +33,10 @@ struct StoredKeyframe {
   int64_t utime = 0;
   Eigen::Isometry3d T_world_camera = Eigen::Isometry3d::Identity();
   RgbdFrame frame;  ///< as inserted (decimated)
+  /// The depth image's camera in the camera at utime (a SLAM keyframe's timing; identity for
+  /// frames placed at their depth time already). The depth goes in at T_world_depth().
+  Eigen::Isometry3d T_camera_depth = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d T_world_depth() const { return T_world_camera * T_camera_depth; }
   size_t bytes() const;
 };
 

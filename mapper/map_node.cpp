@@ -142,6 +142,7 @@ std::optional<kestrel::octomap_t> MapNode::on_graph(const kestrel::slam_graph_t&
     g.id = k.id;
     g.utime = k.utime;
     g.T_world_camera = transport::from_message(k.T_world_camera, channel);
+    g.T_camera_depth = transport::from_message(k.T_camera_depth, channel);
     keyframes.push_back(g);
   }
   last_graph_revision_ = msg.revision;

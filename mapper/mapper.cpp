@@ -55,7 +55,7 @@ void Mapper::integrate(const RgbdFrame& decimated, const Eigen::Isometry3d& T_wo
 }
 
 void Mapper::integrate_keyframe(const StoredKeyframe& kf) {
-  integrate(kf.frame, kf.T_world_camera, kf.utime, "keyframe");
+  integrate(kf.frame, kf.T_world_depth(), kf.utime, "keyframe");
   if (!map_is_sequence_) return;
   sequence_.emplace_back(kf.id, kf.T_world_camera);
   maybe_checkpoint();
@@ -159,6 +159,7 @@ GraphResult Mapper::apply_graph(const std::vector<GraphKeyframe>& graph) {
     kf.id = g.id;
     kf.utime = g.utime;
     kf.T_world_camera = g.T_world_camera;
+    kf.T_camera_depth = g.T_camera_depth;
     kf.frame = *frame;
     // A keyframe older than a stored one breaks the live map's time order (a rebuild would
     // insert it earlier), so the live map is no longer a checkpointable sequence.

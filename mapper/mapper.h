@@ -58,6 +58,7 @@ struct GraphKeyframe {
   int64_t id = 0;
   int64_t utime = 0;
   Eigen::Isometry3d T_world_camera = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d T_camera_depth = Eigen::Isometry3d::Identity();  ///< slam_keyframe_t's
 };
 
 struct GraphResult {

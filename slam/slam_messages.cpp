@@ -32,6 +32,7 @@ kestrel::slam_graph_t graph_message(const Slam& slam) {
     kf.id = keyframes[k].id;
     kf.utime = keyframes[k].utime;
     kf.T_world_camera = transport::to_message(graph.poses[k]);
+    kf.T_camera_depth = transport::to_message(keyframes[k].T_camera_depth);
     m.keyframes.push_back(kf);
   }
   m.num_keyframes = static_cast<int32_t>(m.keyframes.size());

@@ -36,14 +36,15 @@ std::vector<PlaybackEvent> playback_schedule(const TumSequence& sequence, const 
     }
   }
   if (window.ground_truth) {
-    // From the last pose at or before the first frame to the first at or after the last one,
-    // so that every frame's true pose can be interpolated (the motion capture runs at its own
-    // rate: fr1's first frames come between two of its samples).
+    // From the last pose at or before the margin before the first frame to the first at or
+    // after it past the last one, so that every frame's true pose can be interpolated, at its
+    // colour time and at its depth's (the motion capture runs at its own rate: fr1's first
+    // frames come between two of its samples).
     const auto& poses = sequence.ground_truth().poses();
     size_t begin_pose = 0, end_pose = poses.size();  // [begin_pose, end_pose)
     for (size_t i = 0; i < poses.size(); ++i) {
-      if (poses[i].utime <= first) begin_pose = i;
-      if (poses[i].utime >= last) {
+      if (poses[i].utime <= first - kGroundTruthMarginUs) begin_pose = i;
+      if (poses[i].utime >= last + kGroundTruthMarginUs) {
         end_pose = i + 1;
         break;
       }

@@ -7,8 +7,9 @@
 // a frame before it sees the frame). The window holds the frames whose RGB time lies in
 // [first + start, first + start + duration] (first = the sequence's first frame), the IMU
 // samples between the window's first and last frame times, inclusive, and the poses from the
-// last at or before the first frame to the first at or after the last frame (so that every
-// frame's true pose can be interpolated).
+// last at or before kGroundTruthMarginUs before the first frame to the first at or after as
+// long after the last (so that every frame's true pose can be interpolated, at its colour
+// time and at its depth's capture, which on fr1 precedes the colour stamp by up to ~31 ms).
 
 #include <cstddef>
 #include <cstdint>
@@ -17,6 +18,9 @@
 #include "drivers/tum/tum_sequence.h"
 
 namespace kestrel::tum {
+
+/// How far beyond the frames' colour stamps the ground truth reaches (see above).
+inline constexpr int64_t kGroundTruthMarginUs = 50000;
 
 struct PlaybackWindow {
   double start_s = 0.0;     ///< seconds after the first frame, in [0, 1e9]

@@ -34,6 +34,9 @@ struct Keyframe {
   int64_t utime = 0;
   Eigen::Isometry3d T_odom_camera = Eigen::Isometry3d::Identity();
   Eigen::Isometry3d T_body_camera = Eigen::Isometry3d::Identity();
+  /// The camera at the depth image's time, in the camera at utime's frame (the timing's
+  /// motion over the depth offset; identity when the motion is unknown).
+  Eigen::Isometry3d T_camera_depth = Eigen::Isometry3d::Identity();
   FrameFeatures features;
 };
 

@@ -69,6 +69,39 @@ TEST(Mapper, RebuildAfterLoopClosureEqualsTheMapAtTheCorrectedPoses) {
   expect_same_maps(drifted.map(), direct.map());
 }
 
+// A Kinect's depth is taken up to 31 ms before its colour: SLAM's keyframe pose is the
+// colour camera's, and the depth belongs where the camera was at the depth's time. The map of
+// keyframes given with their T_camera_depth equals the map of the same depth images placed at
+// their depth-time poses, and differs from the one that ignores it.
+TEST(Mapper, AKeyframesDepthGoesInAtTheCameraPoseOfItsOwnTime) {
+  const Scene scene = room();
+  const auto colour_poses = sweep(6);
+  // 25 ms at 0.5 m/s and 30 deg/s, backwards: the depth's camera 1.25 cm and 0.75 deg behind.
+  Eigen::Isometry3d T_camera_depth = Eigen::Isometry3d::Identity();
+  T_camera_depth.translation() << -0.0125, 0.0, 0.0;
+  T_camera_depth.rotate(Eigen::AngleAxisd(-0.75 * M_PI / 180.0, Eigen::Vector3d::UnitY()));
+  MapperOptions options;
+  Mapper timed(options), at_depth(options), untimed(options);
+  std::vector<GraphKeyframe> graph, depth_graph, colour_graph;
+  for (size_t i = 0; i < colour_poses.size(); ++i) {
+    const int64_t utime = 1000000 + 200000 * static_cast<int64_t>(i);
+    const Eigen::Isometry3d T_world_depth = colour_poses[i] * T_camera_depth;
+    const RgbdFrame frame = scene.render(test::kinect_camera(), T_world_depth, utime);
+    for (Mapper* m : {&timed, &at_depth, &untimed}) m->buffer_frame(frame);
+    graph.push_back({static_cast<int64_t>(i), utime, colour_poses[i], T_camera_depth});
+    depth_graph.push_back({static_cast<int64_t>(i), utime, T_world_depth});
+    colour_graph.push_back({static_cast<int64_t>(i), utime, colour_poses[i]});
+  }
+  timed.apply_graph(graph);
+  at_depth.apply_graph(depth_graph);
+  untimed.apply_graph(colour_graph);
+  ASSERT_GT(timed.map().num_occupied(), 100u);
+  expect_same_maps(timed.map(), at_depth.map());
+  size_t differing = 0;
+  untimed.map().for_each_cell([&](const Key& k, float v) { differing += timed.map().log_odds(k) != v; });
+  EXPECT_GT(differing, untimed.map().num_cells() / 20) << "the offset should matter for this test to mean anything";
+}
+
 TEST(Mapper, RebuildStartsFromTheLastCheckpointBeforeTheFirstMovedKeyframe) {
   const Scene scene = room();
   const auto truth = sweep(12);

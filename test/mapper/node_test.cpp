@@ -90,6 +90,7 @@ TEST(MapNode, SlamGraphInsertsKeyframesAndPublishesRebuildsAtOnce) {
     k.id = i;
     k.utime = t;
     k.T_world_camera = transport::to_message(pose_at(1e-6 * t));
+    k.T_camera_depth = transport::to_message(Eigen::Isometry3d::Identity());
     graph.keyframes.push_back(k);
   }
   graph.num_keyframes = 4;

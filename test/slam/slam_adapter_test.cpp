@@ -9,6 +9,7 @@
 #include <cmath>
 
 #include "common/error.h"
+#include "common/geometry/se3.h"
 #include "common/transport/convert.h"
 #include "common/transport/rgbd_codec.h"
 #include "slam/slam_adapter.h"
@@ -286,6 +287,18 @@ TEST_F(AdapterTest, KeyframeFeaturesTakeTheCamerasTimingAndTheOdometrysMotion) {
     }
     EXPECT_GT(moved, got.num_points() / 2) << "the correction moved the points (15 mm of depth at 1 m/s)";
   }
+  // The depth's camera for the mapper: the same motion over the depth offset, in SLAM_GRAPH.
+  const Eigen::Isometry3d T_camera_depth = se3::exp(motion.depth_offset_s * motion.twist_per_s);
+  EXPECT_GT(T_camera_depth.translation().norm(), 0.01) << "1 m/s over the Kinect's depth offset";
+  for (const SlamAdapter* a : {&timed, &told}) {
+    EXPECT_TRUE(a->slam().keyframes()[1].T_camera_depth.isApprox(T_camera_depth, 1e-12));
+    const kestrel::slam_graph_t g = graph_message(a->slam());
+    EXPECT_TRUE(transport::from_message(g.keyframes[1].T_camera_depth, "test").isApprox(T_camera_depth, 1e-9));
+  }
+  EXPECT_TRUE(timed.slam().keyframes()[0].T_camera_depth.isApprox(Eigen::Isometry3d::Identity()))
+      << "no frame before the first keyframe: no motion, no offset";
+  EXPECT_TRUE(adapter_.slam().keyframes()[1].T_camera_depth.isApprox(Eigen::Isometry3d::Identity()))
+      << "the simulator's depth is taken with its colour";
   const FrameFeatures& first = timed.slam().keyframes()[0].features;
   const FrameFeatures plain0 = extractor.extract(f0);
   ASSERT_EQ(first.size(), plain0.size());

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <iostream>
 #include <optional>
 
@@ -18,6 +19,8 @@
 #include "mapper/map_compare.h"
 #include "mapper/mapper.h"
 #include "mapper/octree_io.h"
+#include "vo/depth_lookup.h"
+#include "vo/sensor_profile.h"
 
 namespace kestrel::test {
 
@@ -78,7 +81,18 @@ void expect_map_agrees_with_truth(const kestrel::slam_graph_t& graph, const Traj
   const std::map<int64_t, RgbdFrame> frames = read_frames(source_log, true_poses);
   ASSERT_EQ(frames.size(), true_poses.size()) << "keyframes whose frame is not in the log";
   mapper::Mapper reference;  // the process's defaults
-  for (const auto& [utime, frame] : frames) reference.insert(frame, *T_slam_true * true_poses.at(utime));
+  for (const auto& [utime, frame] : frames) {
+    // The depth image where the camera truly was when it was taken (a Kinect's depth precedes
+    // its colour: by its stamps' difference and the profile's extra latency, the VO's timing
+    // model), as the mapper places it (slam_keyframe_t.T_camera_depth). Interpolated across
+    // the motion capture's gaps too: fr1_xyz has one of 0.11 s where a keyframe's depth falls.
+    const vo::DepthOptions timing = vo::with_sensor(vo::profile_of_sensor(frame.sensor), vo::VoOptions{}).depth;
+    const int64_t depth_time =
+        utime + std::llround(1e6 * vo::depth_time_offset_s(timing, utime, frame.depth_utime != 0 ? frame.depth_utime : utime));
+    const std::optional<Eigen::Isometry3d> T = true_camera.at(depth_time, 120'000);
+    ASSERT_TRUE(T.has_value()) << "no true pose at the depth's time " << depth_time;
+    reference.insert(frame, *T_slam_true * *T);
+  }
   const mapper::VoxelMap flown = mapper::read_map_file(map_file);
   const mapper::MapAgreement agree = mapper::compare_maps(flown, reference.map());
   std::cout << "map: " << flown.num_occupied() << " occupied cells, at true poses " << reference.map().num_occupied()

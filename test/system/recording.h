@@ -32,7 +32,7 @@ std::map<int64_t, RgbdFrame> read_frames(const std::string& path, const std::map
 
 /// Expects the map in `map_file` (kestrel-mapper --save) to agree with the map the library
 /// builds, with the process's defaults, from the keyframes' frames in `source_log` at their
-/// poses in `true_camera` (T_world_camera, interpolated at the keyframes' times): at least
+/// poses in `true_camera` (T_world_camera, interpolated at their depth images' times): at least
 /// `min_agreement` of the cells both know in the same class, and as large a share of either
 /// map's occupied cells within a cell of an occupied cell of the other.
 void expect_map_agrees_with_truth(const kestrel::slam_graph_t& graph, const Trajectory& true_camera,

@@ -12,7 +12,7 @@
 // odometry alone (visual_only.h), its start levelled by the accelerometer, and publishes a
 // STATE per frame, which SLAM anchors its map on and corrects after its loop closure. Its
 // poses are the odometry's chain (ATE 1.09 cm against the VO's 1.13), its velocities the
-// constant-velocity filter's (0.081 m/s RMS off the motion capture's, at 0.35 m/s RMS).
+// constant-velocity filter's (0.083 m/s RMS off the motion capture's, at 0.35 m/s RMS).
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -76,7 +76,7 @@ void expect_visual_only_state(const std::string& recorded, const Trajectory& tru
   const double rmse = std::sqrt(sum_sq / velocities.size()), speed = std::sqrt(sum_sq_true / velocities.size());
   std::cout << "visual-only STATE: ATE " << scored.ate.error_m.rmse << " m, velocity RMSE " << rmse << " m/s over "
             << velocities.size() << " states (RMS speed " << speed << " m/s)\n";
-  EXPECT_LT(rmse, 0.3 * speed) << "the velocity does not follow the motion";  // 0.081 of 0.35 m/s measured
+  EXPECT_LT(rmse, 0.3 * speed) << "the velocity does not follow the motion";  // 0.083 of 0.35 m/s measured
 
   // Levelled: the world's z is the motion capture's up (TUM's mocap frame has z up), to the
   // accelerometer's accuracy.
@@ -138,9 +138,10 @@ TEST(System, ReplayedTumRecordingRunsWithItsCamerasProfileAndMapsTheScene) {
   EXPECT_GE(loops, 1) << "fr1_xyz returns over its start: SLAM closes a loop";
   EXPECT_GE(rec.last_map_revision, 1000) << "no MAP_OCTOMAP after a rebuild (the revision jumps then)";
   std::cout << "keyframes " << rec.graph->keyframes.size() << ", loop closures " << loops << "\n";
-  // 0.936 measured (the synthetic flights give 0.95 or more: here the truth itself is a motion
-  // capture's, synchronised and calibrated to the camera to a centimetre or so).
-  test::expect_map_agrees_with_truth(*rec.graph, truth, source, map_file, 0.90);
+  // 0.952 measured, each keyframe's depth at its own time in both maps (0.947 when the mapper
+  // ignored the keyframes' T_camera_depth; the synthetic flights give 0.95 or more: here the
+  // truth itself is a motion capture's, synchronised and calibrated to a centimetre or so).
+  test::expect_map_agrees_with_truth(*rec.graph, truth, source, map_file, 0.93);
 }
 
 }  // namespace

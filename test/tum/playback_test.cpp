@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "common/transport/channels.h"
 #include "common/transport/convert.h"
 #include "common/transport/message.h"
@@ -51,17 +53,19 @@ TEST(Playback, MergesFramesImuAndGroundTruthInTimeOrder) {
   }
   EXPECT_EQ(frames, 4);
   // Between the first and last frame (0 .. 99999 us after t0), inclusive: the accelerometer
-  // every 5 ms from t0 - 0.1 s hits t0 exactly; ground truth every 10 ms does too, and its
-  // sample after the last frame comes along so that the last frame's truth can be interpolated.
+  // every 5 ms from t0 - 0.1 s hits t0 exactly. Ground truth, every 10 ms from t0 - 0.1 s,
+  // reaches 50 ms beyond the frames on both sides (an image's capture can precede its stamp).
   EXPECT_EQ(imu, 20);  // t0, t0 + 5 ms, ..., t0 + 95 ms
-  EXPECT_EQ(gt, 11);   // t0, t0 + 10 ms, ..., t0 + 100 ms
-  EXPECT_EQ(events.front().utime, TumFixture::kT0);
-  EXPECT_EQ(events.front().kind, EventKind::kImu);  // IMU before ground truth before the frame
-  EXPECT_EQ(events[1].kind, EventKind::kGroundTruth);
-  EXPECT_EQ(events[2].kind, EventKind::kFrame);
-  EXPECT_EQ(events.back().kind, EventKind::kGroundTruth);  // the pose after the last frame
-  EXPECT_EQ(events.back().utime, TumFixture::kT0 + 100000);
-  EXPECT_EQ(events[events.size() - 2].kind, EventKind::kFrame);
+  EXPECT_EQ(gt, 21);   // t0 - 50 ms, t0 - 40 ms, ..., t0 + 150 ms
+  EXPECT_EQ(events.front().utime, TumFixture::kT0 - kGroundTruthMarginUs);
+  EXPECT_EQ(events.front().kind, EventKind::kGroundTruth);
+  const auto at_t0 = std::find_if(events.begin(), events.end(), [](const PlaybackEvent& e) { return e.utime == TumFixture::kT0; });
+  ASSERT_NE(at_t0, events.end());
+  EXPECT_EQ(at_t0[0].kind, EventKind::kImu);  // IMU before ground truth before the frame
+  EXPECT_EQ(at_t0[1].kind, EventKind::kGroundTruth);
+  EXPECT_EQ(at_t0[2].kind, EventKind::kFrame);
+  EXPECT_EQ(events.back().kind, EventKind::kGroundTruth);
+  EXPECT_EQ(events.back().utime, TumFixture::kT0 + 150000);
 }
 
 TEST(Playback, WindowSelectsFramesByTimeAndCanDropStreams) {
@@ -81,9 +85,10 @@ TEST(Playback, WindowSelectsFramesByTimeAndCanDropStreams) {
     if (e.kind == EventKind::kGroundTruth) poses.push_back(e.utime - TumFixture::kT0);
   }
   EXPECT_EQ(frames, (std::vector<size_t>{2, 3}));
-  // The poses (every 10 ms from t0) that bracket frames 2 and 3 (66.7 and 100 ms): none inside
-  // the window left out, none beyond the one on each side.
-  EXPECT_EQ(poses, (std::vector<int64_t>{60000, 70000, 80000, 90000, 100000}));
+  // The poses (every 10 ms) from 50 ms before frame 2 (66.7 ms) to 50 ms after frame 3 (100 ms),
+  // bracketed: none inside left out, none beyond the one on each side.
+  EXPECT_EQ(poses, (std::vector<int64_t>{10000, 20000, 30000, 40000, 50000, 60000, 70000, 80000, 90000, 100000,
+                                         110000, 120000, 130000, 140000, 150000}));
   w.start_s = 10.0;
   EXPECT_TRUE(playback_schedule(s, w).empty());
   w.start_s = -1.0;
@@ -171,8 +176,9 @@ TEST(Player, LoopingKeepsTimeAndSequenceNumbersIncreasing) {
   EXPECT_EQ(stats.passes, 3);
   ASSERT_EQ(out.size(), 3 * events.size());
   const int64_t period = loop_period_us(s, events);
-  // The span (t0 to the pose after the last frame, at 40 ms) and one frame interval.
-  EXPECT_EQ(period, 40000 + TumFixture::kPeriod);
+  // The span (from the pose 50 ms before t0 to the one at or after 50 ms past the last frame,
+  // at 90 ms) and one frame interval.
+  EXPECT_EQ(period, 140000 + TumFixture::kPeriod);
   std::vector<int64_t> seqs;
   for (size_t i = 0; i < out.size(); ++i) {
     EXPECT_EQ(out[i].utime, events[i % events.size()].utime + static_cast<int64_t>(i / events.size()) * period);

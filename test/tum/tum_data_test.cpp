@@ -14,6 +14,7 @@
 #include "common/text.h"
 #include "common/time.h"
 #include "common/transport/channels.h"
+#include "drivers/tum/playback.h"
 #include "common/transport/log_file.h"
 #include "common/transport/rgbd_codec.h"
 #include "drivers/kinect/accelerometer.h"
@@ -54,12 +55,14 @@ TEST(TumData, Fr1RpyLogHoldsAllFramesImuAndGroundTruthInTimeOrder) {
   const auto in_window = [&](const auto& list) {
     return std::count_if(list.begin(), list.end(), [&](const auto& s) { return within(s.first); });
   };
-  // The poses from the last at or before the first frame to the first at or after the last.
+  // The poses from the last at or before 50 ms before the first frame to the first at or
+  // after 50 ms past the last (the depth's capture precedes the colour stamp).
   const auto bracketing = [&](const auto& list) {
-    const auto n = in_window(list);
-    const bool at_first = std::any_of(list.begin(), list.end(), [&](const auto& s) { return s.first == rgb.front().first; });
-    const bool at_last = std::any_of(list.begin(), list.end(), [&](const auto& s) { return s.first == rgb.back().first; });
-    return n + (at_first ? 0 : 1) + (at_last ? 0 : 1);
+    const int64_t from = rgb.front().first - tum::kGroundTruthMarginUs, to = rgb.back().first + tum::kGroundTruthMarginUs;
+    const auto n = std::count_if(list.begin(), list.end(), [&](const auto& s) { return s.first >= from && s.first <= to; });
+    const bool at_from = std::any_of(list.begin(), list.end(), [&](const auto& s) { return s.first == from; });
+    const bool at_to = std::any_of(list.begin(), list.end(), [&](const auto& s) { return s.first == to; });
+    return n + (at_from ? 0 : 1) + (at_to ? 0 : 1);
   };
 
   transport::LogReader reader(log.string());

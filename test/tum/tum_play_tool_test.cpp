@@ -59,7 +59,7 @@ TEST(TumPlayTool, WritesEveryMessageToTheLogInTimeOrder) {
   const LogContents c = read_log(log);
   EXPECT_EQ(c.count.at(channel::kCameraRgbd), 4);
   EXPECT_EQ(c.count.at(channel::kImu), 20);
-  EXPECT_EQ(c.count.at(channel::kGroundTruth), 11);  // t0 .. t0 + 100 ms: the last frame's (99.999 ms) bracketed
+  EXPECT_EQ(c.count.at(channel::kGroundTruth), 21);  // t0 - 50 ms .. t0 + 150 ms: 50 ms beyond the frames on each side
   EXPECT_EQ(c.count.size(), 3u);  // no heartbeats: nothing but the data goes into the log
   int frame = 0;
   for (size_t i = 0; i < c.events.size(); ++i) {
