@@ -56,13 +56,7 @@ void Estimator::apply(Event& e, FilterState& s) {
       return;
     }
     case EventKind::kCorrection: {
-      Matrix6d Q = e.correction.covariance;
-      if (Q.isZero(0.0)) {
-        Q.setZero();
-        Q.diagonal() << Eigen::Vector3d::Constant(std::pow(options_.correction_sigma_position, 2)),
-            Eigen::Vector3d::Constant(std::pow(options_.correction_sigma_rotation, 2));
-      }
-      const AbsolutePoseMeasurement m(e.correction.T_world_body, Q);
+      const AbsolutePoseMeasurement m(e.correction.T_world_body, correction_noise(options_, e.correction));
       const UpdateResult r = filter_->update(s, m, options_.correction_gate_chi2);
       e.outcome = r.applied ? Outcome::kApplied : Outcome::kGated;
       return;

@@ -28,6 +28,14 @@ Matrix6d vo_noise(const VoNoiseOptions& options, const VoUpdate& u) {
   return options.reported_scale * u.covariance;
 }
 
+Matrix6d correction_noise(const EstimatorOptions& options, const PoseCorrection& c) {
+  if (!c.covariance.isZero(0.0)) return c.covariance;
+  Matrix6d Q = Matrix6d::Zero();
+  Q.topLeftCorner<3, 3>().diagonal().setConstant(options.correction_sigma_position * options.correction_sigma_position);
+  Q.bottomRightCorner<3, 3>().diagonal().setConstant(options.correction_sigma_rotation * options.correction_sigma_rotation);
+  return Q;
+}
+
 void validate_imu(const ImuSample& s, const std::string& what) {
   if (!s.gyro.allFinite() || !s.accel.allFinite())
     throw InputError(what + ": non-finite IMU reading at utime " + std::to_string(s.utime));

@@ -33,6 +33,9 @@ struct PoseCorrection {
 
 /// The noise of a VO update's [dp; dtheta] under `options` (reported or constant).
 Matrix6d vo_noise(const VoNoiseOptions& options, const VoUpdate& update);
+/// The noise of a correction's [dp; dtheta]: its covariance, or the options' sigmas when it
+/// carries none (all zero).
+Matrix6d correction_noise(const EstimatorOptions& options, const PoseCorrection& correction);
 
 /// Throws InputError (naming `what`) unless the input is usable: finite values, a proper
 /// rotation, a symmetric positive semi-definite covariance (all zero allowed where noted).

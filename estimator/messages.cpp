@@ -22,9 +22,9 @@ ImuReading imu_from_message(const kestrel::imu_t& m, const std::string& channel)
   if (!r.gyro && !r.accel)
     throw InputError(what + " has neither a gyro nor an accelerometer reading (fields = " +
                      std::to_string(static_cast<int>(m.fields)) + ")");
-  if ((r.gyro && !r.gyro->allFinite()) || (r.accel && !r.accel->allFinite()))
-    throw InputError(what + ": non-finite reading");
-  if (m.utime < 0) throw InputError(what + ": negative utime");
+  // The filter's own checks, on the parts there are (a missing part stands in as zero).
+  validate_imu({r.utime, r.gyro.value_or(Eigen::Vector3d::Zero()), r.accel.value_or(Eigen::Vector3d::Zero())},
+               channel);
   return r;
 }
 

@@ -10,13 +10,11 @@ void StateEstimator::reset() {
   imu_filter_.reset();
   visual_.reset();
   first_vo_utime_ = -1;
-  imu_seen_ = false;
 }
 
 StepResult StateEstimator::add_imu(const ImuReading& r) {
   if (mode_ == EstimatorMode::kAuto)
     mode_ = r.gyro ? EstimatorMode::kImu : EstimatorMode::kVisualOnly;
-  imu_seen_ = true;
   StepResult result;
   if (mode_ == EstimatorMode::kVisualOnly) {
     if (r.accel) visual_.add_accel(r.utime, *r.accel);
@@ -36,7 +34,7 @@ StepResult StateEstimator::add_imu(const ImuReading& r) {
 
 StepResult StateEstimator::add_vo(const VoUpdate& u) {
   StepResult result;
-  if (mode_ == EstimatorMode::kAuto && !imu_seen_) {
+  if (mode_ == EstimatorMode::kAuto) {  // still undecided: no IMU reading has come
     if (first_vo_utime_ < 0) first_vo_utime_ = u.utime;
     const double span_s = static_cast<double>(u.utime - first_vo_utime_) * 1e-6;
     if (span_s >= options_.visual_only.no_imu_after_s) mode_ = EstimatorMode::kVisualOnly;

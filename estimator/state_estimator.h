@@ -49,8 +49,7 @@ class StateEstimator {
   EstimatorMode mode_;
   Estimator imu_filter_;
   VisualOnlyEstimator visual_;
-  int64_t first_vo_utime_ = -1;  // while undecided and no IMU reading seen
-  bool imu_seen_ = false;
+  int64_t first_vo_utime_ = -1;  // while undecided (the first IMU reading decides at once)
   int64_t vo_before_decision_ = 0;
   int64_t incomplete_imu_ = 0;
 };

@@ -241,12 +241,7 @@ Verdict VisualOnlyEstimator::add_correction(const PoseCorrection& c) {
     T = se3::interpolate(before.T_world_body, after->T_world_body, s);
     P = (1.0 - s) * before.covariance + s * after->covariance;
   }
-  Matrix6d Q = c.covariance;
-  if (Q.isZero(0.0)) {
-    Q.setZero();
-    Q.topLeftCorner<3, 3>().diagonal().setConstant(sq(options_.correction_sigma_position));
-    Q.bottomRightCorner<3, 3>().diagonal().setConstant(sq(options_.correction_sigma_rotation));
-  }
+  const Matrix6d Q = correction_noise(options_, c);
   const Vector6d innovation = se3::boxminus(c.T_world_body, T);
   if (options_.correction_gate_chi2 > 0.0 &&
       innovation.dot((P + Q).ldlt().solve(innovation)) > options_.correction_gate_chi2) {

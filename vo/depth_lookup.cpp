@@ -61,7 +61,7 @@ void attach_depth(const cv::Mat& depth_mm, const Lens& lens, const DepthOptions&
   const float fx = float(cam.fx), fy = float(cam.fy), cx = float(cam.cx), cy = float(cam.cy);
   const bool compensate = options.compensate_time_offset && motion.known && motion.depth_offset_s != 0.0;
   const Eigen::Isometry3f T_rgb_depth =
-      compensate ? se3::exp(motion.twist_per_s * motion.depth_offset_s).cast<float>() : Eigen::Isometry3f::Identity();
+      compensate ? motion.T_rgb_depth().cast<float>() : Eigen::Isometry3f::Identity();
   const Eigen::Isometry3f T_depth_rgb = T_rgb_depth.inverse();
   std::array<int, kMaxLevels + 1> begin = frame.level_begin;
   size_t kept = 0;

@@ -150,7 +150,7 @@ SlamStep Slam::add(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camer
   kf.utime = frame.utime;
   kf.T_odom_camera = T_odom_camera;
   kf.T_body_camera = frame.T_body_camera;
-  if (motion.known) kf.T_camera_depth = se3::exp(motion.depth_offset_s * motion.twist_per_s);
+  kf.T_camera_depth = motion.T_rgb_depth();
   kf.features = extractor_.extract(frame, motion);
   const Eigen::Isometry3d T_world_camera =
       keyframes_.empty() ? T_odom_camera

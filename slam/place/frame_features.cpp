@@ -108,8 +108,7 @@ FrameFeatures FeatureExtractor::extract(const cv::Mat& grey, const cv::Mat& dept
   // depth offset, whose points stay exactly as read at the keypoint.
   const bool timed = motion.known && (motion.depth_offset_s != 0.0 || motion.readout_s > 0.0);
   const bool depth_time = motion.known && motion.depth_offset_s != 0.0;
-  const Eigen::Isometry3d T_rgb_depth =
-      depth_time ? se3::exp(motion.twist_per_s * motion.depth_offset_s) : Eigen::Isometry3d::Identity();
+  const Eigen::Isometry3d T_rgb_depth = motion.T_rgb_depth();
   const Eigen::Isometry3d T_depth_rgb = T_rgb_depth.inverse();
   // The lens (top of frame_features.h): without distortion ideal pixels are the raw ones and
   // the untimed path below is the one keyframes always took.

@@ -288,7 +288,7 @@ TEST_F(AdapterTest, KeyframeFeaturesTakeTheCamerasTimingAndTheOdometrysMotion) {
     EXPECT_GT(moved, got.num_points() / 2) << "the correction moved the points (15 mm of depth at 1 m/s)";
   }
   // The depth's camera for the mapper: the same motion over the depth offset, in SLAM_GRAPH.
-  const Eigen::Isometry3d T_camera_depth = se3::exp(motion.depth_offset_s * motion.twist_per_s);
+  const Eigen::Isometry3d T_camera_depth = se3::exp(motion.depth_offset_s * motion.twist_per_s);  // by hand
   EXPECT_GT(T_camera_depth.translation().norm(), 0.01) << "1 m/s over the Kinect's depth offset";
   for (const SlamAdapter* a : {&timed, &told}) {
     EXPECT_TRUE(a->slam().keyframes()[1].T_camera_depth.isApprox(T_camera_depth, 1e-12));
