@@ -3,8 +3,11 @@
 // hold"). The hold target is the first truth pose: the sim's vehicle starts at rest there and
 // holds it. --print-start gives that pose as the estimator's start options.
 
+#include <algorithm>
 #include <cmath>
 #include <iostream>
+#include <set>
+#include <vector>
 
 #include "common/cli.h"
 #include "common/error.h"
@@ -73,11 +76,20 @@ int run(const Options& o) {
   if (o.truth_only) flown.clear();
   const double on_state_s = flown.empty() ? 0.0 : 1e-6 * static_cast<double>(flown.front().utime - start.utime);
   const double from_s = o.from_s >= 0 ? o.from_s : std::max(0.0, on_state_s);
+  // The VO's keyframe policy decides how its errors add up over a hold: count the references
+  // its motions were measured from, and their inliers.
   int64_t vo = 0, vo_ok = 0;
+  std::set<int64_t> references;
+  std::vector<int> inliers;
   for (const auto& m : transport::read_messages<kestrel::vo_update_t>(o.log, channel::kVoUpdate)) {
     ++vo;
-    if (m.status == kestrel::vo_update_t::STATUS_OK) ++vo_ok;
+    if (m.status != kestrel::vo_update_t::STATUS_OK) continue;
+    ++vo_ok;
+    references.insert(m.reference_utime);
+    inliers.push_back(m.num_reprojection_inliers);
   }
+  std::sort(inliers.begin(), inliers.end());
+  const int median_inliers = inliers.empty() ? 0 : inliers[inliers.size() / 2];
   HoldScore s;
   try {
     s = score_hold(truth, flown, start.p, from_s);
@@ -95,6 +107,7 @@ int run(const Options& o) {
     std::printf("STATE: %lld messages, %lld usable, %lld of them DEGRADED; VO_UPDATE: %lld (%lld OK)\n",
                 static_cast<long long>(states), static_cast<long long>(flown.size()),
                 static_cast<long long>(degraded), static_cast<long long>(vo), static_cast<long long>(vo_ok));
+    std::printf("VO: motions from %zu reference frames, median %d inliers\n", references.size(), median_inliers);
   }
   std::cout << "hold, truth from target, horizontal: " << cm(s.truth_horizontal) << "\n"
             << "hold, truth from target, 3D:         " << cm(s.truth_3d) << "\n";

@@ -1,5 +1,6 @@
 #include "vo/odometry.h"
 
+#include <algorithm>
 #include <cmath>
 #include <opencv2/imgproc.hpp>
 
@@ -254,7 +255,13 @@ VoResult VisualOdometry::process(const RgbdFrame& input) {
   const bool against_keyframe = attempt.reference == keyframe_;
   if (against_keyframe && keyframe_first_inliers_ == 0) keyframe_first_inliers_ = e.num_reprojection_inliers;
   const double relative_floor = options_.keyframe.min_inlier_fraction_to_keep * keyframe_first_inliers_;
-  if (result.fell_back_to_previous || e.num_reprojection_inliers < options_.keyframe.min_inliers_to_keep ||
+  const KeyframeOptions& k = options_.keyframe;
+  const bool near_keyframe = against_keyframe && k.min_inliers_to_keep_near > 0 &&
+                             e.T_ref_cur.translation().norm() <= k.near_translation_m &&
+                             Eigen::AngleAxisd(e.T_ref_cur.linear()).angle() <= k.near_rotation_rad;
+  const int absolute_floor = near_keyframe ? std::min(k.min_inliers_to_keep_near, k.min_inliers_to_keep)
+                                           : k.min_inliers_to_keep;
+  if (result.fell_back_to_previous || e.num_reprojection_inliers < absolute_floor ||
       e.num_reprojection_inliers < relative_floor) {
     keyframe_ = &cur;
     keyframe_first_inliers_ = 0;

@@ -145,6 +145,14 @@ struct KeyframeOptions {
   /// Relative rule: the current frame also becomes the reference when its inliers fall below this
   /// fraction of the keyframe's inliers at its first match (0 = off, only the floor applies).
   double min_inlier_fraction_to_keep = 0.0;
+  /// Near rule: while the camera is within near_translation_m and near_rotation_rad of the
+  /// keyframe, the keyframe is kept down to min_inliers_to_keep_near instead (0 = off). A
+  /// hovering camera stays near its keyframe, often with fewer than min_inliers_to_keep
+  /// inliers in view; re-keying it at every frame turns a bounded error into a random walk
+  /// (vo/README.md, "Keyframes"). 150 is fovis's own re-keying threshold.
+  int min_inliers_to_keep_near = 150;
+  double near_translation_m = 0.03;
+  double near_rotation_rad = 0.03;
   bool fall_back_to_previous = true;
 };
 

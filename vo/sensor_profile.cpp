@@ -15,6 +15,7 @@ VoOptions with_sensor(SensorProfile profile, VoOptions options) {
   options.covariance.translation_per_rad_m = kKinect1TranslationPerRadM;
   options.covariance.rotation_per_rad = kKinect1RotationPerRad;
   options.dense.weight = kKinect1DenseWeight;
+  options.keyframe.min_inliers_to_keep_near = kKinect1MinInliersToKeepNear;
   options.validate();
   return options;
 }

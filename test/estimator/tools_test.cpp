@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <array>
 #include <string>
 #include <vector>
 
@@ -15,6 +16,7 @@
 #include "common/transport/log_file.h"
 #include "kestrel/ground_truth_t.hpp"
 #include "kestrel/state_t.hpp"
+#include "kestrel/vo_update_t.hpp"
 #include "test/estimator/synthetic_log.h"
 #include "test/support/test_support.h"
 
@@ -111,13 +113,28 @@ TEST(HoldTool, ScoresTruthFromTargetAndStateFromTruth) {
     w.write_message(channel::kState, 1200000, state(1200000, kestrel::state_t::STATUS_INITIALIZING, 0, 0, 0));
     w.write_message(channel::kState, 1500000, state(1500000, kestrel::state_t::STATUS_OK, 1, 2, 3));
     w.write_message(channel::kState, 2000000, state(2000000, kestrel::state_t::STATUS_DEGRADED, 1.03, 2.04, 3.12));
+    // Three motions from two references (inliers 250, 180, 320: median 250) and a failure.
+    const std::vector<std::array<int64_t, 4>> vo{{1100000, 1000000, 250, kestrel::vo_update_t::STATUS_OK},
+                                                 {1200000, 1000000, 180, kestrel::vo_update_t::STATUS_OK},
+                                                 {1300000, 1200000, 320, kestrel::vo_update_t::STATUS_OK},
+                                                 {1400000, 0, 0, kestrel::vo_update_t::STATUS_INSUFFICIENT_INLIERS}};
+    for (const auto& [utime, reference, inliers, status] : vo) {
+      kestrel::vo_update_t m{};
+      m.utime = utime;
+      m.reference_utime = reference;
+      m.num_reprojection_inliers = static_cast<int32_t>(inliers);
+      m.status = static_cast<int8_t>(status);
+      m.T_reference_current = transport::to_message(Eigen::Isometry3d::Identity());
+      w.write_message(channel::kVoUpdate, utime, m);
+    }
     w.close();
     t.close();
   }
   auto r = ts::run({ts::tool("hold"), "--log", log});
   ASSERT_EQ(r.exit_code, kExitOk) << r.err;
   for (const char* want : {"flying on STATE from 0.50 s; scored 0.50 to 1.00 s",
-                           "STATE: 3 messages, 2 usable, 1 of them DEGRADED",
+                           "STATE: 3 messages, 2 usable, 1 of them DEGRADED; VO_UPDATE: 4 (3 OK)",
+                           "VO: motions from 2 reference frames, median 250 inliers",
                            "truth from target, horizontal: mean   5.0 cm, max   5.0 cm",
                            "truth from target, 3D:         mean   9.0 cm, max  13.0 cm",
                            "truth vs STATE, horizontal: mean   2.5 cm, max   5.0 cm",

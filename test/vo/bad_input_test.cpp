@@ -161,7 +161,10 @@ TEST(Options, SetByNameAndRejectedByName) {
   set_option(o, "refinement.pixel_sigma_from_residuals", "false");
   EXPECT_FALSE(o.refinement.pixel_sigma_from_residuals);
   EXPECT_THROW(set_option(o, "refinement.min_pixel_sigma", "0"), std::invalid_argument);
-  EXPECT_EQ(describe_options(o).size(), 69u);
+  set_option(o, "keyframe.min_inliers_to_keep_near", "0");
+  EXPECT_EQ(o.keyframe.min_inliers_to_keep_near, 0);
+  EXPECT_THROW(set_option(o, "keyframe.near_translation_m", "-0.01"), std::invalid_argument);
+  EXPECT_EQ(describe_options(o).size(), 72u);
 }
 
 }  // namespace

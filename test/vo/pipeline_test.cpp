@@ -112,6 +112,43 @@ TEST(Pipeline, RelativeKeyframeRuleFollowsTheFirstMatchCount) {
   EXPECT_GT(new_references, 0) << "the arc loses more than 10 % of the first view's inliers";
 }
 
+// The near rule: with the absolute floor above any frame's inliers, the keyframe is kept exactly
+// while the camera is within the near radius of it. The arc moves 1.23 cm per frame, so with a
+// 3 cm radius frames 1 and 2 are measured against frame 0, frame 3 (3.7 cm) re-keys, and so on.
+// Its inlier floor still applies near the keyframe.
+TEST(Pipeline, NearKeyframeRuleKeepsTheKeyframeWithinItsRadius) {
+  const auto& frames = rendered().frames;
+  VoOptions o;
+  o.keyframe.min_inliers_to_keep = 1000000;
+  o.keyframe.min_inliers_to_keep_near = 1;
+  o.keyframe.near_translation_m = 0.03;
+  o.keyframe.near_rotation_rad = 0.05;
+  VisualOdometry vo(o);
+  vo.process(frames[0]);
+  std::vector<size_t> new_references;
+  for (size_t k = 1; k < frames.size(); ++k) {
+    const VoResult r = vo.process(frames[k]);
+    ASSERT_EQ(r.status, VoStatus::kOk) << r.message;
+    if (r.new_reference) new_references.push_back(k);
+  }
+  EXPECT_EQ(new_references, (std::vector<size_t>{3, 6}));
+
+  o.keyframe.min_inliers_to_keep_near = 1000000;
+  VisualOdometry strict(o);
+  strict.process(frames[0]);
+  for (size_t k = 1; k < frames.size(); ++k) {
+    EXPECT_TRUE(strict.process(frames[k]).new_reference) << "frame " << k << ": below the near floor";
+  }
+
+  o.keyframe.min_inliers_to_keep_near = 1;
+  o.keyframe.near_rotation_rad = 0.005;  // the arc turns 0.008 rad per frame
+  VisualOdometry turning(o);
+  turning.process(frames[0]);
+  for (size_t k = 1; k < frames.size(); ++k) {
+    EXPECT_TRUE(turning.process(frames[k]).new_reference) << "frame " << k << ": turned beyond the near angle";
+  }
+}
+
 TEST(Pipeline, ResetForgetsTheReference) {
   VisualOdometry vo;
   const auto& frames = rendered().frames;
