@@ -1,7 +1,11 @@
 #include "slam/sequence_run.h"
 
+#include <algorithm>
 #include <chrono>
+#include <stdexcept>
+#include <string>
 
+#include "common/geometry/se3.h"
 #include "slam/backend/odometry_chain.h"
 #include "vo/odometry.h"
 
@@ -26,6 +30,7 @@ SlamRun run_slam_sequence(size_t count, const std::function<RgbdFrame(size_t)>& 
     Eigen::Isometry3d T_keyframe_camera;  // odometry since that keyframe
   };
   std::vector<Placed> placed;
+  std::vector<bool> continues;  // per keyframe: its odometry follows on from the previous keyframe's
   std::optional<OdometryPose> keyframe_pose;  // the chain's pose of the newest keyframe
   std::optional<OdometryPose> previous_pose;  // the chain's pose of the previous frame with one
   for (size_t i = 0; i < count; ++i) {
@@ -62,7 +67,10 @@ SlamRun run_slam_sequence(size_t count, const std::function<RgbdFrame(size_t)>& 
         odometry_covariance = chain.relative_covariance(*keyframe_pose, *pose);
       }
       const SlamStep step = slam.add(frame, pose->T_odom_camera, link, odometry_covariance, motion);
-      if (step.keyframe) keyframe_pose = *pose;
+      if (step.keyframe) {
+        keyframe_pose = *pose;
+        continues.push_back(link == OdometryLink::kContinuous && !continues.empty());
+      }
       run.keyframe_ms.push_back(
           std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
       run.candidates_verified += step.candidates;
@@ -71,8 +79,15 @@ SlamRun run_slam_sequence(size_t count, const std::function<RgbdFrame(size_t)>& 
     run.vo.push_back(frame.utime, pose->T_odom_camera);
     placed.push_back({frame.utime, static_cast<int>(kf.id), kf.T_odom_camera.inverse() * pose->T_odom_camera});
   }
+  std::vector<KeyframeCorrection> corrections;
+  for (size_t k = 0; k < slam.keyframes().size(); ++k) {
+    const Keyframe& kf = slam.keyframes()[k];
+    corrections.push_back({kf.utime, slam.graph().poses[k] * kf.T_odom_camera.inverse(), continues[k]});
+  }
   for (const Placed& p : placed) {
-    run.slam.push_back(p.utime, slam.graph().poses[static_cast<size_t>(p.keyframe)] * p.T_keyframe_camera);
+    const auto k = static_cast<size_t>(p.keyframe);
+    run.slam.push_back(p.utime, place_frame(corrections, k, p.utime,
+                                            slam.keyframes()[k].T_odom_camera * p.T_keyframe_camera));
   }
   for (const auto& e : slam.graph().edges) {
     if (e.kind != EdgeKind::kLoopClosure) continue;
@@ -83,6 +98,16 @@ SlamRun run_slam_sequence(size_t count, const std::function<RgbdFrame(size_t)>& 
   run.loop_closures = slam.num_loop_closures();
   run.inconsistent_loops = slam.num_inconsistent_loops();
   return run;
+}
+
+Eigen::Isometry3d place_frame(const std::vector<KeyframeCorrection>& keyframes, size_t newest, int64_t utime,
+                              const Eigen::Isometry3d& T_odom_camera) {
+  if (newest >= keyframes.size()) throw std::out_of_range("slam: place_frame: no keyframe " + std::to_string(newest));
+  const KeyframeCorrection& a = keyframes[newest];
+  if (newest + 1 == keyframes.size() || !keyframes[newest + 1].continues_previous) return a.T_world_odom * T_odom_camera;
+  const KeyframeCorrection& b = keyframes[newest + 1];
+  const double s = static_cast<double>(utime - a.utime) / static_cast<double>(b.utime - a.utime);
+  return se3::interpolate(a.T_world_odom, b.T_world_odom, std::clamp(s, 0.0, 1.0)) * T_odom_camera;
 }
 
 std::vector<LoopError> loop_errors(const SlamRun& run, const Trajectory& ground_truth) {

@@ -43,6 +43,22 @@ struct LoopError {
   double rotation_rad = 0.0;
 };
 
+/// What the optimised graph says of the odometry at one keyframe: T_world_odom, the pose the
+/// graph gives the keyframe times the inverse of the odometry's.
+struct KeyframeCorrection {
+  int64_t utime = 0;
+  Eigen::Isometry3d T_world_odom = Eigen::Isometry3d::Identity();
+  bool continues_previous = false;  ///< one odometry segment from the previous keyframe to this one
+};
+
+/// A frame's pose by the graph: `T_odom_camera` after `keyframes[newest]` (the newest keyframe
+/// at its time, at or before `utime`), corrected by the keyframes' T_world_odom interpolated by
+/// time between that keyframe and the next, when the next continues its odometry segment;
+/// else by the keyframe's own. The odometry's error grows from each keyframe, so a loop's
+/// correction is spread along the segment instead of arriving as a jump at the next keyframe.
+Eigen::Isometry3d place_frame(const std::vector<KeyframeCorrection>& keyframes, size_t newest, int64_t utime,
+                              const Eigen::Isometry3d& T_odom_camera);
+
 /// The error of each of `run`'s loop closures against `ground_truth` (T_world_camera, as
 /// TUM's groundtruth.txt; interpolated within 0.1 s).
 std::vector<LoopError> loop_errors(const SlamRun& run, const Trajectory& ground_truth);
