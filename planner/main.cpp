@@ -68,6 +68,11 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"uniform", "su", "gaussian", "bridge"}));
   app.add_option("--sensor", sensor, "kinect or camera (the paper's)")->check(CLI::IsMember({"kinect", "camera"}));
   app.add_option("--feature-density", o.feature_density_per_m2, "Features assumed per m^2 of wall")->check(cli::Positive);
+  double dominance_slack = kToolsDominanceSlack;
+  app.add_option("--dominance-slack", dominance_slack,
+                 "PLANNER_BRM_DOMINANCE requests: a label is also dropped when one kept at its node is within this "
+                 "fraction of dominating it (0: exact dominance, slow on large roadmaps)")
+      ->check(CLI::NonNegativeNumber)->capture_default_str();
   app.add_option("--start-unknown-free", o.start_unknown_free_m,
                  "Unknown map cells within this of the vehicle count as free when planning from STATE (m): the "
                  "camera cannot see the space around the vehicle")
@@ -101,7 +106,10 @@ int main(int argc, char** argv) {
       }
       q.goal = Config(r.goal[0], r.goal[1], r.goal[2], r.goal[3]);
       q.brm = r.planner != kestrel::plan_request_t::PLANNER_PRM;
-      if (r.planner == kestrel::plan_request_t::PLANNER_BRM_DOMINANCE) q.pruning = BrmPruning::kCovarianceDominance;
+      if (r.planner == kestrel::plan_request_t::PLANNER_BRM_DOMINANCE) {
+        q.pruning = BrmPruning::kCovarianceDominance;
+        q.dominance_slack = dominance_slack;
+      }
       q.objective = r.objective == kestrel::plan_request_t::OBJECTIVE_SHORTEST_BOUNDED ? BrmObjective::kShortestBounded
                                                                                        : BrmObjective::kMinGoalUncertainty;
       if (r.objective == kestrel::plan_request_t::OBJECTIVE_SHORTEST_BOUNDED) q.max_trace = r.max_covariance_trace;

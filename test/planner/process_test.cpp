@@ -3,12 +3,14 @@
 // by both label rules, PRM, bad ones) goes through the running planner twice (RESET
 // between). Each request gets one PLAN with the right status; the plans run from their start
 // to their goal through the gap, clear of the known walls, with the predicted tr(Sigma)
-// starting at the request's (or the state's); the second replay answers identically.
+// starting at the request's (or the state's); the second replay answers identically. The
+// dominance request runs with --dominance-slack 0 (exact).
 #include <gtest/gtest.h>
 #include <octomap/OcTree.h>
 
 #include <sstream>
 
+#include "common/error.h"
 #include "common/transport/channels.h"
 #include "common/transport/log_file.h"
 #include "kestrel/octomap_t.hpp"
@@ -118,7 +120,7 @@ TEST(PlannerProcess, AnswersEveryRequestOverLcmAndRepeatsAfterReset) {
   const std::string planner = kestrel::test::tool("planner").string();
   const std::string replay = kestrel::test::tool("replay").string();
   const std::string script =
-      "'" + planner + "' -q --sensor kinect & P=$!; "
+      "'" + planner + "' -q --sensor kinect --dominance-slack 0 & P=$!; "
       "'" + replay + "' '" + in + "' --expect planner --record '" + (dir / "a.lcmlog").string() + "' >/dev/null && "
       "'" + replay + "' '" + in + "' --expect planner --record '" + (dir / "b.lcmlog").string() + "' >/dev/null; "
       "R=$?; kill $P; wait $P; exit $R";
@@ -148,6 +150,9 @@ TEST(PlannerProcess, AnswersEveryRequestOverLcmAndRepeatsAfterReset) {
     EXPECT_GT(check_path(p, 0.3 - 0.05), kGapY) << "plan " << k + 1 << " does not go through the gap";
     EXPECT_GE(p.length, 5.0);
   }
+  // A negative slack is refused on the command line.
+  EXPECT_EQ(kestrel::test::run({planner, "--dominance-slack", "-0.1"}, 10.0).exit_code, kExitUsage);
+
   // The second replay (after a RESET) gives the same plans.
   for (size_t i = 0; i < a.size(); ++i) {
     EXPECT_EQ(b[i].status, a[i].status);
