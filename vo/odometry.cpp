@@ -258,7 +258,7 @@ VoResult VisualOdometry::process(const RgbdFrame& input) {
   const KeyframeOptions& k = options_.keyframe;
   const bool near_keyframe = against_keyframe && k.min_inliers_to_keep_near > 0 &&
                              e.T_ref_cur.translation().norm() <= k.near_translation_m &&
-                             Eigen::AngleAxisd(e.T_ref_cur.linear()).angle() <= k.near_rotation_rad;
+                             so3::angle(e.T_ref_cur.linear()) <= k.near_rotation_rad;
   const int absolute_floor = near_keyframe ? std::min(k.min_inliers_to_keep_near, k.min_inliers_to_keep)
                                            : k.min_inliers_to_keep;
   if (result.fell_back_to_previous || e.num_reprojection_inliers < absolute_floor ||
