@@ -59,11 +59,14 @@ VoxelMap from_octree(const octomap::OcTree& tree, MapOptions options) {
 
 namespace {
 
+// The first line of every OctoMap binary (.bt) stream.
+constexpr const char* kBinaryHeader = "# Octomap OcTree binary file";
+
 // Debian's liboctomap is built with its debug output on: reading a stream prints "Reading
 // binary octree type OcTree" to std::cerr, a line in the planner's log per map it receives.
 // Its failures come back as return values, which are turned into errors here. (Its " done."
-// after writing goes through stdio's stderr and is left: muting file descriptor 2 would also
-// swallow the process's own log lines.)
+// after writing goes through stdio's stderr, which cannot be muted without also swallowing
+// the process's own log lines: write_binary() below does not call the function that prints it.)
 class QuietOctomap {
  public:
   QuietOctomap() : saved_(std::cerr.rdbuf(nullptr)) {}
@@ -75,19 +78,30 @@ class QuietOctomap {
   std::streambuf* saved_;
 };
 
+// OcTree::writeBinary() without the " done." Debian's liboctomap prints to stderr after every
+// tree (a debug line compiled in; the mapper's log had one per published map): the header its
+// readBinary() reads, then the tree's data at maximum likelihood and pruned again, as
+// writeBinary() does, so a .bt is canonical: reading it and writing it again gives the same
+// bytes. Only the header's optional comment lines differ from writeBinary()'s.
+bool write_binary(octomap::OcTree& tree, std::ostream& out) {
+  tree.toMaxLikelihood();
+  tree.prune();
+  out << kBinaryHeader << "\nid " << tree.getTreeType() << "\nsize " << tree.size() << "\nres "
+      << tree.getResolution() << "\ndata\n";
+  tree.writeBinaryData(out);
+  return out.good();
+}
+
 void write_stream(const VoxelMap& map, OctreeFormat format, std::ostream& out) {
   const auto tree = to_octree(map);
-  // writeBinary first turns the tree to maximum likelihood and prunes it again, so a .bt is
-  // canonical: reading it and writing it again gives the same bytes.
-  const bool ok = format == OctreeFormat::kBinary ? tree->writeBinary(out) : tree->write(out);
+  const bool ok = format == OctreeFormat::kBinary ? write_binary(*tree, out) : tree->write(out);
   if (!ok) throw std::runtime_error("OctoMap could not write the tree");
 }
 
 std::unique_ptr<octomap::OcTree> read_tree(const std::string& bytes, OctreeFormat format, const std::string& what) {
   // Check the first line and the node structure here, so that a wrong file gets our one-line
   // error only, and a corrupt one never reaches OctoMap's unbounded recursion.
-  const char* header =
-      format == OctreeFormat::kBinary ? "# Octomap OcTree binary file" : "# Octomap OcTree file";
+  const char* header = format == OctreeFormat::kBinary ? kBinaryHeader : "# Octomap OcTree file";
   if (bytes.compare(0, std::strlen(header), header) != 0) {
     throw InputError(what + ": not an OctoMap " +
                      (format == OctreeFormat::kBinary ? "binary (.bt)" : "full (.ot)") + " stream");

@@ -310,7 +310,9 @@ TEST(OctreeFiles, WrittenFilesReadBackIdentical) {
   }
   kestrel::test::TempDir dir;
   write_map_file(map, (dir / "map.ot").string());
+  ::testing::internal::CaptureStderr();
   write_map_file(map, (dir / "map.bt").string());
+  EXPECT_EQ(::testing::internal::GetCapturedStderr(), "") << "OctoMap's writeBinary prints \" done.\"";
 
   // .ot keeps every value.
   const VoxelMap full = read_map_file((dir / "map.ot").string());
@@ -323,6 +325,12 @@ TEST(OctreeFiles, WrittenFilesReadBackIdentical) {
   map.for_each_cell([&](const Key& k, float v) { ASSERT_EQ(binary.occupancy(k), map.occupancy(v)); });
   write_map_file(binary, (dir / "again.bt").string());
   EXPECT_EQ(kestrel::test::read_file(dir / "again.bt"), kestrel::test::read_file(dir / "map.bt"));
+  // The tree's data are OctoMap's writeBinary's to the byte (only the header's comments differ).
+  std::ostringstream octomap_bt;
+  to_octree(map)->writeBinary(octomap_bt);
+  const std::string ours = kestrel::test::read_file(dir / "map.bt"), theirs = octomap_bt.str();
+  ASSERT_NE(ours.find("\ndata\n"), std::string::npos);
+  EXPECT_EQ(ours.substr(ours.find("\ndata\n")), theirs.substr(theirs.find("\ndata\n")));
 
   // The message form round-trips the same way.
   const auto stream = encode_octree(map, OctreeFormat::kFull);
