@@ -14,6 +14,11 @@ target_compile_options(kestrel_options INTERFACE
 # floating-point options.
 target_compile_options(kestrel_options INTERFACE -fno-math-errno -fno-trapping-math)
 
+# OctoMap's headers print debug lines to stderr ("Writing N nodes to output stream...") from
+# the templates compiled into our own code unless NDEBUG is set; a Debug or sanitizer build
+# would then print what a Release build does not. Off in every build.
+target_compile_definitions(kestrel_options INTERFACE OCTOMAP_NODEBUGOUT)
+
 if(KESTREL_SANITIZE)
   target_compile_options(kestrel_options INTERFACE
     -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined
