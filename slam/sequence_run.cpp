@@ -30,7 +30,6 @@ SlamRun run_slam_sequence(size_t count, const std::function<RgbdFrame(size_t)>& 
     Eigen::Isometry3d T_keyframe_camera;  // odometry since that keyframe
   };
   std::vector<Placed> placed;
-  std::vector<bool> continues;  // per keyframe: its odometry follows on from the previous keyframe's
   std::optional<OdometryPose> keyframe_pose;  // the chain's pose of the newest keyframe
   std::optional<OdometryPose> previous_pose;  // the chain's pose of the previous frame with one
   for (size_t i = 0; i < count; ++i) {
@@ -67,10 +66,7 @@ SlamRun run_slam_sequence(size_t count, const std::function<RgbdFrame(size_t)>& 
         odometry_covariance = chain.relative_covariance(*keyframe_pose, *pose);
       }
       const SlamStep step = slam.add(frame, pose->T_odom_camera, link, odometry_covariance, motion);
-      if (step.keyframe) {
-        keyframe_pose = *pose;
-        continues.push_back(link == OdometryLink::kContinuous && !continues.empty());
-      }
+      if (step.keyframe) keyframe_pose = *pose;
       run.keyframe_ms.push_back(
           std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
       run.candidates_verified += step.candidates;
@@ -82,7 +78,8 @@ SlamRun run_slam_sequence(size_t count, const std::function<RgbdFrame(size_t)>& 
   std::vector<KeyframeCorrection> corrections;
   for (size_t k = 0; k < slam.keyframes().size(); ++k) {
     const Keyframe& kf = slam.keyframes()[k];
-    corrections.push_back({kf.utime, slam.graph().poses[k] * kf.T_odom_camera.inverse(), continues[k]});
+    corrections.push_back({kf.utime, slam.graph().poses[k] * kf.T_odom_camera.inverse(),
+                           k > 0 && kf.link == OdometryLink::kContinuous});
   }
   for (const Placed& p : placed) {
     const auto k = static_cast<size_t>(p.keyframe);

@@ -151,6 +151,7 @@ SlamStep Slam::add(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camer
   kf.T_odom_camera = T_odom_camera;
   kf.T_body_camera = frame.T_body_camera;
   kf.T_camera_depth = motion.T_rgb_depth();
+  kf.link = keyframes_.empty() ? OdometryLink::kContinuous : link;
   kf.features = extractor_.extract(frame, motion);
   const Eigen::Isometry3d T_world_camera =
       keyframes_.empty() ? T_odom_camera

@@ -29,6 +29,13 @@
 
 namespace kestrel::slam {
 
+/// How a frame's odometry pose relates to the previous frame's.
+enum class OdometryLink {
+  kContinuous,  ///< the visual odometry carried on: the pose follows from the previous one
+  kBridged,     ///< the VO restarted and the state estimator (IMU) bridged the gap: related, less certain
+  kBroken,      ///< the VO restarted and nothing relates the poses
+};
+
 struct Keyframe {
   int64_t id = 0;                 ///< = its index
   int64_t utime = 0;
@@ -37,14 +44,9 @@ struct Keyframe {
   /// The camera at the depth image's time, in the camera at utime's frame (the timing's
   /// motion over the depth offset; identity when the motion is unknown).
   Eigen::Isometry3d T_camera_depth = Eigen::Isometry3d::Identity();
+  /// How its odometry pose relates to the previous keyframe's (the first's: kContinuous).
+  OdometryLink link = OdometryLink::kContinuous;
   FrameFeatures features;
-};
-
-/// How a frame's odometry pose relates to the previous frame's.
-enum class OdometryLink {
-  kContinuous,  ///< the visual odometry carried on: the pose follows from the previous one
-  kBridged,     ///< the VO restarted and the state estimator (IMU) bridged the gap: related, less certain
-  kBroken,      ///< the VO restarted and nothing relates the poses
 };
 
 /// What one call of Slam::add did.

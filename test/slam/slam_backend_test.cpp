@@ -139,6 +139,12 @@ TEST(Slam, MakesKeyframesEvery25CmOr10Degrees) {
   EXPECT_TRUE(slam.wants_keyframe(T * se3::exp((Vector6d() << 0, 0, 0, 0, 0.18, 0).finished())));
   EXPECT_FALSE(slam.wants_keyframe(T * se3::exp((Vector6d() << 0.1, 0, 0, 0, 0.16, 0).finished())));
   EXPECT_EQ(slam.graph().num_edges(), 6);
+  // A restart of the odometry always makes a keyframe, which keeps how it relates to the last.
+  frame.utime = 2000;
+  slam.add(frame, Eigen::Isometry3d::Identity(), OdometryLink::kBroken);
+  ASSERT_EQ(slam.keyframes().size(), 8u);
+  EXPECT_EQ(slam.keyframes().back().link, OdometryLink::kBroken);
+  EXPECT_EQ(slam.keyframes()[1].link, OdometryLink::kContinuous);
 }
 
 TEST(Slam, RefusesTimeGoingBackAndPosesThatAreNotRigid) {
