@@ -106,7 +106,7 @@ TEST(EstimatorProcess, AnImuWithoutAGyroRunsVisualOnlyOrIsRefusedInImuModeAndThe
   const std::string replay = kestrel::test::tool("replay").string();
   const std::string script =
       "lcm-logger -q --lcm-url='" + std::string(transport::kDefaultLcmUrl) + "' -f " + logged +
-      " & L=$!; sleep 0.5; " + estimator + " -q & P=$!; " + replay + " " + in +
+      " & L=$!; " + kestrel::test::wait_for_lcm_listener_sh() + "; " + estimator + " -q & P=$!; " + replay + " " + in +
       " --expect estimator --record " + (dir / "visual.lcmlog").string() +
       " >/dev/null || exit 11; sleep 0.3; kill -INT $P; wait $P; " + estimator + " -q --mode imu & P=$!; " +
       replay + " " + in + " --expect estimator --record " + (dir / "imu.lcmlog").string() +

@@ -123,7 +123,7 @@ TEST(KinectTool, PublishesLiveWithHeartbeatsInsideANetworkNamespace) {
   const auto log = dir / "live.lcmlog";
   const auto r = test::run_isolated(
       "lcm-logger -q --lcm-url=" + test::quoted(transport::kDefaultLcmUrl) + " -f " + test::quoted(log.string()) +
-      " & L=$!; sleep 1; LD_LIBRARY_PATH=" + test::quoted(test::fakenect_library_dir()) +
+      " & L=$!; " + test::wait_for_lcm_listener_sh() + "; LD_LIBRARY_PATH=" + test::quoted(test::fakenect_library_dir()) +
       " FAKENECT_PATH=" + test::quoted(dump.string()) + " " + test::quoted(test::tool("kinect").string()) +
       " --config " + test::quoted((dump / "kestrel-kinect.ini").string()) +
       " --depth-encoding zstd; rc=$?; sleep 0.5; kill -INT $L; wait $L || exit 99; exit $rc");

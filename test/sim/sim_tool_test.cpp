@@ -91,7 +91,8 @@ TEST(SimToolTest, LivePublishingReachesAnLcmLogger) {
   const std::string script =
       "ip link set lo up && ip link set lo multicast on && ip route add 224.0.0.0/4 dev lo && "
       "export LCM_DEFAULT_URL='udpm://239.255.76.67:7667?ttl=0' && "
-      "(lcm-logger -f '" + log + "' >/dev/null 2>&1 & echo $! > '" + (dir / "pid").string() + "') && sleep 1 && '" +
+      "(lcm-logger -f '" + log + "' >/dev/null 2>&1 & echo $! > '" + (dir / "pid").string() + "') && " +
+      kestrel::test::wait_for_lcm_listener_sh() + " && '" +
       tool("sim").string() + "' --world office --flight hover --duration 1 --rate 0 -q && sleep 1 && "
       "kill $(cat '" + (dir / "pid").string() + "')";
   const auto r = run({"unshare", "-n", "sh", "-c", script}, 200.0);
@@ -124,7 +125,8 @@ TEST(SimToolTest, VehicleFliesAVehicleCommandReceivedOverLcm) {
   const std::string script =
       "ip link set lo up && ip link set lo multicast on && ip route add 224.0.0.0/4 dev lo && "
       "export LCM_DEFAULT_URL='udpm://239.255.76.67:7667?ttl=0' && "
-      "(lcm-logger -f '" + log + "' >/dev/null 2>&1 & echo $! > '" + pid + "') && sleep 1 && "
+      "(lcm-logger -f '" + log + "' >/dev/null 2>&1 & echo $! > '" + pid + "') && " +
+      kestrel::test::wait_for_lcm_listener_sh() + " && "
       "('" + tool("sim").string() + "' --world office --flight vehicle --vehicle-feedback truth --duration 4 "
       "--camera-rate 3 -q & "
       // Once the flight is on the wire (so the sim has subscribed), half a second later.

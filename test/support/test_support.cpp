@@ -7,12 +7,16 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
+#include <cstdio>
 #include <chrono>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
 #include <random>
+
+#include "common/transport/lcm_url.h"
 
 namespace kestrel::test {
 
@@ -122,6 +126,17 @@ RunResult run(const std::vector<std::string>& argv, double timeout_s) {
     result.exit_code = 128 + WTERMSIG(status);
   }
   return result;
+}
+
+std::string wait_for_lcm_listener_sh(double timeout_s) {
+  // The port of udpm://group:port?..., as /proc/net/udp lists a local address (hex, upper case).
+  const std::string url = transport::kDefaultLcmUrl;
+  const size_t colon = url.find(':', url.find("//") + 2), end = url.find('?', colon);
+  char port[8];
+  std::snprintf(port, sizeof port, "%04X", std::stoi(url.substr(colon + 1, end - colon - 1)));
+  const int tries = std::max(1, static_cast<int>(timeout_s / 0.05));
+  return std::string("{ i=0; until grep -q ':") + port + " ' /proc/net/udp; do i=$((i+1)); [ $i -ge " +
+         std::to_string(tries) + " ] && exit 98; sleep 0.05; done; }";
 }
 
 bool can_isolate_network() {

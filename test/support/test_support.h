@@ -43,6 +43,12 @@ struct RunResult {
 /// Runs argv[0] with the rest as arguments, waits at most `timeout_s`, captures stdout/stderr.
 RunResult run(const std::vector<std::string>& argv, double timeout_s = 120.0);
 
+/// A shell command that returns once a socket in the current network namespace listens on the
+/// port of kestrel's default LCM URL, i.e. once an lcm-logger started before it has subscribed
+/// (a fixed sleep was not always enough on a loaded machine); after `timeout_s` it exits the
+/// script with status 98. Meant for a private namespace, where only the logger listens yet.
+std::string wait_for_lcm_listener_sh(double timeout_s = 20.0);
+
 /// True if this process may create a network namespace (root or unprivileged user
 /// namespaces); integration tests that need one skip otherwise.
 bool can_isolate_network();

@@ -151,10 +151,10 @@ TEST(TumPlayTool, PublishesLiveWithHeartbeatsInsideANetworkNamespace) {
   test::TempDir dir;
   const TumFixture fx(dir.path(), 3);
   const auto log = dir / "live.lcmlog";
-  // The logger needs a moment to subscribe before the player starts, and kestrel's receive
+  // The logger must have subscribed before the player starts, and needs kestrel's receive
   // buffer (the default URL) to take whole frames.
   const auto r = test::run_isolated("lcm-logger -q --lcm-url='" + std::string(transport::kDefaultLcmUrl) + "' -f '" +
-                          log.string() + "' & L=$!; sleep 1; '" + play() + "' '" + fx.folder().string() +
+                          log.string() + "' & L=$!; " + test::wait_for_lcm_listener_sh() + "; '" + play() + "' '" + fx.folder().string() +
                           "' --rate 2 --rgb-encoding jpeg; rc=$?; sleep 0.5; kill -INT $L; wait $L || exit 99; "
                           "exit $rc");
   ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
