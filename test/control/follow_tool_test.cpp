@@ -59,7 +59,7 @@ TEST(FollowTool, TurnsAPlanAndStatesIntoCommandsUnderLockStepReplay) {
   }
   const std::string script = test::tool("follow").string() + " -q & F=$!; " + test::tool("replay").string() + " " +
                              in + " --expect follow --record " + out + "; R=$?; kill -INT $F; wait $F; exit $R";
-  const auto r = test::run({test::tool("isolated").string(), "--", "sh", "-c", script}, 120.0);
+  const auto r = test::run_isolated(script, 120.0);
   ASSERT_EQ(r.exit_code, 0) << r.err;
 
   transport::LogReader log(out);

@@ -42,7 +42,7 @@ TEST(EstimatorProcess, LockStepReplayIsDeterministicResetsAndEqualsTheLibrary) {
       (dir / "a.lcmlog").string() + " || exit 11; " + replay + " " + in +
       " --expect estimator --record " + (dir / "b.lcmlog").string() +
       " || exit 12; kill -INT $P; wait $P";
-  const auto r = kestrel::test::run({kestrel::test::tool("isolated").string(), "--", "sh", "-c", script}, 240.0);
+  const auto r = kestrel::test::run_isolated(script, 240.0);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const std::string a = kestrel::test::read_file(dir / "a.lcmlog");
   ASSERT_FALSE(a.empty());
@@ -111,7 +111,7 @@ TEST(EstimatorProcess, AnImuWithoutAGyroRunsVisualOnlyOrIsRefusedInImuModeAndThe
       " >/dev/null || exit 11; sleep 0.3; kill -INT $P; wait $P; " + estimator + " -q --mode imu & P=$!; " +
       replay + " " + in + " --expect estimator --record " + (dir / "imu.lcmlog").string() +
       " >/dev/null; R=$?; sleep 0.3; kill -INT $P $L; wait $P; wait $L; exit $R";
-  const auto r = kestrel::test::run({kestrel::test::tool("isolated").string(), "--", "sh", "-c", script}, 120.0);
+  const auto r = kestrel::test::run_isolated(script, 120.0);
   ASSERT_EQ(r.exit_code, 0) << r.err;
 
   const auto states = transport::read_messages<kestrel::state_t>((dir / "visual.lcmlog").string(), channel::kState);

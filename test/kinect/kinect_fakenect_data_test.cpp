@@ -59,8 +59,9 @@ Comparison round_trip(const std::filesystem::path& seq, int frames, const std::v
                                    "--frames", std::to_string(frames)};
   test::RunResult r;
   if (test::can_isolate_network()) {
-    std::vector<std::string> argv = {"unshare", "-n", "env", "LD_LIBRARY_PATH=" + test::fakenect_library_dir(),
-                                     "FAKENECT_PATH=" + dump.string(), test::tool("kinect").string()};
+    std::vector<std::string> argv = {test::tool("isolated").string(), "--", "env",
+                                     "LD_LIBRARY_PATH=" + test::fakenect_library_dir(), "FAKENECT_PATH=" + dump.string(),
+                                     test::tool("kinect").string()};
     argv.insert(argv.end(), args.begin(), args.end());
     r = test::run(argv);
   } else {

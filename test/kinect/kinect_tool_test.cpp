@@ -21,7 +21,6 @@
 #include "kestrel/process_status_t.hpp"
 #include "test/kinect/fakenect_support.h"
 #include "test/support/test_support.h"
-#include "test/tum/isolated_run.h"
 #include "test/tum/tum_fixture.h"
 
 namespace kestrel {

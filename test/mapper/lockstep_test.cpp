@@ -53,7 +53,7 @@ TEST(MapperProcess, LockStepReplayIsDeterministicAndResets) {
       mapper + " --pose-source ground-truth --publish-period 0.4 --format full & P=$!; " + replay + " " + in +
       " --expect mapper --record " + (dir / "a.lcmlog").string() + " || exit 11; " + replay + " " + in +
       " --expect mapper --record " + (dir / "b.lcmlog").string() + " || exit 12; kill -INT $P; wait $P";
-  const auto r = kestrel::test::run({kestrel::test::tool("isolated").string(), "--", "sh", "-c", script}, 240.0);
+  const auto r = kestrel::test::run_isolated(script, 240.0);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const std::string a = kestrel::test::read_file(dir / "a.lcmlog");
   ASSERT_FALSE(a.empty());

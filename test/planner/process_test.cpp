@@ -125,7 +125,7 @@ TEST(PlannerProcess, AnswersEveryRequestOverLcmAndRepeatsAfterReset) {
       "'" + replay + "' '" + in + "' --expect planner --record '" + (dir / "b.lcmlog").string() + "' >/dev/null; "
       "R=$?; kill $P; wait $P; exit $R";
   const kestrel::test::RunResult r =
-      kestrel::test::run({kestrel::test::tool("isolated").string(), "--", "sh", "-c", script}, 120.0);
+      kestrel::test::run_isolated(script, 120.0);
   ASSERT_EQ(r.exit_code, 0) << r.err;
 
   const auto a = plans((dir / "a.lcmlog").string()), b = plans((dir / "b.lcmlog").string());

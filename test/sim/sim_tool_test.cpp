@@ -89,13 +89,12 @@ TEST(SimToolTest, LivePublishingReachesAnLcmLogger) {
   TempDir dir;
   const std::string log = (dir / "live.lcmlog").string();
   const std::string script =
-      "ip link set lo up && ip link set lo multicast on && ip route add 224.0.0.0/4 dev lo && "
       "export LCM_DEFAULT_URL='udpm://239.255.76.67:7667?ttl=0' && "
       "(lcm-logger -f '" + log + "' >/dev/null 2>&1 & echo $! > '" + (dir / "pid").string() + "') && " +
       kestrel::test::wait_for_lcm_listener_sh() + " && '" +
       tool("sim").string() + "' --world office --flight hover --duration 1 --rate 0 -q && sleep 1 && "
       "kill $(cat '" + (dir / "pid").string() + "')";
-  const auto r = run({"unshare", "-n", "sh", "-c", script}, 200.0);
+  const auto r = kestrel::test::run_isolated(script, 200.0);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("frames: 31"), std::string::npos) << r.out;
   if (!fs::exists(tool("eval"))) GTEST_SKIP() << "kestrel-eval is not built";
@@ -123,7 +122,6 @@ TEST(SimToolTest, VehicleFliesAVehicleCommandReceivedOverLcm) {
   }
   const std::string pid = (dir / "pid").string();
   const std::string script =
-      "ip link set lo up && ip link set lo multicast on && ip route add 224.0.0.0/4 dev lo && "
       "export LCM_DEFAULT_URL='udpm://239.255.76.67:7667?ttl=0' && "
       "(lcm-logger -f '" + log + "' >/dev/null 2>&1 & echo $! > '" + pid + "') && " +
       kestrel::test::wait_for_lcm_listener_sh() + " && "
@@ -133,7 +131,7 @@ TEST(SimToolTest, VehicleFliesAVehicleCommandReceivedOverLcm) {
       "while [ $(stat -c %s '" + log + "') -lt 20000 ]; do sleep 0.05; done; sleep 0.5 && "
       "lcm-logplayer '" + commands + "' >/dev/null 2>&1; wait) && sleep 1 && "
       "kill $(cat '" + pid + "')";
-  const auto r = run({"unshare", "-n", "sh", "-c", script}, 200.0);
+  const auto r = kestrel::test::run_isolated(script, 200.0);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto eval = run({tool("eval").string(), "--est", log + ":GROUND_TRUTH", "--to-tum", (dir / "gt.txt").string()});
   ASSERT_EQ(eval.exit_code, 0) << eval.err;
@@ -162,10 +160,9 @@ TEST(SimToolTest, VehicleFliesAVehicleCommandReceivedOverLcm) {
 TEST(SimToolTest, LockstepWithoutConsumersWaitsOnceThenFinishes) {
   if (!kestrel::test::can_isolate_network()) GTEST_SKIP() << "cannot create a network namespace here";
   const std::string script =
-      "ip link set lo up && ip link set lo multicast on && ip route add 224.0.0.0/4 dev lo && "
       "export LCM_DEFAULT_URL='udpm://239.255.76.67:7667?ttl=0' && '" + tool("sim").string() +
       "' --world room --flight vehicle --duration 0.5 --rate 0 --lockstep 1.5 -q";
-  const auto r = run({"unshare", "-n", "sh", "-c", script}, 120.0);
+  const auto r = kestrel::test::run_isolated(script, 120.0);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("frames: 16\n"), std::string::npos) << r.out;  // 0 .. 0.5 s at 30 Hz
   EXPECT_NE(r.out.find("imu samples: 101\n"), std::string::npos) << r.out;

@@ -145,4 +145,14 @@ bool can_isolate_network() {
   return run({"unshare", "-rn", "true"}, 10.0).exit_code == 0;
 }
 
+RunResult run_isolated(const std::string& script, double timeout_s) {
+  return run({tool("isolated").string(), "--", "sh", "-c", script}, timeout_s);
+}
+
+std::string quoted(const std::string& s) {
+  std::string q = "'";
+  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
 }  // namespace kestrel::test

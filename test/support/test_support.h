@@ -53,6 +53,13 @@ std::string wait_for_lcm_listener_sh(double timeout_s = 20.0);
 /// namespaces); integration tests that need one skip otherwise.
 bool can_isolate_network();
 
+/// Runs `script` with sh in a private network namespace whose loopback carries multicast
+/// (kestrel-isolated, DESIGN.md), so the LCM traffic of the processes it starts stays there.
+RunResult run_isolated(const std::string& script, double timeout_s = 120.0);
+
+/// `s` in single quotes for sh.
+std::string quoted(const std::string& s);
+
 }  // namespace kestrel::test
 
 /// Skips the current test with a clear message when ../shared/data/tum/<name> is absent.

@@ -82,7 +82,7 @@ void fly_figure_eight(const std::string& vo_options, bool with_mapper) {
                              (with_mapper ? ",mapper" : "") + " --ack-timeout 60 --record " + recorded +
                              "; R=$?; kill -INT $V $E $S " + (with_mapper ? "$M" : "") + "; wait $V $E $S " +
                              (with_mapper ? "$M" : "") + "; exit $R";
-  const auto r = test::run({test::tool("isolated").string(), "--", "sh", "-c", script}, 600.0);
+  const auto r = test::run_isolated(script, 600.0);
   ASSERT_EQ(r.exit_code, 0) << r.err;
 
   const test::Recording rec = test::read_recording(recorded);

@@ -103,7 +103,7 @@ TEST(System, ReplayedTumRecordingRunsWithItsCamerasProfileAndMapsTheScene) {
       " & M=$!; " + test::tool("replay").string() + " " + source +
       " --expect vo,estimator,slam,mapper --ack-timeout 60 --record " + recorded +
       "; R=$?; kill -INT $V $E $S $M; wait $V $E $S $M; exit $R";
-  const auto r = test::run({test::tool("isolated").string(), "--", "sh", "-c", script}, 600.0);
+  const auto r = test::run_isolated(script, 600.0);
   ASSERT_EQ(r.exit_code, 0) << r.err;
 
   // The odometry: the offline run's, so the Kinect's profile (timing, floors, dense weight).

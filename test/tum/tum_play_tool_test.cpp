@@ -17,7 +17,6 @@
 #include "kestrel/imu_t.hpp"
 #include "kestrel/process_status_t.hpp"
 #include "test/support/test_support.h"
-#include "test/tum/isolated_run.h"
 #include "test/tum/tum_fixture.h"
 
 namespace kestrel {

@@ -58,7 +58,7 @@ TEST(VoProcess, LockStepReplayGivesOneUpdatePerFrameAndRepeats) {
       "'" + replay + "' '" + in + "' --expect vo --record '" + (dir / "b.lcmlog").string() + "' >/dev/null; "
       "R=$?; kill $VO; wait $VO; exit $R";
   const kestrel::test::RunResult r =
-      kestrel::test::run({kestrel::test::tool("isolated").string(), "--", "sh", "-c", script}, 120.0);
+      kestrel::test::run_isolated(script, 120.0);
   ASSERT_EQ(r.exit_code, 0) << r.err;
 
   const auto a = updates((dir / "a.lcmlog").string()), b = updates((dir / "b.lcmlog").string());
@@ -118,7 +118,7 @@ TEST(VoProcess, TakesTheCameraProfileTheFramesName) {
       "'" + replay + "' '" + in + "' --expect vo --record '" + (dir / "told.lcmlog").string() + "' >/dev/null; "
       "R=$?; kill $VO; wait $VO; exit $R";
   const kestrel::test::RunResult r =
-      kestrel::test::run({kestrel::test::tool("isolated").string(), "--", "sh", "-c", script}, 120.0);
+      kestrel::test::run_isolated(script, 120.0);
   ASSERT_EQ(r.exit_code, 0) << r.err;
 
   const VoOptions simulator, kinect = with_sensor(SensorProfile::kKinect1, VoOptions{});
