@@ -74,8 +74,9 @@ void add_options(cli::App& app, Options& o, SlamOptions& s) {
   app.add_option("--kernel", o.kernel, "Robust kernel on loop closures: none, huber, cauchy or dcs")
       ->check(CLI::IsMember({"none", "huber", "cauchy", "dcs"}))->capture_default_str();
   app.add_option("--sensor", o.sensor,
-                 "Camera profile, as kestrel-vo's (its timing corrects the keyframes' features): simulator "
-                 "(global shutter) or kinect1 (rolling shutter, depth before colour); by default the one "
+                 "Camera profile, as kestrel-vo's (its timing corrects the keyframes' features, its noise "
+                 "floors the loops'): simulator (global shutter) or kinect1 (rolling shutter, depth before "
+                 "colour, loops 1 degree uncertain); by default the one "
                  "each frame's sensor model names (with --tum the folder's: kinect1 for freiburg1)")
       ->check(CLI::IsMember({vo::to_string(vo::SensorProfile::kSimulator), vo::to_string(vo::SensorProfile::kKinect1)}));
   app.add_option("--tum", o.tum, "Offline: run VO + SLAM over this TUM RGB-D folder");
@@ -105,8 +106,8 @@ int run_offline(const Options& o, const SlamOptions& options, std::shared_ptr<co
   const vo::SensorProfile sensor = o.sensor.empty() ? vo::tum_sensor(o.tum) : *vo::parse_sensor_profile(o.sensor);
   std::cout << "camera profile: " << vo::to_string(sensor) << "\n";
   const SlamRun run = run_slam_sequence(
-      sequence.size(), [&sequence](size_t i) { return sequence.frame(i); }, vo::with_sensor(sensor, vo::VoOptions{}),
-      options, std::move(vocabulary));
+      sequence.size(), [&sequence](size_t i) { return sequence.frame(i); }, sensor, vo::VoOptions{}, options,
+      std::move(vocabulary));
   write_tum_trajectory(o.out, run.slam);
   if (!o.vo_out.empty()) write_tum_trajectory(o.vo_out, run.vo);
   std::vector<double> ms = run.keyframe_ms;

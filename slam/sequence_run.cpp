@@ -11,15 +11,17 @@
 
 namespace kestrel::slam {
 
-SlamRun run_slam_sequence(const std::vector<RgbdFrame>& frames, const vo::VoOptions& vo_options,
-                          const SlamOptions& options, std::shared_ptr<const Vocabulary> vocabulary) {
-  return run_slam_sequence(
-      frames.size(), [&frames](size_t i) { return frames[i]; }, vo_options, options, std::move(vocabulary));
-}
-
-SlamRun run_slam_sequence(size_t count, const std::function<RgbdFrame(size_t)>& frame_at,
+SlamRun run_slam_sequence(const std::vector<RgbdFrame>& frames, vo::SensorProfile sensor,
                           const vo::VoOptions& vo_options, const SlamOptions& options,
                           std::shared_ptr<const Vocabulary> vocabulary) {
+  return run_slam_sequence(
+      frames.size(), [&frames](size_t i) { return frames[i]; }, sensor, vo_options, options, std::move(vocabulary));
+}
+
+SlamRun run_slam_sequence(size_t count, const std::function<RgbdFrame(size_t)>& frame_at, vo::SensorProfile sensor,
+                          const vo::VoOptions& base_vo_options, const SlamOptions& options,
+                          std::shared_ptr<const Vocabulary> vocabulary) {
+  const vo::VoOptions vo_options = vo::with_sensor(sensor, base_vo_options);
   vo::VisualOdometry odometry(vo_options);
   OdometryChain chain;
   Slam slam(options, std::move(vocabulary));
@@ -65,7 +67,7 @@ SlamRun run_slam_sequence(size_t count, const std::function<RgbdFrame(size_t)>& 
       if (link == OdometryLink::kContinuous && keyframe_pose) {
         odometry_covariance = chain.relative_covariance(*keyframe_pose, *pose);
       }
-      const SlamStep step = slam.add(frame, pose->T_odom_camera, link, odometry_covariance, motion);
+      const SlamStep step = slam.add(frame, pose->T_odom_camera, link, odometry_covariance, motion, sensor);
       if (step.keyframe) keyframe_pose = *pose;
       run.keyframe_ms.push_back(
           std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());

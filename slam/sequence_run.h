@@ -3,8 +3,8 @@
 // tests): each frame through the visual odometry, the chained odometry pose to SLAM, and at
 // the end every frame's pose both as the odometry had it and as the optimised graph puts it.
 // Keyframes' features get the odometry's timing correction (place/frame_features.h): the
-// camera's timing is vo_options.depth's (the sensor profile: with_tum_sensor() for a TUM folder),
-// the motion the odometry's from the previous frame to the keyframe.
+// camera's timing is that of the VO options of its sensor profile (vo::tum_sensor() for a TUM
+// folder), the motion the odometry's from the previous frame to the keyframe.
 
 #include <functional>
 #include <memory>
@@ -63,12 +63,15 @@ Eigen::Isometry3d place_frame(const std::vector<KeyframeCorrection>& keyframes, 
 /// TUM's groundtruth.txt; interpolated within 0.1 s).
 std::vector<LoopError> loop_errors(const SlamRun& run, const Trajectory& ground_truth);
 
-SlamRun run_slam_sequence(const std::vector<RgbdFrame>& frames, const vo::VoOptions& vo_options,
-                          const SlamOptions& options, std::shared_ptr<const Vocabulary> vocabulary);
+/// `sensor`: the camera's profile, which sets the odometry's options (vo::with_sensor() of
+/// `vo_options`; the keyframes' timing) and the noise of SLAM's loops (Slam::add).
+SlamRun run_slam_sequence(const std::vector<RgbdFrame>& frames, vo::SensorProfile sensor,
+                          const vo::VoOptions& vo_options, const SlamOptions& options,
+                          std::shared_ptr<const Vocabulary> vocabulary);
 
 /// The same over `count` frames decoded one at a time by `frame_at(i)` (a long sequence need
 /// not fit in memory: 1.5 MB a VGA frame).
-SlamRun run_slam_sequence(size_t count, const std::function<RgbdFrame(size_t)>& frame_at,
+SlamRun run_slam_sequence(size_t count, const std::function<RgbdFrame(size_t)>& frame_at, vo::SensorProfile sensor,
                           const vo::VoOptions& vo_options, const SlamOptions& options,
                           std::shared_ptr<const Vocabulary> vocabulary);
 

@@ -213,13 +213,13 @@ AdapterOutputs SlamAdapter::process(const kestrel::rgbd_frame_t& message, const 
     odometry_covariance = chain_.relative_covariance(*keyframe_pose_, chained);
   }
   // The features' timing: the odometry's motion from the previous update (not across a restart).
+  const vo::SensorProfile sensor = options_.sensor.value_or(vo::profile_of_sensor(frame.sensor));
   vo::FrameMotion motion;
   if (link == OdometryLink::kContinuous && waiting.previous_utime != 0) {
-    const vo::SensorProfile sensor = options_.sensor.value_or(vo::profile_of_sensor(frame.sensor));
     motion = keyframe_motion(vo::with_sensor(sensor, vo::VoOptions{}).depth, frame.utime, frame.depth_utime,
                              waiting.previous_utime, waiting.T_previous_current);
   }
-  const SlamStep step = slam_.add(frame, pose.T_odom_camera, link, odometry_covariance, motion);
+  const SlamStep step = slam_.add(frame, pose.T_odom_camera, link, odometry_covariance, motion, sensor);
   if (step.keyframe) keyframe_pose_ = chained;
   lost_break_ = false;
   remember(*last_pose_, step.keyframe);

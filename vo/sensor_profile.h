@@ -49,14 +49,13 @@ constexpr double kKinect1RotationFloorRad = 0.002;
 constexpr double kKinect1TranslationPerRadM = 0.10;
 constexpr double kKinect1RotationPerRad = 0.085;
 constexpr double kKinect1DenseWeight = 2.0;
-/// The near-keyframe rule (KeyframeOptions::min_inliers_to_keep_near) is off for this profile.
-/// On fr1 it makes the VO better on every column but one (ATE 1.13 -> 0.94 cm on fr1_xyz, 2.53
-/// -> 2.17 cm on fr1_rpy) and the estimator's STATE too, but SLAM's one loop on fr1_xyz, 1.7 cm
-/// and 1 degree off (as far off as the VO is between the same frames), then leaves SLAM's ATE
-/// above the better VO's (0.97 against 0.94 cm; issue 6 asks SLAM to be no worse). Until SLAM's
-/// loops measure better than that, recordings keep the 300-inlier rule; a hovering Kinect wants
-/// it on: --set keyframe.min_inliers_to_keep_near=150 (vo/README.md, "Keyframes").
-constexpr int kKinect1MinInliersToKeepNear = 0;
+/// The near-keyframe rule (KeyframeOptions::min_inliers_to_keep_near), as the simulator's: a
+/// hovering Kinect keeps its keyframe. On fr1 it makes the VO better on every column but one
+/// (ATE 1.13 -> 0.94 cm on fr1_xyz, 2.53 -> 2.17 cm on fr1_rpy) and the estimator's STATE too.
+/// It was off until SLAM's loops on a Kinect took their real noise (kKinect1LoopRotationFloorRad,
+/// slam/place/loop_verifier.h): fr1_xyz's one loop, 1.7 cm and 1 degree off, had left SLAM's
+/// ATE above the better VO's (0.97 against 0.94 cm; issue 6 asks SLAM to be no worse).
+constexpr int kKinect1MinInliersToKeepNear = 150;
 
 /// `options` with the profile's timing and floors set (kSimulator: unchanged).
 VoOptions with_sensor(SensorProfile profile, VoOptions options);

@@ -130,7 +130,8 @@ void Slam::add_odometry_edge(const Keyframe& previous, const Keyframe& current, 
 }
 
 SlamStep Slam::add(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera, OdometryLink link,
-                   const std::optional<Matrix6d>& odometry_covariance, const vo::FrameMotion& motion) {
+                   const std::optional<Matrix6d>& odometry_covariance, const vo::FrameMotion& motion,
+                   vo::SensorProfile sensor) {
   const bool odometry_broken = link == OdometryLink::kBroken;
   if (have_frame_ && frame.utime <= last_utime_) {
     throw InputError("slam: frame utime " + std::to_string(frame.utime) + " does not follow " +
@@ -152,6 +153,7 @@ SlamStep Slam::add(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camer
   kf.T_body_camera = frame.T_body_camera;
   kf.T_camera_depth = motion.T_rgb_depth();
   kf.link = keyframes_.empty() ? OdometryLink::kContinuous : link;
+  kf.sensor = sensor;
   kf.features = extractor_.extract(frame, motion);
   const Eigen::Isometry3d T_world_camera =
       keyframes_.empty() ? T_odom_camera
@@ -188,7 +190,8 @@ SlamStep Slam::close_loop(SlamStep step) {
     const Keyframe& earlier = keyframes_[static_cast<size_t>(candidate.entry)];
     // The seed depends on the pair only, so that a replay verifies identically.
     const uint64_t seed = static_cast<uint64_t>(earlier.id) * 1000003u + static_cast<uint64_t>(query.id);
-    step.loop = verify_loop(query.features, earlier.features, options_.verification, seed);
+    step.loop = verify_loop(query.features, earlier.features,
+                            loop_verification(options_.verification, earlier.sensor, query.sensor), seed);
     if (!step.loop.accepted) continue;
     if (gate && !check_loop_against_odometry(graph_, static_cast<int>(earlier.id), static_cast<int>(query.id),
                                              step.loop.T_candidate_query, options_.loop_consistency,

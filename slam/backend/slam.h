@@ -46,6 +46,7 @@ struct Keyframe {
   Eigen::Isometry3d T_camera_depth = Eigen::Isometry3d::Identity();
   /// How its odometry pose relates to the previous keyframe's (the first's: kContinuous).
   OdometryLink link = OdometryLink::kContinuous;
+  vo::SensorProfile sensor = vo::SensorProfile::kSimulator;  ///< its camera's (loop noise)
   FrameFeatures features;
 };
 
@@ -86,11 +87,12 @@ class Slam {
   /// keyframe to this frame (right perturbation [rho; phi], OdometryChain::relative_covariance):
   /// the odometry edge then takes it (OdometryNoise::use_reported) instead of the constant model.
   /// `motion`: the camera's motion around the frame, for its features' timing correction
-  /// (keyframe_motion(), place/frame_features.h); unknown = no correction.
+  /// (keyframe_motion(), place/frame_features.h); unknown = no correction. `sensor`: the
+  /// camera's profile, whose noise its loops take (loop_verification(), place/loop_verifier.h).
   SlamStep add(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera,
                OdometryLink link = OdometryLink::kContinuous,
                const std::optional<Matrix6d>& odometry_covariance = std::nullopt,
-               const vo::FrameMotion& motion = {});
+               const vo::FrameMotion& motion = {}, vo::SensorProfile sensor = vo::SensorProfile::kSimulator);
 
   const std::vector<Keyframe>& keyframes() const { return keyframes_; }
   /// Vertices are keyframes (poses T_world_camera); edges odometry and loop closures.

@@ -99,6 +99,13 @@ Matrix6d edge_information(const Eigen::Isometry3d& T_a_b, const Matrix6d& covari
   return 0.5 * (info + info.transpose());
 }
 
+VerificationOptions loop_verification(VerificationOptions options, vo::SensorProfile a, vo::SensorProfile b) {
+  if (a == vo::SensorProfile::kKinect1 || b == vo::SensorProfile::kKinect1) {
+    options.rotation_sigma_floor_rad = std::max(options.rotation_sigma_floor_rad, kKinect1LoopRotationFloorRad);
+  }
+  return options;
+}
+
 LoopConstraint verify_loop(const FrameFeatures& query, const FrameFeatures& candidate,
                            const VerificationOptions& o, uint64_t seed) {
   LoopConstraint c;

@@ -71,6 +71,41 @@ TEST(LoopVerifier, AcceptsTheSamePlaceFromAnotherViewWithTheTrueRelativePose) {
   EXPECT_GT(Eigen::SelfAdjointEigenSolver<Matrix6d>(c.information).eigenvalues().minCoeff(), 0.0);
 }
 
+// A loop with a Kinect keyframe at either end takes the Kinect's 1 degree rotation floor (its
+// per-frame errors, loop_verifier.h); the simulator's camera keeps the options' own floors.
+TEST(LoopVerifier, AKinectsLoopTakesTheKinectsRotationFloor) {
+  using vo::SensorProfile;
+  VerificationOptions o;
+  o.rotation_sigma_floor_rad = 0.001;
+  EXPECT_EQ(loop_verification(o, SensorProfile::kSimulator, SensorProfile::kSimulator).rotation_sigma_floor_rad, 0.001);
+  EXPECT_EQ(loop_verification(o, SensorProfile::kKinect1, SensorProfile::kSimulator).rotation_sigma_floor_rad,
+            M_PI / 180.0);
+  EXPECT_EQ(loop_verification(o, SensorProfile::kSimulator, SensorProfile::kKinect1).rotation_sigma_floor_rad,
+            M_PI / 180.0);
+  EXPECT_EQ(loop_verification(o, SensorProfile::kKinect1, SensorProfile::kKinect1).translation_sigma_floor_m,
+            o.translation_sigma_floor_m);
+  o.rotation_sigma_floor_rad = 0.05;  // a larger floor of the options' own stays
+  EXPECT_EQ(loop_verification(o, SensorProfile::kKinect1, SensorProfile::kKinect1).rotation_sigma_floor_rad, 0.05);
+
+  // On a real pair: the same constraint, its rotation at least 1 degree uncertain per axis (the
+  // edge's covariance, the information's inverse; its rotation error is vec(q), half the
+  // angle, hence a quarter of the variance), which the simulator's floors do not give.
+  const SyntheticRoom room(3, 3.0, 2.5, 2.5);
+  const auto views = views_along(room, {test::level_camera({0.0, 0.0, 1.0}, 0.0),
+                                        test::level_camera({0.4, 0.3, 1.1}, 0.25)});
+  const VerificationOptions sim;
+  const LoopConstraint a = verify_loop(views[1].features, views[0].features, sim, 7);
+  const LoopConstraint b = verify_loop(views[1].features, views[0].features,
+                                       loop_verification(sim, SensorProfile::kKinect1, SensorProfile::kKinect1), 7);
+  ASSERT_TRUE(a.accepted && b.accepted) << a.reason << " / " << b.reason;
+  EXPECT_TRUE(a.T_candidate_query.isApprox(b.T_candidate_query));
+  const Eigen::Vector3d sim_var = a.information.inverse().diagonal().tail<3>();
+  const Eigen::Vector3d kinect_var = b.information.inverse().diagonal().tail<3>();
+  const double floor_var = std::pow(0.5 * M_PI / 180.0, 2);
+  EXPECT_LT(sim_var.maxCoeff(), 0.5 * floor_var) << sim_var.transpose();
+  EXPECT_GT(kinect_var.minCoeff(), 0.95 * floor_var) << kinect_var.transpose();
+}
+
 TEST(LoopVerifier, RejectsViewsOfDifferentPlaces) {
   const SyntheticRoom room(3, 3.0, 2.5, 2.5);
   const auto views = views_along(room, {test::level_camera({0.0, 0.0, 1.0}, 0.0),

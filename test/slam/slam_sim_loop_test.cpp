@@ -56,7 +56,8 @@ TEST(SlamSimLoop, FloorLoopCutsTheOdometryDriftWithNoFalseClosure) {
     truth.push_back(utime, sim.T_world_camera(sim.seconds(utime)));
   }
   const SlamRun run = run_slam_sequence(
-      kFrames, [&sim](size_t i) { return sim.render(static_cast<int64_t>(i)); }, vo::VoOptions{}, SlamOptions{},
+      kFrames, [&sim](size_t i) { return sim.render(static_cast<int64_t>(i)); }, vo::SensorProfile::kSimulator,
+      vo::VoOptions{}, SlamOptions{},
       builtin_vocabulary());
   ASSERT_GT(run.vo.size(), kFrames * 95 / 100) << "the odometry lost the camera";
   const double vo_ate = ate_rmse(run.vo, truth), slam_ate = ate_rmse(run.slam, truth);

@@ -46,7 +46,7 @@ TEST_P(SlamOnTum, AteIsNoWorseThanTheOdometrys) {
   const vo::LoadedSequence sequence = vo::load_tum_sequence(folder.string());
   ASSERT_FALSE(sequence.ground_truth.empty());
   const SlamRun run =
-      run_slam_sequence(sequence.frames, vo::with_tum_sensor(folder.string(), vo::VoOptions{}), SlamOptions{},
+      run_slam_sequence(sequence.frames, vo::tum_sensor(folder.string()), vo::VoOptions{}, SlamOptions{},
                         builtin ? builtin_vocabulary() : nullptr);
   ASSERT_GT(run.slam.size(), sequence.frames.size() * 9 / 10);
   const double vo_ate = ate_rmse(run.vo, sequence.ground_truth);
@@ -58,7 +58,8 @@ TEST_P(SlamOnTum, AteIsNoWorseThanTheOdometrys) {
   // 0.977 cm); since the VO uses freiburg1's lens distortion with the kinect1 profile's dense
   // weight (1.133 cm there) SLAM is below it: 1.063 cm with raw keypoint pixels, 1.026 cm with
   // the keyframe features through the lens too, 0.968 cm with frames between keyframes placed
-  // by the interpolated correction (slam/README.md).
+  // by the interpolated correction; since the Kinect's loops take a 1 degree rotation floor and
+  // its VO keeps a near keyframe, 0.927 against the VO's 0.944 cm (slam/README.md).
   EXPECT_LE(slam_ate, vo_ate + 1e-9);
   for (const LoopError& e : loop_errors(run, sequence.ground_truth)) {
     ASSERT_TRUE(e.has_truth);

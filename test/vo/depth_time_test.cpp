@@ -138,7 +138,7 @@ TEST(SensorProfiles, NamedAndAppliedByName) {
   EXPECT_GT(kinect.covariance.rotation_floor_rad, given.covariance.rotation_floor_rad);
   EXPECT_DOUBLE_EQ(kinect.depth.rolling_shutter_readout_s, kKinect1RollingShutterReadoutS);
   EXPECT_GT(sim.keyframe.min_inliers_to_keep_near, 0) << "a hovering simulated camera keeps its keyframe";
-  EXPECT_EQ(kinect.keyframe.min_inliers_to_keep_near, 0) << "off on recordings (sensor_profile.h)";
+  EXPECT_EQ(kinect.keyframe.min_inliers_to_keep_near, 150) << "so does a hovering Kinect (sensor_profile.h)";
 }
 
 }  // namespace
