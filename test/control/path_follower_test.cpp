@@ -33,7 +33,7 @@ TEST(PathFollower, IdleHoldsWhereTheVehicleIs) {
 // The vehicle jumps along the path between commands in these cases: a search window as long as
 // the path lets the progress follow (the window matters only where the path comes back).
 FollowerOptions wide_window() {
-  FollowerOptions o;  // cruise 0.5 m/s, decel 0.5 m/s^2, lookahead 0.5 m
+  FollowerOptions o;  // cruise 0.5 m/s, decel 0.3 m/s^2, lookahead 0.3 m
   o.search_window_m = 10.0;
   return o;
 }
@@ -42,7 +42,7 @@ TEST(PathFollower, OnAStraightPathCommandsTheNearestPointAndCruisesAlongIt) {
   PathFollower f(wide_window());
   f.set_path(straight());
   // 10 cm to the side of x = 1: the set point is the foot of the perpendicular, the velocity
-  // is along the path at cruise speed (3 m left: sqrt(2 * 0.5 * 3) > 0.5).
+  // is along the path at cruise speed (3 m left: sqrt(2 * 0.3 * 3) > 0.5).
   const FollowerCommand c = f.command(at(1.0, 0.1));
   EXPECT_EQ(c.mode, FollowerCommand::Mode::kPosition);
   EXPECT_NEAR(f.progress_m(), 1.0, 1e-12);
@@ -50,9 +50,9 @@ TEST(PathFollower, OnAStraightPathCommandsTheNearestPointAndCruisesAlongIt) {
   EXPECT_TRUE(c.position.isApprox(Eigen::Vector3d(1, 0, 1), 1e-12));
   EXPECT_TRUE(c.velocity.isApprox(Eigen::Vector3d(0.5, 0, 0), 1e-12));
   EXPECT_NEAR(c.yaw, 0.0, 1e-12);
-  // 0.16 m from the end: v = sqrt(2 * 0.5 * 0.16) = 0.4 m/s.
-  const FollowerCommand slow = f.command(at(3.84, 0.0));
-  EXPECT_NEAR(slow.velocity.norm(), 0.4, 1e-9);
+  // 0.15 m from the end: v = sqrt(2 * 0.3 * 0.15) = 0.3 m/s.
+  const FollowerCommand slow = f.command(at(3.85, 0.0));
+  EXPECT_NEAR(slow.velocity.norm(), 0.3, 1e-9);
   EXPECT_EQ(f.status(), FollowStatus::kFollowing);
 }
 
