@@ -3,6 +3,7 @@
 // present) — as Markdown tables with the paper's figures beside ours, and PNG plots of the
 // five paths. See planner/README.md.
 #include <spdlog/spdlog.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <filesystem>
@@ -84,10 +85,24 @@ int main(int argc, char** argv) {
   app.add_option("--png-dir", png_dir, "Draw <world>_paths.png (PRM red, BRM-SU blue, all five pairs) here");
   return app.run(argc, argv, [&]() -> int {
     features.seed = o.seed;
-    std::ostringstream md;
+    // The outputs are checked before the experiments, which take many minutes: a missing
+    // --png-dir is made, and what cannot be written is an error now rather than at the end.
+    if (!png_dir.empty()) {
+      std::error_code ec;
+      std::filesystem::create_directories(png_dir, ec);
+      if (ec) throw InputError(png_dir + ": cannot make the folder: " + ec.message());
+      if (!std::filesystem::is_directory(png_dir) || ::access(png_dir.c_str(), W_OK) != 0)
+        throw InputError(png_dir + ": not a writable folder");
+    }
+    std::ofstream out;
+    if (!out_path.empty()) {
+      out.open(out_path);
+      if (!out) throw InputError(out_path + ": cannot write");
+    }
+    // Each section goes to the file as it is done, so an interrupted run keeps what it made.
     const auto emit = [&](const std::string& text) {
-      md << text;
       std::cout << text << std::flush;
+      if (out.is_open() && !(out << text << std::flush)) throw InputError(out_path + ": cannot write");
     };
     const auto section = [&](const std::string& name, const std::string& title, const auto& body) {
       if (only != "all" && only != name) return;
@@ -143,10 +158,6 @@ int main(int argc, char** argv) {
         if (!cv::imwrite(path, draw_paths(w, sc, o))) throw InputError(path + ": cannot write");
         spdlog::info("wrote {}", path);
       }
-    }
-    if (!out_path.empty()) {
-      std::ofstream f(out_path);
-      if (!(f << md.str())) throw InputError(out_path + ": cannot write");
     }
     return kExitOk;
   });

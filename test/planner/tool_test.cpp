@@ -94,7 +94,7 @@ TEST(PlanExperimentsTool, OneCommandWritesTheTableAndThePlot) {
   test::TempDir dir;
   const test::RunResult r =
       test::run({test::tool("plan-experiments").string(), "--world", "floor", "--only", "table5", "--trials", "1",
-                 "--out", (dir / "tables.md").string(), "--png-dir", dir.path().string(), "-q"});
+                 "--out", (dir / "tables.md").string(), "--png-dir", (dir / "figures").string(), "-q"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const std::string md = test::read_file(dir / "tables.md");
   EXPECT_EQ(md, r.out);  // --out holds what was printed
@@ -102,9 +102,27 @@ TEST(PlanExperimentsTool, OneCommandWritesTheTableAndThePlot) {
   for (const char* row : {"| prm | uniform |", "| brm | su |", "| brm | su-ukf |", "| brm | gaussian |", "| brm | bridge |",
                           "| brm-dominance | su |"})
     EXPECT_NE(md.find(row), std::string::npos) << row << "\n" << md;
-  const cv::Mat png = cv::imread((dir / "floor_paths.png").string());
+  const cv::Mat png = cv::imread((dir / "figures" / "floor_paths.png").string());  // the folder was made
   ASSERT_FALSE(png.empty());
   EXPECT_GT(png.rows, 200);
+}
+
+// Outputs that cannot be written are refused before any experiment runs (a whole run takes
+// tens of minutes), naming the path: exit 3 at once, nothing printed.
+TEST(PlanExperimentsTool, UnwritableOutputsAreRefusedBeforeTheExperimentsRun) {
+  test::TempDir dir;
+  { std::ofstream(dir / "a-file") << "x"; }
+  const std::string png_under_file = (dir / "a-file" / "figures").string();
+  const std::string out_in_missing = (dir / "missing" / "tables.md").string();
+  for (const std::vector<std::string>& extra : {std::vector<std::string>{"--png-dir", png_under_file},
+                                                std::vector<std::string>{"--out", out_in_missing}}) {
+    std::vector<std::string> argv = {test::tool("plan-experiments").string(), "--trials", "30", "-q"};
+    argv.insert(argv.end(), extra.begin(), extra.end());
+    const test::RunResult r = test::run(argv, 20.0);
+    EXPECT_EQ(r.exit_code, 3) << r.err;
+    EXPECT_NE(r.err.find(extra[1]), std::string::npos) << r.err;
+    EXPECT_EQ(r.out.find("### Table"), std::string::npos) << r.out;
+  }
 }
 
 TEST(PlanExperimentsTool, WithoutTheStataMapItSaysSoAndGoesOn) {
