@@ -22,6 +22,7 @@ void Estimator::reset() {
   last_imu_utime_ = -1;
   last_vo_utime_ = -1;
   last_retired_vo_applied_ = -1;
+  settling_ = false;
   ++counters_.resets;
 }
 
@@ -64,6 +65,7 @@ Verdict Estimator::add_imu(const ImuSample& sample) {
     if (init) {
       counters_.moving_starts += init->moving;
       start(init->nav, init->P, init->last);
+      settling_ = init->moving;
     }
     return Verdict::kAccepted;
   }
@@ -85,6 +87,15 @@ Verdict Estimator::add_imu(const ImuSample& sample) {
     return Verdict::kAccepted;
   }
   trim();
+  if (settling_) {
+    // Checked at IMU rate only: a VO update lands between samples, and the next sample
+    // carries its effect. Once settled, a start stays settled (no flicker at the bound).
+    const auto& P = history_.back().state.P;
+    const InitOptions& o = options_.init;
+    settling_ = std::sqrt(P.block<3, 3>(idx::kV, idx::kV).diagonal().maxCoeff()) > o.sigma_velocity ||
+                tilt_sigma(history_.back().state.mean.nav.R_world_body,
+                           P.block<3, 3>(idx::kTheta, idx::kTheta)) > o.sigma_tilt;
+  }
   return Verdict::kAccepted;
 }
 
@@ -208,7 +219,7 @@ const FilterState* Estimator::filter_state() const {
 }
 
 std::optional<EstimatorOutput> Estimator::output() const {
-  if (!initialized()) return std::nullopt;
+  if (!initialized() || settling_) return std::nullopt;
   const Snapshot& now = history_.back();
   EstimatorOutput out;
   out.utime = now.imu.utime;

@@ -98,7 +98,10 @@ class Estimator {
   void reset();
 
   bool initialized() const { return !history_.empty(); }
-  /// The state at the newest IMU sample; empty while initialising.
+  /// Started on the move, and the VO has not yet measured velocity and tilt as well as a
+  /// still start knows them (InitOptions): the filter runs, but there is no state to publish.
+  bool settling() const { return settling_; }
+  /// The state at the newest IMU sample; empty while initialising or settling.
   std::optional<EstimatorOutput> output() const;
   /// The full filter state (with clones) at the newest IMU sample; empty while initialising.
   const FilterState* filter_state() const;
@@ -150,6 +153,7 @@ class Estimator {
   int64_t last_imu_utime_ = -1;
   int64_t last_vo_utime_ = -1;
   int64_t last_retired_vo_applied_ = -1;
+  bool settling_ = false;
   EstimatorCounters counters_;  // inputs, and outcomes of retired events
 };
 

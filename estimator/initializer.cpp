@@ -1,6 +1,9 @@
 #include "estimator/initializer.h"
 
+#include <algorithm>
 #include <cmath>
+
+#include <Eigen/Eigenvalues>
 
 #include "common/geometry/so3.h"
 
@@ -29,6 +32,13 @@ Eigen::Matrix3d attitude_covariance(const Eigen::Matrix3d& R_world_body, double 
   const Eigen::Vector3d up_body = R_world_body.transpose() * Eigen::Vector3d::UnitZ();
   return sq(sigma_tilt) * (Eigen::Matrix3d::Identity() - up_body * up_body.transpose()) +
          sq(sigma_yaw) * up_body * up_body.transpose();
+}
+
+double tilt_sigma(const Eigen::Matrix3d& R_world_body, const Eigen::Matrix3d& P_theta) {
+  const Eigen::Vector3d up_body = R_world_body.transpose() * Eigen::Vector3d::UnitZ();
+  const Eigen::Matrix3d level = Eigen::Matrix3d::Identity() - up_body * up_body.transpose();
+  const Eigen::Matrix3d P_tilt = level * P_theta * level.transpose();
+  return std::sqrt(std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(P_tilt).eigenvalues().maxCoeff()));
 }
 
 Eigen::Matrix3d attitude_from_gravity(const Eigen::Vector3d& f, double yaw) {

@@ -62,6 +62,10 @@ Eigen::Matrix3d attitude_from_gravity(const Eigen::Vector3d& specific_force_body
 Eigen::Matrix3d attitude_covariance(const Eigen::Matrix3d& R_world_body, double sigma_tilt,
                                     double sigma_yaw);
 
+/// The largest standard deviation of roll and pitch (tilt) in a covariance of dtheta (body
+/// frame), whatever the yaw's: the inverse of attitude_covariance for its tilt.
+double tilt_sigma(const Eigen::Matrix3d& R_world_body, const Eigen::Matrix3d& P_theta);
+
 /// The mean of the window's specific forces, each rotated into the body frame of the last
 /// sample by the gyro integrated between them (bias ignored): gravity plus the mean
 /// acceleration, in one frame even when the vehicle turns.

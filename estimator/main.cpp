@@ -35,6 +35,9 @@ void report_health(transport::Node& node, const StateEstimator& estimator) {
     node.set_health(kestrel::process_status_t::STATE_DEGRADED,
                     "IMU samples lack the gyro or the accelerometer: --mode imu needs both "
                     "(--mode auto runs on the visual odometry without a gyro)");
+  } else if (!out && estimator.settling()) {
+    node.set_health(kestrel::process_status_t::STATE_STARTING,
+                    "started on the move: waiting for the VO to measure velocity and tilt");
   } else if (!out) {
     node.set_health(kestrel::process_status_t::STATE_STARTING,
                     visual ? "visual only (no gyro): waiting for the first VO update"

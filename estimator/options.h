@@ -43,7 +43,10 @@ struct InitOptions {
   double moving_sigma_gyro_bias = 0.02;  ///< rad/s: the bias is not measured at all
   Eigen::Vector3d position = Eigen::Vector3d::Zero();  ///< world frame origin choice, m
   double yaw = 0.0;               ///< rad: yaw is unobservable, so it is given
-  // Prior standard deviations of the initial state.
+  // Prior standard deviations of the initial state. A start on the move publishes no state
+  // until the visual odometry has measured its velocity and tilt as well as sigma_velocity and
+  // sigma_tilt here (a controller would act on a velocity of 0 +- 1.5 m/s, and the first VO
+  // update would move the state by all the vehicle flew since the start).
   double sigma_position = 1e-3;   ///< m
   double sigma_velocity = 0.05;   ///< m/s
   double sigma_tilt = 0.02;       ///< rad, roll and pitch

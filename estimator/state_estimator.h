@@ -38,8 +38,10 @@ class StateEstimator {
 
   /// kAuto while undecided, else the estimator that runs.
   EstimatorMode mode() const { return mode_; }
-  /// The newest state; empty while undecided or initialising.
+  /// The newest state; empty while undecided, initialising or settling.
   std::optional<EstimatorOutput> output() const;
+  /// The IMU filter started on the move and waits for the VO (Estimator::settling()).
+  bool settling() const { return mode_ == EstimatorMode::kImu && imu_filter_.settling(); }
   EstimatorCounters counters() const;
   /// IMU readings refused for a missing part (the IMU filter's mode only).
   int64_t incomplete_imu() const { return incomplete_imu_; }
