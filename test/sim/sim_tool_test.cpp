@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "common/transport/channels.h"
+#include "common/transport/lcm_url.h"
 #include "common/transport/log_file.h"
 #include "kestrel/vehicle_command_t.hpp"
 #include "test/support/test_support.h"
@@ -23,6 +24,11 @@ namespace fs = std::filesystem;
 using kestrel::test::run;
 using kestrel::test::TempDir;
 using kestrel::test::tool;
+
+// The stock lcm-logger and lcm-logplayer in a script take kestrel's URL from the environment.
+std::string lcm_url_export() {
+  return "export LCM_DEFAULT_URL=" + kestrel::test::quoted(kestrel::transport::kDefaultLcmUrl) + " && ";
+}
 
 int data_lines(const fs::path& file) {
   std::ifstream in(file);
@@ -89,7 +95,7 @@ TEST(SimToolTest, LivePublishingReachesAnLcmLogger) {
   TempDir dir;
   const std::string log = (dir / "live.lcmlog").string();
   const std::string script =
-      "export LCM_DEFAULT_URL='udpm://239.255.76.67:7667?ttl=0' && "
+      lcm_url_export() +
       "(lcm-logger -f '" + log + "' >/dev/null 2>&1 & echo $! > '" + (dir / "pid").string() + "') && " +
       kestrel::test::wait_for_lcm_listener_sh() + " && '" +
       tool("sim").string() + "' --world office --flight hover --duration 1 --rate 0 -q && sleep 1 && "
@@ -122,7 +128,7 @@ TEST(SimToolTest, VehicleFliesAVehicleCommandReceivedOverLcm) {
   }
   const std::string pid = (dir / "pid").string();
   const std::string script =
-      "export LCM_DEFAULT_URL='udpm://239.255.76.67:7667?ttl=0' && "
+      lcm_url_export() +
       "(lcm-logger -f '" + log + "' >/dev/null 2>&1 & echo $! > '" + pid + "') && " +
       kestrel::test::wait_for_lcm_listener_sh() + " && "
       "('" + tool("sim").string() + "' --world office --flight vehicle --vehicle-feedback truth --duration 4 "
@@ -160,7 +166,7 @@ TEST(SimToolTest, VehicleFliesAVehicleCommandReceivedOverLcm) {
 TEST(SimToolTest, LockstepWithoutConsumersWaitsOnceThenFinishes) {
   if (!kestrel::test::can_isolate_network()) GTEST_SKIP() << "cannot create a network namespace here";
   const std::string script =
-      "export LCM_DEFAULT_URL='udpm://239.255.76.67:7667?ttl=0' && '" + tool("sim").string() +
+      lcm_url_export() + "'" + tool("sim").string() +
       "' --world room --flight vehicle --duration 0.5 --rate 0 --lockstep 1.5 -q";
   const auto r = kestrel::test::run_isolated(script, 120.0);
   ASSERT_EQ(r.exit_code, 0) << r.err;
