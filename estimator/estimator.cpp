@@ -122,6 +122,7 @@ Verdict Estimator::add_vo(const VoUpdate& u) {
   last_vo_utime_ = u.utime;
   if (!initialized()) {
     ++counters_.vo_before_init;
+    initializer_.add_vo(u);  // motion the IMU cannot see rules a still start out
     return Verdict::kNotInitialized;
   }
   if (u.utime <= oldest_utime()) {

@@ -67,6 +67,16 @@ Eigen::Vector3d mean_specific_force_in_last_frame(const std::vector<ImuSample>& 
 void Initializer::reset() {
   window_.clear();
   first_utime_ = -1;
+  last_vo_motion_utime_ = -1;
+}
+
+void Initializer::add_vo(const VoUpdate& u) {
+  if (!u.ok || u.utime <= u.reference_utime) return;
+  const double dt = 1e-6 * static_cast<double>(u.utime - u.reference_utime);
+  const double moved = u.T_refcam_curcam.translation().norm();
+  const double noise = std::sqrt(std::max(0.0, u.covariance.topLeftCorner<3, 3>().trace()));
+  if (moved > options_.max_still_vo_speed * dt && moved > 3.0 * noise)
+    last_vo_motion_utime_ = std::max(last_vo_motion_utime_, u.utime);
 }
 
 std::optional<InitialState> Initializer::add(const ImuSample& sample) {
@@ -91,7 +101,8 @@ std::optional<InitialState> Initializer::add(const ImuSample& sample) {
   const bool still = std::sqrt(var_w / n) <= options_.max_gyro_std &&
                      std::sqrt(var_a / n) <= options_.max_accel_std &&
                      mean_w.norm() <= options_.max_gyro_mean &&
-                     std::abs(mean_a.norm() - gravity_) < 0.1 * gravity_;
+                     std::abs(mean_a.norm() - gravity_) < 0.1 * gravity_ &&
+                     last_vo_motion_utime_ < window_.front().utime;
   std::optional<InitialState> init;
   if (still) {
     init = still_start(mean_w, mean_a);

@@ -14,6 +14,12 @@
 // velocity is unknown (moving_sigma_velocity) and the gyro bias unmeasured. The visual
 // odometry then makes velocity, tilt and biases observable.
 //
+// An IMU cannot tell standing still from cruising at a constant velocity; the visual odometry
+// can. A window in which a VO update showed the camera moving (significantly, and faster
+// than max_still_vo_speed against its reference frame) is not still: the filter then starts
+// on the move, where the velocity is unknown rather than wrongly known to be zero (an
+// estimator restarted in flight found "still" windows in the demo's figure-eight).
+//
 // Either way yaw and position are not observable: they come from the options (they define
 // the world frame).
 
@@ -21,6 +27,7 @@
 #include <vector>
 
 #include "estimator/imu.h"
+#include "estimator/inputs.h"
 #include "estimator/nav_state.h"
 #include "estimator/options.h"
 
@@ -39,6 +46,8 @@ class Initializer {
   /// Adds a sample (in time order); returns the initial state once a still window is full,
   /// or once moving_start_after_s has passed without one.
   std::optional<InitialState> add(const ImuSample& sample);
+  /// A VO update received before the start (any order against the IMU samples).
+  void add_vo(const VoUpdate& update);
   void reset();
   /// Windows that were not still.
   int restarts() const { return restarts_; }
@@ -51,6 +60,7 @@ class Initializer {
   double gravity_;
   std::vector<ImuSample> window_;
   int64_t first_utime_ = -1;
+  int64_t last_vo_motion_utime_ = -1;  ///< the newest frame at which the VO saw motion
   int restarts_ = 0;
 };
 

@@ -32,6 +32,9 @@ struct InitOptions {
   /// rad/s: a mean rate above this is motion, not gyro bias (a slow constant turn passes
   /// the spread tests above, and its rate taken for bias would stay wrong for good).
   double max_gyro_mean = 0.05;
+  /// m/s: a VO update showing the camera faster than this against its reference frame (and
+  /// beyond 3 sigma of its own noise) makes its window not still.
+  double max_still_vo_speed = 0.1;
   /// Without a still window after this long, start on the move (0 = wait for a still vehicle
   /// however long it takes). Must be at least duration_s.
   double moving_start_after_s = 1.0;  ///< s

@@ -428,5 +428,37 @@ TEST(Estimator, AStartOnTheMoveIsPublishedOnlyOnceTheVoHasSettledIt) {
   }
 }
 
+// Cruising at a constant velocity, level, the IMU reads what it reads at rest; the VO sees
+// the motion. Started in flight (an estimator restarted by the launcher), the filter must not
+// take "velocity 0 +- 0.05 m/s" for a vehicle doing 0.4 m/s: the VO rules the still start out,
+// the filter starts on the move and publishes once settled, with the right velocity. Without
+// the VO (every update failed) the same IMU gives a still start: the VO is what decides.
+TEST(Estimator, ACruiseAtConstantVelocityIsNotTakenForStandingStill) {
+  AnalyticMotion cruise = AnalyticMotion::still();
+  cruise.x.terms.push_back({2.5, 2.0 * M_PI / 40.0, 0.0});  // 0.39 m/s at t = 0, 0.06 m/s^2 at most
+  const auto run = [&](bool vo_works, EstimatorCounters& counters) {
+    Estimator e{EstimatorOptions{}};
+    ScenarioOptions o = scenario(3.0);
+    o.start_from_truth = false;
+    if (!vo_works) o.alter_vo = [](VoUpdate& u) { u.ok = false; };
+    const auto steps = test::run_scenario(e, cruise, o);
+    counters = e.counters();
+    return steps;
+  };
+  EstimatorCounters with_vo, without_vo;
+  const auto steps = run(true, with_vo);
+  run(false, without_vo);
+  EXPECT_EQ(with_vo.moving_starts, 1);
+  EXPECT_EQ(without_vo.moving_starts, 0);
+  ASSERT_FALSE(steps.empty());
+  const test::ScenarioStep& first = steps.front();
+  std::printf("first state at %.3f s: speed %.3f m/s, truth %.3f m/s\n", test::seconds(first.output.utime),
+              first.output.nav.v_world_body.norm(), first.truth.v_world_body.norm());
+  EXPECT_NEAR(first.output.nav.v_world_body.norm(), first.truth.v_world_body.norm(),
+              3.0 * EstimatorOptions{}.init.sigma_velocity);
+  for (const auto& s : steps)
+    ASSERT_NEAR(s.output.nav.v_world_body.norm(), s.truth.v_world_body.norm(), 0.1) << test::seconds(s.output.utime);
+}
+
 }  // namespace
 }  // namespace kestrel::estimator
