@@ -71,6 +71,10 @@ void add_estimator_options(CLI::App& app, EstimatorOptions& o) {
   app.add_option("--correction-gate", o.correction_gate_chi2,
                  "Chi-square (6 dof) gate on SLAM corrections, 0 = off")
       ->check(non_negative)->capture_default_str();
+  app.add_option("--world-align", o.world_align_chi2,
+                 "A first SLAM correction further than this (chi-square, 6 dof) moves the filter's "
+                 "world onto SLAM's: a filter restarted while SLAM ran on (0 = never)")
+      ->check(non_negative)->capture_default_str();
   app.add_option("--correction-sigma-position", o.correction_sigma_position,
                  "m, for a correction without covariance")->check(positive)->capture_default_str();
   app.add_option("--correction-sigma-rotation", o.correction_sigma_rotation,

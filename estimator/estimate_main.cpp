@@ -48,7 +48,8 @@ int run(const Options& o) {
             << c.vo_duplicate + c.vo_out_of_order + c.vo_too_old + c.vo_before_init
             << " dropped)\n"
             << "SLAM corrections: " << r.correction_messages << " (" << c.corrections_applied
-            << " applied, " << c.corrections_too_old << " too old)\n"
+            << " applied, " << c.corrections_too_old << " too old, " << c.world_alignments
+            << " moved the world onto SLAM's)\n"
             << "messages skipped: " << r.skips.rejected << "\n"
             << "filter restarts: " << c.filter_failures << "\n"
             << "started: " << (visual ? "on the first VO update" : c.moving_starts > 0 ? "on the move" : "still") << " at "

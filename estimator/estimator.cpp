@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "common/error.h"
+#include "estimator/measurements.h"
 
 namespace kestrel::estimator {
 
@@ -23,6 +24,7 @@ void Estimator::reset() {
   last_vo_utime_ = -1;
   last_retired_vo_applied_ = -1;
   settling_ = false;
+  correction_since_start_ = false;
   ++counters_.resets;
 }
 
@@ -188,6 +190,10 @@ Verdict Estimator::add_correction(const PoseCorrection& c) {
     replay_from(c.utime);
     return Verdict::kAccepted;
   }
+  if (!correction_since_start_) {
+    correction_since_start_ = true;
+    if (align_world(c)) ++counters_.world_alignments;
+  }
   Event e;
   e.utime = c.utime;
   e.kind = EventKind::kCorrection;
@@ -195,6 +201,25 @@ Verdict Estimator::add_correction(const PoseCorrection& c) {
   insert_event(e);
   replay_from(c.utime);
   return Verdict::kAccepted;
+}
+
+bool Estimator::align_world(const PoseCorrection& c) {
+  if (!(options_.world_align_chi2 > 0.0)) return false;
+  // The state at the correction's time, to the IMU period (the correction, fused after the
+  // change of world, takes up the rest).
+  size_t k = history_.size() - 1;
+  while (k > 0 && history_[k].imu.utime > c.utime) --k;
+  const FilterState& s = history_[k].state;
+  const AbsolutePoseMeasurement m(c.T_world_body, correction_noise(options_, c));
+  if (mahalanobis2(m, s) <= options_.world_align_chi2) return false;
+  // The turn about z and the shift that put the filter's pose there onto SLAM's; tilt is
+  // gravity's in both worlds.
+  const Eigen::Matrix3d R_delta = c.T_world_body.linear() * s.mean.nav.R_world_body.transpose();
+  const Eigen::Matrix3d R_z =
+      Eigen::AngleAxisd(std::atan2(R_delta(1, 0), R_delta(0, 0)), Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const Eigen::Vector3d t = c.T_world_body.translation() - R_z * s.mean.nav.p_world_body;
+  for (size_t i = 0; i < history_.size(); ++i) change_world(history_[i].state, R_z, t);
+  return true;
 }
 
 EstimatorCounters Estimator::counters() const {

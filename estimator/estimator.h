@@ -77,6 +77,7 @@ struct EstimatorCounters {
   int64_t corrections_applied = 0, corrections_gated = 0;
   int64_t replays = 0, replayed_steps = 0, resets = 0, filter_failures = 0, init_restarts = 0;
   int64_t moving_starts = 0;  ///< initialisations on the move (no still window)
+  int64_t world_alignments = 0;  ///< first corrections that moved the filter's world onto SLAM's
   int64_t gravity_updates = 0;  ///< visual only: frames levelled by the accelerometer
 };
 
@@ -137,6 +138,7 @@ class Estimator {
   void step_filter(const Snapshot& previous, Snapshot& next);
   void apply(Event& event, FilterState& s);
   void trim();
+  bool align_world(const PoseCorrection& c);
   void retire(const Event& event);
   int64_t oldest_utime() const { return history_.front().imu.utime; }
   static int64_t to_utime(double seconds) { return static_cast<int64_t>(std::llround(seconds * 1e6)); }
@@ -154,6 +156,7 @@ class Estimator {
   int64_t last_vo_utime_ = -1;
   int64_t last_retired_vo_applied_ = -1;
   bool settling_ = false;
+  bool correction_since_start_ = false;  // only the first correction may align the world
   EstimatorCounters counters_;  // inputs, and outcomes of retired events
 };
 

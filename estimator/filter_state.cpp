@@ -106,4 +106,24 @@ void symmetrize(Covariance& P) {
   P = 0.5 * (P + Pt);
 }
 
+void change_world(FilterState& s, const Eigen::Matrix3d& R_z, const Eigen::Vector3d& t) {
+  // The error state's world-frame blocks turn with the world: P <- J P J^T, J = R_z on them.
+  const auto turn = [&](int b) {
+    s.P.middleRows(b, 3) = (R_z * s.P.middleRows(b, 3)).eval();
+    s.P.middleCols(b, 3) = (s.P.middleCols(b, 3) * R_z.transpose()).eval();
+  };
+  NavState& nav = s.mean.nav;
+  nav.p_world_body = R_z * nav.p_world_body + t;
+  nav.v_world_body = R_z * nav.v_world_body;
+  nav.R_world_body = R_z * nav.R_world_body;
+  turn(idx::kP);
+  turn(idx::kV);
+  for (int i = 0; i < s.mean.num_clones; ++i) {
+    Clone& c = s.mean.clones[static_cast<size_t>(i)];
+    c.p_world_body = R_z * c.p_world_body + t;
+    c.R_world_body = R_z * c.R_world_body;
+    turn(FilterMean::clone_offset(i));
+  }
+}
+
 }  // namespace kestrel::estimator

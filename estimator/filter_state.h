@@ -77,6 +77,11 @@ void remove_clone(FilterState& s, int i);
 /// dtheta / 2 to first order, so P <- G P G^T with G = I - [dx_theta]x / 2 on those blocks.
 void inject(FilterState& s, const Eigen::Ref<const ErrorVector>& dx);
 
+/// Expresses the state in another world frame, x' = R_z x + t (R_z a turn about the vertical,
+/// which gravity leaves free): positions, velocity and attitudes of the mean, and the world
+/// blocks of P (position and velocity errors; rotation errors are in the body frame).
+void change_world(FilterState& s, const Eigen::Matrix3d& R_z, const Eigen::Vector3d& t);
+
 /// Makes P exactly symmetric (rounding in the updates breaks it slowly).
 void symmetrize(Covariance& P);
 

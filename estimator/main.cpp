@@ -92,19 +92,23 @@ int run(const Options& o) {
                                               [&](const kestrel::slam_correction_t& m) {
     const PoseCorrection c = correction_from_message(m, channel::kSlamCorrection);
     validate_correction(c, channel::kSlamCorrection);
+    const int64_t aligned = estimator.counters().world_alignments;
     if (estimator.add_correction(c) == Verdict::kTooOld)
       spdlog::warn("SLAM_CORRECTION: correction for utime {} is outside the {} s history; dropped",
                    c.utime, o.estimator.history_s);
+    if (estimator.counters().world_alignments > aligned)
+      spdlog::warn("SLAM_CORRECTION: the first correction is far from this filter's world (a "
+                   "restart while SLAM ran on?): the filter moved its world onto SLAM's");
   });
 
   const int code = node->spin();
   const EstimatorCounters c = estimator.counters();
   spdlog::info("{}IMU {} accepted, {} duplicate, {} out of order, {} gaps; VO {} applied, {} failed, "
-               "{} gated ({} forced past the gate), {} dropped; corrections {} applied, {} too old; filter restarts {}",
+               "{} gated ({} forced past the gate), {} dropped; corrections {} applied, {} too old, {} moved the world onto SLAM's; filter restarts {}",
                estimator.mode() == EstimatorMode::kVisualOnly ? "visual only; " : "",
                c.imu_accepted, c.imu_duplicate, c.imu_out_of_order, c.imu_gaps, c.vo_applied,
                c.vo_failed, c.vo_gated, c.vo_forced, c.vo_duplicate + c.vo_out_of_order + c.vo_too_old,
-               c.corrections_applied, c.corrections_too_old, c.filter_failures);
+               c.corrections_applied, c.corrections_too_old, c.world_alignments, c.filter_failures);
   return code;
 }
 

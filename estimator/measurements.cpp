@@ -1,5 +1,7 @@
 #include "estimator/measurements.h"
 
+#include <limits>
+
 #include "common/geometry/so3.h"
 
 namespace kestrel::estimator {
@@ -66,6 +68,15 @@ MeasurementJacobian AbsolutePoseMeasurement::jacobian(const FilterMean& x) const
   H.block<3, 3>(0, idx::kP).setIdentity();
   H.block<3, 3>(3, idx::kTheta) = so3::right_jacobian_inverse(residual(x).tail<3>());
   return H;
+}
+
+double mahalanobis2(const Measurement& m, const FilterState& s) {
+  const Residual g = m.residual(s.mean);
+  const MeasurementJacobian H = m.jacobian(s.mean);
+  const MeasurementNoise S = H * s.P * H.transpose() + m.noise();
+  const Eigen::LLT<MeasurementNoise> llt(S);
+  if (llt.info() != Eigen::Success || !g.allFinite()) return std::numeric_limits<double>::infinity();
+  return g.dot(llt.solve(g));
 }
 
 }  // namespace kestrel::estimator

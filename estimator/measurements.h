@@ -51,6 +51,10 @@ class RelativePoseMeasurement final : public Measurement {
 };
 
 /// An absolute body pose T_world_body (a SLAM correction) at the state's time.
+/// y^T S^-1 y for the measurement's innovation y at the state, S = H P H^T + Q linearised
+/// there: how far the measurement is from what the state expects (chi^2, dim(y) dof).
+double mahalanobis2(const Measurement& m, const FilterState& s);
+
 class AbsolutePoseMeasurement final : public Measurement {
  public:
   AbsolutePoseMeasurement(const Eigen::Isometry3d& T_world_body, const Matrix6d& covariance);

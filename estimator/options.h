@@ -101,6 +101,12 @@ struct EstimatorOptions {
   int vo_max_gated_in_row = 10;
   /// The same for SLAM corrections; off by default: a loop closure may move the state far.
   double correction_gate_chi2 = 0.0;
+  /// The first SLAM correction after the start further than this from the filter (chi^2, 6
+  /// dof) says the filter's world is not SLAM's: the filter was restarted while SLAM's map,
+  /// anchored to the filter that ran before, lived on. The filter then moves its world onto
+  /// SLAM's (a turn about z and a shift) instead of fusing the correction; 0 = never. A filter
+  /// that started with SLAM shares its world and is within a few units of chi^2.
+  double world_align_chi2 = 1000.0;
   /// Used for a correction that carries no covariance (all zero): sigmas of [dp; dtheta].
   double correction_sigma_position = 0.05;  ///< m
   double correction_sigma_rotation = 0.02;  ///< rad

@@ -172,5 +172,46 @@ TEST(FilterState, InjectMovesTheMeanAndKeepsPSymmetric) {
   EXPECT_FALSE(bad.is_valid());
 }
 
+// A change of world moves every pose and the velocity, and the error state with them: the
+// world-frame blocks (positions, velocity) turn, the body-frame ones (rotations, biases) stay.
+TEST(FilterState, ChangingTheWorldTurnsItsBlocksAndLeavesTheBodysAlone) {
+  std::mt19937 rng(41);
+  FilterState s;
+  s.mean = random_mean(rng, 2);
+  s.mean.nav.v_world_body = Eigen::Vector3d(1.0, 0.0, 0.2);
+  const int n = s.mean.dim();
+  Eigen::MatrixXd A = Eigen::MatrixXd::Random(n, n);
+  s.P = A * A.transpose();
+  const FilterState before = s;
+  const Eigen::Matrix3d R_z = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const Eigen::Vector3d t(3.0, -2.0, 0.5);
+  change_world(s, R_z, t);
+
+  // By hand: a quarter turn takes x to y.
+  EXPECT_LT((s.mean.nav.v_world_body - Eigen::Vector3d(0.0, 1.0, 0.2)).norm(), 1e-15);
+  const Eigen::Isometry3d T = se3::make(R_z, t);
+  EXPECT_TRUE(s.mean.nav.T_world_body().isApprox(T * before.mean.nav.T_world_body(), 1e-12));
+  for (int i = 0; i < 2; ++i) {
+    const Clone& c = s.mean.clones[static_cast<size_t>(i)];
+    const Clone& c0 = before.mean.clones[static_cast<size_t>(i)];
+    EXPECT_TRUE(se3::make(c.R_world_body, c.p_world_body).isApprox(T * se3::make(c0.R_world_body, c0.p_world_body), 1e-12));
+  }
+  EXPECT_TRUE(s.mean.nav.gyro_bias.isApprox(before.mean.nav.gyro_bias));
+
+  // The error state maps through J = R_z on the world blocks, I elsewhere, and P with it.
+  Eigen::MatrixXd J = Eigen::MatrixXd::Identity(n, n);
+  for (const int b : {idx::kP, idx::kV, FilterMean::clone_offset(0), FilterMean::clone_offset(1)})
+    J.block<3, 3>(b, b) = R_z;
+  ErrorVector dx(n);
+  for (int i = 0; i < n; ++i) dx[i] = 0.1 * std::normal_distribution<double>()(rng);
+  FilterState moved;
+  moved.mean = boxplus(before.mean, dx);
+  moved.P = before.P;
+  change_world(moved, R_z, t);
+  EXPECT_LT((boxminus(moved.mean, s.mean) - J * dx).norm(), 1e-12);
+  EXPECT_LT((Eigen::MatrixXd(s.P) - J * Eigen::MatrixXd(before.P) * J.transpose()).norm(), 1e-9);
+  EXPECT_TRUE(s.is_valid());
+}
+
 }  // namespace
 }  // namespace kestrel::estimator
