@@ -158,14 +158,21 @@ int serve(const Options& o, const SlamOptions& options, std::shared_ptr<const Vo
   };
   node->subscribe<rgbd_frame_t>(o.adapter.camera_channel, [&](const rgbd_frame_t& m) { publish(adapter.on_frame(m)); });
   node->subscribe<vo_update_t>(o.adapter.vo_channel, [&](const vo_update_t& m) { publish(adapter.on_vo_update(m)); });
-  node->subscribe<state_t>(o.adapter.state_channel, [&](const state_t& m) { publish(adapter.on_state(m)); });
+  node->subscribe<state_t>(o.adapter.state_channel, [&](const state_t& m) {
+    const int restarts = adapter.estimator_restarts();
+    publish(adapter.on_state(m));
+    if (adapter.estimator_restarts() > restarts)
+      spdlog::warn("{}: a new estimator (its seq started again): the next keyframe's {} gives it the map's world",
+                   o.adapter.state_channel, o.correction_channel);
+  });
   node->set_health(process_status_t::STATE_RUNNING, "");
   spdlog::info("{}: {} + {} -> {}, {}", o.name, o.adapter.camera_channel, o.adapter.vo_channel,
                o.graph_channel, o.correction_channel);
   const int status = node->spin();
-  spdlog::info("{} keyframes, {} loop closures, {} VO restarts bridged by the estimator, {} messages rejected",
+  spdlog::info("{} keyframes, {} loop closures, {} VO restarts bridged by the estimator, {} estimator restarts, "
+               "{} messages rejected",
                adapter.slam().keyframes().size(), adapter.slam().num_loop_closures(), adapter.bridges(),
-               node->counters().messages_rejected);
+               adapter.estimator_restarts(), node->counters().messages_rejected);
   return status;
 }
 

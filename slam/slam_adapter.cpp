@@ -32,6 +32,9 @@ void SlamAdapter::reset() {
   previous_chained_.reset();
   keyframe_pose_.reset();
   bridges_ = 0;
+  last_state_seq_ = -1;
+  restart_correction_due_ = false;
+  estimator_restarts_ = 0;
 }
 
 void SlamAdapter::trim_frames() {
@@ -92,6 +95,15 @@ AdapterOutputs SlamAdapter::on_state(const kestrel::state_t& state) {
     throw InputError(options_.state_channel + ": state " + std::to_string(state.utime) +
                      " is not newer than the previous one");
   }
+  if (last_state_seq_ >= 0 && state.seq < last_state_seq_) {
+    // A new estimator (its seq starts again): its world is its own until SLAM's first
+    // correction moves it onto the map's (estimator.h), so the map's world stays, the old
+    // filter's states are no use for bridges, and the next keyframe sends that correction.
+    states_.clear();
+    restart_correction_due_ = anchored_;
+    ++estimator_restarts_;
+  }
+  last_state_seq_ = state.seq;
   // DEGRADED is the IMU alone through a VO outage: what a bridge needs; anchoring wants OK.
   const bool ok = state.status == kestrel::state_t::STATUS_OK;
   if (!ok && state.status != kestrel::state_t::STATUS_DEGRADED) return out;
@@ -232,8 +244,9 @@ AdapterOutputs SlamAdapter::process(const kestrel::rgbd_frame_t& message, const 
   try_anchor(out);
   // A correction is a pose in the estimator's world: none before the graph is anchored in it
   // (in SLAM's odometry frame it would pull the state by the frames' difference).
-  if (step.optimisation && anchored_) {
+  if ((step.optimisation || restart_correction_due_) && anchored_) {
     out.correction = correction_message(slam_, options_.correction_sigma_m, options_.correction_sigma_rad);
+    restart_correction_due_ = false;
   }
   return out;
 }

@@ -17,6 +17,11 @@
 // SLAM_CORRECTION is published until the graph is anchored: the estimator applies one as a
 // pose in its own world.
 //
+// Estimator restarts: a restarted estimator (its STATE seq starts again) begins a world of its
+// own; SLAM keeps the map's, drops the old filter's states, and sends a SLAM_CORRECTION for its
+// next keyframe, which the new filter takes as the map's world (estimator.h) without waiting
+// for a loop closure.
+//
 // VO restarts: when the visual odometry loses its reference (a blank wall, a fast turn) its
 // new segment is unrelated to the old one, and the heading turned in the gap would be lost for
 // good. The estimator carries on through the gap on the IMU, so its motion from the last frame
@@ -70,7 +75,7 @@ struct AdapterOptions {
 
 struct AdapterOutputs {
   std::optional<kestrel::slam_graph_t> graph;            ///< after a new keyframe or optimisation
-  std::optional<kestrel::slam_correction_t> correction;  ///< after an optimisation
+  std::optional<kestrel::slam_correction_t> correction;  ///< after an optimisation, or for a new estimator
   std::optional<SlamStep> step;                          ///< what SLAM did (a keyframe was made)
   bool anchored = false;  ///< the graph was just moved into the estimator's world
 };
@@ -93,6 +98,8 @@ class SlamAdapter {
   bool anchored() const { return anchored_; }
   /// VO restarts bridged by the estimator's motion so far.
   int bridges() const { return bridges_; }
+  /// New estimators seen on STATE (its seq started again): a restarted process.
+  int estimator_restarts() const { return estimator_restarts_; }
 
   const Slam& slam() const { return slam_; }
 
@@ -139,6 +146,9 @@ class SlamAdapter {
   std::optional<OdometryPose> keyframe_pose_;  ///< the chain's pose of the newest keyframe
   Eigen::Isometry3d odometry_fix_ = Eigen::Isometry3d::Identity();  ///< chain -> SLAM's odometry frame
   int bridges_ = 0;
+  int64_t last_state_seq_ = -1;
+  bool restart_correction_due_ = false;  ///< a new estimator waits for the map's world
+  int estimator_restarts_ = 0;
   std::deque<FramePose> recent_;  ///< frames since the newest keyframe, until anchored
 };
 

@@ -112,6 +112,51 @@ TEST_F(AdapterTest, AnchorsTheGraphInTheEstimatorsWorldAtTheFirstKeyframeItsStat
   EXPECT_FALSE(adapter_.on_state(state(6.5, Eigen::Isometry3d::Identity())).graph);
 }
 
+// A restarted estimator (its STATE seq starts again, in a world of its own) gets a
+// SLAM_CORRECTION at the next keyframe, in the map's world, which it takes as its world
+// (estimator.h): no waiting for a loop closure. The same run without the restart sends none.
+TEST_F(AdapterTest, ARestartedEstimatorGetsTheMapsWorldAtTheNextKeyframe) {
+  const Eigen::Isometry3d X = estimator_world();
+  for (const bool restart : {false, true}) {
+    SCOPED_TRACE(restart ? "restarted" : "the same estimator");
+    SlamAdapter adapter(SlamOptions{}, nullptr);
+    int64_t seq = 10;
+    const auto state_at = [&](double k, const Eigen::Isometry3d& world) {
+      kestrel::state_t m = state(k, world);
+      m.seq = seq++;
+      return adapter.on_state(m);
+    };
+    for (int k = 0; k <= 3; ++k) {
+      adapter.on_frame(frame(k));
+      adapter.on_vo_update(update(k));
+      if (k > 0) state_at(k - 0.5, X);
+    }
+    state_at(3.05, X);
+    ASSERT_TRUE(adapter.anchored());
+    for (int k = 4; k <= 5; ++k) {
+      adapter.on_frame(frame(k));
+      EXPECT_FALSE(adapter.on_vo_update(update(k)).correction);
+    }
+    if (restart) seq = 0;  // a new process, in its own world (here the odometry frame)
+    state_at(5.5, restart ? Eigen::Isometry3d::Identity() : X);
+    EXPECT_EQ(adapter.estimator_restarts(), restart ? 1 : 0);
+    adapter.on_frame(frame(6));
+    const AdapterOutputs out = adapter.on_vo_update(update(6));
+    ASSERT_TRUE(out.graph) << "frame 6 is a keyframe";
+    EXPECT_FALSE(out.step->optimisation);
+    ASSERT_EQ(out.correction.has_value(), restart);
+    if (!restart) continue;
+    EXPECT_EQ(out.correction->utime, utime(6));
+    const Eigen::Isometry3d expected = X * pose(0).inverse() * pose(6);  // the map's world
+    EXPECT_LT((transport::from_message(out.correction->T_world_body, "test").matrix() - expected.matrix()).norm(), 1e-9);
+    // Once: the keyframe after carries none.
+    for (int k = 7; k <= 9; ++k) {
+      adapter.on_frame(frame(k));
+      EXPECT_FALSE(adapter.on_vo_update(update(k)).correction) << k;
+    }
+  }
+}
+
 TEST_F(AdapterTest, OdometryEdgesTakeTheVosReportedCovarianceChainedBetweenKeyframes) {
   // Every frame is the next one's reference, 2 mm (per axis) of translation noise per step:
   // keyframe 1 is frame 3, three steps on, so its edge has 3 * (2 mm)^2 plus the 1 mm floor.
