@@ -212,13 +212,8 @@ bool Estimator::align_world(const PoseCorrection& c) {
   const FilterState& s = history_[k].state;
   const AbsolutePoseMeasurement m(c.T_world_body, correction_noise(options_, c));
   if (mahalanobis2(m, s) <= options_.world_align_chi2) return false;
-  // The turn about z and the shift that put the filter's pose there onto SLAM's; tilt is
-  // gravity's in both worlds.
-  const Eigen::Matrix3d R_delta = c.T_world_body.linear() * s.mean.nav.R_world_body.transpose();
-  const Eigen::Matrix3d R_z =
-      Eigen::AngleAxisd(std::atan2(R_delta(1, 0), R_delta(0, 0)), Eigen::Vector3d::UnitZ()).toRotationMatrix();
-  const Eigen::Vector3d t = c.T_world_body.translation() - R_z * s.mean.nav.p_world_body;
-  for (size_t i = 0; i < history_.size(); ++i) change_world(history_[i].state, R_z, t);
+  const Eigen::Isometry3d change = world_change(s.mean.nav.T_world_body(), c.T_world_body);
+  for (size_t i = 0; i < history_.size(); ++i) change_world(history_[i].state, change);
   return true;
 }
 

@@ -106,23 +106,27 @@ void symmetrize(Covariance& P) {
   P = 0.5 * (P + Pt);
 }
 
-void change_world(FilterState& s, const Eigen::Matrix3d& R_z, const Eigen::Vector3d& t) {
-  // The error state's world-frame blocks turn with the world: P <- J P J^T, J = R_z on them.
-  const auto turn = [&](int b) {
-    s.P.middleRows(b, 3) = (R_z * s.P.middleRows(b, 3)).eval();
-    s.P.middleCols(b, 3) = (s.P.middleCols(b, 3) * R_z.transpose()).eval();
-  };
+Eigen::Isometry3d world_change(const Eigen::Isometry3d& ours, const Eigen::Isometry3d& theirs) {
+  const Eigen::Matrix3d R_delta = theirs.linear() * ours.linear().transpose();
+  Eigen::Isometry3d change = Eigen::Isometry3d::Identity();
+  change.linear() = Eigen::AngleAxisd(std::atan2(R_delta(1, 0), R_delta(0, 0)), Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  change.translation() = theirs.translation() - change.linear() * ours.translation();
+  return change;
+}
+
+void change_world(FilterState& s, const Eigen::Isometry3d& change) {
+  const Eigen::Matrix3d& R_z = change.linear();
   NavState& nav = s.mean.nav;
-  nav.p_world_body = R_z * nav.p_world_body + t;
+  nav.p_world_body = change * nav.p_world_body;
   nav.v_world_body = R_z * nav.v_world_body;
   nav.R_world_body = R_z * nav.R_world_body;
-  turn(idx::kP);
-  turn(idx::kV);
+  turn_world_block(s.P, idx::kP, R_z);
+  turn_world_block(s.P, idx::kV, R_z);
   for (int i = 0; i < s.mean.num_clones; ++i) {
     Clone& c = s.mean.clones[static_cast<size_t>(i)];
-    c.p_world_body = R_z * c.p_world_body + t;
+    c.p_world_body = change * c.p_world_body;
     c.R_world_body = R_z * c.R_world_body;
-    turn(FilterMean::clone_offset(i));
+    turn_world_block(s.P, FilterMean::clone_offset(i), R_z);
   }
 }
 

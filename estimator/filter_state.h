@@ -12,6 +12,7 @@
 // dimension of the mean.
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <array>
 #include <cstdint>
 
@@ -77,10 +78,23 @@ void remove_clone(FilterState& s, int i);
 /// dtheta / 2 to first order, so P <- G P G^T with G = I - [dx_theta]x / 2 on those blocks.
 void inject(FilterState& s, const Eigen::Ref<const ErrorVector>& dx);
 
-/// Expresses the state in another world frame, x' = R_z x + t (R_z a turn about the vertical,
-/// which gravity leaves free): positions, velocity and attitudes of the mean, and the world
-/// blocks of P (position and velocity errors; rotation errors are in the body frame).
-void change_world(FilterState& s, const Eigen::Matrix3d& R_z, const Eigen::Vector3d& t);
+/// The change of world x' = R_z x + t (R_z a turn about the vertical, which gravity leaves
+/// free) that takes the pose `ours` onto `theirs` in position and yaw; their tilts are taken
+/// to agree (both worlds level by gravity).
+Eigen::Isometry3d world_change(const Eigen::Isometry3d& ours, const Eigen::Isometry3d& theirs);
+
+/// Turns the rows and columns of a covariance at `block` (a world-frame 3-vector's error) by
+/// R_z: the covariance's part of a change of world.
+template <typename Matrix>
+void turn_world_block(Matrix& P, int block, const Eigen::Matrix3d& R_z) {
+  P.middleRows(block, 3) = (R_z * P.middleRows(block, 3)).eval();
+  P.middleCols(block, 3) = (P.middleCols(block, 3) * R_z.transpose()).eval();
+}
+
+/// Expresses the state in another world frame (world_change): positions, velocity and
+/// attitudes of the mean, and the world blocks of P (position and velocity errors; rotation
+/// errors are in the body frame).
+void change_world(FilterState& s, const Eigen::Isometry3d& change);
 
 /// Makes P exactly symmetric (rounding in the updates breaks it slowly).
 void symmetrize(Covariance& P);

@@ -35,6 +35,7 @@ void VisualOnlyEstimator::reset() {
   omega_body_.setZero();
   rate_covariance_.setZero();
   newest_reference_ = last_applied_utime_ = last_vo_utime_ = -1;
+  correction_since_start_ = false;
   counters_.resets++;
 }
 
@@ -232,17 +233,41 @@ Verdict VisualOnlyEstimator::add_correction(const PoseCorrection& c) {
   // The pose at the correction's utime: a frame, or interpolated between two.
   const auto after = std::lower_bound(frames_.begin(), frames_.end(), c.utime,
                                       [](const Frame& f, int64_t t) { return f.utime < t; });
-  Eigen::Isometry3d T = after->T_world_body;
-  Matrix6d P = after->covariance;
-  if (after->utime != c.utime) {
-    const Frame& before = *std::prev(after);
-    const double s = static_cast<double>(c.utime - before.utime) /
-                     static_cast<double>(after->utime - before.utime);
-    T = se3::interpolate(before.T_world_body, after->T_world_body, s);
-    P = (1.0 - s) * before.covariance + s * after->covariance;
-  }
+  Eigen::Isometry3d T;
+  Matrix6d P;
+  const auto pose_there = [&] {
+    T = after->T_world_body;
+    P = after->covariance;
+    if (after->utime != c.utime) {
+      const Frame& before = *std::prev(after);
+      const double s = static_cast<double>(c.utime - before.utime) /
+                       static_cast<double>(after->utime - before.utime);
+      T = se3::interpolate(before.T_world_body, after->T_world_body, s);
+      P = (1.0 - s) * before.covariance + s * after->covariance;
+    }
+  };
+  pose_there();
   const Matrix6d Q = correction_noise(options_, c);
-  const Vector6d innovation = se3::boxminus(c.T_world_body, T);
+  Vector6d innovation = se3::boxminus(c.T_world_body, T);
+  // A first correction a world away: SLAM's map outlived the estimator before this one (as
+  // in Estimator::align_world): move every kept frame and the velocity onto SLAM's world.
+  if (!correction_since_start_) {
+    correction_since_start_ = true;
+    if (options_.world_align_chi2 > 0.0 &&
+        innovation.dot((P + Q).ldlt().solve(innovation)) > options_.world_align_chi2) {
+      const Eigen::Isometry3d change = world_change(T, c.T_world_body);
+      for (Frame& f : frames_) {
+        f.T_world_body = change * f.T_world_body;
+        turn_world_block(f.covariance, idx::kP, change.linear());
+        turn_world_block(f.vo_noise, idx::kP, change.linear());
+      }
+      v_world_ = change.linear() * v_world_;
+      turn_world_block(rate_covariance_, 0, change.linear());
+      counters_.world_alignments++;
+      pose_there();
+      innovation = se3::boxminus(c.T_world_body, T);
+    }
+  }
   if (options_.correction_gate_chi2 > 0.0 &&
       innovation.dot((P + Q).ldlt().solve(innovation)) > options_.correction_gate_chi2) {
     counters_.corrections_gated++;

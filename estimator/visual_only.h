@@ -31,6 +31,10 @@
 // of the correction seen through the chain. A correction between two frames uses the pose
 // interpolated there. This is first order: the chain's cross-covariances are not kept.
 //
+// A first correction a world away (beyond world_align_chi2) moves every kept frame and the
+// velocity onto SLAM's world before it is fused, as the IMU filter does (estimator.h): this
+// estimator was restarted while SLAM's map lived on.
+//
 // Start. The first successful update's reference frame is the world frame's origin pose:
 // position and yaw from InitOptions, roll and pitch from the accelerometer readings given
 // before it (the mean over init.duration_s, if their spread is that of a still sensor:
@@ -109,6 +113,7 @@ class VisualOnlyEstimator {
   int64_t newest_reference_ = -1;
   int64_t last_applied_utime_ = -1;
   int64_t last_vo_utime_ = -1;
+  bool correction_since_start_ = false;  // only the first correction may change the world
   EstimatorCounters counters_;
 };
 

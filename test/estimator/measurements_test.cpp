@@ -185,11 +185,11 @@ TEST(FilterState, ChangingTheWorldTurnsItsBlocksAndLeavesTheBodysAlone) {
   const FilterState before = s;
   const Eigen::Matrix3d R_z = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   const Eigen::Vector3d t(3.0, -2.0, 0.5);
-  change_world(s, R_z, t);
+  const Eigen::Isometry3d T = se3::make(R_z, t);
+  change_world(s, T);
 
   // By hand: a quarter turn takes x to y.
   EXPECT_LT((s.mean.nav.v_world_body - Eigen::Vector3d(0.0, 1.0, 0.2)).norm(), 1e-15);
-  const Eigen::Isometry3d T = se3::make(R_z, t);
   EXPECT_TRUE(s.mean.nav.T_world_body().isApprox(T * before.mean.nav.T_world_body(), 1e-12));
   for (int i = 0; i < 2; ++i) {
     const Clone& c = s.mean.clones[static_cast<size_t>(i)];
@@ -207,10 +207,14 @@ TEST(FilterState, ChangingTheWorldTurnsItsBlocksAndLeavesTheBodysAlone) {
   FilterState moved;
   moved.mean = boxplus(before.mean, dx);
   moved.P = before.P;
-  change_world(moved, R_z, t);
+  change_world(moved, T);
   EXPECT_LT((boxminus(moved.mean, s.mean) - J * dx).norm(), 1e-12);
   EXPECT_LT((Eigen::MatrixXd(s.P) - J * Eigen::MatrixXd(before.P) * J.transpose()).norm(), 1e-9);
   EXPECT_TRUE(s.is_valid());
+  // The change that takes one pose onto another in position and yaw, the tilt left alone.
+  const Eigen::Isometry3d ours = before.mean.nav.T_world_body();
+  const Eigen::Isometry3d found = world_change(ours, T * ours);
+  EXPECT_TRUE(found.isApprox(T, 1e-12));
 }
 
 }  // namespace

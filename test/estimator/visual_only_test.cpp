@@ -242,6 +242,7 @@ TEST(VisualOnly, ASlamCorrectionMovesTheChainAfterItAndALateOneToo) {
   EXPECT_LT(so3::angle(out->nav.R_world_body.transpose() * expected.linear()), 1e-5);
   EXPECT_LT(pose_covariance(*out).trace(), P_old.trace()) << "the correction removed uncertainty";
   EXPECT_EQ(e.counters().corrections_applied, 1);
+  EXPECT_EQ(e.counters().world_alignments, 0) << "a correction in the estimator's own world";
   // Older than the kept frames (2 s): refused, nothing moves.
   PoseCorrection old = c;
   old.utime = frame_utime(10);
@@ -275,6 +276,46 @@ TEST(VisualOnly, ASlamCorrectionMovesTheChainAfterItAndALateOneToo) {
   PoseCorrection bad = c;
   bad.T_world_body.translation().x() = std::nan("");
   EXPECT_EQ(e.add_correction(bad), Verdict::kInvalid);
+}
+
+// Restarted while SLAM's map lived on: the estimator's world (the options' origin) is not
+// SLAM's, and SLAM's first correction, a world away, moves every kept frame and the velocity
+// onto SLAM's world instead of being weighed against the chain's millimetres.
+TEST(VisualOnly, ARestartedEstimatorMovesOntoSlamsWorldAtItsFirstCorrection) {
+  const Truth truth;
+  const Eigen::Isometry3d slam_world =
+      se3::make(Eigen::AngleAxisd(1.0, Eigen::Vector3d::UnitZ()).toRotationMatrix(), Eigen::Vector3d(3.0, -2.0, 0.5));
+  for (const bool aligned : {true, false}) {
+    SCOPED_TRACE(aligned ? "aligned" : "world_align_chi2 = 0");
+    EstimatorOptions o = exact_start();
+    if (!aligned) o.world_align_chi2 = 0.0;
+    VisualOnlyEstimator e(o);
+    level_start(e, truth);
+    SyntheticVo vo(vo_options(true), 11);
+    vo.next(frame_utime(0), truth.pose(0));
+    for (int k = 1; k < 60; ++k) e.add_vo(vo.next(frame_utime(k), truth.pose(k)));
+    PoseCorrection c;
+    c.utime = frame_utime(40);
+    c.T_world_body = slam_world * truth.pose(40);
+    c.covariance = Matrix6d::Identity() * 1e-4;
+    EXPECT_EQ(e.add_correction(c), Verdict::kAccepted);
+    EXPECT_EQ(e.counters().world_alignments, aligned ? 1 : 0);
+    EXPECT_EQ(e.counters().corrections_applied, 1);
+    const Eigen::Isometry3d expected = slam_world * truth.pose(59);
+    const double error = (e.output()->nav.p_world_body - expected.translation()).norm();
+    const Eigen::Vector3d v_error = e.output()->nav.v_world_body - slam_world.linear() * truth.velocity(59);
+    std::printf("frame 59 against SLAM's world: %.4f m, velocity %.3f m/s\n", error, v_error.norm());
+    if (aligned) {
+      // The noisy chain's own drift over the 19 frames since (up to 1.5 m/s) is a few cm.
+      EXPECT_LT(error, 0.05);
+      EXPECT_LT(v_error.norm(), 0.2) << "the velocity turned with the world";
+      // Later frames chain on in SLAM's world.
+      for (int k = 60; k < 70; ++k) e.add_vo(vo.next(frame_utime(k), truth.pose(k)));
+      EXPECT_LT((e.output()->nav.p_world_body - (slam_world * truth.pose(69)).translation()).norm(), 0.06);
+    } else {
+      EXPECT_GT(error, 1.0) << "fused, the correction barely moves a chain that knows its start";
+    }
+  }
 }
 
 TEST(VisualOnly, TheWorldIsLevelledByTheAccelerometerAndYawAndPositionComeFromTheOptions) {
