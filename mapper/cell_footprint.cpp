@@ -4,10 +4,11 @@
 #include <cmath>
 #include <limits>
 
+#include "common/numbers.h"
+
 namespace kestrel::mapper {
 
 namespace {
-constexpr double kInf = std::numeric_limits<double>::infinity();
 
 // Inclusive index range [lo, hi] of the pixels whose centre (at integer coordinates) lies in
 // [a, b], clamped to [0, n). The corners were grown by the margin, which covers rounding.

@@ -6,12 +6,12 @@
 
 #include "common/error.h"
 #include "common/geometry/se3.h"
+#include "common/numbers.h"
 #include "mapper/scan.h"
 
 namespace kestrel::mapper {
 
 namespace {
-constexpr double kDegree = M_PI / 180.0;
 
 bool moved(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b, double metres, double degrees) {
   return se3::translation_distance(a, b) > metres || se3::rotation_distance(a, b) > degrees * kDegree;

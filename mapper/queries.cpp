@@ -4,10 +4,11 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "common/numbers.h"
+
 namespace kestrel::mapper {
 
 namespace {
-constexpr double kInf = std::numeric_limits<double>::infinity();
 
 double point_to_box(const Eigen::Vector3d& p, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
   const Eigen::Vector3d outside = (lo - p).cwiseMax(p - hi).cwiseMax(0.0);

@@ -3,10 +3,11 @@
 #include <algorithm>
 #include <limits>
 
+#include "common/numbers.h"
+
 namespace kestrel::mapper {
 
 namespace {
-constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kRelativeError = 1e-9;
 }  // namespace
 

@@ -98,8 +98,9 @@ void ScanIntegrator::begin(const Scan& scan) {
 }
 
 void ScanIntegrator::begin_axis_parts(const Scan& scan) {
-  const Eigen::Matrix3d R_camera_world = scan.T_world_camera.linear().transpose();
-  const Eigen::Vector3d t_camera_world = -R_camera_world * scan.T_world_camera.translation();
+  const Eigen::Isometry3d T_camera_world = scan.T_world_camera.inverse(Eigen::Isometry);
+  const Eigen::Matrix3d R_camera_world = T_camera_world.linear();
+  const Eigen::Vector3d t_camera_world = T_camera_world.translation();
   const double origin[3] = {static_cast<double>(scan.origin.x()), static_cast<double>(scan.origin.y()),
                             static_cast<double>(scan.origin.z())};
   quick_margin_ = projector_.margin();

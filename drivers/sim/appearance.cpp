@@ -5,13 +5,13 @@
 #include <cmath>
 #include <map>
 
+#include "common/numbers.h"
 #include "drivers/sim/noise.h"
 #include "drivers/sim/random.h"
 
 namespace kestrel::sim {
 namespace {
 
-constexpr double kTwoPi = 6.283185307179586;
 // Relative amplitude of the wear layer on tiled and on fitted materials.
 constexpr float kWearGainTiled = 0.10f;
 constexpr float kWearGainFitted = 0.03f;

@@ -4,10 +4,10 @@
 #include <cmath>
 #include <limits>
 
+#include "common/numbers.h"
+
 namespace kestrel::sim {
 namespace {
-
-constexpr double kInf = std::numeric_limits<double>::infinity();
 
 // Minimum of a convex function of u in [0, 1] by golden-section search; distances from a
 // moving point to a convex set are convex along a segment, so this is exact.

@@ -3,12 +3,11 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "common/numbers.h"
 #include "drivers/sim/route.h"
 
 namespace kestrel::sim {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 // a sin(w tau + phase), with its first two derivatives.
 struct Wave {

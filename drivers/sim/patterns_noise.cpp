@@ -4,12 +4,12 @@
 #include <algorithm>
 #include <cmath>
 
+#include "common/numbers.h"
 #include "drivers/sim/noise.h"
 #include "drivers/sim/patterns.h"
 
 namespace kestrel::sim::patterns {
 namespace {
-constexpr double kTwoPi = 6.283185307179586;
 }  // namespace
 
 cv::Mat tint(const cv::Mat& luminance, const Eigen::Vector3d& color) {

@@ -5,13 +5,12 @@
 #include <cmath>
 #include <vector>
 
+#include "common/numbers.h"
 #include "drivers/sim/noise.h"
 #include "drivers/sim/patterns.h"
 
 namespace kestrel::sim::patterns {
 namespace {
-
-constexpr double kTwoPi = 6.283185307179586;
 
 cv::Vec3f vec(const Eigen::Vector3d& c) {
   return {static_cast<float>(c.x()), static_cast<float>(c.y()), static_cast<float>(c.z())};

@@ -7,10 +7,10 @@
 #include <queue>
 #include <stdexcept>
 
+#include "common/numbers.h"
+
 namespace kestrel::sim {
 namespace {
-
-constexpr double kInf = std::numeric_limits<double>::infinity();
 
 struct Grid {
   int cols = 0, rows = 0;

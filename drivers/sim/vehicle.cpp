@@ -4,10 +4,10 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "common/numbers.h"
+
 namespace kestrel::sim {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 double wrap_angle(double a) { return std::remainder(a, 2.0 * kPi); }
 

@@ -9,13 +9,12 @@
 #include <vector>
 
 #include "common/error.h"
+#include "common/numbers.h"
 #include "common/text.h"
 #include "drivers/sim/world_builder.h"
 
 namespace kestrel::sim {
 namespace {
-
-constexpr double kDegree = 3.14159265358979323846 / 180.0;
 
 // One statement: its fields and where it came from, with checked accessors.
 class Statement {

@@ -4,10 +4,10 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "common/numbers.h"
+
 namespace kestrel::estimator {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 class SpreadSum {
  public:

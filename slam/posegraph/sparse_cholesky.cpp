@@ -7,7 +7,10 @@
 #include <stdexcept>
 
 namespace kestrel::slam {
-namespace {
+// Named rather than anonymous: Impl below holds a Common, and GCC warns about a class with a
+// member of an anonymous-namespace type whenever this file is compiled inside another
+// (the unity build, CMakeLists.txt).
+namespace cholmod_glue {
 
 struct Common {
   cholmod_common c;
@@ -20,7 +23,8 @@ struct Common {
   Common& operator=(const Common&) = delete;
 };
 
-}  // namespace
+}  // namespace cholmod_glue
+using cholmod_glue::Common;
 
 std::vector<int> order_blocks(int num_blocks, const std::vector<std::pair<int, int>>& pairs) {
   if (num_blocks <= 0) return {};

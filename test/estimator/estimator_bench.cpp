@@ -21,7 +21,7 @@ struct Flight {
 };
 
 const Flight& flight() {
-  static const Flight f = [] {
+  static const Flight recorded = [] {
     Flight f;
     const auto motion = test::AnalyticMotion::aggressive();
     f.imu = test::generate_imu(motion, kImuRate, 60.0, test::ImuNoiseTruth{}, 3);
@@ -30,7 +30,7 @@ const Flight& flight() {
       f.vo.push_back(vo.next(t, motion.state(test::seconds(t)).T_world_body()));
     return f;
   }();
-  return f;
+  return recorded;
 }
 
 // Runs an estimator over the first `seconds` of the flight (IMU and VO as they arrive).

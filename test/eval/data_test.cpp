@@ -7,14 +7,13 @@
 #include <cmath>
 #include <random>
 
+#include "common/numbers.h"
 #include "test/support/test_support.h"
 #include "tools/eval/evaluate.h"
 #include "tools/eval/trajectory_input.h"
 
 namespace kestrel::eval {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 struct Sequence {
   std::vector<int64_t> frames;  // rgb.txt

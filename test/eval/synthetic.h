@@ -8,13 +8,13 @@
 
 #include "common/geometry/se3.h"
 #include "common/geometry/so3.h"
+#include "common/numbers.h"
 #include "common/trajectory.h"
 
 namespace kestrel::eval::test {
 
 constexpr int64_t kStart_us = 1305031104000000;  // a TUM-like epoch
 constexpr int64_t kFrame_us = 33333;             // 30 Hz
-constexpr double kPi = 3.14159265358979323846;
 
 /// Frame times kStart_us + i * step_us, i = 0 .. n-1.
 inline std::vector<int64_t> frame_times(int n, int64_t step_us = kFrame_us) {

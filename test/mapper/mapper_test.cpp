@@ -15,12 +15,6 @@ namespace {
 
 using test::Scene;
 
-Scene room() {
-  Scene scene(Eigen::Vector3d(-2.0, -2.0, 0.0), Eigen::Vector3d(3.0, 2.0, 2.5));
-  scene.add_box(Eigen::Vector3d(0.8, -0.4, 0.0), Eigen::Vector3d(1.4, 0.3, 0.9));
-  return scene;
-}
-
 // Camera poses sweeping the room, 0.2 s apart.
 std::vector<Eigen::Isometry3d> sweep(int n) {
   std::vector<Eigen::Isometry3d> poses;
@@ -38,7 +32,7 @@ void expect_same_maps(const VoxelMap& a, const VoxelMap& b) {
 }
 
 TEST(Mapper, RebuildAfterLoopClosureEqualsTheMapAtTheCorrectedPoses) {
-  const Scene scene = room();
+  const Scene scene = test::room_with_a_box();
   const auto truth = sweep(8);
   MapperOptions options;
   options.rebuild_interval_s = 0.0;
@@ -74,7 +68,7 @@ TEST(Mapper, RebuildAfterLoopClosureEqualsTheMapAtTheCorrectedPoses) {
 // keyframes given with their T_camera_depth equals the map of the same depth images placed at
 // their depth-time poses, and differs from the one that ignores it.
 TEST(Mapper, AKeyframesDepthGoesInAtTheCameraPoseOfItsOwnTime) {
-  const Scene scene = room();
+  const Scene scene = test::room_with_a_box();
   const auto colour_poses = sweep(6);
   // 25 ms at 0.5 m/s and 30 deg/s, backwards: the depth's camera 1.25 cm and 0.75 deg behind.
   Eigen::Isometry3d T_camera_depth = Eigen::Isometry3d::Identity();
@@ -103,7 +97,7 @@ TEST(Mapper, AKeyframesDepthGoesInAtTheCameraPoseOfItsOwnTime) {
 }
 
 TEST(Mapper, RebuildStartsFromTheLastCheckpointBeforeTheFirstMovedKeyframe) {
-  const Scene scene = room();
+  const Scene scene = test::room_with_a_box();
   const auto truth = sweep(12);
   MapperOptions options;
   options.rebuild_interval_s = 0.0;
@@ -148,7 +142,7 @@ TEST(Mapper, RebuildStartsFromTheLastCheckpointBeforeTheFirstMovedKeyframe) {
 }
 
 TEST(Mapper, RebuildsAreRateLimitedAndMissingFramesCounted) {
-  const Scene scene = room();
+  const Scene scene = test::room_with_a_box();
   const auto truth = sweep(3);
   MapperOptions options;
   options.rebuild_interval_s = 1.0;
@@ -174,7 +168,7 @@ TEST(Mapper, RebuildsAreRateLimitedAndMissingFramesCounted) {
 }
 
 TEST(Mapper, OutOfOrderFramesAndBadPosesAreInputErrors) {
-  const Scene scene = room();
+  const Scene scene = test::room_with_a_box();
   Mapper mapper;
   const RgbdFrame frame = scene.render(test::kinect_camera(64, 48), sweep(2)[0], 1000);
   mapper.buffer_frame(frame);
@@ -189,7 +183,7 @@ TEST(Mapper, OutOfOrderFramesAndBadPosesAreInputErrors) {
 }
 
 TEST(Mapper, NanAndZeroDepthNeverMarkCells) {
-  const Scene scene = room();
+  const Scene scene = test::room_with_a_box();
   const Eigen::Isometry3d T = sweep(2)[1];
   const RgbdFrame frame = scene.render(test::kinect_camera(160, 120), T, 1000);
   // Depth from a float source with holes: NaN, infinities, zero and negative readings.

@@ -13,12 +13,6 @@
 namespace kestrel::mapper {
 namespace {
 
-test::Scene room() {
-  test::Scene scene(Eigen::Vector3d(-2.0, -2.0, 0.0), Eigen::Vector3d(3.0, 2.0, 2.5));
-  scene.add_box(Eigen::Vector3d(0.8, -0.4, 0.0), Eigen::Vector3d(1.4, 0.3, 0.9));
-  return scene;
-}
-
 Eigen::Isometry3d pose_at(double t_s) {
   return test::look_at({-1.2 + 0.2 * t_s, 0.013, 1.2}, {2.0, 0.5 - 0.5 * t_s, 0.7});
 }
@@ -42,7 +36,7 @@ VoxelMap decode(const kestrel::octomap_t& m) {
 }
 
 TEST(MapNode, GroundTruthPosesGiveTheLibrarysMap) {
-  const test::Scene scene = room();
+  const test::Scene scene = test::room_with_a_box();
   NodeOptions options;
   options.pose_source = PoseSource::kGroundTruth;
   options.full_format = true;
@@ -77,7 +71,7 @@ TEST(MapNode, GroundTruthPosesGiveTheLibrarysMap) {
 }
 
 TEST(MapNode, SlamGraphInsertsKeyframesAndPublishesRebuildsAtOnce) {
-  const test::Scene scene = room();
+  const test::Scene scene = test::room_with_a_box();
   NodeOptions options;
   options.publish_period_s = 10.0;
   options.mapper.rebuild_interval_s = 0.0;
@@ -119,7 +113,7 @@ TEST(MapNode, SlamGraphInsertsKeyframesAndPublishesRebuildsAtOnce) {
 }
 
 TEST(MapNode, BadFramesAreRejectedNamingTheChannel) {
-  const test::Scene scene = room();
+  const test::Scene scene = test::room_with_a_box();
   MapNode node(NodeOptions{});
   auto msg = frame_message(scene, 500000);
   node.on_frame(msg, "CAMERA_RGBD");

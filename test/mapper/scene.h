@@ -85,6 +85,13 @@ class Scene {
   std::vector<SceneBox> boxes_;
 };
 
+/// The mapper tests' room: 5 x 4 x 2.5 m with one table-sized box in it.
+inline Scene room_with_a_box() {
+  Scene scene(Eigen::Vector3d(-2.0, -2.0, 0.0), Eigen::Vector3d(3.0, 2.0, 2.5));
+  scene.add_box(Eigen::Vector3d(0.8, -0.4, 0.0), Eigen::Vector3d(1.4, 0.3, 0.9));
+  return scene;
+}
+
 /// Camera at `position` looking at `target` (optical z towards it, image x right, y down with
 /// world z up).
 inline Eigen::Isometry3d look_at(const Eigen::Vector3d& position, const Eigen::Vector3d& target) {

@@ -137,7 +137,7 @@ class ListSampler : public Sampler {
   size_t next_ = 0;
 };
 
-testing::PredicateEnvironment open_space() {
+testing::PredicateEnvironment open_plane() {
   return testing::PredicateEnvironment(Eigen::AlignedBox3d(Eigen::Vector3d(-20, -20, 1), Eigen::Vector3d(20, 20, 1)),
                                        [](const Eigen::Vector3d&) { return true; });
 }
@@ -145,7 +145,7 @@ testing::PredicateEnvironment open_space() {
 TEST(BuildRoadmap, ThePapersRuleJoinsAPairBeyondTheRadius) {
   // Start and goal 10 m apart in open space, no samples: the line is free, so Algorithm 1
   // joins them; a 6 m radius does not.
-  const auto env = open_space();
+  const auto env = open_plane();
   const ConfigurationSpace space(env, SpaceOptions{});
   const Config start(0, 0, 1, 0), goal(10, 0, 1, 0);
   Rng rng(1);
@@ -167,7 +167,7 @@ TEST(BuildRoadmap, ThePapersRuleJoinsClustersANeighbourLimitKeepsApart) {
   // view of each other: every node's 20 nearest lie in its own cluster, so with 20 neighbours
   // (inside the 6 m radius) no edge crosses; the paper's rule joins every pair: 44 nodes,
   // 44 * 43 / 2 undirected edges.
-  const auto env = open_space();
+  const auto env = open_plane();
   const ConfigurationSpace space(env, SpaceOptions{});
   const Config start(0, 0, 1, 0), goal(5, 0, 1, 0);
   std::vector<Config> list;

@@ -23,8 +23,6 @@ PinholeCamera fr1(bool with_distortion) {
   return c;
 }
 
-cv::Mat texture(const PinholeCamera& camera) { return test::texture(camera, 11); }
-
 /// Depth that changes with the raw column (1 mm a pixel, under the edge test's 3 %), so a
 /// reading taken at the ideal pixel instead of the raw one would show.
 cv::Mat column_ramp(const PinholeCamera& camera) {
@@ -46,7 +44,7 @@ TEST(KeyframeLens, Fr1sLensMapsTheHandWorkedPixel) {
 
 TEST(KeyframeLens, PointOnTheIdealRayWithDepthReadAtTheRawPixel) {
   const PinholeCamera raw_camera = fr1(false), camera = fr1(true);
-  const cv::Mat grey = texture(camera), depth = column_ramp(camera);
+  const cv::Mat grey = test::texture(camera, 11), depth = column_ramp(camera);
   const FeatureExtractor extractor;
   const FrameFeatures plain = extractor.extract(grey, depth, raw_camera);  // zero distortion
   const FrameFeatures f = extractor.extract(grey, depth, camera);
@@ -89,7 +87,7 @@ TEST(KeyframeLens, RollingShutterTakesTheRawRowsTime) {
   const PinholeCamera raw_camera = fr1(false), camera = fr1(true);
   const double Z = 2.0, w = 1.0, readout = 0.015;
   const cv::Mat depth(camera.height, camera.width, CV_32FC1, cv::Scalar(Z));
-  const cv::Mat grey = texture(camera);
+  const cv::Mat grey = test::texture(camera, 11);
   const vo::FrameMotion motion = test::moving({0, 0, 0}, {0, w, 0}, 0.0, readout);
   const FeatureExtractor extractor;
   const FrameFeatures plain = extractor.extract(grey, depth, raw_camera);

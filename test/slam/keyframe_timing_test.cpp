@@ -21,8 +21,6 @@ namespace {
 using test::carried_to_middle_row;
 using test::moving;
 
-cv::Mat texture(const PinholeCamera& camera) { return test::texture(camera, 7); }
-
 // Camera sliding along +x at 4 m/s, its depth image 30 ms older than the colour, over a plane
 // tilted about the y axis: in the camera at depth time z = Z0 + k x (Z0 = 2 m, k = 0.25). At
 // colour time the camera is 0.12 m further along x (x_depth = x - d with d = offset * v =
@@ -36,7 +34,7 @@ TEST(KeyframeTiming, DepthReadWhereThePointWasAtDepthTime) {
   for (int r = 0; r < camera.height; ++r)
     for (int c = 0; c < camera.width; ++c)
       depth.at<float>(r, c) = static_cast<float>(Z0 / (1.0 - k * (c - camera.cx) / camera.fx));
-  const cv::Mat grey = texture(camera);
+  const cv::Mat grey = test::texture(camera, 7);
   const FeatureExtractor extractor;
   const FrameFeatures still = extractor.extract(grey, depth, camera);
   const FrameFeatures timed = extractor.extract(grey, depth, camera, moving({v, 0, 0}, {0, 0, 0}, offset, 0.0));
@@ -69,7 +67,7 @@ TEST(KeyframeTiming, RollingShutterCarriesPointAndPixelToTheMiddleRow) {
   const PinholeCamera camera = test::test_camera();
   const double Z = 2.0, w = 1.0, readout = 0.015;
   const cv::Mat depth(camera.height, camera.width, CV_32FC1, cv::Scalar(Z));
-  const cv::Mat grey = texture(camera);
+  const cv::Mat grey = test::texture(camera, 7);
   const FeatureExtractor extractor;
   const FrameFeatures still = extractor.extract(grey, depth, camera);
   const FrameFeatures timed = extractor.extract(grey, depth, camera, moving({0, 0, 0}, {0, w, 0}, 0.0, readout));

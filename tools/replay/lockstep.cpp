@@ -10,6 +10,7 @@
 #include <random>
 #include <set>
 
+#include "common/text.h"
 #include "common/transport/channels.h"
 #include "common/transport/lcm_url.h"
 #include "common/transport/message.h"
@@ -34,12 +35,6 @@ int64_t random_session() {
   std::mt19937_64 gen((uint64_t{rd()} << 32) ^ rd());
   std::uniform_int_distribution<int64_t> dist(1, INT64_MAX);
   return dist(gen);
-}
-
-std::string join(const std::vector<std::string>& items) {
-  std::string s;
-  for (const auto& i : items) s += (s.empty() ? "" : ", ") + i;
-  return s;
 }
 
 std::string event_label(int64_t index, const transport::LogEvent& e) {
@@ -97,7 +92,8 @@ class Session {
           throw PeerError(fmt::format(
               "no heartbeat within {:.1f} s from: {} (heard from: {}); is it running on this "
               "LCM URL and network namespace?",
-              o_.discovery_timeout_s, join(missing), heard.empty() ? "nobody" : join(heard)));
+              o_.discovery_timeout_s, join(missing, ", "),
+              heard.empty() ? "nobody" : join(heard, ", ")));
         }
         spdlog::warn("the set of processes kept changing for {:.1f} s; going ahead with it",
                      o_.discovery_timeout_s);
@@ -128,7 +124,7 @@ class Session {
 
   [[noreturn]] static void refuse(const std::vector<std::string>& conflicts) {
     throw PeerError("several processes share a name, which lock-step cannot tell apart: " +
-                    join(conflicts) + "; give each a unique name");
+                    join(conflicts, ", ") + "; give each a unique name");
   }
 
   bool reset_processes() {
@@ -143,7 +139,7 @@ class Session {
       if (silent.empty()) return true;
       if (now_s() - sent > o_.ack_timeout_s)
         throw PeerError(fmt::format("no answer to RESET within {:.1f} s from: {}",
-                                    o_.ack_timeout_s, join(silent)));
+                                    o_.ack_timeout_s, join(silent, ", ")));
       pump(0.05);
     }
   }

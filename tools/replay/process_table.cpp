@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "common/text.h"
 #include "common/transport/channels.h"
 
 namespace kestrel::replay {
@@ -16,10 +17,9 @@ std::vector<std::string> data_channels(const std::vector<std::string>& channels)
   return out;
 }
 
-std::string join(const std::vector<std::string>& items) {
-  std::string s;
-  for (const auto& i : items) s += (s.empty() ? "" : ", ") + i;
-  return s.empty() ? "-" : s;
+// A table cell: the items, or "-" for none.
+std::string cell(const std::vector<std::string>& items) {
+  return items.empty() ? "-" : join(items, ", ");
 }
 
 }  // namespace
@@ -58,7 +58,7 @@ std::vector<std::string> ProcessTable::conflicts(double now_s) const {
     std::vector<std::string> pids;
     for (const auto& [pid, heard_s] : p.pids_heard_s)
       if (now_s - heard_s <= conflict_window_s_) pids.push_back(std::to_string(pid));
-    if (pids.size() > 1) out.push_back(name + " (pids " + join(pids) + ")");
+    if (pids.size() > 1) out.push_back(name + " (pids " + join(pids, ", ") + ")");
   }
   return out;
 }
@@ -81,8 +81,8 @@ std::vector<std::string> ProcessTable::publishers(const std::string& channel) co
 std::vector<std::string> describe(const ProcessTable& table) {
   std::vector<std::string> lines;
   for (const auto& [name, p] : table.processes())
-    lines.push_back(name + " (pid " + std::to_string(p.pid) + "): " + join(p.subscriptions) +
-                    " -> " + join(p.publications));
+    lines.push_back(name + " (pid " + std::to_string(p.pid) + "): " + cell(p.subscriptions) +
+                    " -> " + cell(p.publications));
   return lines;
 }
 
