@@ -20,8 +20,9 @@
 #include "slam/slam_adapter.h"
 #include "vo/sensor_profile.h"
 #if KESTREL_SLAM_OFFLINE
-#include "slam/sequence_run.h"
+#include "common/numbers.h"
 #include "drivers/tum/tum_sequence.h"
+#include "slam/sequence_run.h"
 #include "vo/options.h"
 #include "vo/sequence_run.h"
 #endif
@@ -125,7 +126,7 @@ int run_offline(const Options& o, const SlamOptions& options, std::shared_ptr<co
     for (const LoopError& e : loop_errors(run, sequence.ground_truth())) {
       std::cout << "loop " << e.edge.from_utime << " -> " << e.edge.to_utime << ": ";
       if (e.has_truth) {
-        std::cout << "error " << e.translation_m << " m, " << e.rotation_rad * 180.0 / M_PI << " deg\n";
+        std::cout << "error " << e.translation_m << " m, " << e.rotation_rad * 180.0 / kPi << " deg\n";
       } else {
         std::cout << "no ground truth\n";
       }
@@ -147,12 +148,14 @@ int serve(const Options& o, const SlamOptions& options, std::shared_ptr<const Vo
   node->advertise(o.correction_channel);
   node->on_reset([&] { adapter.reset(); });
   auto publish = [&](const AdapterOutputs& out) {
-    if (out.anchored) spdlog::info("map anchored in the estimator's world at keyframe {}", adapter.slam().keyframes().back().id);
+    if (out.anchored) spdlog::info("map anchored in the estimator's world at keyframe {}",
+                                 published_id(adapter.slam(), adapter.slam().keyframes().back().id));
     if (out.graph) node->publish(o.graph_channel, *out.graph);
     if (out.correction) node->publish(o.correction_channel, *out.correction);
     if (out.step && out.step->loop_closed) {
       spdlog::info("keyframe {} closes a loop with keyframe {} ({} inliers, {:.2f} px); chi2 {:.4g} -> {:.4g}",
-                   out.step->keyframe_id, out.step->loop_keyframe_id, out.step->loop.inliers,
+                   published_id(adapter.slam(), out.step->keyframe_id),
+                   published_id(adapter.slam(), out.step->loop_keyframe_id), out.step->loop.inliers,
                    out.step->loop.rms_px, out.step->optimisation->start_chi2, out.step->optimisation->final_chi2);
     }
   };

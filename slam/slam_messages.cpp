@@ -21,15 +21,25 @@ VoMotion motion_from_message(const kestrel::vo_update_t& m, const char* channel)
   return motion;
 }
 
+namespace {
+int64_t session_base(const Slam& slam) {
+  return slam.keyframes().empty() ? 0 : slam.keyframes().front().utime;
+}
+}  // namespace
+
+int64_t published_id(const Slam& slam, int64_t keyframe_index) { return session_base(slam) + keyframe_index; }
+
+int64_t published_revision(const Slam& slam) { return session_base(slam) + slam.revision(); }
+
 kestrel::slam_graph_t graph_message(const Slam& slam) {
   kestrel::slam_graph_t m{};
   const auto& keyframes = slam.keyframes();
   const PoseGraph3d& graph = slam.graph();
   m.utime = keyframes.empty() ? 0 : keyframes.back().utime;
-  m.revision = slam.revision();
+  m.revision = published_revision(slam);
   for (size_t k = 0; k < keyframes.size(); ++k) {
     kestrel::slam_keyframe_t kf{};
-    kf.id = keyframes[k].id;
+    kf.id = published_id(slam, keyframes[k].id);
     kf.utime = keyframes[k].utime;
     kf.T_world_camera = transport::to_message(graph.poses[k]);
     kf.T_camera_depth = transport::to_message(keyframes[k].T_camera_depth);
@@ -38,8 +48,8 @@ kestrel::slam_graph_t graph_message(const Slam& slam) {
   m.num_keyframes = static_cast<int32_t>(m.keyframes.size());
   for (const auto& e : graph.edges) {
     kestrel::slam_edge_t edge{};
-    edge.from_id = graph.ids[static_cast<size_t>(e.from)];
-    edge.to_id = graph.ids[static_cast<size_t>(e.to)];
+    edge.from_id = published_id(slam, graph.ids[static_cast<size_t>(e.from)]);
+    edge.to_id = published_id(slam, graph.ids[static_cast<size_t>(e.to)]);
     edge.kind = e.kind == EdgeKind::kLoopClosure ? kestrel::slam_edge_t::KIND_LOOP_CLOSURE
                                                  : kestrel::slam_edge_t::KIND_ODOMETRY;
     edge.T_from_to = transport::to_message(e.measurement);
@@ -64,8 +74,8 @@ kestrel::slam_correction_t correction_message(const Slam& slam, double sigma_tra
   const Keyframe& kf = slam.keyframes().back();
   kestrel::slam_correction_t m{};
   m.utime = kf.utime;
-  m.keyframe_id = kf.id;
-  m.graph_revision = slam.revision();
+  m.keyframe_id = published_id(slam, kf.id);
+  m.graph_revision = published_revision(slam);
   const Eigen::Isometry3d T_world_body = slam.graph().poses.back() * kf.T_body_camera.inverse();
   m.T_world_body = transport::to_message(T_world_body);
   Matrix6d covariance = Matrix6d::Zero();

@@ -5,6 +5,13 @@
 // Frames: SLAM_GRAPH carries T_world_camera of each keyframe; SLAM_CORRECTION carries
 // T_world_body = T_world_camera * T_body_camera^-1 of the newest keyframe, world being the
 // body frame at the first keyframe (odometry_chain.h).
+//
+// Published keyframe ids and graph revisions count from the session's first keyframe: its
+// utime (µs) plus the library's own index or revision. A SLAM process restarted in flight
+// (a new session) therefore never reuses an id of the one before and never goes back in
+// revision, so the mapper keeps the old session's keyframes where they were and adds the new
+// ones (the library's indices restart at 0; a session has fewer keyframes and revisions than
+// microseconds).
 
 #include "kestrel/slam_correction_t.hpp"
 #include "kestrel/slam_graph_t.hpp"
@@ -16,6 +23,10 @@ namespace kestrel::slam {
 
 /// Throws InputError naming `channel` for a pose that is not a finite rigid transform.
 VoMotion motion_from_message(const kestrel::vo_update_t& m, const char* channel);
+
+/// The published id of a keyframe and revision of a graph (see above).
+int64_t published_id(const Slam& slam, int64_t keyframe_index);
+int64_t published_revision(const Slam& slam);
 
 kestrel::slam_graph_t graph_message(const Slam& slam);
 

@@ -12,6 +12,7 @@
 #include "common/transport/log_file.h"
 #include "kestrel/ground_truth_t.hpp"
 #include "kestrel/imu_t.hpp"
+#include "kestrel/slam_graph_t.hpp"
 #include "kestrel/state_t.hpp"
 #include "kestrel/vo_update_t.hpp"
 #include "test/eval/known_log.h"
@@ -163,6 +164,47 @@ TEST(EvalLog, StateGivesBodyPosesWhenTheFilterIsRunning) {
   ASSERT_TRUE(est.T_body_camera.has_value());
   EXPECT_TRUE(est.T_body_camera->isApprox(kBodyCamera, 1e-12));
   EXPECT_FALSE(read_log_input(dir / "state.lcmlog", {"VO_UPDATE"}).trajectory.empty());
+}
+
+// SLAM_GRAPH: the final graph of each SLAM session. The first session's graphs grow and one
+// moves a keyframe; a restarted SLAM (new ids, slam/slam_messages.h) maps on with a graph of
+// its own; a graph of a lower revision is out of order.
+TEST(EvalLog, SlamGraphGivesEachSessionsFinalKeyframes) {
+  auto graph = [](int64_t first_id, int64_t revision, const std::vector<double>& x) {
+    kestrel::slam_graph_t g{};
+    g.revision = revision;
+    for (size_t i = 0; i < x.size(); ++i) {
+      kestrel::slam_keyframe_t k{};
+      k.id = first_id + static_cast<int64_t>(i);
+      k.utime = first_id * 10 + 1000 * static_cast<int64_t>(i);
+      k.T_world_camera = to_message(se3::make(Eigen::Matrix3d::Identity(), Eigen::Vector3d(x[i], 0, 0)));
+      k.T_camera_depth = to_message(Eigen::Isometry3d::Identity());
+      g.keyframes.push_back(k);
+    }
+    g.num_keyframes = static_cast<int32_t>(g.keyframes.size());
+    g.utime = g.keyframes.back().utime;
+    return g;
+  };
+  kestrel::test::TempDir dir;
+  {
+    LogWriter w(dir / "slam.lcmlog");
+    w.write_message("SLAM_GRAPH", 1, graph(1000, 1000, {0.0, 1.0}));
+    w.write_message("SLAM_GRAPH", 2, graph(1000, 1001, {0.0, 1.5, 2.0}));
+    w.write_message("SLAM_GRAPH", 3, graph(9000, 9000, {5.0}));
+    w.write_message("SLAM_GRAPH", 4, graph(1000, 1002, {0.0, 9.0, 9.0}));  // the old session, late
+    w.write_message("SLAM_GRAPH", 5, graph(9000, 9001, {5.0, 6.0}));
+    w.close();
+  }
+  const TrajectoryInput est = read_log_input(dir / "slam.lcmlog", {"SLAM_GRAPH"});
+  EXPECT_EQ(est.frame, PoseFrame::kCamera);
+  EXPECT_EQ(est.diagnostics.out_of_order, 1u);
+  const std::vector<std::pair<int64_t, double>> expected = {
+      {10000, 0.0}, {11000, 1.5}, {12000, 2.0}, {90000, 5.0}, {91000, 6.0}};
+  ASSERT_EQ(est.trajectory.size(), expected.size());
+  for (size_t i = 0; i < expected.size(); ++i) {
+    EXPECT_EQ(est.trajectory.poses()[i].utime, expected[i].first) << i;
+    EXPECT_DOUBLE_EQ(est.trajectory.poses()[i].T.translation().x(), expected[i].second) << i;
+  }
 }
 
 TEST(EvalLog, MissingChannelNamesTheChannelsPresent) {

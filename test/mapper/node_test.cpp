@@ -112,6 +112,41 @@ TEST(MapNode, SlamGraphInsertsKeyframesAndPublishesRebuildsAtOnce) {
   EXPECT_THROW(node.on_graph(graph, "SLAM_GRAPH"), InputError);
 }
 
+// A SLAM process restarted in flight publishes a graph of its own keyframes only, with ids
+// and revisions counted from its first keyframe's utime (slam/slam_messages.h): the map keeps
+// the first session's keyframes where they were and adds the new session's, without a rebuild.
+TEST(MapNode, ARestartedSlamAddsItsKeyframesAndKeepsTheEarlierOnes) {
+  const test::Scene scene = test::room_with_a_box();
+  NodeOptions options;
+  options.mapper.rebuild_interval_s = 0.0;
+  MapNode node(options);
+  auto session = [&](int64_t first_utime, int64_t revision) {
+    kestrel::slam_graph_t graph{};
+    for (int i = 0; i < 3; ++i) {
+      const int64_t t = first_utime + 100000 * i;
+      node.on_frame(frame_message(scene, t), "CAMERA_RGBD");
+      kestrel::slam_keyframe_t k{};
+      k.id = first_utime + i;
+      k.utime = t;
+      k.T_world_camera = transport::to_message(pose_at(1e-6 * t));
+      k.T_camera_depth = transport::to_message(Eigen::Isometry3d::Identity());
+      graph.keyframes.push_back(k);
+    }
+    graph.num_keyframes = 3;
+    graph.revision = first_utime + revision;
+    return graph;
+  };
+  node.on_graph(session(100000, 2), "SLAM_GRAPH");
+  ASSERT_EQ(node.mapper().keyframes().size(), 3u);
+  const size_t cells_before = node.mapper().map().num_cells();
+  // The new session's graph lacks the first three keyframes and starts its revisions again.
+  EXPECT_NO_THROW(node.on_graph(session(900000, 1), "SLAM_GRAPH"));
+  EXPECT_EQ(node.mapper().keyframes().size(), 6u);
+  EXPECT_EQ(node.stats().frames_inserted, 6);
+  EXPECT_EQ(node.stats().rebuilds, 0) << "no keyframe of the first session moved";
+  EXPECT_GT(node.mapper().map().num_cells(), cells_before) << "the new keyframes see more of the room";
+}
+
 TEST(MapNode, BadFramesAreRejectedNamingTheChannel) {
   const test::Scene scene = test::room_with_a_box();
   MapNode node(NodeOptions{});

@@ -10,6 +10,7 @@
 
 #include "common/error.h"
 #include "common/geometry/se3.h"
+#include "common/numbers.h"
 #include "common/transport/convert.h"
 #include "common/transport/rgbd_codec.h"
 #include "slam/slam_adapter.h"
@@ -110,6 +111,35 @@ TEST_F(AdapterTest, AnchorsTheGraphInTheEstimatorsWorldAtTheFirstKeyframeItsStat
     }
   }
   EXPECT_FALSE(adapter_.on_state(state(6.5, Eigen::Isometry3d::Identity())).graph);
+}
+
+// A SLAM process restarted in flight starts its keyframes from index 0 again; what it publishes
+// must not reuse an id of the session before, nor go back in revision, or the mapper would
+// move the old session's images to the new keyframes' poses (slam_messages.h).
+TEST_F(AdapterTest, ARestartedSlamNeverReusesAKeyframeIdOrGoesBackInRevision) {
+  auto run = [this](SlamAdapter& adapter, int first, int last) {
+    std::optional<kestrel::slam_graph_t> graph;
+    for (int k = first; k <= last; ++k) {
+      adapter.on_frame(frame(k));
+      kestrel::vo_update_t u = update(k);
+      if (k == first) {  // the session's first frame has no reference
+        u.reference_utime = 0;
+        u.status = kestrel::vo_update_t::STATUS_NO_REFERENCE;
+        u.T_reference_current = transport::to_message(Eigen::Isometry3d::Identity());
+      }
+      if (const AdapterOutputs out = adapter.on_vo_update(u); out.graph) graph = out.graph;
+    }
+    return *graph;
+  };
+  const kestrel::slam_graph_t before = run(adapter_, 0, 6);
+  SlamAdapter restarted(SlamOptions{}, nullptr);
+  const kestrel::slam_graph_t after = run(restarted, 8, 14);
+  ASSERT_EQ(before.num_keyframes, 3);
+  ASSERT_EQ(after.num_keyframes, 3);
+  EXPECT_EQ(after.keyframes.front().id, utime(8)) << "the new session counts from its first keyframe";
+  for (const auto& a : after.keyframes)
+    for (const auto& b : before.keyframes) EXPECT_NE(a.id, b.id);
+  EXPECT_GT(after.revision, before.revision);
 }
 
 // A restarted estimator (its STATE seq starts again, in a world of its own) gets a
@@ -224,8 +254,8 @@ TEST_F(AdapterTest, TheEstimatorsMotionBridgesAVoRestart) {
   }
   // The edge across the restart measures the 10 cm the estimator saw.
   const kestrel::slam_edge_t& edge = bridged.edges[1];
-  ASSERT_EQ(edge.from_id, 1);
-  ASSERT_EQ(edge.to_id, 2);
+  ASSERT_EQ(edge.from_id, bridged.keyframes[1].id);
+  ASSERT_EQ(edge.to_id, bridged.keyframes[2].id);
   EXPECT_EQ(edge.kind, kestrel::slam_edge_t::KIND_ODOMETRY);
   EXPECT_NEAR(transport::from_message(edge.T_from_to, "test").translation().norm(), 0.1, 1e-9);
   // Without states the restart is a break: keyframe 4 stays where keyframe 3 was, and the new
@@ -281,8 +311,10 @@ TEST_F(AdapterTest, PairsFramesAndUpdatesInEitherOrderAndPublishesTheGraph) {
   EXPECT_EQ(g.keyframes[1].utime, utime(3));
   const Eigen::Isometry3d T1 = transport::from_message(g.keyframes[1].T_world_camera, "test");
   EXPECT_NEAR(T1.translation().z(), 0.3, 1e-9);
-  EXPECT_EQ(g.edges[1].from_id, 1);
-  EXPECT_EQ(g.edges[1].to_id, 2);
+  // Ids count from the first keyframe's utime (slam_messages.h), the edges name them.
+  for (int i = 0; i < 3; ++i) EXPECT_EQ(g.keyframes[static_cast<size_t>(i)].id, utime(0) + i);
+  EXPECT_EQ(g.edges[1].from_id, utime(0) + 1);
+  EXPECT_EQ(g.edges[1].to_id, utime(0) + 2);
   EXPECT_EQ(g.edges[1].kind, kestrel::slam_edge_t::KIND_ODOMETRY);
 }
 
@@ -425,7 +457,7 @@ TEST(CorrectionCovariance, CarriesTheCameraMarginalToTheBody) {
   EXPECT_LT((body - expected).cwiseAbs().maxCoeff(), 1e-15) << body;
   // A body turned by 90 degrees about z in the world: the sideways swing is along world x.
   Eigen::Isometry3d T_world_body = Eigen::Isometry3d::Identity();
-  T_world_body.linear() = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  T_world_body.linear() = Eigen::AngleAxisd(kPi / 2, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   const Matrix6d turned = body_covariance(T_world_body, T_body_camera, camera);
   EXPECT_NEAR(turned(0, 0), 0.01 * s2, 1e-15);
   EXPECT_NEAR(turned(1, 1), 0.0, 1e-15);

@@ -1,10 +1,12 @@
-// A peer process dying in flight: the estimator is killed halfway through the room's
+// A peer process dying in flight. The estimator is killed halfway through the room's
 // figure-eight while VO and SLAM run on, and `kestrel launch --restart` starts it again. The
 // new filter must not take the walking-pace flight for standing still (its IMU cannot tell),
 // publishes once the VO has settled it, and takes the map's world from the SLAM_CORRECTION
 // that kestrel-slam sends for its next keyframe on seeing a new estimator (estimator.h,
 // slam_adapter.h). Before these, the restarted filter started with velocity zero and SLAM's
-// corrections pulled it about by up to 0.6 m for seconds.
+// corrections pulled it about by up to 0.6 m for seconds. Then SLAM is killed the same way
+// while the estimator and the mapper run on: the new SLAM session's map lies in the same world
+// and the mapper keeps both sessions' keyframes (slam/slam_messages.h).
 //
 // Live and timed: the simulator's recording is replayed at its own pace (lock-step replay
 // would stall on the dead process), so the figures vary a little from run to run; the bounds
@@ -13,11 +15,14 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <regex>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -26,7 +31,9 @@
 #include "common/transport/log_file.h"
 #include "common/transport/message.h"
 #include "kestrel/ground_truth_t.hpp"
+#include "kestrel/slam_graph_t.hpp"
 #include "kestrel/state_t.hpp"
+#include "kestrel/vo_update_t.hpp"
 #include "test/support/test_support.h"
 
 namespace kestrel {
@@ -122,6 +129,96 @@ TEST(System, AnEstimatorKilledInFlightRestartsInTheMapsWorld) {
   std::printf("both filters' states under one rigid fit: RMS %.4f m over %zu states (%zu after the restart)\n",
               rms, est.size(), after);
   EXPECT_LT(rms, 0.03);
+}
+
+TEST(System, ASlamKilledInFlightStartsANewSessionInTheSameWorldAndTheMapKeepsBoth) {
+  if (!test::can_isolate_network()) GTEST_SKIP() << "no network namespace available";
+  if (!std::filesystem::exists("/usr/bin/lcm-logger")) GTEST_SKIP() << "lcm-logger is not installed";
+  test::TempDir dir;
+  const std::string source = (dir / "source.lcmlog").string(), live = (dir / "live.lcmlog").string();
+  const auto sim = test::run({test::tool("sim").string(), "--world", "room", "--flight", "figure8", "--duration",
+                              "16", "--seed", "1", "--log", source, "-q"},
+                             300.0);
+  ASSERT_EQ(sim.exit_code, 0) << sim.err;
+  const std::string launch_out = test::quoted((dir / "launch.txt").string());
+  const std::string script =
+      "lcm-logger -q -c 'GROUND_TRUTH|SLAM_GRAPH|VO_UPDATE' -f " + test::quoted(live) + " & L=$!; " +
+      test::wait_for_lcm_listener_sh() + " && (" + test::quoted(test::tool("launch").string()) +
+      " all --only vo,estimator,slam,mapper --restart --status-period 0 --log-dir " +
+      test::quoted((dir / "logs").string()) + " --source " + test::quoted("replay " + source + " --realtime") +
+      " > " + launch_out + " 2>&1 & P=$!; sleep 8; kill -KILL $(sed -n 's/.*started slam (pid \\([0-9]*\\)).*/\\1/p' " +
+      launch_out + " | head -n 1); wait $P); sleep 0.5; kill $L";
+  const auto r = test::run_isolated(script, 200.0);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string launch = test::read_file(dir / "launch.txt");
+  const std::string mapper = test::read_file(dir / "logs" / "mapper.log");
+  ASSERT_NE(launch.find("killed by SIGKILL"), std::string::npos) << launch;
+
+  std::map<int64_t, Eigen::Isometry3d> truth;
+  std::vector<kestrel::slam_graph_t> graphs;
+  Eigen::Isometry3d T_body_camera = Eigen::Isometry3d::Identity();
+  transport::LogReader log(live);
+  while (auto e = log.next()) {
+    const auto& data = e->data;
+    if (e->channel == channel::kGroundTruth) {
+      const auto m = transport::decode_message<kestrel::ground_truth_t>(data.data(), data.size(), "GROUND_TRUTH");
+      truth[m.utime] = transport::from_message(m.T_world_frame, "GROUND_TRUTH");
+    } else if (e->channel == channel::kSlamGraph) {
+      graphs.push_back(transport::decode_message<kestrel::slam_graph_t>(data.data(), data.size(), "SLAM_GRAPH"));
+    } else if (e->channel == channel::kVoUpdate) {
+      const auto m = transport::decode_message<kestrel::vo_update_t>(data.data(), data.size(), "VO_UPDATE");
+      T_body_camera = transport::from_message(m.T_body_camera, "VO_UPDATE");
+    }
+  }
+  ASSERT_FALSE(graphs.empty());
+  // The sessions: graphs holding the very first keyframe are the first SLAM's.
+  const int64_t first_id = graphs.front().keyframes.front().id;
+  const auto of_first = [&](const kestrel::slam_graph_t& g) {
+    return std::any_of(g.keyframes.begin(), g.keyframes.end(), [&](const auto& k) { return k.id == first_id; });
+  };
+  const kestrel::slam_graph_t* before = nullptr;
+  const kestrel::slam_graph_t* after = nullptr;
+  for (size_t i = 0; i < graphs.size(); ++i) {
+    if (i > 0) {
+      EXPECT_GE(graphs[i].revision, graphs[i - 1].revision) << "graph " << i << " went back in revision";
+    }
+    (of_first(graphs[i]) ? before : after) = &graphs[i];
+  }
+  ASSERT_NE(before, nullptr);
+  ASSERT_NE(after, nullptr) << "no graph from the restarted SLAM";
+  std::set<int64_t> old_ids;
+  for (const auto& k : before->keyframes) old_ids.insert(k.id);
+  for (const auto& k : after->keyframes) EXPECT_EQ(old_ids.count(k.id), 0u) << "id " << k.id << " reused";
+  std::printf("first session %d keyframes (revision %lld), second %d (revision %lld)\n", before->num_keyframes,
+              static_cast<long long>(before->revision), after->num_keyframes, static_cast<long long>(after->revision));
+
+  // Both sessions' keyframes against the true camera positions under one rigid fit: one world,
+  // centimetres; a new session in a world of its own would be off by where the vehicle was.
+  std::vector<Eigen::Vector3d> est, gt;
+  for (const auto* g : {before, after}) {
+    for (const auto& k : g->keyframes) {
+      const auto hi = truth.lower_bound(k.utime);
+      if (hi == truth.end() || hi == truth.begin()) continue;
+      const auto lo = std::prev(hi);
+      const double s = static_cast<double>(k.utime - lo->first) / static_cast<double>(hi->first - lo->first);
+      const Eigen::Vector3d a = (lo->second * T_body_camera).translation();
+      const Eigen::Vector3d b = (hi->second * T_body_camera).translation();
+      gt.push_back((1.0 - s) * a + s * b);
+      est.push_back(transport::from_message(k.T_world_camera, "SLAM_GRAPH").translation());
+    }
+  }
+  ASSERT_GT(est.size(), 10u);
+  const double rms = rigid_fit_rms(est, gt);
+  std::printf("both sessions' keyframes under one rigid fit: RMS %.4f m over %zu keyframes\n", rms, est.size());
+  EXPECT_LT(rms, 0.05);
+
+  // The mapper refused nothing and put the second session's keyframes into the map too.
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(mapper, m, std::regex(R"((\d+) frames \((\d+) inserted.* (\d+) rejected)"))) << mapper;
+  const int inserted = std::stoi(m[2]), rejected = std::stoi(m[3]);
+  std::printf("mapper: %d keyframes inserted, %d messages rejected\n", inserted, rejected);
+  EXPECT_EQ(rejected, 0) << mapper;
+  EXPECT_GT(inserted, before->num_keyframes + after->num_keyframes / 2) << mapper;
 }
 
 }  // namespace

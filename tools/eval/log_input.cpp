@@ -6,6 +6,7 @@
 #include <fstream>
 #include <map>
 #include <optional>
+#include <set>
 
 #include "common/error.h"
 #include "common/time.h"
@@ -129,7 +130,7 @@ class ChannelReader {
       out_.diagnostics.no_pose = chain_.without_estimate();
       out_.frame = PoseFrame::kCamera;
     }
-    if (kind_ == Kind::kSlamGraph && graph_) add_keyframes(*graph_);
+    if (kind_ == Kind::kSlamGraph && graph_) add_keyframes();
     out_.format = std::string("LCM log, ") + type_name(kind_);
   }
 
@@ -210,19 +211,32 @@ class ChannelReader {
     chain_.add(step);
   }
 
-  // Only the newest revision counts: every graph supersedes the ones before it.
+  // Only the newest revision counts: every graph supersedes the ones before it, except that a
+  // graph sharing no keyframe with the current one comes from a restarted SLAM (a new session,
+  // slam/slam_messages.h), whose map starts afresh: the session before keeps its final graph.
   void add_graph(kestrel::slam_graph_t m) {
     if (graph_ && m.revision < graph_->revision) {
       ++out_.diagnostics.out_of_order;
       return;
     }
+    if (graph_ && !graph_->keyframes.empty() && !m.keyframes.empty() && !shares_a_keyframe(*graph_, m))
+      finished_sessions_.push_back(std::move(*graph_));
     graph_ = std::move(m);
   }
 
-  // The keyframes of the final graph, in time order: SLAM's optimised camera trajectory.
-  void add_keyframes(const kestrel::slam_graph_t& g) {
+  static bool shares_a_keyframe(const kestrel::slam_graph_t& a, const kestrel::slam_graph_t& b) {
+    std::set<int64_t> ids;
+    for (const auto& k : a.keyframes) ids.insert(k.id);
+    return std::any_of(b.keyframes.begin(), b.keyframes.end(), [&](const auto& k) { return ids.count(k.id) > 0; });
+  }
+
+  // The keyframes of each session's final graph, in time order: SLAM's optimised camera
+  // trajectory.
+  void add_keyframes() {
     std::vector<const kestrel::slam_keyframe_t*> keyframes;
-    for (const auto& k : g.keyframes) keyframes.push_back(&k);
+    for (const auto& g : finished_sessions_)
+      for (const auto& k : g.keyframes) keyframes.push_back(&k);
+    for (const auto& k : graph_->keyframes) keyframes.push_back(&k);
     std::stable_sort(keyframes.begin(), keyframes.end(),
                      [](const auto* a, const auto* b) { return a->utime < b->utime; });
     out_.frame = PoseFrame::kCamera;
@@ -237,6 +251,7 @@ class ChannelReader {
   TrajectoryInput& out_;
   Kind kind_;
   std::optional<kestrel::slam_graph_t> graph_;
+  std::vector<kestrel::slam_graph_t> finished_sessions_;
   std::optional<int64_t> last_utime_;
   VoChain chain_;
 };

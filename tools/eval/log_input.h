@@ -10,7 +10,9 @@
 //    the camera mounting T_body_camera is taken from the first such message;
 //  * slam_graph_t (SLAM_GRAPH): the keyframes' optimised T_world_camera in the graph of the
 //    highest revision (the final map), one pose per keyframe; a graph of a lower revision
-//    after a higher one is counted as out of order.
+//    after a higher one is counted as out of order. A SLAM process restarted in flight starts
+//    a new session whose graphs share no keyframe with the old one's: the trajectory is then
+//    each session's final graph, one after the other.
 // The standard channel names fix the type; any other channel takes the type of its first
 // message of one of the four. Time is the messages' utime, not the log's time stamps.
 //
