@@ -38,13 +38,4 @@ std::optional<long long> parse_int(std::string_view token) {
   return v;
 }
 
-std::string join(const std::vector<std::string>& items, std::string_view separator) {
-  std::string s;
-  for (size_t i = 0; i < items.size(); ++i) {
-    if (i > 0) s += separator;
-    s += items[i];
-  }
-  return s;
-}
-
 }  // namespace kestrel

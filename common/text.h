@@ -20,7 +20,4 @@ std::optional<double> parse_double(std::string_view token);
 /// The whole token as a base-10 integer, or empty.
 std::optional<long long> parse_int(std::string_view token);
 
-/// `items` with `separator` between them ("" for none).
-std::string join(const std::vector<std::string>& items, std::string_view separator);
-
 }  // namespace kestrel

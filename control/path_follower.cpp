@@ -1,5 +1,7 @@
 #include "control/path_follower.h"
 
+#include "common/numbers.h"
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -7,7 +9,7 @@
 namespace kestrel::control {
 namespace {
 
-double wrap_angle(double a) { return std::remainder(a, 2.0 * M_PI); }
+double wrap_angle(double a) { return std::remainder(a, 2.0 * kPi); }
 
 void require(bool ok, const char* what) {
   if (!ok) throw std::invalid_argument(std::string("path follower: ") + what);

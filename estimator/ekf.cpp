@@ -79,19 +79,14 @@ void Ekf::predict(FilterState& s, const ImuInterval& u) const {
 UpdateResult Ekf::update(FilterState& s, const Measurement& m, double gate_chi2) const {
   using Gain = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, kMaxDim,
                              kMaxMeasurementDim>;
-  const Residual g = m.residual(s.mean);
-  const MeasurementJacobian H = m.jacobian(s.mean);
-  const MeasurementJacobian HP = H * s.P;
-  const MeasurementNoise S = HP * H.transpose() + m.noise();
-  const Eigen::LLT<MeasurementNoise> llt(S);
+  const Innovation in = innovation(m, s);
   UpdateResult result;
-  if (llt.info() != Eigen::Success || !g.allFinite()) return result;
-  const Residual y = -g;
-  result.mahalanobis2 = y.dot(llt.solve(y));
+  if (!in.valid) return result;
+  result.mahalanobis2 = in.mahalanobis2();
   if (gate_chi2 > 0.0 && result.mahalanobis2 > gate_chi2) return result;
-  const Gain K = llt.solve(HP).transpose();  // P H^T S^-1
-  const ErrorVector dx = K * y;
-  s.P.noalias() -= K * HP;
+  const Gain K = in.S.solve(in.HP).transpose();  // P H^T S^-1
+  const ErrorVector dx = K * in.y;
+  s.P.noalias() -= K * in.HP;
   inject(s, dx);
   result.applied = true;
   return result;

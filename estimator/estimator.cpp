@@ -211,7 +211,7 @@ bool Estimator::align_world(const PoseCorrection& c) {
   while (k > 0 && history_[k].imu.utime > c.utime) --k;
   const FilterState& s = history_[k].state;
   const AbsolutePoseMeasurement m(c.T_world_body, correction_noise(options_, c));
-  if (mahalanobis2(m, s) <= options_.world_align_chi2) return false;
+  if (innovation(m, s).mahalanobis2() <= options_.world_align_chi2) return false;
   const Eigen::Isometry3d change = world_change(s.mean.nav.T_world_body(), c.T_world_body);
   for (size_t i = 0; i < history_.size(); ++i) change_world(history_[i].state, change);
   return true;

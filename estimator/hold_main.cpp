@@ -11,6 +11,7 @@
 
 #include "common/cli.h"
 #include "common/error.h"
+#include "common/numbers.h"
 #include "common/transport/channels.h"
 #include "common/transport/convert.h"
 #include "common/transport/log_file.h"
@@ -114,8 +115,8 @@ int run(const Options& o) {
   if (!o.truth_only) {
     std::cout << "estimator, truth vs STATE, horizontal: " << cm(s.error_horizontal) << "\n"
               << "estimator, truth vs STATE, 3D:         " << cm(s.error_3d) << "\n";
-    std::printf("estimator, yaw error: mean %.2f deg, max %.2f deg\n", s.error_yaw.mean * 180 / M_PI,
-                s.error_yaw.max * 180 / M_PI);
+    std::printf("estimator, yaw error: mean %.2f deg, max %.2f deg\n", s.error_yaw.mean * 180 / kPi,
+                s.error_yaw.max * 180 / kPi);
   }
   if (s.unmatched_estimates > 0)
     std::printf("STATE without a GROUND_TRUTH within 3 ms: %lld (left out)\n",

@@ -70,13 +70,18 @@ MeasurementJacobian AbsolutePoseMeasurement::jacobian(const FilterMean& x) const
   return H;
 }
 
-double mahalanobis2(const Measurement& m, const FilterState& s) {
-  const Residual g = m.residual(s.mean);
+Innovation innovation(const Measurement& m, const FilterState& s) {
+  Innovation in;
+  in.y = -m.residual(s.mean);
   const MeasurementJacobian H = m.jacobian(s.mean);
-  const MeasurementNoise S = H * s.P * H.transpose() + m.noise();
-  const Eigen::LLT<MeasurementNoise> llt(S);
-  if (llt.info() != Eigen::Success || !g.allFinite()) return std::numeric_limits<double>::infinity();
-  return g.dot(llt.solve(g));
+  in.HP = H * s.P;
+  in.S.compute(in.HP * H.transpose() + m.noise());
+  in.valid = in.S.info() == Eigen::Success && in.y.allFinite();
+  return in;
+}
+
+double Innovation::mahalanobis2() const {
+  return valid ? y.dot(S.solve(y)) : std::numeric_limits<double>::infinity();
 }
 
 }  // namespace kestrel::estimator

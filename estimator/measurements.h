@@ -7,6 +7,7 @@
 // Pose observations use the message convention [dp; dtheta], p = p_obs + dp (parent frame),
 // R = R_obs Exp(dtheta) (child frame), so a covariance from a message is Q as it is.
 
+#include <Eigen/Cholesky>
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
@@ -51,9 +52,19 @@ class RelativePoseMeasurement final : public Measurement {
 };
 
 /// An absolute body pose T_world_body (a SLAM correction) at the state's time.
-/// y^T S^-1 y for the measurement's innovation y at the state, S = H P H^T + Q linearised
-/// there: how far the measurement is from what the state expects (chi^2, dim(y) dof).
-double mahalanobis2(const Measurement& m, const FilterState& s);
+/// A measurement's innovation y = -g(x) at the state, linearised there: H P and the factored
+/// S = H P H^T + Q, what the EKF update and the tests of how far a measurement lies from what
+/// the state expects need. `valid` is false when S is not positive definite or y not finite.
+struct Innovation {
+  Residual y;
+  MeasurementJacobian HP;
+  Eigen::LLT<MeasurementNoise> S;
+  bool valid = false;
+
+  /// y^T S^-1 y (chi^2 with dim(y) degrees of freedom); infinity when not valid.
+  double mahalanobis2() const;
+};
+Innovation innovation(const Measurement& m, const FilterState& s);
 
 class AbsolutePoseMeasurement final : public Measurement {
  public:

@@ -1,5 +1,7 @@
 #include "mapper/keyframe_store.h"
 
+#include "common/numbers.h"
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -27,7 +29,7 @@ KeyframeStore::KeyframeStore(const KeyframeOptions& options) : options_(options)
 KeyframeStore::Bin KeyframeStore::bin_of(const Eigen::Isometry3d& T) const {
   const Eigen::Vector3d p = T.translation() / options_.bin_size_m;
   const Eigen::Vector3d axis = T.linear().col(2);
-  const double sector = options_.bin_angle_deg * M_PI / 180.0;
+  const double sector = options_.bin_angle_deg * kPi / 180.0;
   const double azimuth = std::atan2(axis.y(), axis.x());
   const double elevation = std::asin(std::clamp(axis.z(), -1.0, 1.0));
   return {static_cast<int>(std::floor(p.x())), static_cast<int>(std::floor(p.y())),

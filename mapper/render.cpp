@@ -1,5 +1,7 @@
 #include "mapper/render.h"
 
+#include "common/numbers.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -141,7 +143,7 @@ cv::Mat render_perspective(const VoxelMap& map, const RenderOptions& o) {
   const Eigen::Vector3d b(keys.upper(hi[0]), keys.upper(hi[1]), keys.upper(hi[2]));
   const Eigen::Vector3d centre = 0.5 * (a + b);
   const double radius = 0.5 * (b - a).norm();
-  const double az = o.view_azimuth_deg * M_PI / 180.0, el = o.view_elevation_deg * M_PI / 180.0;
+  const double az = o.view_azimuth_deg * kPi / 180.0, el = o.view_elevation_deg * kPi / 180.0;
   const Eigen::Vector3d back(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
   const double f = 0.9 * o.view_width_px;  // about 60 degrees across
   // Far enough for the bounding sphere to fit the narrower side of the image.

@@ -1,6 +1,8 @@
 // ConfigurationSpace: validity and uniform sampling of (x, y, z, yaw).
 #include "planner/configuration_space.h"
 
+#include "common/numbers.h"
+
 #include <stdexcept>
 
 namespace kestrel::planner {
@@ -27,7 +29,7 @@ Config ConfigurationSpace::uniform(Rng& rng) const {
   std::uniform_real_distribution<double> u01(0.0, 1.0);
   Config q;
   for (int i = 0; i < 3; ++i) q[i] = box_.min()[i] + u01(rng) * (box_.max()[i] - box_.min()[i]);
-  q[3] = wrap_angle((2.0 * u01(rng) - 1.0) * M_PI);
+  q[3] = wrap_angle((2.0 * u01(rng) - 1.0) * kPi);
   return q;
 }
 

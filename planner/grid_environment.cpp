@@ -2,6 +2,8 @@
 // sight by walking the cells (Amanatides-Woo).
 #include "planner/grid_environment.h"
 
+#include "common/numbers.h"
+
 #include <opencv2/imgproc.hpp>
 #include <cmath>
 #include <stdexcept>
@@ -9,8 +11,8 @@
 namespace kestrel::planner {
 
 double wrap_angle(double a) {
-  a = std::remainder(a, 2.0 * M_PI);
-  return a <= -M_PI ? a + 2.0 * M_PI : a;
+  a = std::remainder(a, 2.0 * kPi);
+  return a <= -kPi ? a + 2.0 * kPi : a;
 }
 
 OccupancyGrid make_grid(int width, int height, double resolution, double x0, double y0) {

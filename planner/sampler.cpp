@@ -1,6 +1,8 @@
 // The four samplers and the running-normal threshold of Algorithm 2.
 #include "planner/sampler.h"
 
+#include "common/numbers.h"
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -32,7 +34,7 @@ Config offset(const ConfigurationSpace& space, const Config& q, double sigma, Rn
   std::normal_distribution<double> n(0.0, sigma);
   Config out = q;
   for (int i = 0; i < 3; ++i) out[i] += n(rng);
-  std::uniform_real_distribution<double> yaw(-M_PI, M_PI);
+  std::uniform_real_distribution<double> yaw(-kPi, kPi);
   out[3] = yaw(rng);
   return space.clamp_band(out);
 }
@@ -95,7 +97,7 @@ class BridgeSampler : public Sampler {
   }
   std::string name() const override { return "bridge"; }
   std::optional<Config> sample(Rng& rng, SampleTrace* trace) override {
-    std::uniform_real_distribution<double> yaw(-M_PI, M_PI);
+    std::uniform_real_distribution<double> yaw(-kPi, kPi);
     for (int i = 1; i <= max_; ++i) {
       const Config q1 = space_.uniform(rng);
       if (space_.is_valid(q1)) continue;

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "common/numbers.h"
 #include "estimator/information.h"
 
 namespace kestrel::planner {
@@ -43,8 +44,8 @@ FeatureSensorOptions FeatureSensorOptions::kinect() {
   FeatureSensorOptions o;
   o.max_range_m = 4.0;
   o.min_range_m = 0.5;
-  o.horizontal_fov_rad = 57.0 * M_PI / 180.0;
-  o.vertical_fov_rad = 43.0 * M_PI / 180.0;
+  o.horizontal_fov_rad = 57.0 * kPi / 180.0;
+  o.vertical_fov_rad = 43.0 * kPi / 180.0;
   o.range_sigma_m = 0.0;
   o.range_sigma_per_m2 = 1.4e-3;
   o.bearing_sigma_rad = 1e-3;  // about one pixel at 580 px focal length
@@ -55,10 +56,10 @@ FeatureSensorOptions FeatureSensorOptions::planar_laser(double range_m) {
   FeatureSensorOptions o;
   o.max_range_m = range_m;
   o.min_range_m = 0.1;
-  o.horizontal_fov_rad = 2.0 * M_PI;
-  o.vertical_fov_rad = M_PI;
+  o.horizontal_fov_rad = 2.0 * kPi;
+  o.vertical_fov_rad = kPi;
   o.range_sigma_m = 0.01;
-  o.bearing_sigma_rad = 0.5 * M_PI / 180.0;
+  o.bearing_sigma_rad = 0.5 * kPi / 180.0;
   return o;
 }
 
@@ -98,10 +99,10 @@ FeatureSensor::FeatureSensor(const Environment& env, FeatureSensorOptions option
   for (int i = 0; i < static_cast<int>(features.size()); ++i)
     fine_[static_cast<size_t>(fill[fine_cell(features[i])]++)] = {features[i].position, features[i].normal, i};
   const double half_h = 0.5 * o.horizontal_fov_rad, half_v = 0.5 * o.vertical_fov_rad;
-  fast_azimuth_ = half_h > kFastFovLimit_rad && half_h < M_PI - kFastFovLimit_rad;
+  fast_azimuth_ = half_h > kFastFovLimit_rad && half_h < kPi - kFastFovLimit_rad;
   cos_h_out_ = std::cos(half_h + kFovMargin_rad);
   cos_h_in_ = std::cos(half_h - kFovMargin_rad);
-  fast_elevation_ = half_v > kFastFovLimit_rad && half_v < 0.5 * M_PI - kFastFovLimit_rad;
+  fast_elevation_ = half_v > kFastFovLimit_rad && half_v < 0.5 * kPi - kFastFovLimit_rad;
   tan_v_out_ = std::tan(half_v + kFovMargin_rad);
   tan_v_in_ = std::tan(half_v - kFovMargin_rad);
 }
@@ -122,7 +123,7 @@ std::vector<int> FeatureSensor::visible_reference(const Config& q) const {
         if (r > options_.max_range_m || r < options_.min_range_m) continue;
         if (features[i].normal.dot(d) >= 0.0) continue;  // seen from behind its surface
         const double rho = d.head<2>().norm();
-        if (half_h < M_PI && std::abs(wrap_angle(std::atan2(d.y(), d.x()) - q[3])) > half_h) continue;
+        if (half_h < kPi && std::abs(wrap_angle(std::atan2(d.y(), d.x()) - q[3])) > half_h) continue;
         if (std::abs(std::atan2(d.z(), rho)) > half_v) continue;
         if (!env_.line_of_sight(p, features[i].position)) continue;
         out.push_back(i);
@@ -149,7 +150,7 @@ std::vector<int> FeatureSensor::visible(const Config& q) const {
   const double cos_yaw = std::cos(q[3]), sin_yaw = std::sin(q[3]);
   // The wedge of the horizontal field of view, widened by 1e-6 rad, as two half-planes
   // n . (x - p) >= 0 (when it is narrower than a half-plane).
-  const bool wedge = fast_azimuth_ && half_h + 1e-6 < 0.5 * M_PI;
+  const bool wedge = fast_azimuth_ && half_h + 1e-6 < 0.5 * kPi;
   const double edge = half_h + 1e-6;
   const Eigen::Vector2d n_left(std::sin(q[3] + edge), -std::cos(q[3] + edge));
   const Eigen::Vector2d n_right(-std::sin(q[3] - edge), std::cos(q[3] - edge));
@@ -185,7 +186,7 @@ std::vector<int> FeatureSensor::visible(const Config& q) const {
         if (r > options_.max_range_m || r < options_.min_range_m) continue;
         if (f.normal.dot(d) >= 0.0) continue;  // seen from behind its surface
         const double rho = d.head<2>().norm();
-        if (half_h < M_PI) {
+        if (half_h < kPi) {
           // Outside the horizontal field of view: |wrap(atan2(dy, dx) - yaw)| > half_h. The
           // cosine of that angle, d . heading / rho, decides away from the edge.
           int decided = 0;  // -1 outside, +1 inside, 0 ask atan2

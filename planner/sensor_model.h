@@ -14,6 +14,7 @@
 #include <functional>
 #include <vector>
 
+#include "common/numbers.h"
 #include "planner/environment.h"
 #include "planner/types.h"
 
@@ -22,8 +23,8 @@ namespace kestrel::planner {
 struct FeatureSensorOptions {
   double max_range_m = 2.0;
   double min_range_m = 0.3;
-  double horizontal_fov_rad = 30.0 * M_PI / 180.0;  ///< >= 2 pi: all round
-  double vertical_fov_rad = 30.0 * M_PI / 180.0;
+  double horizontal_fov_rad = 30.0 * kPi / 180.0;  ///< >= 2 pi: all round
+  double vertical_fov_rad = 30.0 * kPi / 180.0;
   double range_sigma_m = 1.0;         ///< constant part of the range noise
   double range_sigma_per_m2 = 0.0;    ///< + this * d^2 (depth cameras)
   double bearing_sigma_rad = 1.0;     ///< azimuth and elevation

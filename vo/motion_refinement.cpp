@@ -1,5 +1,7 @@
 #include "vo/motion_refinement.h"
 
+#include "common/numbers.h"
+
 #include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
@@ -200,7 +202,7 @@ DenseQuadratic linearise_dense(const DenseTerm& d, const PinholeCamera& cam, con
   const DenseDepth& cur = *d.cur;
   const Eigen::Matrix3f R = T.linear().cast<float>();
   const Eigen::Vector3f p = T.translation().cast<float>();
-  const float cos_max = static_cast<float>(std::cos(o.max_normal_angle_deg * M_PI / 180.0));
+  const float cos_max = static_cast<float>(std::cos(o.max_normal_angle_deg * kPi / 180.0));
   const float floor2 = static_cast<float>(1e-6 * o.sigma_floor_mm * o.sigma_floor_mm);
   const float max_d2 = static_cast<float>(o.max_distance_m * o.max_distance_m);
   const float k2 = static_cast<float>(d.sigma_z_coeff * d.sigma_z_coeff);

@@ -1,5 +1,7 @@
 #include "estimator/eval/consistency.h"
 
+#include "common/numbers.h"
+
 #include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
@@ -23,7 +25,7 @@ double normal_quantile(double p) {
   double z = 0.0;
   for (int i = 0; i < 100; ++i) {
     const double cdf = 0.5 * std::erfc(-z / std::sqrt(2.0));
-    const double pdf = std::exp(-0.5 * z * z) / std::sqrt(2.0 * M_PI);
+    const double pdf = std::exp(-0.5 * z * z) / std::sqrt(2.0 * kPi);
     const double step = (cdf - p) / pdf;
     z -= step;
     if (std::abs(step) < 1e-14) break;

@@ -10,6 +10,7 @@
 #include <functional>
 #include <random>
 
+#include "common/numbers.h"
 #include "estimator/estimator.h"
 
 namespace kestrel::estimator {
@@ -20,7 +21,7 @@ struct SyntheticVoOptions {
   Eigen::Matrix<double, 6, 1> sigma =
       (Eigen::Matrix<double, 6, 1>() << 0.004, 0.004, 0.006, 0.003, 0.003, 0.002).finished();
   double keyframe_distance_m = 0.25;
-  double keyframe_angle_rad = 10.0 * M_PI / 180.0;
+  double keyframe_angle_rad = 10.0 * kPi / 180.0;
   double failure_probability = 0.0;  ///< per frame: a failed update, as the VO reports it
   /// Frames for which this returns true see nothing to track (a blank wall): failed updates
   /// that keep the keyframe, as the real VO keeps it. The first frame that sees again is
@@ -28,7 +29,7 @@ struct SyntheticVoOptions {
   /// max_match_angle_rad of it; otherwise it fails and becomes the new keyframe (a restart).
   std::function<bool(int64_t utime)> blind;
   double max_match_distance_m = 1.0;
-  double max_match_angle_rad = 30.0 * M_PI / 180.0;
+  double max_match_angle_rad = 30.0 * kPi / 180.0;
 };
 
 class SyntheticVo {

@@ -1,6 +1,8 @@
 // draw_plans: OpenCV drawing of free space, samples and paths with covariance ellipses.
 #include "planner/eval/plot.h"
 
+#include "common/numbers.h"
+
 #include <Eigen/Eigenvalues>
 #include <opencv2/imgproc.hpp>
 
@@ -29,7 +31,7 @@ cv::Mat draw_plans(const Environment& env, const std::vector<Config>& samples, c
       const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(path.covariances[i].topLeftCorner<2, 2>());
       const Eigen::Vector2d axes = es.eigenvalues().cwiseMax(0.0).cwiseSqrt() * ppm;
       const Eigen::Vector2d major = es.eigenvectors().col(1);
-      const double angle = -std::atan2(major.y(), major.x()) * 180.0 / M_PI;  // image y is down
+      const double angle = -std::atan2(major.y(), major.x()) * 180.0 / kPi;  // image y is down
       cv::ellipse(img, px(position(path.nodes[i])), cv::Size(std::max(1, static_cast<int>(axes[1])), std::max(1, static_cast<int>(axes[0]))),
                   angle, 0, 360, path.colour, 1, cv::LINE_AA);
     }

@@ -5,6 +5,7 @@
 
 #include <cmath>
 
+#include "common/numbers.h"
 #include "slam/backend/loop_consistency.h"
 #include "slam/place/frame_features.h"
 #include "slam/place/loop_verifier.h"
@@ -15,7 +16,7 @@ namespace kestrel::slam {
 
 struct KeyframeOptions {
   double min_translation_m = 0.25;           ///< a keyframe when the camera moved this far...
-  double min_rotation_rad = 10.0 * M_PI / 180.0;  ///< ...or turned this much since the last
+  double min_rotation_rad = 10.0 * kPi / 180.0;  ///< ...or turned this much since the last
 };
 
 struct LoopSearchOptions {
@@ -23,7 +24,7 @@ struct LoopSearchOptions {
   /// Candidates lie within this distance and angle of the current estimate; <= 0 disables the
   /// gate (for when the estimate is not trustworthy, e.g. after the odometry broke).
   double max_distance_m = 5.0;
-  double max_angle_rad = M_PI / 2;
+  double max_angle_rad = kPi / 2;
   int max_candidates = 15;      ///< by appearance score, verified best first
   double min_score = 0.0;       ///< appearance score below which a candidate is not verified
 };

@@ -15,6 +15,7 @@
 #include <string>
 
 #include "common/geometry/se3.h"
+#include "common/numbers.h"
 #include "slam/place/frame_features.h"
 #include "slam/place/two_view_adjustment.h"
 #include "vo/sensor_profile.h"
@@ -45,7 +46,7 @@ struct VerificationOptions {
 /// motions partly cancels but a two-frame measurement carries whole. With the simulator's
 /// 0.005 rad such a loop outweighed the odometry between its ends (slam/README.md, "Loop
 /// noise").
-constexpr double kKinect1LoopRotationFloorRad = M_PI / 180.0;
+constexpr double kKinect1LoopRotationFloorRad = kPi / 180.0;
 
 /// `options` for a loop between keyframes of cameras `a` and `b`: the Kinect's rotation floor
 /// when either is one (the larger of it and options.rotation_sigma_floor_rad).

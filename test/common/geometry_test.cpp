@@ -9,6 +9,7 @@
 #include "common/geometry/align.h"
 #include "common/geometry/se3.h"
 #include "common/geometry/so3.h"
+#include "common/numbers.h"
 
 namespace kestrel {
 namespace {
@@ -18,8 +19,8 @@ std::vector<Eigen::Vector3d> rotation_samples() {
   std::normal_distribution<double> n(0.0, 1.0);
   std::vector<Eigen::Vector3d> out = {Eigen::Vector3d::Zero(), Eigen::Vector3d(1e-9, 0, 0),
                                       Eigen::Vector3d(0, 1e-5, -1e-5),
-                                      Eigen::Vector3d(M_PI - 1e-7, 0, 0),
-                                      Eigen::Vector3d(0, 0, M_PI * 0.999)};
+                                      Eigen::Vector3d(kPi - 1e-7, 0, 0),
+                                      Eigen::Vector3d(0, 0, kPi * 0.999)};
   for (int i = 0; i < 50; ++i) {
     Eigen::Vector3d axis(n(rng), n(rng), n(rng));
     out.push_back(axis.normalized() * std::uniform_real_distribution<double>(0.0, 3.1)(rng));

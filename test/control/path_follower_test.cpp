@@ -7,6 +7,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "common/numbers.h"
 #include "control/path_follower.h"
 
 namespace kestrel::control {
@@ -77,8 +78,8 @@ TEST(PathFollower, ProgressNeverGoesBackNorShortCutsAPathThatPassesCloseToItself
   PathFollower f(o);
   f.set_path({{Eigen::Vector3d(0, 0, 1), 0.0},
               {Eigen::Vector3d(3, 0, 1), 0.0},
-              {Eigen::Vector3d(3, 0.4, 1), M_PI},
-              {Eigen::Vector3d(0, 0.4, 1), M_PI}});
+              {Eigen::Vector3d(3, 0.4, 1), kPi},
+              {Eigen::Vector3d(0, 0.4, 1), kPi}});
   f.command(at(1.0, 0.0));
   EXPECT_NEAR(f.progress_m(), 1.0, 1e-12);
   // Nearer the return leg (y = 0.3) than the outbound one, but the return leg's nearest point
@@ -95,12 +96,12 @@ TEST(PathFollower, ProgressNeverGoesBackNorShortCutsAPathThatPassesCloseToItself
 TEST(PathFollower, YawIsInterpolatedTheShortWayRoundAtTheProgressWithItsRate) {
   PathFollower f;  // cruise 0.5 m/s
   // From yaw 170 deg to -170 deg over 2 m: the short way is +20 deg through 180.
-  const double a = 170.0 * M_PI / 180.0;
+  const double a = 170.0 * kPi / 180.0;
   f.set_path({{Eigen::Vector3d(0, 0, 1), a}, {Eigen::Vector3d(2, 0, 1), -a}});
   const FollowerCommand c = f.command(at(1.0, 0.0));  // half way: 180 deg
   EXPECT_NEAR(std::cos(c.yaw), -1.0, 1e-12);
-  EXPECT_NEAR(std::remainder(c.yaw - M_PI, 2 * M_PI), 0.0, 1e-9);
-  EXPECT_NEAR(c.yaw_rate, 0.5 * (20.0 * M_PI / 180.0) / 2.0, 1e-12);  // 0.5 m/s * 10 deg per metre
+  EXPECT_NEAR(std::remainder(c.yaw - kPi, 2 * kPi), 0.0, 1e-9);
+  EXPECT_NEAR(c.yaw_rate, 0.5 * (20.0 * kPi / 180.0) / 2.0, 1e-12);  // 0.5 m/s * 10 deg per metre
   // A turn on the spot (two waypoints at one place) is a step: no rate to feed forward.
   PathFollower g;
   g.set_path({{Eigen::Vector3d(0, 0, 1), 0.0}, {Eigen::Vector3d(0, 0, 1), 1.0}, {Eigen::Vector3d(2, 0, 1), 1.0}});

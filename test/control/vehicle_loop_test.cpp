@@ -9,6 +9,7 @@
 #include <cmath>
 #include <iostream>
 
+#include "common/numbers.h"
 #include "control/path_follower.h"
 #include "drivers/sim/vehicle.h"
 
@@ -62,7 +63,7 @@ Flight fly(const std::vector<Waypoint>& path) {
       loop.set_command(command);
       if (f.arrived_at < 0 && follower.status() == FollowStatus::kArrived) f.arrived_at = t;
       if (follower.status() == FollowStatus::kFollowing)
-        f.worst_yaw = std::max(f.worst_yaw, std::abs(std::remainder(q.yaw - follower.yaw_at(follower.progress_m()), 2 * M_PI)));
+        f.worst_yaw = std::max(f.worst_yaw, std::abs(std::remainder(q.yaw - follower.yaw_at(follower.progress_m()), 2 * kPi)));
     }
     f.worst_m = std::max(f.worst_m, distance_to(path, q.p));
     f.fastest = std::max(f.fastest, q.v.norm());
@@ -80,7 +81,7 @@ Flight fly(const std::vector<Waypoint>& path) {
 TEST(FollowerWithVehicle, FliesAnLShapedPathWithinCentimetresAndStopsAtItsEnd) {
   const std::vector<Waypoint> path = {{Eigen::Vector3d(1, 1, 1), 0.0},
                                       {Eigen::Vector3d(4, 1, 1), 0.0},
-                                      {Eigen::Vector3d(4, 3, 1.5), M_PI / 2}};
+                                      {Eigen::Vector3d(4, 3, 1.5), kPi / 2}};
   const Flight f = fly(path);
   // 5.7 m at 0.5 m/s with a stop: about 12 s.
   ASSERT_GT(f.arrived_at, 0.0) << "never arrived; status " << to_string(f.status) << " at " << f.progress_m << " of "
@@ -96,7 +97,7 @@ TEST(FollowerWithVehicle, FliesAnLShapedPathWithinCentimetresAndStopsAtItsEnd) {
   EXPECT_LT(f.worst_yaw, 0.06);
   EXPECT_LT((f.end.p - path.back().position).norm(), 0.05);
   EXPECT_LT(f.end.v.norm(), 0.05);
-  EXPECT_NEAR(std::remainder(f.end.yaw - M_PI / 2, 2 * M_PI), 0.0, 0.05);
+  EXPECT_NEAR(std::remainder(f.end.yaw - kPi / 2, 2 * kPi), 0.0, 0.05);
 }
 
 // Right angles one metre apart, left and right, the yaw swinging with each leg: no leg is

@@ -7,6 +7,7 @@
 #include <map>
 
 #include "common/geometry/so3.h"
+#include "common/numbers.h"
 #include "estimator/estimator.h"
 #include "test/estimator/scenario.h"
 
@@ -435,7 +436,7 @@ TEST(Estimator, AStartOnTheMoveIsPublishedOnlyOnceTheVoHasSettledIt) {
 // the VO (every update failed) the same IMU gives a still start: the VO is what decides.
 TEST(Estimator, ACruiseAtConstantVelocityIsNotTakenForStandingStill) {
   AnalyticMotion cruise = AnalyticMotion::still();
-  cruise.x.terms.push_back({2.5, 2.0 * M_PI / 40.0, 0.0});  // 0.39 m/s at t = 0, 0.06 m/s^2 at most
+  cruise.x.terms.push_back({2.5, 2.0 * kPi / 40.0, 0.0});  // 0.39 m/s at t = 0, 0.06 m/s^2 at most
   const auto run = [&](bool vo_works, EstimatorCounters& counters) {
     Estimator e{EstimatorOptions{}};
     ScenarioOptions o = scenario(3.0);

@@ -5,6 +5,7 @@
 
 #include <stdexcept>
 
+#include "common/numbers.h"
 #include "estimator/eval/hold_score.h"
 
 namespace kestrel::estimator {
@@ -32,7 +33,7 @@ TEST(HoldScore, TruthFromTargetAndEstimateFromTruth) {
   EXPECT_NEAR(s.error_horizontal.max, 0.05, 1e-12);
   // Yaw errors 0.1, 0.1 and 2 pi - 6.2 (wrapped, not 6.2).
   EXPECT_NEAR(s.error_yaw.max, 0.1, 1e-12);
-  EXPECT_NEAR(s.error_yaw.mean, (0.2 + 2 * M_PI - 6.2) / 3, 1e-12);
+  EXPECT_NEAR(s.error_yaw.mean, (0.2 + 2 * kPi - 6.2) / 3, 1e-12);
   EXPECT_NEAR(s.scored_to_s, 0.01, 1e-12);
 }
 

@@ -9,6 +9,7 @@
 #include <random>
 
 #include "common/geometry/so3.h"
+#include "common/numbers.h"
 #include "estimator/filter_state.h"
 #include "estimator/measurements.h"
 
@@ -183,7 +184,7 @@ TEST(FilterState, ChangingTheWorldTurnsItsBlocksAndLeavesTheBodysAlone) {
   Eigen::MatrixXd A = Eigen::MatrixXd::Random(n, n);
   s.P = A * A.transpose();
   const FilterState before = s;
-  const Eigen::Matrix3d R_z = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const Eigen::Matrix3d R_z = Eigen::AngleAxisd(kPi / 2, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   const Eigen::Vector3d t(3.0, -2.0, 0.5);
   const Eigen::Isometry3d T = se3::make(R_z, t);
   change_world(s, T);

@@ -269,7 +269,7 @@ TEST(Robustness, AfterTooManyGatedUpdatesInARowTheNextIsFused) {
     r.options.vo_max_gated_in_row = max_in_row;
     Estimator e(r.options);
     const auto steps =
-      test::run_scenario(e, AnalyticMotion::gentle(), scenario_with_gyro_bias(3.0));
+        test::run_scenario(e, AnalyticMotion::gentle(), scenario_with_gyro_bias(3.0));
     const int64_t now = e.output()->utime;
     const auto gated_before = e.counters().vo_gated;
     for (int k = 0; k < 5; ++k) {

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "common/error.h"
+#include "common/numbers.h"
 #include "mapper/map_compare.h"
 #include "mapper/octree_io.h"
 #include "mapper/scan.h"
@@ -31,7 +32,7 @@ Scene box_scene() {
 std::vector<Eigen::Isometry3d> circle_poses(int n, double radius, const Eigen::Vector3d& target) {
   std::vector<Eigen::Isometry3d> poses;
   for (int i = 0; i < n; ++i) {
-    const double a = 2.0 * M_PI * i / n;
+    const double a = 2.0 * kPi * i / n;
     poses.push_back(test::look_at(
         target + Eigen::Vector3d(radius * std::cos(a), radius * std::sin(a), 0.0) +
             Eigen::Vector3d(0.013, 0.027, 0.6 + 0.011 * i),

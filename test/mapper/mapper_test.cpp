@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "common/error.h"
+#include "common/numbers.h"
 #include "mapper/mapper.h"
 #include "mapper/scan.h"
 #include "test/mapper/scene.h"
@@ -46,7 +47,7 @@ TEST(Mapper, RebuildAfterLoopClosureEqualsTheMapAtTheCorrectedPoses) {
     // Odometry drift: 3 cm and 0.5 degrees more per keyframe.
     Eigen::Isometry3d T = truth[i];
     T.translation() += Eigen::Vector3d(0.03, -0.02, 0.01) * static_cast<double>(i);
-    T.rotate(Eigen::AngleAxisd(0.5 * M_PI / 180.0 * i, Eigen::Vector3d::UnitY()));
+    T.rotate(Eigen::AngleAxisd(0.5 * kPi / 180.0 * i, Eigen::Vector3d::UnitY()));
     graph.push_back({static_cast<int64_t>(i), utime, T});
     true_graph.push_back({static_cast<int64_t>(i), utime, truth[i]});
     const GraphResult r = drifted.apply_graph(graph);
@@ -73,7 +74,7 @@ TEST(Mapper, AKeyframesDepthGoesInAtTheCameraPoseOfItsOwnTime) {
   // 25 ms at 0.5 m/s and 30 deg/s, backwards: the depth's camera 1.25 cm and 0.75 deg behind.
   Eigen::Isometry3d T_camera_depth = Eigen::Isometry3d::Identity();
   T_camera_depth.translation() << -0.0125, 0.0, 0.0;
-  T_camera_depth.rotate(Eigen::AngleAxisd(-0.75 * M_PI / 180.0, Eigen::Vector3d::UnitY()));
+  T_camera_depth.rotate(Eigen::AngleAxisd(-0.75 * kPi / 180.0, Eigen::Vector3d::UnitY()));
   MapperOptions options;
   Mapper timed(options), at_depth(options), untimed(options);
   std::vector<GraphKeyframe> graph, depth_graph, colour_graph;

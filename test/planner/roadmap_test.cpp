@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "common/numbers.h"
 #include "planner/roadmap.h"
 #include "test/planner/test_environments.h"
 
@@ -24,25 +25,25 @@ struct Recorder {
 TEST(BeliefModel, TurnsFromTheStartYawToTheEndYawTheShortWayRound) {
   Recorder r;
   // 2 m along x while turning from 170 deg to -170 deg: 20 deg through +-180, not 340 back.
-  const auto steps = r.model().steps(Config(0, 0, 1, 170 * M_PI / 180), Config(2, 0, 1, -170 * M_PI / 180));
+  const auto steps = r.model().steps(Config(0, 0, 1, 170 * kPi / 180), Config(2, 0, 1, -170 * kPi / 180));
   ASSERT_EQ(steps.size(), 8u);  // 2 m / 0.25 m; 20 deg needs fewer steps
   ASSERT_EQ(r.seen.size(), 8u);
   for (size_t k = 0; k < r.seen.size(); ++k) {
     const double f = (k + 1) / 8.0;
     EXPECT_NEAR(r.seen[k].x(), 2.0 * f, 1e-12);
-    EXPECT_NEAR(std::remainder(r.seen[k][3] - (170.0 + 20.0 * f) * M_PI / 180, 2 * M_PI), 0.0, 1e-12) << k;
+    EXPECT_NEAR(std::remainder(r.seen[k][3] - (170.0 + 20.0 * f) * kPi / 180, 2 * kPi), 0.0, 1e-12) << k;
   }
-  EXPECT_NEAR(std::remainder(r.seen.back()[3] + 170 * M_PI / 180, 2 * M_PI), 0.0, 1e-12);
+  EXPECT_NEAR(std::remainder(r.seen.back()[3] + 170 * kPi / 180, 2 * kPi), 0.0, 1e-12);
 }
 
 TEST(BeliefModel, ALargeTurnOnAShortEdgeIsCutIntoYawSteps) {
   Recorder r;
   // 0.1 m and a half turn: one distance step, but pi / 0.25 rad -> 13 yaw steps, so the
   // sensor's view is sampled every 14 deg, under half the paper camera's 30 deg.
-  const auto steps = r.model().steps(Config(0, 0, 1, 0), Config(0, 0.1, 1, M_PI));
+  const auto steps = r.model().steps(Config(0, 0, 1, 0), Config(0, 0.1, 1, kPi));
   EXPECT_EQ(steps.size(), 13u);
   for (size_t k = 1; k < r.seen.size(); ++k)
-    EXPECT_LE(std::abs(std::remainder(r.seen[k][3] - r.seen[k - 1][3], 2 * M_PI)), 0.25 + 1e-12);
+    EXPECT_LE(std::abs(std::remainder(r.seen[k][3] - r.seen[k - 1][3], 2 * kPi)), 0.25 + 1e-12);
 }
 
 TEST(BeliefModel, ProcessNoiseGrowsWithTheDistanceFlownNotWithTheSteps) {
@@ -50,7 +51,7 @@ TEST(BeliefModel, ProcessNoiseGrowsWithTheDistanceFlownNotWithTheSteps) {
   motion.variance_per_m = Eigen::Vector4d(0.5, 0.4, 0.1, 0.05);
   Recorder r;
   // 3 m with a half turn (13 yaw steps > 12 distance steps): the noise still adds up to 3 m's.
-  const auto steps = r.model(motion).steps(Config(1, 1, 1, 0), Config(1, 4, 1, M_PI));
+  const auto steps = r.model(motion).steps(Config(1, 1, 1, 0), Config(1, 4, 1, kPi));
   ASSERT_EQ(steps.size(), 13u);
   Mat4 total = Mat4::Zero();
   for (const BeliefStep& s : steps) {
@@ -172,7 +173,7 @@ TEST(BuildRoadmap, ThePapersRuleJoinsClustersANeighbourLimitKeepsApart) {
   const Config start(0, 0, 1, 0), goal(5, 0, 1, 0);
   std::vector<Config> list;
   for (int k = 0; k < 21; ++k) {
-    const double a = 2.0 * M_PI * k / 21.0, r = 0.1 + 0.01 * k;
+    const double a = 2.0 * kPi * k / 21.0, r = 0.1 + 0.01 * k;
     list.push_back(Config(r * std::cos(a), r * std::sin(a), 1, 0));
     list.push_back(Config(5 + r * std::cos(a), r * std::sin(a), 1, 0));
   }

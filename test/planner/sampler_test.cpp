@@ -3,6 +3,7 @@
 
 #include <cmath>
 
+#include "common/numbers.h"
 #include "planner/sampler.h"
 #include "test_environments.h"
 
@@ -55,7 +56,7 @@ TEST(GaussianSampler, ConcentratesNearObstaclesAsDefined) {
     EXPECT_FALSE(space.is_valid(trace.witnesses[0]));
     mean_x += (*q)[0] / n;
   }
-  EXPECT_NEAR(mean_x, sigma * std::sqrt(2.0 * M_PI) / 4.0, 0.035);  // sd 0.52 / sqrt(n) = 0.008
+  EXPECT_NEAR(mean_x, sigma * std::sqrt(2.0 * kPi) / 4.0, 0.035);  // sd 0.52 / sqrt(n) = 0.008
 }
 
 TEST(BridgeSampler, KeepsFreeMidpointsOfBlockedPairs) {

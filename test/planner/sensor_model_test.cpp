@@ -1,6 +1,7 @@
 // The feature sensor: visibility rules, analytic Jacobians, and M against its definition.
 #include <gtest/gtest.h>
 
+#include "common/numbers.h"
 #include "estimator/information.h"
 #include "planner/grid_environment.h"
 #include "planner/sensor_model.h"
@@ -34,9 +35,9 @@ TEST(FeatureSensor, SeesOnlyFeaturesInRangeInViewAndFacingIt) {
                     feature(1.0, 0, 1.5, towards)});  // 26.6 deg above: outside the vertical FOV
   const FeatureSensor sensor(env, FeatureSensorOptions::paper_camera());
   EXPECT_EQ(sensor.visible(Config(0, 0, 1, 0)), (std::vector<int>{0, 3}));
-  EXPECT_TRUE(sensor.visible(Config(0, 0, 1, M_PI)).empty());  // facing away
+  EXPECT_TRUE(sensor.visible(Config(0, 0, 1, kPi)).empty());  // facing away
   const FeatureSensor laser(env, FeatureSensorOptions::planar_laser(3.0));
-  EXPECT_EQ(laser.visible(Config(0, 0, 1, M_PI)), (std::vector<int>{0, 1, 2, 3, 5}));
+  EXPECT_EQ(laser.visible(Config(0, 0, 1, kPi)), (std::vector<int>{0, 1, 2, 3, 5}));
 }
 
 TEST(FeatureSensor, WallsHideFeatures) {
@@ -89,7 +90,7 @@ TEST(FeatureSensor, InformationOfAFeatureStraightAheadIsKnown) {
   expected(3, 3) = ib;
   expected(2, 2) = ib / (d * d);
   EXPECT_LT((sensor.information(Config(0, 0, 1, 0)) - expected).norm(), 1e-12);
-  EXPECT_EQ(sensor.information(Config(0, 0, 1, M_PI)), Mat4::Zero());
+  EXPECT_EQ(sensor.information(Config(0, 0, 1, kPi)), Mat4::Zero());
 }
 
 TEST(FeatureSensor, UkfInformationTendsToTheEkfsForASmallPrior) {
@@ -102,7 +103,7 @@ TEST(FeatureSensor, UkfInformationTendsToTheEkfsForASmallPrior) {
   const Mat4 ukf = sensor.ukf_information(q, 1e-6 * Mat4::Identity());
   EXPECT_LT((ukf - ekf).norm(), 1e-3 * ekf.norm());
   EXPECT_GT(sensor.ukf_information_gain(q, 0.1 * Mat4::Identity()), 0.0);
-  EXPECT_EQ(sensor.ukf_information_gain(Config(0, 0, 1, M_PI), 0.1 * Mat4::Identity()), 0.0);
+  EXPECT_EQ(sensor.ukf_information_gain(Config(0, 0, 1, kPi), 0.1 * Mat4::Identity()), 0.0);
 }
 
 TEST(FeatureSensor, UkfInformationEqualsTheGenericUkf) {
@@ -179,7 +180,7 @@ TEST(FeatureSensor, FastVisibilityEqualsTheDefinition) {
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   const std::vector<FeatureSensorOptions> presets = {FeatureSensorOptions::paper_camera(), FeatureSensorOptions::kinect(),
                                                      FeatureSensorOptions::planar_laser(4.0)};
-  const std::vector<double> yaws = {0.0, 0.3, -1.2, M_PI, -M_PI, 2.5};
+  const std::vector<double> yaws = {0.0, 0.3, -1.2, kPi, -kPi, 2.5};
   std::vector<Feature> features;
   for (const FeatureSensorOptions& o : presets)
     for (double yaw : yaws)
@@ -205,7 +206,7 @@ TEST(FeatureSensor, FastVisibilityEqualsTheDefinition) {
     const FeatureSensor sensor(env, o);
     std::vector<Config> poses;
     for (double yaw : yaws) poses.emplace_back(0.0, 0.0, 1.0, yaw);
-    for (int i = 0; i < 50; ++i) poses.emplace_back(0.3 * u(rng), 0.3 * u(rng), 1.0 + 0.2 * u(rng), M_PI * u(rng));
+    for (int i = 0; i < 50; ++i) poses.emplace_back(0.3 * u(rng), 0.3 * u(rng), 1.0 + 0.2 * u(rng), kPi * u(rng));
     for (const Config& q : poses) {
       const std::vector<int> seen = sensor.visible(q);
       ASSERT_EQ(seen, sensor.visible_reference(q)) << "yaw " << q[3];

@@ -6,6 +6,7 @@
 #include <fstream>
 
 #include "common/error.h"
+#include "common/numbers.h"
 #include "planner/configuration_space.h"
 #include "planner/experiment_worlds.h"
 #include "planner/sensor_model.h"
@@ -85,7 +86,7 @@ TEST(WorldEnvironment, FeaturesFollowTheWallsTexturesAndAreSeenFromTheirSide) {
   ASSERT_FALSE(seen.empty());
   for (int i : seen) EXPECT_NEAR(dense.features()[i].position.x(), 7.425, 1e-6);
   EXPECT_GT(camera.information(Config(6.2, 9.0, 1.0, 0.0)).trace(), 0.0);
-  for (int i : camera.visible(Config(8.7, 9.0, 1.0, M_PI))) EXPECT_GT(dense.features()[i].position.x(), 7.5);
+  for (int i : camera.visible(Config(8.7, 9.0, 1.0, kPi))) EXPECT_GT(dense.features()[i].position.x(), 7.5);
 }
 
 // line_of_sight (the fine grid and the sim's ray tests, stopping at the first hit) and

@@ -8,6 +8,7 @@
 #include <cmath>
 
 #include "common/geometry/so3.h"
+#include "common/numbers.h"
 #include "drivers/sim/imu.h"
 #include "drivers/sim/vehicle.h"
 
@@ -67,7 +68,7 @@ TEST(VehicleTest, FliesToASetPointWithinItsLimits) {
   const PathPoint end = vehicle.point(9.0);
   EXPECT_LT((end.p - go.position).norm(), 0.02);
   EXPECT_LT(end.v.norm(), 0.02);
-  EXPECT_NEAR(std::remainder(end.yaw - go.yaw, 2 * M_PI), 0.0, 0.01);
+  EXPECT_NEAR(std::remainder(end.yaw - go.yaw, 2 * kPi), 0.0, 0.01);
 }
 
 TEST(VehicleTest, TracksAVelocityCommandAndLatchesAHold) {
@@ -83,7 +84,7 @@ TEST(VehicleTest, TracksAVelocityCommandAndLatchesAHold) {
   fly(vehicle, loop, 0.0, 4.0);
   const PathPoint moving = vehicle.point(4.0);
   EXPECT_LT((moving.v - move.velocity).norm(), 0.01);
-  EXPECT_NEAR(std::remainder(vehicle.point(4.0).yaw - vehicle.point(3.0).yaw, 2 * M_PI), 0.5, 0.01);
+  EXPECT_NEAR(std::remainder(vehicle.point(4.0).yaw - vehicle.point(3.0).yaw, 2 * kPi), 0.5, 0.01);
   VehicleCommand stop;
   stop.mode = VehicleCommand::kHold;
   loop.set_command(stop);
@@ -112,7 +113,7 @@ TEST(VehicleTest, PositionModeTracksATurningYawWithTheYawRateFeedForward) {
       turn.yaw_rate = feed_forward ? rate : 0.0;
       loop.set_command(turn);
       const PathPoint q = vehicle.point(t);
-      error_at_4s = std::remainder(turn.yaw - q.yaw, 2 * M_PI);
+      error_at_4s = std::remainder(turn.yaw - q.yaw, 2 * kPi);
       loop.advance_to(t, VehicleEstimate{q.p, q.v, q.yaw});
     }
     if (feed_forward) {

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "common/geometry/se3.h"
+#include "common/numbers.h"
 
 namespace kestrel::slam::test {
 namespace {
@@ -20,8 +21,8 @@ Eigen::Matrix<double, N, N> square_root(const Eigen::Matrix<double, N, N>& omega
 
 template <class T>
 T wrap(const T& a) {
-  const T two_pi(2.0 * M_PI);
-  return a - two_pi * ceres::floor((a + T(M_PI)) / two_pi);
+  const T two_pi(2.0 * kPi);
+  return a - two_pi * ceres::floor((a + T(kPi)) / two_pi);
 }
 
 struct Se2Error {

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "common/error.h"
+#include "common/numbers.h"
 #include "slam/posegraph/g2o_io.h"
 #include "test/slam/synthetic_graphs.h"
 #include "test/support/test_support.h"
@@ -85,7 +86,7 @@ TEST(G2o, ReadsVerticesEdgesAndFix) {
   EXPECT_DOUBLE_EQ(g.edges[1].information(1, 0), 2.0);
   EXPECT_DOUBLE_EQ(g.edges[1].information(2, 2), 30.0);
   EXPECT_EQ(g.fixed, (std::vector<char>{0, 1, 0}));
-  EXPECT_NEAR(g.poses[2].z(), M_PI, 1e-15);
+  EXPECT_NEAR(g.poses[2].z(), kPi, 1e-15);
 }
 
 TEST(G2o, EdgesOnlyFilesAreInitialisedByChainingOdometry) {
@@ -99,7 +100,7 @@ TEST(G2o, EdgesOnlyFilesAreInitialisedByChainingOdometry) {
   const auto g = std::get<PoseGraph2d>(parse_g2o(text, "square.g2o"));
   ASSERT_EQ(g.num_vertices(), 4);
   EXPECT_EQ(g.ids, (std::vector<int64_t>{10, 11, 12, 13}));
-  const Eigen::Vector3d expected[] = {{0, 0, 0}, {1, 0, M_PI / 2}, {1, 1, M_PI}, {0, 1, -M_PI / 2}};
+  const Eigen::Vector3d expected[] = {{0, 0, 0}, {1, 0, kPi / 2}, {1, 1, kPi}, {0, 1, -kPi / 2}};
   for (int v = 0; v < 4; ++v) {
     EXPECT_LT((g.poses[v].head<2>() - expected[v].head<2>()).norm(), 1e-12) << v;
     EXPECT_NEAR(std::abs(wrap_angle(g.poses[v].z() - expected[v].z())), 0.0, 1e-12) << v;

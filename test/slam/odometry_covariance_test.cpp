@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "common/geometry/se3.h"
+#include "common/numbers.h"
 #include "slam/backend/odometry_chain.h"
 #include "slam/backend/slam.h"
 #include "slam/backend/slam_options.h"
@@ -132,7 +133,7 @@ TEST(OdometryChainCovariance, TheVosTranslationPartIsInTheReferenceFrame) {
   OdometryChain chain;
   const auto p10 = chain.add(motion(10, 0, true, Eigen::Isometry3d::Identity(), Matrix6d::Zero()));
   Eigen::Isometry3d yaw = Eigen::Isometry3d::Identity();
-  yaw.linear() = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  yaw.linear() = Eigen::AngleAxisd(kPi / 2, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   const auto p20 = chain.add(motion(20, 10, false, yaw, translation_covariance(0.01, 0.0, 0.0)));
   const auto c = chain.relative_covariance(*p10, *p20);
   ASSERT_TRUE(c.has_value());
@@ -170,7 +171,7 @@ MiniLoop mini_loop(bool reported) {
   MiniLoop m;
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
   Eigen::Isometry3d step = along_x(0.25);
-  step.linear() = Eigen::AngleAxisd(2 * M_PI / 20, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  step.linear() = Eigen::AngleAxisd(2 * kPi / 20, Eigen::Vector3d::UnitY()).toRotationMatrix();
   for (int i = 0; i < 20; ++i) {
     m.truth.push_back(T);
     m.graph.add_vertex(i, T, i == 0);

@@ -12,6 +12,7 @@
 
 #include "common/error.h"
 #include "common/geometry/se3.h"
+#include "common/numbers.h"
 #include "slam/place/loop_verifier.h"
 #include "slam/place/place_recognizer.h"
 #include "test/slam/synthetic_room.h"
@@ -79,9 +80,9 @@ TEST(LoopVerifier, AKinectsLoopTakesTheKinectsRotationFloor) {
   o.rotation_sigma_floor_rad = 0.001;
   EXPECT_EQ(loop_verification(o, SensorProfile::kSimulator, SensorProfile::kSimulator).rotation_sigma_floor_rad, 0.001);
   EXPECT_EQ(loop_verification(o, SensorProfile::kKinect1, SensorProfile::kSimulator).rotation_sigma_floor_rad,
-            M_PI / 180.0);
+            kPi / 180.0);
   EXPECT_EQ(loop_verification(o, SensorProfile::kSimulator, SensorProfile::kKinect1).rotation_sigma_floor_rad,
-            M_PI / 180.0);
+            kPi / 180.0);
   EXPECT_EQ(loop_verification(o, SensorProfile::kKinect1, SensorProfile::kKinect1).translation_sigma_floor_m,
             o.translation_sigma_floor_m);
   o.rotation_sigma_floor_rad = 0.05;  // a larger floor of the options' own stays
@@ -101,7 +102,7 @@ TEST(LoopVerifier, AKinectsLoopTakesTheKinectsRotationFloor) {
   EXPECT_TRUE(a.T_candidate_query.isApprox(b.T_candidate_query));
   const Eigen::Vector3d sim_var = a.information.inverse().diagonal().tail<3>();
   const Eigen::Vector3d kinect_var = b.information.inverse().diagonal().tail<3>();
-  const double floor_var = std::pow(0.5 * M_PI / 180.0, 2);
+  const double floor_var = std::pow(0.5 * kPi / 180.0, 2);
   EXPECT_LT(sim_var.maxCoeff(), 0.5 * floor_var) << sim_var.transpose();
   EXPECT_GT(kinect_var.minCoeff(), 0.95 * floor_var) << kinect_var.transpose();
 }
@@ -109,8 +110,8 @@ TEST(LoopVerifier, AKinectsLoopTakesTheKinectsRotationFloor) {
 TEST(LoopVerifier, RejectsViewsOfDifferentPlaces) {
   const SyntheticRoom room(3, 3.0, 2.5, 2.5);
   const auto views = views_along(room, {test::level_camera({0.0, 0.0, 1.0}, 0.0),
-                                        test::level_camera({0.0, 0.0, 1.0}, M_PI),
-                                        test::level_camera({0.0, 0.0, 1.0}, M_PI / 2)});
+                                        test::level_camera({0.0, 0.0, 1.0}, kPi),
+                                        test::level_camera({0.0, 0.0, 1.0}, kPi / 2)});
   for (const auto& [q, c] : {std::pair{1, 0}, std::pair{2, 0}, std::pair{2, 1}}) {
     const LoopConstraint r = verify_loop(views[q].features, views[c].features, VerificationOptions{}, 7);
     EXPECT_FALSE(r.accepted) << "views " << q << " and " << c << " see different walls";

@@ -7,6 +7,7 @@
 
 #include "common/geometry/se3.h"
 #include "common/geometry/so3.h"
+#include "common/numbers.h"
 #include "slam/posegraph/spaces.h"
 
 namespace kestrel::slam {
@@ -84,13 +85,13 @@ TYPED_TEST(SpaceTest, JacobiansMatchCentralDifferences) {
 TEST(Se2, ErrorIsG2osTranslationInTheMeasurementFrameAndWrappedAngle) {
   // X_i at the origin, X_j one metre ahead turned by 170 degrees; the measurement says
   // 0.9 m ahead and -170 degrees: e = (0.1, 0, 20 degrees) wrapped, in the measurement frame.
-  const Se2::Pose Xi(0, 0, 0), Xj(1, 0, 170 * M_PI / 180);
-  const Se2::Pose Z(0.9, 0, -170 * M_PI / 180);
+  const Se2::Pose Xi(0, 0, 0), Xj(1, 0, 170 * kPi / 180);
+  const Se2::Pose Z(0.9, 0, -170 * kPi / 180);
   const Se2::Vector e = Se2::error(Xi, Xj, Se2::inverse(Z));
   const Eigen::Vector2d t = Se2::rotation(-Z.z()) * Eigen::Vector2d(0.1, 0.0);
   EXPECT_NEAR(e.x(), t.x(), 1e-12);
   EXPECT_NEAR(e.y(), t.y(), 1e-12);
-  EXPECT_NEAR(e.z(), -20 * M_PI / 180, 1e-12);
+  EXPECT_NEAR(e.z(), -20 * kPi / 180, 1e-12);
 }
 
 TEST(Se3, RotationErrorIsTheVectorOfAPositiveQuaternion) {
@@ -110,7 +111,7 @@ TEST(Se3, TranslationErrorIsInTheMeasurementFrame) {
   // Measured 1 m along x of a frame turned 90 degrees about z; the truth is 1.5 m: the error is
   // R_z^T (t - t_z) = (0.5, 0, 0) in the measurement's frame.
   const Se3::Pose Xi = Se3::Pose::Identity();
-  const Eigen::Matrix3d Rz = so3::exp(Eigen::Vector3d(0, 0, M_PI / 2));
+  const Eigen::Matrix3d Rz = so3::exp(Eigen::Vector3d(0, 0, kPi / 2));
   const Se3::Pose Z = se3::make(Rz, Rz * Eigen::Vector3d(1, 0, 0));
   const Se3::Pose Xj = se3::make(Rz, Rz * Eigen::Vector3d(1.5, 0, 0));
   const Se3::Vector e = Se3::error(Xi, Xj, Se3::inverse(Z));
@@ -119,9 +120,9 @@ TEST(Se3, TranslationErrorIsInTheMeasurementFrame) {
 }
 
 TEST(WrapAngle, StaysInTheHalfOpenInterval) {
-  EXPECT_DOUBLE_EQ(wrap_angle(M_PI), M_PI);
-  EXPECT_DOUBLE_EQ(wrap_angle(-M_PI), M_PI);
-  EXPECT_NEAR(wrap_angle(3 * M_PI + 0.1), -M_PI + 0.1, 1e-12);
+  EXPECT_DOUBLE_EQ(wrap_angle(kPi), kPi);
+  EXPECT_DOUBLE_EQ(wrap_angle(-kPi), kPi);
+  EXPECT_NEAR(wrap_angle(3 * kPi + 0.1), -kPi + 0.1, 1e-12);
   EXPECT_NEAR(wrap_angle(-0.2), -0.2, 1e-15);
 }
 

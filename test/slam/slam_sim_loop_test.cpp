@@ -16,6 +16,7 @@
 #include <iostream>
 
 #include "common/geometry/align.h"
+#include "common/numbers.h"
 #include "drivers/sim/flights.h"
 #include "drivers/sim/simulation.h"
 #include "drivers/sim/world_catalog.h"
@@ -69,11 +70,11 @@ TEST(SlamSimLoop, FloorLoopCutsTheOdometryDriftWithNoFalseClosure) {
   }
   std::cout << "floor loop: ATE VO " << vo_ate << " m, SLAM " << slam_ate << " m (" << slam_ate / vo_ate
             << "x), " << run.keyframes << " keyframes, " << run.loop_closures << " loop closures, worst "
-            << worst_m << " m / " << worst_rad * 180.0 / M_PI << " deg, "
+            << worst_m << " m / " << worst_rad * 180.0 / kPi << " deg, "
             << std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() << " s\n";
   EXPECT_GE(run.loop_closures, 1);
   EXPECT_LT(worst_m, 0.10) << "a false loop closure";
-  EXPECT_LT(worst_rad, 3.0 * M_PI / 180.0) << "a false loop closure";
+  EXPECT_LT(worst_rad, 3.0 * kPi / 180.0) << "a false loop closure";
   EXPECT_GT(vo_ate, 0.3) << "too little drift for the test to mean anything";
   EXPECT_LE(slam_ate, 0.3 * vo_ate);
 }

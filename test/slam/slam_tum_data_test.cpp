@@ -11,6 +11,7 @@
 #include <tuple>
 
 #include "common/geometry/align.h"
+#include "common/numbers.h"
 #include "slam/place/builtin_vocabulary.h"
 #include "slam/sequence_run.h"
 #include "test/support/test_support.h"
@@ -64,9 +65,9 @@ TEST_P(SlamOnTum, AteIsNoWorseThanTheOdometrys) {
   for (const LoopError& e : loop_errors(run, sequence.ground_truth)) {
     ASSERT_TRUE(e.has_truth);
     std::cout << "  loop " << e.edge.from_utime << " -> " << e.edge.to_utime << ": " << e.translation_m * 100.0
-              << " cm, " << e.rotation_rad * 180.0 / M_PI << " deg\n";
+              << " cm, " << e.rotation_rad * 180.0 / kPi << " deg\n";
     EXPECT_LT(e.translation_m, 0.10) << "a false loop closure";
-    EXPECT_LT(e.rotation_rad, 3.0 * M_PI / 180.0) << "a false loop closure";
+    EXPECT_LT(e.rotation_rad, 3.0 * kPi / 180.0) << "a false loop closure";
   }
   if (name == "rgbd_dataset_freiburg1_rpy") {
     EXPECT_GE(run.loop_closures, 1);

@@ -4,6 +4,7 @@
 
 #include "common/geometry/se3.h"
 #include "common/geometry/so3.h"
+#include "common/numbers.h"
 
 namespace kestrel::slam::test {
 namespace {
@@ -35,12 +36,12 @@ PoseGraph3d helix_graph(const SyntheticOptions& o) {
   PoseGraph3d g;
   const double radius = 5.0, climb = 0.5;
   for (int k = 0; k < o.num_poses; ++k) {
-    const double a = 2.0 * M_PI * k / o.poses_per_turn;
+    const double a = 2.0 * kPi * k / o.poses_per_turn;
     const Eigen::Vector3d p(radius * std::cos(a), radius * std::sin(a),
                             climb * k / o.poses_per_turn);
     // Facing along the path, with a wobble so that every axis of rotation is exercised.
     const Eigen::Matrix3d R = so3::exp(Eigen::Vector3d(0.1 * std::sin(3 * a), 0.1 * std::cos(2 * a),
-                                                       a + M_PI / 2));
+                                                       a + kPi / 2));
     g.add_vertex(k, se3::make(R, p), k == 0);
   }
   std::mt19937 rng(o.seed);
@@ -59,9 +60,9 @@ PoseGraph3d helix_graph(const SyntheticOptions& o) {
 PoseGraph2d spiral_graph(const SyntheticOptions& o) {
   PoseGraph2d g;
   for (int k = 0; k < o.num_poses; ++k) {
-    const double a = 2.0 * M_PI * k / o.poses_per_turn;
+    const double a = 2.0 * kPi * k / o.poses_per_turn;
     const double r = 5.0 + 0.2 * k / o.poses_per_turn;
-    g.add_vertex(k, Se2::Pose(r * std::cos(a), r * std::sin(a), wrap_angle(a + M_PI / 2)), k == 0);
+    g.add_vertex(k, Se2::Pose(r * std::cos(a), r * std::sin(a), wrap_angle(a + kPi / 2)), k == 0);
   }
   std::mt19937 rng(o.seed);
   std::normal_distribution<double> n(0.0, 1.0);

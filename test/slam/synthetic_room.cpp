@@ -1,5 +1,7 @@
 #include "test/slam/synthetic_room.h"
 
+#include "common/numbers.h"
+
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -90,7 +92,7 @@ Eigen::Isometry3d level_camera(const Eigen::Vector3d& position, double yaw_rad) 
 std::vector<Eigen::Isometry3d> circle_path(int n, double radius_m, double turns) {
   std::vector<Eigen::Isometry3d> path;
   for (int k = 0; k < n; ++k) {
-    const double a = 2.0 * M_PI * turns * k / std::max(n - 1, 1);
+    const double a = 2.0 * kPi * turns * k / std::max(n - 1, 1);
     path.push_back(level_camera(Eigen::Vector3d(radius_m * std::cos(a), radius_m * std::sin(a), 1.0), a));
   }
   return path;
@@ -100,7 +102,7 @@ std::vector<Eigen::Isometry3d> straight_path(int n, double length_m) {
   std::vector<Eigen::Isometry3d> path;
   for (int k = 0; k < n; ++k) {
     const double x = -0.5 * length_m + length_m * k / std::max(n - 1, 1);
-    path.push_back(level_camera(Eigen::Vector3d(x, 0.0, 1.0), -M_PI / 2));
+    path.push_back(level_camera(Eigen::Vector3d(x, 0.0, 1.0), -kPi / 2));
   }
   return path;
 }
@@ -109,7 +111,7 @@ PinholeCamera test_camera() {
   PinholeCamera c;
   c.width = 320;
   c.height = 240;
-  c.fx = c.fy = 0.5 * c.width / std::tan(M_PI / 6);
+  c.fx = c.fy = 0.5 * c.width / std::tan(kPi / 6);
   c.cx = 159.5;
   c.cy = 119.5;
   return c;

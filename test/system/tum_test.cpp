@@ -23,16 +23,17 @@
 #include <vector>
 
 #include "common/geometry/align.h"
+#include "common/numbers.h"
 #include "common/trajectory.h"
+#include "common/transport/channels.h"
 #include "common/transport/convert.h"
 #include "common/transport/log_file.h"
-#include "kestrel/state_t.hpp"
-#include "common/transport/channels.h"
 #include "kestrel/slam_edge_t.hpp"
-#include "tools/eval/evaluate.h"
-#include "tools/eval/log_input.h"
+#include "kestrel/state_t.hpp"
 #include "test/support/test_support.h"
 #include "test/system/recording.h"
+#include "tools/eval/evaluate.h"
+#include "tools/eval/log_input.h"
 
 namespace kestrel {
 namespace {
@@ -81,7 +82,7 @@ void expect_visual_only_state(const std::string& recorded, const Trajectory& tru
   // Levelled: the world's z is the motion capture's up (TUM's mocap frame has z up), to the
   // accelerometer's accuracy.
   const Eigen::Vector3d up = T_gt_est->linear() * Eigen::Vector3d::UnitZ();
-  EXPECT_GT(up.z(), std::cos(5.0 * M_PI / 180.0)) << "the estimator's world is not level: up = " << up.transpose();
+  EXPECT_GT(up.z(), std::cos(5.0 * kPi / 180.0)) << "the estimator's world is not level: up = " << up.transpose();
 }
 
 TEST(System, ReplayedTumRecordingRunsWithItsCamerasProfileAndMapsTheScene) {

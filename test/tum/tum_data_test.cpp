@@ -11,13 +11,14 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "common/numbers.h"
 #include "common/text.h"
 #include "common/time.h"
 #include "common/transport/channels.h"
-#include "drivers/tum/playback.h"
 #include "common/transport/log_file.h"
 #include "common/transport/rgbd_codec.h"
 #include "drivers/kinect/accelerometer.h"
+#include "drivers/tum/playback.h"
 #include "drivers/tum/tum_sequence.h"
 #include "kestrel/ground_truth_t.hpp"
 #include "kestrel/imu_t.hpp"
@@ -136,7 +137,7 @@ double mean_angle_deg(const tum::TumSequence& s, bool convert) {
     if (!T) continue;
     const Eigen::Vector3d predicted = T->linear().transpose() * Eigen::Vector3d::UnitZ();
     const Eigen::Vector3d measured = convert ? kinect::accel_to_camera(a.accel_kinect) : a.accel_kinect;
-    sum += std::acos(std::clamp(predicted.dot(measured.normalized()), -1.0, 1.0)) * 180.0 / M_PI;
+    sum += std::acos(std::clamp(predicted.dot(measured.normalized()), -1.0, 1.0)) * 180.0 / kPi;
     ++n;
   }
   EXPECT_GT(n, 1000);

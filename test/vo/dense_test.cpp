@@ -10,6 +10,7 @@
 
 #include "common/geometry/se3.h"
 #include "common/geometry/so3.h"
+#include "common/numbers.h"
 #include "test/vo/synthetic_scene.h"
 #include "vo/dense_depth.h"
 #include "vo/motion_refinement.h"
@@ -143,7 +144,7 @@ TEST(DenseRefinement, RecoversAKnownMotionFromDepthAlone) {
   EXPECT_GT(std::min({axis[0], axis[1], axis[2]}), 300);
   // Millimetre depth rounding and 8-pixel cells: half a millimetre and a hundredth of a degree.
   EXPECT_LT((T.translation() - T_ref_cur.translation()).norm(), 5e-4);
-  EXPECT_LT(so3::angle(T.linear().transpose() * T_ref_cur.linear()) * 180.0 / M_PI, 0.015);
+  EXPECT_LT(so3::angle(T.linear().transpose() * T_ref_cur.linear()) * 180.0 / kPi, 0.015);
   EXPECT_GT((start.translation() - T_ref_cur.translation()).norm(), 5e-3);
 }
 

@@ -8,6 +8,7 @@
 #include <random>
 
 #include "common/geometry/so3.h"
+#include "common/numbers.h"
 #include "test/vo/synthetic_scene.h"
 #include "vo/fast.h"
 #include "vo/image_pyramid.h"
@@ -64,7 +65,7 @@ TEST(RotationPrior, RecoversARotationOfTheCameraFromCoarseImages) {
   const int level = 3;  // 80 x 60, the pipeline's default
   const RotationPriorResult r = prior.estimate(prev.level(level), cur.level(level),
                                                cam.scaled(1.0 / double(1 << level)), Eigen::Matrix3d::Identity(), 30);
-  const double error_deg = so3::angle(r.R_cur_prev.transpose() * R_cur_prev) * 180.0 / M_PI;
+  const double error_deg = so3::angle(r.R_cur_prev.transpose() * R_cur_prev) * 180.0 / kPi;
   EXPECT_LT(error_deg, 0.3) << "after " << r.iterations << " iterations";
   EXPECT_GT(r.iterations, 1);
 }

@@ -7,6 +7,7 @@
 #include <set>
 
 #include "common/geometry/se3.h"
+#include "common/numbers.h"
 #include "test/vo/synthetic_scene.h"
 #include "vo/odometry.h"
 #include "vo/pose_chain.h"
@@ -54,7 +55,7 @@ void run_and_check(const VoOptions& options, double max_translation_m, double ma
     EXPECT_GT(r.covariance.diagonal().minCoeff(), 0.0);
     const Eigen::Isometry3d T_true = truth(0).inverse() * truth(int(k));
     EXPECT_LT(se3::translation_distance(*pose, T_true), max_translation_m) << what << " frame " << k;
-    EXPECT_LT(se3::rotation_distance(*pose, T_true) * 180.0 / M_PI, max_rotation_deg) << what << " frame " << k;
+    EXPECT_LT(se3::rotation_distance(*pose, T_true) * 180.0 / kPi, max_rotation_deg) << what << " frame " << k;
   }
 }
 

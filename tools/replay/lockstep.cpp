@@ -1,6 +1,7 @@
 // Lock-step replay: the LCM side of replayer.h. The accounting lives in AckLedger, the
 // discovered processes in ProcessTable; this file moves messages and keeps time.
 
+#include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
 #include <chrono>
@@ -10,7 +11,6 @@
 #include <random>
 #include <set>
 
-#include "common/text.h"
 #include "common/transport/channels.h"
 #include "common/transport/lcm_url.h"
 #include "common/transport/message.h"
@@ -92,8 +92,8 @@ class Session {
           throw PeerError(fmt::format(
               "no heartbeat within {:.1f} s from: {} (heard from: {}); is it running on this "
               "LCM URL and network namespace?",
-              o_.discovery_timeout_s, join(missing, ", "),
-              heard.empty() ? "nobody" : join(heard, ", ")));
+              o_.discovery_timeout_s, fmt::join(missing, ", "),
+              heard.empty() ? "nobody" : fmt::format("{}", fmt::join(heard, ", "))));
         }
         spdlog::warn("the set of processes kept changing for {:.1f} s; going ahead with it",
                      o_.discovery_timeout_s);
@@ -123,8 +123,10 @@ class Session {
   }
 
   [[noreturn]] static void refuse(const std::vector<std::string>& conflicts) {
-    throw PeerError("several processes share a name, which lock-step cannot tell apart: " +
-                    join(conflicts, ", ") + "; give each a unique name");
+    throw PeerError(fmt::format(
+        "several processes share a name, which lock-step cannot tell apart: {}; give each a "
+        "unique name",
+        fmt::join(conflicts, ", ")));
   }
 
   bool reset_processes() {
@@ -139,7 +141,7 @@ class Session {
       if (silent.empty()) return true;
       if (now_s() - sent > o_.ack_timeout_s)
         throw PeerError(fmt::format("no answer to RESET within {:.1f} s from: {}",
-                                    o_.ack_timeout_s, join(silent, ", ")));
+                                    o_.ack_timeout_s, fmt::join(silent, ", ")));
       pump(0.05);
     }
   }

@@ -1,8 +1,9 @@
 #include "tools/replay/process_table.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 
-#include "common/text.h"
 #include "common/transport/channels.h"
 
 namespace kestrel::replay {
@@ -19,7 +20,7 @@ std::vector<std::string> data_channels(const std::vector<std::string>& channels)
 
 // A table cell: the items, or "-" for none.
 std::string cell(const std::vector<std::string>& items) {
-  return items.empty() ? "-" : join(items, ", ");
+  return items.empty() ? "-" : fmt::format("{}", fmt::join(items, ", "));
 }
 
 }  // namespace
@@ -58,7 +59,7 @@ std::vector<std::string> ProcessTable::conflicts(double now_s) const {
     std::vector<std::string> pids;
     for (const auto& [pid, heard_s] : p.pids_heard_s)
       if (now_s - heard_s <= conflict_window_s_) pids.push_back(std::to_string(pid));
-    if (pids.size() > 1) out.push_back(name + " (pids " + join(pids, ", ") + ")");
+    if (pids.size() > 1) out.push_back(fmt::format("{} (pids {})", name, fmt::join(pids, ", ")));
   }
   return out;
 }
