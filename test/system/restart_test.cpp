@@ -57,33 +57,41 @@ double rigid_fit_rms(const std::vector<Eigen::Vector3d>& from, const std::vector
   return std::sqrt((moved - b).colwise().squaredNorm().mean());
 }
 
-TEST(System, AnEstimatorKilledInFlightRestartsInTheMapsWorld) {
-  if (!test::can_isolate_network()) GTEST_SKIP() << "no network namespace available";
-  if (!std::filesystem::exists("/usr/bin/lcm-logger")) GTEST_SKIP() << "lcm-logger is not installed";
-  test::TempDir dir;
-  const std::string source = (dir / "source.lcmlog").string(), live = (dir / "live.lcmlog").string();
+// Flies the room's figure-eight (16 s, replayed at its own pace) through `processes` under
+// `kestrel launch --restart` and kills `victim` 8 s after the set started (about 7 s into the
+// flight; by the pid the launcher reports, since other tests' processes may run beside it).
+// `channels` are recorded in dir/live.lcmlog; the launcher's output is dir/launch.txt, the
+// processes' logs are in dir/logs.
+void fly_and_kill(const test::TempDir& dir, const std::string& processes, const std::string& victim,
+                  const std::string& channels) {
+  const std::string source = (dir / "source.lcmlog").string();
   const auto sim = test::run({test::tool("sim").string(), "--world", "room", "--flight", "figure8", "--duration",
                               "16", "--seed", "1", "--log", source, "-q"},
                              300.0);
   ASSERT_EQ(sim.exit_code, 0) << sim.err;
-
-  // Killed 8 s after the set started (about 7 s into the flight), restarted a second later;
-  // by the pid the launcher reports (other tests' estimators may be running beside it).
   const std::string launch_out = test::quoted((dir / "launch.txt").string());
   const std::string script =
-      "lcm-logger -q -c 'STATE|GROUND_TRUTH' -f " + test::quoted(live) + " & L=$!; " +
-      test::wait_for_lcm_listener_sh() + " && (" + test::quoted(test::tool("launch").string()) +
-      " all --only vo,estimator,slam --restart --status-period 0 --log-dir " + test::quoted((dir / "logs").string()) +
+      "lcm-logger -q -c '" + channels + "' -f " + test::quoted((dir / "live.lcmlog").string()) + " & L=$!; " +
+      test::wait_for_lcm_listener_sh() + " && (" + test::quoted(test::tool("launch").string()) + " all --only " +
+      processes + " --restart --status-period 0 --log-dir " + test::quoted((dir / "logs").string()) +
       " --source " + test::quoted("replay " + source + " --realtime") + " > " + launch_out +
-      " 2>&1 & P=$!; sleep 8; kill -KILL $(sed -n 's/.*started estimator (pid \\([0-9]*\\)).*/\\1/p' " +
+      " 2>&1 & P=$!; sleep 8; kill -KILL $(sed -n 's/.*started " + victim + " (pid \\([0-9]*\\)).*/\\1/p' " +
       launch_out + " | head -n 1); wait $P); sleep 0.5; kill $L";
   const auto r = test::run_isolated(script, 200.0);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const std::string launch = test::read_file(dir / "launch.txt");
+  ASSERT_NE(launch.find("started " + victim + " ("), std::string::npos) << launch;
+  ASSERT_NE(launch.find("killed by SIGKILL"), std::string::npos) << launch;
+}
+
+TEST(System, AnEstimatorKilledInFlightRestartsInTheMapsWorld) {
+  if (!test::can_isolate_network()) GTEST_SKIP() << "no network namespace available";
+  if (!std::filesystem::exists("/usr/bin/lcm-logger")) GTEST_SKIP() << "lcm-logger is not installed";
+  test::TempDir dir;
+  ASSERT_NO_FATAL_FAILURE(fly_and_kill(dir, "vo,estimator,slam", "estimator", "STATE|GROUND_TRUTH"));
+  const std::string live = (dir / "live.lcmlog").string();
   const std::string estimator = test::read_file(dir / "logs" / "estimator.log");
   const std::string slam = test::read_file(dir / "logs" / "slam.log");
-  ASSERT_NE(launch.find("estimator ("), std::string::npos) << launch;
-  ASSERT_NE(launch.find("killed by SIGKILL"), std::string::npos) << launch;
   EXPECT_NE(slam.find("1 estimator restarts"), std::string::npos) << slam;
   EXPECT_NE(estimator.find("1 moved the world onto SLAM's"), std::string::npos) << estimator;
 
@@ -135,24 +143,9 @@ TEST(System, ASlamKilledInFlightStartsANewSessionInTheSameWorldAndTheMapKeepsBot
   if (!test::can_isolate_network()) GTEST_SKIP() << "no network namespace available";
   if (!std::filesystem::exists("/usr/bin/lcm-logger")) GTEST_SKIP() << "lcm-logger is not installed";
   test::TempDir dir;
-  const std::string source = (dir / "source.lcmlog").string(), live = (dir / "live.lcmlog").string();
-  const auto sim = test::run({test::tool("sim").string(), "--world", "room", "--flight", "figure8", "--duration",
-                              "16", "--seed", "1", "--log", source, "-q"},
-                             300.0);
-  ASSERT_EQ(sim.exit_code, 0) << sim.err;
-  const std::string launch_out = test::quoted((dir / "launch.txt").string());
-  const std::string script =
-      "lcm-logger -q -c 'GROUND_TRUTH|SLAM_GRAPH|VO_UPDATE' -f " + test::quoted(live) + " & L=$!; " +
-      test::wait_for_lcm_listener_sh() + " && (" + test::quoted(test::tool("launch").string()) +
-      " all --only vo,estimator,slam,mapper --restart --status-period 0 --log-dir " +
-      test::quoted((dir / "logs").string()) + " --source " + test::quoted("replay " + source + " --realtime") +
-      " > " + launch_out + " 2>&1 & P=$!; sleep 8; kill -KILL $(sed -n 's/.*started slam (pid \\([0-9]*\\)).*/\\1/p' " +
-      launch_out + " | head -n 1); wait $P); sleep 0.5; kill $L";
-  const auto r = test::run_isolated(script, 200.0);
-  ASSERT_EQ(r.exit_code, 0) << r.err;
-  const std::string launch = test::read_file(dir / "launch.txt");
+  ASSERT_NO_FATAL_FAILURE(fly_and_kill(dir, "vo,estimator,slam,mapper", "slam", "GROUND_TRUTH|SLAM_GRAPH|VO_UPDATE"));
+  const std::string live = (dir / "live.lcmlog").string();
   const std::string mapper = test::read_file(dir / "logs" / "mapper.log");
-  ASSERT_NE(launch.find("killed by SIGKILL"), std::string::npos) << launch;
 
   std::map<int64_t, Eigen::Isometry3d> truth;
   std::vector<kestrel::slam_graph_t> graphs;
