@@ -51,7 +51,6 @@ class RelativePoseMeasurement final : public Measurement {
   Eigen::Isometry3d T_body_camera_;
 };
 
-/// An absolute body pose T_world_body (a SLAM correction) at the state's time.
 /// A measurement's innovation y = -g(x) at the state, linearised there: H P and the factored
 /// S = H P H^T + Q, what the EKF update and the tests of how far a measurement lies from what
 /// the state expects need. `valid` is false when S is not positive definite or y not finite.
@@ -66,6 +65,7 @@ struct Innovation {
 };
 Innovation innovation(const Measurement& m, const FilterState& s);
 
+/// An absolute body pose T_world_body (a SLAM correction) at the state's time.
 class AbsolutePoseMeasurement final : public Measurement {
  public:
   AbsolutePoseMeasurement(const Eigen::Isometry3d& T_world_body, const Matrix6d& covariance);
