@@ -1,7 +1,8 @@
 // kestrel-mapper: the occupancy map process. Reads CAMERA_RGBD and SLAM_GRAPH (or, with
 // --pose-source ground-truth, GROUND_TRUTH) and publishes MAP_OCTOMAP, rate-limited in sensor
-// time, with heartbeats and lock-step replay (RESET forgets the map). On exit it can write the
-// final map (--save) . The logic is MapNode (map_node.h); this file only wires it to LCM.
+// time, with heartbeats and lock-step replay (RESET forgets the map). With --journal it keeps its
+// keyframes on disk and restores them when restarted. On exit it can write the final map
+// (--save). The logic is MapNode (map_node.h); this file only wires it to LCM.
 
 #include <spdlog/spdlog.h>
 
@@ -36,6 +37,12 @@ int serve(Options& o) {
   o.node.full_format = o.format == "full";
   if (!o.save.empty()) mapper::format_of(o.save);  // a bad extension is an error now, not at exit
   mapper::MapNode map(o.node);
+  if (!o.node.journal_path.empty()) {
+    if (!map.journal_damage().empty()) {
+      spdlog::warn("{}: read up to the damage and cut it off: {}", o.node.journal_path, map.journal_damage());
+    }
+    spdlog::info("journal {}: {} keyframes restored", o.node.journal_path, map.stats().keyframes_restored);
+  }
 
   std::unique_ptr<transport::Node> node;
   node = std::make_unique<transport::Node>(o.name, o.lcm_url);  // UnavailableError: exit 4
@@ -50,13 +57,20 @@ int serve(Options& o) {
   if (o.node.pose_source == mapper::PoseSource::kSlamGraph) {
     // Graphs are rare and each may trigger a rebuild: never drop one.
     node->subscribe<slam_graph_t>(channel::kSlamGraph, [&](const slam_graph_t& m) {
+      const bool journalling = !o.node.journal_path.empty() && map.journal_error().empty();
       publish(map.on_graph(m, channel::kSlamGraph));
+      if (journalling && !map.journal_error().empty()) {
+        spdlog::error("journal stopped (the map goes on without it): {}", map.journal_error());
+        node->set_health(process_status_t::STATE_DEGRADED, "journal stopped: " + map.journal_error());
+      }
     }, 0);
   } else {
     node->subscribe<ground_truth_t>(channel::kGroundTruth, [&](const ground_truth_t& m) {
       publish(map.on_ground_truth(m, channel::kGroundTruth));
     }, 0);
   }
+  // A restored map goes out at once: the planner should not wait for the next keyframe.
+  if (map.stats().keyframes_restored > 0) publish(map.map_message());
   node->set_health(process_status_t::STATE_RUNNING, "");
   spdlog::info("{}: CAMERA_RGBD + {} -> MAP_OCTOMAP at {} m", o.name,
                o.pose_source == "slam" ? "SLAM_GRAPH" : "GROUND_TRUTH", o.node.mapper.map.resolution_m);
@@ -95,6 +109,9 @@ int main(int argc, char** argv) {
       ->check(cli::Positive)
       ->capture_default_str();
   app.add_option("--save", o.save, "Write the final map here on exit (.bt or .ot)");
+  app.add_option("--journal", o.node.journal_path,
+                 "slam: journal the keyframes to this file and, if it exists, restore the map from it "
+                 "first (a mapper restarted in flight; kestrel launch gives each launch its own)");
   mapper::add_mapper_options(app, o.node.mapper);
   return app.run(argc, argv, [&] { return serve(o); });
 }

@@ -1,5 +1,6 @@
 #include "mapper/map_node.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -24,13 +25,76 @@ void NodeOptions::validate() const {
   if (!(std::isfinite(max_pose_gap_s) && max_pose_gap_s > 0.0))
     throw std::invalid_argument("max-pose-gap: must be > 0");
   if (max_pending_frames < 1) throw std::invalid_argument("max-pending-frames: must be >= 1");
+  if (!journal_path.empty() && pose_source != PoseSource::kSlamGraph)
+    throw std::invalid_argument("journal: only with the slam pose source");
 }
 
+namespace {
+
+GraphKeyframe graph_keyframe(const kestrel::slam_keyframe_t& k, const char* what) {
+  GraphKeyframe g;
+  g.id = k.id;
+  g.utime = k.utime;
+  g.T_world_camera = transport::from_message(k.T_world_camera, what);
+  g.T_camera_depth = transport::from_message(k.T_camera_depth, what);
+  return g;
+}
+
+}  // namespace
+
 MapNode::MapNode(const NodeOptions& options)
-    : options_((options.validate(), options)), mapper_(options.mapper) {}
+    : options_((options.validate(), options)), mapper_(options.mapper) {
+  if (options_.journal_path.empty()) return;
+  const JournalContents journal = read_journal(options_.journal_path);
+  journal_damage_ = journal.damage;
+  restore(journal);
+  journal_ = std::make_unique<JournalWriter>(options_.journal_path, journal.intact_bytes);
+}
+
+void MapNode::restore(const JournalContents& journal) {
+  const std::string what = options_.journal_path;
+  for (const JournalRecord& r : journal.records) {
+    if (r.kind == JournalRecord::Kind::kKeyframe) {
+      mapper_.restore_keyframe(graph_keyframe(r.keyframe, what.c_str()), r.frame);
+      ++stats_.keyframes_restored;
+    } else {
+      std::vector<GraphKeyframe> keyframes;
+      for (const auto& k : r.graph.keyframes) keyframes.push_back(graph_keyframe(k, what.c_str()));
+      mapper_.restore_poses(keyframes);
+      last_graph_revision_ = r.graph.revision;
+    }
+  }
+  if (stats_.keyframes_restored > 0) mapper_.rebuild_from_scratch();
+}
+
+void MapNode::write_journal(const kestrel::slam_graph_t& msg, const GraphResult& result) {
+  try {
+    // In apply_graph's order: the graph, if it moved stored keyframes (one that moved none
+    // changed nothing stored), then the new keyframes as the message gave them, so a restore
+    // replays the same steps and ends with the same poses, bit for bit.
+    if (result.moved > 0) {
+      kestrel::slam_graph_t poses = msg;
+      poses.num_edges = 0;
+      poses.edges.clear();
+      journal_->graph(poses);
+    }
+    for (const int64_t id : result.inserted) {
+      const auto k = std::find_if(msg.keyframes.begin(), msg.keyframes.end(),
+                                  [&](const kestrel::slam_keyframe_t& m) { return m.id == id; });
+      // (Over the keyframe budget, one stored by this graph may have gone already.)
+      if (const StoredKeyframe* stored = mapper_.keyframes().find(id)) journal_->keyframe(*k, stored->frame);
+    }
+  } catch (const std::exception& e) {
+    // The map matters more than its copy: stop journalling (a later record after a lost one
+    // would restore a different map) and map on.
+    journal_error_ = e.what();
+    journal_.reset();
+  }
+}
 
 void MapNode::reset() {
   mapper_.reset();
+  if (journal_) journal_->clear();
   stats_ = {};
   last_frame_utime_ = 0;
   last_published_utime_ = -1;
@@ -137,18 +201,13 @@ std::optional<kestrel::octomap_t> MapNode::on_graph(const kestrel::slam_graph_t&
   }
   std::vector<GraphKeyframe> keyframes;
   keyframes.reserve(msg.keyframes.size());
-  for (const auto& k : msg.keyframes) {
-    GraphKeyframe g;
-    g.id = k.id;
-    g.utime = k.utime;
-    g.T_world_camera = transport::from_message(k.T_world_camera, channel);
-    g.T_camera_depth = transport::from_message(k.T_camera_depth, channel);
-    keyframes.push_back(g);
-  }
+  for (const auto& k : msg.keyframes) keyframes.push_back(graph_keyframe(k, channel));
   last_graph_revision_ = msg.revision;
   ++stats_.graphs;
   const GraphResult result = mapper_.apply_graph(keyframes);
-  stats_.frames_inserted += result.inserted;  // keyframes: the frames a SLAM map is made of
+  // keyframes: the frames a SLAM map is made of
+  stats_.frames_inserted += static_cast<int64_t>(result.inserted.size());
+  if (journal_) write_journal(msg, result);
   if (result.rebuilt) {
     ++stats_.rebuilds;
     stats_.last_rebuild_keyframes = static_cast<double>(result.rebuild_keyframes);

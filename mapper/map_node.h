@@ -9,6 +9,14 @@
 //    time, once poses on both sides of that time have arrived (for bench runs before SLAM
 //    exists, and to compare maps). A frame in a gap of the ground truth is dropped and counted.
 //
+// Journal (kSlamGraph, NodeOptions::journal_path): every keyframe stored and every graph that
+// moved stored keyframes is appended to a file (keyframe_journal.h). A node started on an
+// existing journal first restores those keyframes at the poses they had and rebuilds the map
+// from them, so a mapper killed and restarted in flight carries on with its map; keyframes
+// SLAM made while it was down are missing (their frames went by). RESET empties the journal.
+// A journal that cannot be written mid-flight (a full disk) is given up, not the map:
+// journal_error() says why and mapping goes on.
+//
 // MAP_OCTOMAP is produced at most once per publish_period_s of sensor time, and at once after
 // a rebuild. Everything is driven by the messages' utime, so a lock-step replay publishes the
 // same maps at the same points every time. Bad messages throw InputError naming the channel
@@ -16,13 +24,16 @@
 
 #include <cstdint>
 #include <deque>
+#include <memory>
 #include <optional>
+#include <string>
 
 #include "common/trajectory.h"
 #include "kestrel/ground_truth_t.hpp"
 #include "kestrel/octomap_t.hpp"
 #include "kestrel/rgbd_frame_t.hpp"
 #include "kestrel/slam_graph_t.hpp"
+#include "mapper/keyframe_journal.h"
 #include "mapper/mapper.h"
 
 namespace kestrel::mapper {
@@ -36,6 +47,7 @@ struct NodeOptions {
   bool full_format = false;         ///< FORMAT_FULL (.ot, log-odds) instead of FORMAT_BINARY (.bt)
   double max_pose_gap_s = 0.1;      ///< kGroundTruth: largest gap to interpolate across
   int max_pending_frames = 90;      ///< kGroundTruth: frames waiting for a pose after theirs
+  std::string journal_path;         ///< kSlamGraph: journal here, restore from it ("" = none)
   void validate() const;
 };
 
@@ -47,10 +59,13 @@ struct NodeStats {
   int64_t rebuilds = 0;
   int64_t published = 0;
   double last_rebuild_keyframes = 0;
+  int64_t keyframes_restored = 0;  ///< from the journal at start
 };
 
 class MapNode {
  public:
+  /// With a journal_path, restores what the journal holds (InputError naming the file if it is
+  /// not a journal; a damaged end is cut off and reported by journal_damage()).
   explicit MapNode(const NodeOptions& options);
 
   /// Each returns the MAP_OCTOMAP message to publish now, if one is due.
@@ -65,10 +80,16 @@ class MapNode {
 
   const Mapper& mapper() const { return mapper_; }
   const NodeStats& stats() const { return stats_; }
+  /// Why the journal was read only in part at start ("" = it was read whole, or there is none).
+  const std::string& journal_damage() const { return journal_damage_; }
+  /// Why journalling stopped ("" = it did not).
+  const std::string& journal_error() const { return journal_error_; }
 
  private:
   std::optional<kestrel::octomap_t> maybe_publish(bool now);
   void insert_pending();
+  void restore(const JournalContents& journal);
+  void write_journal(const kestrel::slam_graph_t& msg, const GraphResult& result);
 
   NodeOptions options_;
   Mapper mapper_;
@@ -79,6 +100,9 @@ class MapNode {
   int64_t last_graph_revision_ = -1;
   std::deque<RgbdFrame> pending_;  // kGroundTruth: frames waiting for their pose
   Trajectory poses_;               // kGroundTruth: T_world_camera, recent
+  std::unique_ptr<JournalWriter> journal_;
+  std::string journal_damage_;
+  std::string journal_error_;
 };
 
 }  // namespace kestrel::mapper

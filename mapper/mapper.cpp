@@ -126,22 +126,44 @@ const RgbdFrame* Mapper::buffered(int64_t utime) const {
   return it != buffer_.end() && it->utime == utime ? &*it : nullptr;
 }
 
-GraphResult Mapper::apply_graph(const std::vector<GraphKeyframe>& graph) {
-  GraphResult result;
-  std::vector<GraphKeyframe> fresh;
-  int64_t newest = 0;
+size_t Mapper::move_stored(const std::vector<GraphKeyframe>& graph, std::vector<GraphKeyframe>* fresh) {
+  size_t count = 0;
   for (const GraphKeyframe& g : graph) {
-    newest = std::max(newest, g.utime);
     if (const StoredKeyframe* kf = keyframes_.find(g.id)) {
       if (moved(kf->T_world_camera, g.T_world_camera, options_.rebuild_translation_m,
                 options_.rebuild_rotation_deg)) {
         keyframes_.set_pose(g.id, g.T_world_camera);
-        ++result.moved;
+        ++count;
       }
-    } else {
-      fresh.push_back(g);
+    } else if (fresh != nullptr) {
+      fresh->push_back(g);
     }
   }
+  return count;
+}
+
+void Mapper::restore_keyframe(const GraphKeyframe& keyframe, RgbdFrame decimated) {
+  decimated.validate("restored keyframe");
+  StoredKeyframe kf;
+  kf.id = keyframe.id;
+  kf.utime = keyframe.utime;
+  kf.T_world_camera = keyframe.T_world_camera;
+  kf.T_camera_depth = keyframe.T_camera_depth;
+  kf.frame = std::move(decimated);
+  keyframes_.add(std::move(kf));
+  map_is_sequence_ = false;  // the map does not hold it until the rebuild
+}
+
+size_t Mapper::restore_poses(const std::vector<GraphKeyframe>& keyframes) {
+  return move_stored(keyframes, nullptr);
+}
+
+GraphResult Mapper::apply_graph(const std::vector<GraphKeyframe>& graph) {
+  GraphResult result;
+  std::vector<GraphKeyframe> fresh;
+  int64_t newest = 0;
+  for (const GraphKeyframe& g : graph) newest = std::max(newest, g.utime);
+  result.moved = move_stored(graph, &fresh);
   std::sort(fresh.begin(), fresh.end(),
             [](const GraphKeyframe& a, const GraphKeyframe& b) { return a.utime < b.utime; });
   if (result.moved > 0) rebuild_pending_ = true;
@@ -168,7 +190,7 @@ GraphResult Mapper::apply_graph(const std::vector<GraphKeyframe>& graph) {
     // Inserted now unless the whole map is about to be rebuilt anyway.
     if (!(rebuild_pending_ && may_rebuild)) integrate_keyframe(kf);
     keyframes_.add(std::move(kf));
-    ++result.inserted;
+    result.inserted.push_back(g.id);
   }
   if (rebuild_pending_ && may_rebuild) {
     result.reinserted = rebuild();

@@ -62,7 +62,7 @@ struct GraphKeyframe {
 };
 
 struct GraphResult {
-  size_t inserted = 0;   ///< new keyframes put into the map
+  std::vector<int64_t> inserted;  ///< ids of the new keyframes stored and put into the map
   size_t moved = 0;      ///< stored keyframes that moved beyond the threshold
   size_t missing = 0;    ///< new keyframes whose frame was not (or no longer) buffered
   bool rebuilt = false;  ///< the map was rebuilt from the stored keyframes
@@ -84,6 +84,14 @@ class Mapper {
   void buffer_frame(const RgbdFrame& frame, const char* what = "frame");
   /// SLAM mode: one graph revision.
   GraphResult apply_graph(const std::vector<GraphKeyframe>& keyframes);
+
+  /// A restarted mapper (map_node.h's journal): a keyframe stored before the restart, its frame
+  /// as stored then. It goes into the store, not yet into the map: rebuild() after the last.
+  void restore_keyframe(const GraphKeyframe& keyframe, RgbdFrame decimated);
+  /// A restarted mapper: a graph that moved stored keyframes then; they move as apply_graph()
+  /// moved them (the same thresholds), so the restored poses are the ones the store had.
+  /// Returns how many moved.
+  size_t restore_poses(const std::vector<GraphKeyframe>& keyframes);
   /// Rebuilds the map from the stored keyframes at their current poses; returns how many were
   /// inserted (the others came from a checkpoint).
   size_t rebuild();
@@ -111,6 +119,9 @@ class Mapper {
     VoxelMap map;
   };
   void integrate_keyframe(const StoredKeyframe& kf);
+  // Moves the stored keyframes of `graph` that moved beyond the rebuild thresholds; the others
+  // go to `fresh` when given. Returns how many moved.
+  size_t move_stored(const std::vector<GraphKeyframe>& graph, std::vector<GraphKeyframe>* fresh);
   void maybe_checkpoint();
   size_t rebuild_from(bool use_checkpoints);
 

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <fstream>
 
 #include "common/error.h"
@@ -100,6 +101,19 @@ TEST(ProcessSets, TheShippedFileIsValidAndHasBothSides) {
   const ProcessSet all = read_process_sets(KESTREL_DEFAULT_PROCESS_SETS);
   EXPECT_FALSE(select(all, "onboard", {}, {}).empty());
   EXPECT_FALSE(select(all, "offboard", {}, {}).empty());
+}
+
+TEST(ProcessSets, RunDirIsPutIntoTheArgumentsThatNameIt) {
+  ProcessSet set = {{"mapper", {"mapper", "--journal", "{run_dir}/m.journal", "--x={run_dir}:{run_dir}"}, "offboard"},
+                    {"vo", {"vo", "--name", "run_dir"}, "onboard"}};
+  set = with_run_dir(set, "/tmp/r");
+  EXPECT_EQ(set[0].argv, (std::vector<std::string>{"mapper", "--journal", "/tmp/r/m.journal", "--x=/tmp/r:/tmp/r"}));
+  EXPECT_EQ(set[1].argv, (std::vector<std::string>{"vo", "--name", "run_dir"}));
+  // The shipped set journals the mapper's keyframes in the launch's own folder.
+  const ProcessSet shipped = with_run_dir(read_process_sets(KESTREL_DEFAULT_PROCESS_SETS), "/R");
+  const auto mapper = std::find_if(shipped.begin(), shipped.end(), [](const ProcessSpec& p) { return p.name == "mapper"; });
+  ASSERT_NE(mapper, shipped.end());
+  EXPECT_EQ(mapper->argv, (std::vector<std::string>{"mapper", "--journal", "/R/mapper.journal"}));
 }
 
 TEST(ResolveExecutable, PrefersKestrelToolsThenPath) {

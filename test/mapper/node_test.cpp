@@ -1,7 +1,14 @@
 // The mapper process's logic on messages (MapNode), without LCM: ground-truth and SLAM pose
 // sources, the published stream decodes to the map the library builds, the rate limit, a
-// rebuild published at once, RESET, and bad messages rejected with the channel named.
+// rebuild published at once, RESET, bad messages rejected with the channel named, and the
+// journal a restarted mapper gets its map back from (whole, cut short, corrupt, not a journal).
 #include <gtest/gtest.h>
+
+#include <sys/resource.h>
+
+#include <csignal>
+#include <filesystem>
+#include <fstream>
 
 #include "common/error.h"
 #include "common/transport/convert.h"
@@ -9,6 +16,7 @@
 #include "mapper/map_node.h"
 #include "mapper/octree_io.h"
 #include "test/mapper/scene.h"
+#include "test/support/test_support.h"
 
 namespace kestrel::mapper {
 namespace {
@@ -33,6 +41,31 @@ VoxelMap decode(const kestrel::octomap_t& m) {
   return decode_octree(m.data.data(), m.data.size(),
                        m.format == kestrel::octomap_t::FORMAT_FULL ? OctreeFormat::kFull : OctreeFormat::kBinary,
                        "MAP_OCTOMAP");
+}
+
+// SLAM_GRAPH's entry for a keyframe made from the frame at time t (along pose_at()).
+kestrel::slam_keyframe_t keyframe_message(int64_t id, int64_t t) {
+  kestrel::slam_keyframe_t k{};
+  k.id = id;
+  k.utime = t;
+  k.T_world_camera = transport::to_message(pose_at(1e-6 * t));
+  k.T_camera_depth = transport::to_message(Eigen::Isometry3d::Identity());
+  return k;
+}
+
+// Keyframes `first`..`last` (ids = their index) of the slow pan pose_at() describes, 0.1 s
+// apart: their frames go to the node, and the graph holds keyframes 0..last.
+kestrel::slam_graph_t feed_keyframes(MapNode& node, const test::Scene& scene, int first, int last,
+                                     int64_t revision) {
+  kestrel::slam_graph_t graph{};
+  for (int i = 0; i <= last; ++i) {
+    const int64_t t = 100000 * (i + 1);
+    if (i >= first) node.on_frame(frame_message(scene, t), "CAMERA_RGBD");
+    graph.keyframes.push_back(keyframe_message(i, t));
+  }
+  graph.num_keyframes = static_cast<int32_t>(graph.keyframes.size());
+  graph.revision = revision;
+  return graph;
 }
 
 TEST(MapNode, GroundTruthPosesGiveTheLibrarysMap) {
@@ -76,19 +109,7 @@ TEST(MapNode, SlamGraphInsertsKeyframesAndPublishesRebuildsAtOnce) {
   options.publish_period_s = 10.0;
   options.mapper.rebuild_interval_s = 0.0;
   MapNode node(options);
-  kestrel::slam_graph_t graph{};
-  for (int i = 0; i < 4; ++i) {
-    const int64_t t = 100000 * (i + 1);
-    node.on_frame(frame_message(scene, t), "CAMERA_RGBD");
-    kestrel::slam_keyframe_t k{};
-    k.id = i;
-    k.utime = t;
-    k.T_world_camera = transport::to_message(pose_at(1e-6 * t));
-    k.T_camera_depth = transport::to_message(Eigen::Isometry3d::Identity());
-    graph.keyframes.push_back(k);
-  }
-  graph.num_keyframes = 4;
-  graph.revision = 1;
+  kestrel::slam_graph_t graph = feed_keyframes(node, scene, 0, 3, 1);
   const auto first = node.on_graph(graph, "SLAM_GRAPH");
   ASSERT_TRUE(first.has_value()) << "the first map is published at once";
   EXPECT_EQ(first->revision, 1);
@@ -125,12 +146,7 @@ TEST(MapNode, ARestartedSlamAddsItsKeyframesAndKeepsTheEarlierOnes) {
     for (int i = 0; i < 3; ++i) {
       const int64_t t = first_utime + 100000 * i;
       node.on_frame(frame_message(scene, t), "CAMERA_RGBD");
-      kestrel::slam_keyframe_t k{};
-      k.id = first_utime + i;
-      k.utime = t;
-      k.T_world_camera = transport::to_message(pose_at(1e-6 * t));
-      k.T_camera_depth = transport::to_message(Eigen::Isometry3d::Identity());
-      graph.keyframes.push_back(k);
+      graph.keyframes.push_back(keyframe_message(first_utime + i, t));
     }
     graph.num_keyframes = 3;
     graph.revision = first_utime + revision;
@@ -168,6 +184,168 @@ TEST(MapNode, BadFramesAreRejectedNamingTheChannel) {
   no_depth.depth_size = 0;
   EXPECT_THROW(node.on_frame(no_depth, "CAMERA_RGBD"), InputError);
   EXPECT_EQ(node.stats().frames, 1);
+}
+
+void expect_same_keyframes(const Mapper& a, const Mapper& b) {
+  const auto ka = a.keyframes().in_time_order();
+  const auto kb = b.keyframes().in_time_order();
+  ASSERT_EQ(ka.size(), kb.size());
+  for (size_t i = 0; i < ka.size(); ++i) {
+    EXPECT_EQ(ka[i]->id, kb[i]->id);
+    EXPECT_EQ(ka[i]->utime, kb[i]->utime);
+    EXPECT_TRUE(ka[i]->T_world_camera.matrix() == kb[i]->T_world_camera.matrix()) << "keyframe " << ka[i]->id;
+    EXPECT_EQ(cv::norm(ka[i]->frame.depth_mm, kb[i]->frame.depth_mm, cv::NORM_INF), 0.0);
+    EXPECT_EQ(cv::norm(ka[i]->frame.rgb, kb[i]->frame.rgb, cv::NORM_INF), 0.0);
+  }
+}
+
+void expect_same_map(const VoxelMap& a, const VoxelMap& b) {
+  ASSERT_EQ(a.num_cells(), b.num_cells());
+  a.for_each_cell([&](const Key& k, float v) { ASSERT_EQ(b.log_odds(k), v); });
+}
+
+// A mapper killed in flight and started again on its journal: the keyframes it had, at the
+// poses a loop closure moved them to, and the same map, cell for cell; then it carries on.
+TEST(MapNode, ARestartedMapperRestoresItsKeyframesAndMapFromTheJournal) {
+  const test::Scene scene = test::room_with_a_box();
+  kestrel::test::TempDir dir;
+  NodeOptions options;
+  options.mapper.rebuild_interval_s = 0.0;
+  options.journal_path = (dir / "mapper.journal").string();
+  MapNode before(options);
+  before.on_graph(feed_keyframes(before, scene, 0, 3, 1), "SLAM_GRAPH");
+  // A loop closure moves keyframe 1 by 5 cm (beyond the 2 cm threshold) and keyframe 2 by
+  // 1 cm (below it: the store keeps its old pose), and keyframes 4 and 5 arrive with it.
+  kestrel::slam_graph_t closed = feed_keyframes(before, scene, 4, 5, 2);
+  closed.keyframes[1].T_world_camera.position[1] += 0.05;
+  closed.keyframes[2].T_world_camera.position[1] += 0.01;
+  before.on_graph(closed, "SLAM_GRAPH");
+  ASSERT_EQ(before.stats().rebuilds, 1);
+  ASSERT_EQ(before.mapper().keyframes().size(), 6u);
+
+  MapNode after(options);
+  EXPECT_EQ(after.stats().keyframes_restored, 6);
+  EXPECT_EQ(after.journal_damage(), "");
+  expect_same_keyframes(before.mapper(), after.mapper());
+  expect_same_map(before.mapper().map(), after.mapper().map());
+
+  // It carries on: a new keyframe goes into the map and the journal.
+  kestrel::slam_graph_t next = closed;
+  const kestrel::slam_graph_t more = feed_keyframes(after, scene, 6, 6, 3);
+  next.keyframes.push_back(more.keyframes.back());
+  next.num_keyframes = 7;
+  next.revision = 3;
+  after.on_graph(next, "SLAM_GRAPH");
+  EXPECT_EQ(after.mapper().keyframes().size(), 7u);
+  EXPECT_EQ(MapNode(options).stats().keyframes_restored, 7);
+
+  // Without a journal the restarted mapper would have nothing: the frames are gone.
+  NodeOptions plain = options;
+  plain.journal_path.clear();
+  MapNode forgetful(plain);
+  forgetful.on_graph(next, "SLAM_GRAPH");
+  EXPECT_EQ(forgetful.mapper().keyframes().size(), 0u);
+
+  // RESET (a lock-step replay starting again) empties the journal.
+  after.reset();
+  EXPECT_TRUE(read_journal(options.journal_path).records.empty());
+  EXPECT_EQ(MapNode(options).stats().keyframes_restored, 0);
+}
+
+TEST(MapNode, AJournalCutShortOrCorruptKeepsTheRecordsBeforeTheDamage) {
+  const test::Scene scene = test::room_with_a_box();
+  kestrel::test::TempDir dir;
+  NodeOptions options;
+  options.journal_path = (dir / "mapper.journal").string();
+  const auto size = [&] { return std::filesystem::file_size(options.journal_path); };
+  std::vector<uintmax_t> ends;  // the journal's size after each keyframe
+  {
+    MapNode node(options);
+    for (int i = 0; i < 3; ++i) {
+      node.on_graph(feed_keyframes(node, scene, i, i, i + 1), "SLAM_GRAPH");
+      ends.push_back(size());
+    }
+  }
+  ASSERT_EQ(read_journal(options.journal_path).records.size(), 3u);
+
+  // Killed halfway through writing the third keyframe.
+  std::filesystem::resize_file(options.journal_path, (ends[1] + ends[2]) / 2);
+  JournalContents cut = read_journal(options.journal_path);
+  EXPECT_EQ(cut.records.size(), 2u);
+  EXPECT_EQ(cut.intact_bytes, ends[1]);
+  EXPECT_NE(cut.damage.find("record 2 is cut short"), std::string::npos) << cut.damage;
+  {
+    MapNode node(options);
+    EXPECT_EQ(node.stats().keyframes_restored, 2);
+    EXPECT_NE(node.journal_damage().find("cut short"), std::string::npos);
+    EXPECT_EQ(size(), ends[1]) << "the damaged end is cut off before appending";
+    node.on_graph(feed_keyframes(node, scene, 2, 2, 3), "SLAM_GRAPH");
+  }
+  cut = read_journal(options.journal_path);
+  EXPECT_EQ(cut.records.size(), 3u) << "appended after the cut, readable again";
+  EXPECT_EQ(cut.damage, "");
+
+  // A flipped bit inside the second keyframe's frame: its CRC fails, the first is kept.
+  {
+    std::fstream f(options.journal_path, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekg(static_cast<std::streamoff>((ends[0] + ends[1]) / 2));
+    const char c = static_cast<char>(f.peek());
+    f.seekp(static_cast<std::streamoff>((ends[0] + ends[1]) / 2));
+    f.put(static_cast<char>(c ^ 0x10));
+  }
+  cut = read_journal(options.journal_path);
+  EXPECT_EQ(cut.records.size(), 1u);
+  EXPECT_NE(cut.damage.find("record 1 fails its CRC"), std::string::npos) << cut.damage;
+}
+
+// A disk that fills up in flight: the journal is given up with the reason, the map goes on.
+TEST(MapNode, AJournalThatCannotBeWrittenIsGivenUpAndTheMapGoesOn) {
+  const test::Scene scene = test::room_with_a_box();
+  kestrel::test::TempDir dir;
+  NodeOptions options;
+  options.journal_path = (dir / "mapper.journal").string();
+  MapNode node(options);
+  node.on_graph(feed_keyframes(node, scene, 0, 0, 1), "SLAM_GRAPH");
+  const uintmax_t written = std::filesystem::file_size(options.journal_path);
+  // The file-size limit stands in for a full disk: a write past it fails (EFBIG).
+  rlimit old_limit{};
+  ASSERT_EQ(getrlimit(RLIMIT_FSIZE, &old_limit), 0);
+  const auto old_handler = std::signal(SIGXFSZ, SIG_IGN);
+  rlimit limit = old_limit;
+  limit.rlim_cur = static_cast<rlim_t>(written + 1000);
+  ASSERT_EQ(setrlimit(RLIMIT_FSIZE, &limit), 0);
+  node.on_graph(feed_keyframes(node, scene, 1, 1, 2), "SLAM_GRAPH");
+  node.on_graph(feed_keyframes(node, scene, 2, 2, 3), "SLAM_GRAPH");
+  setrlimit(RLIMIT_FSIZE, &old_limit);
+  std::signal(SIGXFSZ, old_handler);
+  EXPECT_NE(node.journal_error().find("mapper.journal: writing the mapper journal failed"), std::string::npos)
+      << node.journal_error();
+  EXPECT_EQ(node.mapper().keyframes().size(), 3u) << "the map went on";
+  EXPECT_EQ(node.stats().frames_inserted, 3);
+  // What was written before the failure restores; the partial record is cut off.
+  const JournalContents journal = read_journal(options.journal_path);
+  EXPECT_EQ(journal.records.size(), 1u);
+  EXPECT_NE(journal.damage, "");
+}
+
+TEST(MapNode, AFileThatIsNotAJournalIsAnErrorNamingItAndIsLeftAlone) {
+  kestrel::test::TempDir dir;
+  NodeOptions options;
+  options.journal_path = (dir / "notes.txt").string();
+  std::ofstream(options.journal_path) << "my notes\n";
+  try {
+    MapNode node(options);
+    FAIL() << "a file that is not a journal must not be taken, nor overwritten";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("notes.txt: not a kestrel mapper journal"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(kestrel::test::read_file(options.journal_path), "my notes\n");
+  // A journal that does not exist yet is a new map; ground-truth poses have no journal.
+  options.journal_path = (dir / "new.journal").string();
+  EXPECT_EQ(MapNode(options).stats().keyframes_restored, 0);
+  EXPECT_TRUE(std::filesystem::exists(options.journal_path));
+  options.pose_source = PoseSource::kGroundTruth;
+  EXPECT_THROW(MapNode{options}, std::invalid_argument);
 }
 
 }  // namespace

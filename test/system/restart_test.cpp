@@ -6,7 +6,8 @@
 // slam_adapter.h). Before these, the restarted filter started with velocity zero and SLAM's
 // corrections pulled it about by up to 0.6 m for seconds. Then SLAM is killed the same way
 // while the estimator and the mapper run on: the new SLAM session's map lies in the same world
-// and the mapper keeps both sessions' keyframes (slam/slam_messages.h).
+// and the mapper keeps both sessions' keyframes (slam/slam_messages.h). Last, the mapper is
+// killed: it comes back with its map from its journal (mapper/keyframe_journal.h).
 //
 // Live and timed: the simulator's recording is replayed at its own pace (lock-step replay
 // would stall on the dead process), so the figures vary a little from run to run; the bounds
@@ -31,6 +32,7 @@
 #include "common/transport/log_file.h"
 #include "common/transport/message.h"
 #include "kestrel/ground_truth_t.hpp"
+#include "kestrel/octomap_t.hpp"
 #include "kestrel/slam_graph_t.hpp"
 #include "kestrel/state_t.hpp"
 #include "kestrel/vo_update_t.hpp"
@@ -212,6 +214,53 @@ TEST(System, ASlamKilledInFlightStartsANewSessionInTheSameWorldAndTheMapKeepsBot
   std::printf("mapper: %d keyframes inserted, %d messages rejected\n", inserted, rejected);
   EXPECT_EQ(rejected, 0) << mapper;
   EXPECT_GT(inserted, before->num_keyframes + after->num_keyframes / 2) << mapper;
+}
+
+// The mapper killed in flight: restarted on its journal (the launch's {run_dir}), it publishes
+// the map it had at once and carries on adding SLAM's keyframes; only those SLAM made while it
+// was down are missing. Without the journal it would start from nothing.
+TEST(System, AMapperKilledInFlightComesBackWithItsMapFromTheJournal) {
+  if (!test::can_isolate_network()) GTEST_SKIP() << "no network namespace available";
+  if (!std::filesystem::exists("/usr/bin/lcm-logger")) GTEST_SKIP() << "lcm-logger is not installed";
+  test::TempDir dir;
+  ASSERT_NO_FATAL_FAILURE(fly_and_kill(dir, "vo,estimator,slam,mapper", "mapper", "SLAM_GRAPH|MAP_OCTOMAP"));
+  const std::string mapper = test::read_file(dir / "logs" / "mapper.log");
+
+  kestrel::slam_graph_t last_graph;
+  std::vector<kestrel::octomap_t> before, after;  // maps of the killed mapper and of its successor
+  transport::LogReader log((dir / "live.lcmlog").string());
+  while (auto e = log.next()) {
+    const auto& data = e->data;
+    if (e->channel == channel::kSlamGraph) {
+      last_graph = transport::decode_message<kestrel::slam_graph_t>(data.data(), data.size(), "SLAM_GRAPH");
+    } else if (e->channel == channel::kMapOctomap) {
+      auto m = transport::decode_message<kestrel::octomap_t>(data.data(), data.size(), "MAP_OCTOMAP");
+      // A new process counts its revisions from 1 again.
+      if (!after.empty() || (!before.empty() && m.revision <= before.back().revision)) {
+        after.push_back(std::move(m));
+      } else {
+        before.push_back(std::move(m));
+      }
+    }
+  }
+  ASSERT_FALSE(before.empty());
+  ASSERT_FALSE(after.empty()) << "no map from the restarted mapper\n" << mapper;
+
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(mapper, m, std::regex(R"(journal \S+: ([1-9]\d*) keyframes restored)"))) << mapper;
+  const int restored = std::stoi(m[1]);
+  ASSERT_TRUE(std::regex_search(mapper, m, std::regex(R"((\d+) frames \((\d+) inserted.* (\d+) rejected)"))) << mapper;
+  const int inserted = std::stoi(m[2]), rejected = std::stoi(m[3]);
+  std::printf("mapper: %d keyframes restored, %d inserted after the restart, SLAM's final graph %d; "
+              "last map before the kill %d bytes, first after %d bytes, last %d bytes\n",
+              restored, inserted, last_graph.num_keyframes, before.back().size, after.front().size,
+              after.back().size);
+  EXPECT_EQ(rejected, 0) << mapper;
+  EXPECT_GE(restored, 6) << "the keyframes of the first 7 s";
+  EXPECT_GE(restored + inserted, last_graph.num_keyframes - 6) << "only those made while the mapper was down are missing";
+  // The first map of the restarted mapper is the map it had, published at once.
+  EXPECT_GE(after.front().size, 0.9 * before.back().size);
+  EXPECT_GE(after.back().size, after.front().size);
 }
 
 }  // namespace

@@ -4,12 +4,14 @@
 // --source the set is fed by one more process (a driver or a replay) and the launch ends when
 // that process ends.
 
+#include <fmt/chrono.h>
 #include <signal.h>
 #include <spdlog/spdlog.h>
 #include <unistd.h>
 
 #include <atomic>
 #include <chrono>
+#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <lcm/lcm-cpp.hpp>
@@ -112,6 +114,11 @@ int launch(const Options& o) {
   so.environment = {"LCM_DEFAULT_URL=" + url};
   so.restart = o.restart;
   so.max_restarts = o.max_restarts;
+  // This launch's own folder (its start time and pid), so that a log folder given again does
+  // not hand a new launch the journal of an earlier one.
+  const fs::path run_dir = so.log_dir / fmt::format("run-{:%Y%m%dT%H%M%S}-{}", fmt::gmtime(std::time(nullptr)), ::getpid());
+  fs::create_directories(run_dir);
+  set = with_run_dir(std::move(set), run_dir);
   Supervisor supervisor(set, executables, so);
   HealthBoard board;
   HeartbeatListener listener{&board};

@@ -48,6 +48,17 @@ std::vector<std::string> split_command(const std::string& command) {
   return words;
 }
 
+ProcessSet with_run_dir(ProcessSet set, const std::filesystem::path& run_dir) {
+  static const std::string kKey = "{run_dir}";
+  for (ProcessSpec& p : set) {
+    for (std::string& arg : p.argv) {
+      for (size_t at = arg.find(kKey); at != std::string::npos; at = arg.find(kKey, at + run_dir.string().size()))
+        arg.replace(at, kKey.size(), run_dir.string());
+    }
+  }
+  return set;
+}
+
 ProcessSet read_process_sets(const std::filesystem::path& file) {
   if (!std::filesystem::is_regular_file(file)) throw InputError(file.string() + ": no such file");
   YAML::Node root;

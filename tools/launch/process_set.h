@@ -33,6 +33,11 @@ ProcessSet select(const ProcessSet& all, const std::string& set,
 /// commands here are tool names and plain arguments.
 std::vector<std::string> split_command(const std::string& command);
 
+/// `{run_dir}` in an argument becomes `run_dir`: a folder the launch makes for itself, for
+/// files that must outlive a restarted process but not the launch (the mapper's journal: a
+/// restarted mapper gets its map back, a new launch starts a new map).
+ProcessSet with_run_dir(ProcessSet set, const std::filesystem::path& run_dir);
+
 /// Where argv[0] runs from: a path is used as given; a bare name `x` is `kestrel-x` in
 /// `tool_dir` if present there, else `x` itself looked up in `tool_dir` and then on PATH.
 /// Throws InputError naming the command when nothing runnable is found.
