@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "common/error.h"
+#include "common/transport/convert.h"
 #include "common/transport/message.h"
 #include "common/transport/rgbd_codec.h"
 
@@ -120,6 +121,33 @@ JournalContents read_journal(const std::string& path) {
     contents.intact_bytes += 5 + size + 4;
   }
   return contents;
+}
+
+GraphKeyframe to_graph_keyframe(const kestrel::slam_keyframe_t& keyframe, const char* what) {
+  GraphKeyframe g;
+  g.id = keyframe.id;
+  g.utime = keyframe.utime;
+  g.T_world_camera = transport::from_message(keyframe.T_world_camera, what);
+  g.T_camera_depth = transport::from_message(keyframe.T_camera_depth, what);
+  return g;
+}
+
+Restored restore_journal(const JournalContents& journal, Mapper& mapper, const std::string& what) {
+  Restored restored;
+  for (const JournalRecord& r : journal.records) {
+    if (r.kind == JournalRecord::Kind::kKeyframe) {
+      mapper.restore_keyframe(to_graph_keyframe(r.keyframe, what.c_str()), r.frame);
+      ++restored.keyframes;
+    } else {
+      std::vector<GraphKeyframe> keyframes;
+      keyframes.reserve(r.graph.keyframes.size());
+      for (const auto& k : r.graph.keyframes) keyframes.push_back(to_graph_keyframe(k, what.c_str()));
+      mapper.restore_poses(keyframes);
+      restored.last_revision = r.graph.revision;
+    }
+  }
+  if (restored.keyframes > 0) mapper.rebuild_from_scratch();
+  return restored;
 }
 
 JournalWriter::JournalWriter(std::string path, uint64_t intact_bytes) : path_(std::move(path)) {

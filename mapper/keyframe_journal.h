@@ -26,6 +26,7 @@
 #include "common/rgbd_frame.h"
 #include "kestrel/slam_graph_t.hpp"
 #include "kestrel/slam_keyframe_t.hpp"
+#include "mapper/mapper.h"
 
 namespace kestrel::mapper {
 
@@ -46,6 +47,19 @@ struct JournalContents {
 /// What the journal at `path` holds; empty for a missing or empty file. Throws InputError
 /// naming `path` if it cannot be read or is not a journal.
 JournalContents read_journal(const std::string& path);
+
+/// SLAM_GRAPH's keyframe as the mapper takes it; InputError naming `what` for a broken pose.
+GraphKeyframe to_graph_keyframe(const kestrel::slam_keyframe_t& keyframe, const char* what);
+
+struct Restored {
+  int64_t keyframes = 0;      ///< keyframe records put into the store
+  int64_t last_revision = -1; ///< of the last graph record (-1: none)
+};
+
+/// Replays `journal` into `mapper` (Mapper::restore_keyframe, restore_poses: the steps
+/// apply_graph took, so the keyframes end at the same poses, bit for bit) and rebuilds its
+/// map from them. `what` names the journal in errors.
+Restored restore_journal(const JournalContents& journal, Mapper& mapper, const std::string& what);
 
 class JournalWriter {
  public:

@@ -29,42 +29,15 @@ void NodeOptions::validate() const {
     throw std::invalid_argument("journal: only with the slam pose source");
 }
 
-namespace {
-
-GraphKeyframe graph_keyframe(const kestrel::slam_keyframe_t& k, const char* what) {
-  GraphKeyframe g;
-  g.id = k.id;
-  g.utime = k.utime;
-  g.T_world_camera = transport::from_message(k.T_world_camera, what);
-  g.T_camera_depth = transport::from_message(k.T_camera_depth, what);
-  return g;
-}
-
-}  // namespace
-
 MapNode::MapNode(const NodeOptions& options)
     : options_((options.validate(), options)), mapper_(options.mapper) {
   if (options_.journal_path.empty()) return;
   const JournalContents journal = read_journal(options_.journal_path);
   journal_damage_ = journal.damage;
-  restore(journal);
+  const Restored restored = restore_journal(journal, mapper_, options_.journal_path);
+  stats_.keyframes_restored = restored.keyframes;
+  last_graph_revision_ = restored.last_revision;
   journal_ = std::make_unique<JournalWriter>(options_.journal_path, journal.intact_bytes);
-}
-
-void MapNode::restore(const JournalContents& journal) {
-  const std::string what = options_.journal_path;
-  for (const JournalRecord& r : journal.records) {
-    if (r.kind == JournalRecord::Kind::kKeyframe) {
-      mapper_.restore_keyframe(graph_keyframe(r.keyframe, what.c_str()), r.frame);
-      ++stats_.keyframes_restored;
-    } else {
-      std::vector<GraphKeyframe> keyframes;
-      for (const auto& k : r.graph.keyframes) keyframes.push_back(graph_keyframe(k, what.c_str()));
-      mapper_.restore_poses(keyframes);
-      last_graph_revision_ = r.graph.revision;
-    }
-  }
-  if (stats_.keyframes_restored > 0) mapper_.rebuild_from_scratch();
 }
 
 void MapNode::write_journal(const kestrel::slam_graph_t& msg, const GraphResult& result) {
@@ -201,7 +174,7 @@ std::optional<kestrel::octomap_t> MapNode::on_graph(const kestrel::slam_graph_t&
   }
   std::vector<GraphKeyframe> keyframes;
   keyframes.reserve(msg.keyframes.size());
-  for (const auto& k : msg.keyframes) keyframes.push_back(graph_keyframe(k, channel));
+  for (const auto& k : msg.keyframes) keyframes.push_back(to_graph_keyframe(k, channel));
   last_graph_revision_ = msg.revision;
   ++stats_.graphs;
   const GraphResult result = mapper_.apply_graph(keyframes);

@@ -88,7 +88,6 @@ class MapNode {
  private:
   std::optional<kestrel::octomap_t> maybe_publish(bool now);
   void insert_pending();
-  void restore(const JournalContents& journal);
   void write_journal(const kestrel::slam_graph_t& msg, const GraphResult& result);
 
   NodeOptions options_;

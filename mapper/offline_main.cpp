@@ -1,5 +1,6 @@
 // kestrel-map: builds the occupancy map offline from a TUM RGB-D folder and a trajectory
-// (ground truth, VO, SLAM: any TUM-format file of T_world_camera), writes it as .bt / .ot,
+// (ground truth, VO, SLAM: any TUM-format file of T_world_camera), or from a mapper's journal
+// (the keyframes of a flight, at the poses SLAM last gave them), writes it as .bt / .ot,
 // and optionally renders it (top view, perspective, slice), exports the registered keyframes
 // as a coloured PLY cloud, and compares it with another map. Same library as kestrel-mapper,
 // no LCM. Prints what it did and how long the insertion took per frame (thread CPU time).
@@ -9,6 +10,7 @@
 #include <algorithm>
 #include <ctime>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <string>
 #include <vector>
@@ -21,6 +23,7 @@
 #include "drivers/tum/tum_sequence.h"
 #include "mapper/cli_options.h"
 #include "mapper/export_ply.h"
+#include "mapper/keyframe_journal.h"
 #include "mapper/map_compare.h"
 #include "mapper/mapper.h"
 #include "mapper/octree_io.h"
@@ -32,7 +35,7 @@ namespace {
 using namespace kestrel;
 
 struct Options {
-  std::string tum, poses, anchor, out, png, view_png, slice_png, ply, compare;
+  std::string tum, poses, anchor, journal, out, png, view_png, slice_png, ply, compare;
   double slice_z_m = 1.0;
   double max_pose_gap_s = 0.05;
   double depth_scale = 1.0;
@@ -88,19 +91,15 @@ void mark_surface(const RgbdFrame& frame, const Eigen::Isometry3d& T_world_camer
   }
 }
 
-int run(Options& o) {
-  mapper::check_mapper_options(o.mapper);
-  mapper::format_of(o.out);  // a bad extension is an error before any work
+// The frames of a TUM folder at the poses of a trajectory, into `mapper` (or `surface`).
+void map_sequence(const Options& o, mapper::Mapper& mapper, mapper::VoxelMap& surface) {
   tum::SequenceOptions so;
   so.depth_scale_correction = o.depth_scale;
   const tum::TumSequence sequence(o.tum, so);
   Trajectory poses = read_tum_trajectory(o.poses);
   if (poses.empty()) throw InputError(o.poses + ": no poses");
   if (!o.anchor.empty()) poses = anchored(poses, read_tum_trajectory(o.anchor), o.anchor);
-  mapper::Mapper mapper(o.mapper);
   const int64_t max_gap = static_cast<int64_t>(o.max_pose_gap_s * 1e6);
-
-  mapper::VoxelMap surface(o.mapper.map);
   std::vector<double> ms;
   size_t without_pose = 0;
   for (size_t i = 0; i < sequence.size(); i += o.every) {
@@ -119,15 +118,41 @@ int run(Options& o) {
     ms.push_back(thread_cpu_ms() - t0);
   }
   if (ms.empty()) throw InputError(o.poses + ": no frame of " + o.tum + " has a pose within --max-pose-gap");
+  std::printf("frames inserted: %zu (%zu without a pose), keyframes kept: %zu\n", ms.size(), without_pose,
+              mapper.keyframes().size());
+  std::printf("insertion (decimate + scan + cells + update), CPU ms per frame: median %.3f, p95 %.3f\n",
+              percentile(ms, 0.5), percentile(ms, 0.95));
+}
+
+// The keyframes a mapper journalled, at their last poses (a damaged end is left out, and said).
+void map_journal(const Options& o, mapper::Mapper& mapper) {
+  if (!std::filesystem::exists(o.journal)) throw InputError(o.journal + ": no such file");
+  const mapper::JournalContents journal = mapper::read_journal(o.journal);
+  if (journal.records.empty()) throw InputError(o.journal + ": no keyframes in the journal");
+  if (!journal.damage.empty()) spdlog::warn("{}: read up to the damage: {}", o.journal, journal.damage);
+  const mapper::Restored restored = mapper::restore_journal(journal, mapper, o.journal);
+  std::printf("keyframes restored from the journal: %lld, kept: %zu\n", static_cast<long long>(restored.keyframes),
+              mapper.keyframes().size());
+}
+
+int run(Options& o) {
+  mapper::check_mapper_options(o.mapper);
+  mapper::format_of(o.out);  // a bad extension is an error before any work
+  if (o.journal.empty() == o.tum.empty()) throw CLI::ValidationError("--tum/--journal", "give --tum with --poses, or --journal");
+  if (!o.tum.empty() && o.poses.empty()) throw CLI::ValidationError("--poses", "--tum needs it");
+  if (!o.journal.empty() && o.surface_only) throw CLI::ValidationError("--surface-only", "needs --tum");
+  mapper::Mapper mapper(o.mapper);
+  mapper::VoxelMap surface(o.mapper.map);
+  if (o.journal.empty()) {
+    map_sequence(o, mapper, surface);
+  } else {
+    map_journal(o, mapper);
+  }
   const mapper::VoxelMap& map = o.surface_only ? surface : mapper.map();
   mapper::write_map_file(map, o.out);
 
   const double cell3 = map.resolution() * map.resolution() * map.resolution();
   const double volume = static_cast<double>(map.num_cells()) * cell3;
-  std::printf("frames inserted: %zu (%zu without a pose), keyframes kept: %zu\n", ms.size(), without_pose,
-              mapper.keyframes().size());
-  std::printf("insertion (decimate + scan + cells + update), CPU ms per frame: median %.3f, p95 %.3f\n",
-              percentile(ms, 0.5), percentile(ms, 0.95));
   std::printf("cells known: %zu (%.1f m^3), occupied: %zu; map memory %.2f MB (%.2f MB per 100 m^3)\n",
               map.num_cells(), volume, map.num_occupied(), map.memory_bytes() / 1e6,
               volume > 0 ? map.memory_bytes() / 1e6 * 100.0 / volume : 0.0);
@@ -160,10 +185,15 @@ int run(Options& o) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  cli::App app("map", "Build the occupancy map from a TUM RGB-D folder and a trajectory; write .bt/.ot, PNG renders, PLY");
+  cli::App app("map",
+               "Build the occupancy map from a TUM RGB-D folder and a trajectory, or from a mapper's journal; "
+               "write .bt/.ot, PNG renders, PLY");
   Options o;
-  app.add_option("--tum", o.tum, "TUM RGB-D sequence folder")->required();
-  app.add_option("--poses", o.poses, "Trajectory of the camera, TUM format (ground truth or any estimate)")->required();
+  app.add_option("--tum", o.tum, "TUM RGB-D sequence folder (with --poses)");
+  app.add_option("--poses", o.poses, "Trajectory of the camera, TUM format (ground truth or any estimate)");
+  app.add_option("--journal", o.journal,
+                 "Instead of --tum: a mapper's journal (kestrel mapper --journal; kestrel launch keeps it in "
+                 "<log-dir>/run-*/mapper.journal)");
   app.add_option("--anchor", o.anchor,
                  "Trajectory (e.g. ground truth) whose pose at --poses' first time places --poses in its world");
   app.add_option("--out", o.out, "Map file to write (.bt binary or .ot full)")->required();

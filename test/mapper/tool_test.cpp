@@ -1,6 +1,7 @@
 // kestrel-map and kestrel-mapper as built tools: the offline map of a small synthetic TUM
-// folder equals the library's (also with --discretize), renders and the PLY are written, and usage errors and bad
-// input give the documented exit codes.
+// folder equals the library's (also with --discretize), renders and the PLY are written, a
+// mapper's journal gives the map the mapper had, and usage errors and bad input give the
+// documented exit codes.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -8,6 +9,8 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "common/trajectory.h"
+#include "common/transport/convert.h"
+#include "mapper/keyframe_journal.h"
 #include "mapper/mapper.h"
 #include "mapper/octree_io.h"
 #include "test/mapper/scene.h"
@@ -103,6 +106,56 @@ TEST(MapTool, BuildsTheLibrarysMapAndRendersIt) {
   size_t hit_cells = 0;
   reference.map().for_each_cell([&](const Key& k, float) { hit_cells += truth.occupancy(k) == Occupancy::kOccupied; });
   EXPECT_EQ(hit_cells, truth.num_cells()) << "every surface cell was seen by the full map too";
+}
+
+// A flight's journal (kestrel mapper --journal) made into a map offline: the map the mapper
+// had, i.e. the keyframes' frames at the poses of the graph that brought them.
+TEST(MapTool, BuildsTheMapOfAMappersJournal) {
+  kestrel::test::TempDir tmp;
+  const auto frames = write_sequence(tmp / "seq");
+  Mapper live;
+  std::vector<GraphKeyframe> graph;
+  {
+    JournalWriter journal((tmp / "mapper.journal").string(), 0);
+    for (size_t i = 0; i < frames.size(); ++i) {
+      kestrel::slam_keyframe_t k{};
+      k.id = static_cast<int64_t>(i);
+      k.utime = frames[i].first.utime;
+      k.T_world_camera = transport::to_message(frames[i].second);
+      k.T_camera_depth = transport::to_message(Eigen::Isometry3d::Identity());
+      live.buffer_frame(frames[i].first);
+      graph.push_back(to_graph_keyframe(k, "test"));
+      journal.keyframe(k, decimate(frames[i].first, live.options().scan.stride));
+    }
+  }
+  live.apply_graph(graph);
+  const auto r = kestrel::test::run({kestrel::test::tool("map").string(), "--journal",
+                                     (tmp / "mapper.journal").string(), "--out", (tmp / "flight.ot").string(),
+                                     "--png", (tmp / "flight.png").string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("keyframes restored from the journal: 6"), std::string::npos) << r.out;
+  const VoxelMap map = read_map_file((tmp / "flight.ot").string());
+  ASSERT_EQ(map.num_cells(), live.map().num_cells());
+  live.map().for_each_cell([&](const Key& k, float v) { ASSERT_EQ(map.log_odds(k), v); });
+  EXPECT_FALSE(cv::imread((tmp / "flight.png").string()).empty());
+
+  // Not a journal: exit 3 naming it. Both inputs, or --surface-only with a journal: usage.
+  std::ofstream(tmp / "notes.txt") << "notes\n";
+  const std::string tool = kestrel::test::tool("map").string();
+  const auto bad = kestrel::test::run({tool, "--journal", (tmp / "notes.txt").string(), "--out", (tmp / "m.bt").string()});
+  EXPECT_EQ(bad.exit_code, 3);
+  EXPECT_NE(bad.err.find("notes.txt: not a kestrel mapper journal"), std::string::npos) << bad.err;
+  const auto missing = kestrel::test::run({tool, "--journal", (tmp / "none.journal").string(), "--out", (tmp / "m.bt").string()});
+  EXPECT_EQ(missing.exit_code, 3);
+  EXPECT_NE(missing.err.find("none.journal: no such file"), std::string::npos) << missing.err;
+  EXPECT_EQ(kestrel::test::run({tool, "--journal", (tmp / "mapper.journal").string(), "--tum", (tmp / "seq").string(),
+                                "--poses", (tmp / "seq/truth.txt").string(), "--out", (tmp / "m.bt").string()})
+                .exit_code,
+            2);
+  EXPECT_EQ(kestrel::test::run({tool, "--journal", (tmp / "mapper.journal").string(), "--surface-only", "--out",
+                                (tmp / "m.bt").string()})
+                .exit_code,
+            2);
 }
 
 TEST(MapTool, UsageErrorsAndBadInput) {
