@@ -46,9 +46,12 @@ void MapNode::write_journal(const kestrel::slam_graph_t& msg, const GraphResult&
     // changed nothing stored), then the new keyframes as the message gave them, so a restore
     // replays the same steps and ends with the same poses, bit for bit.
     if (result.moved > 0) {
-      kestrel::slam_graph_t poses = msg;
+      kestrel::slam_graph_t poses;  // the keyframes alone: a restore needs no edges
+      poses.utime = msg.utime;
+      poses.revision = msg.revision;
+      poses.num_keyframes = msg.num_keyframes;
+      poses.keyframes = msg.keyframes;
       poses.num_edges = 0;
-      poses.edges.clear();
       journal_->graph(poses);
     }
     for (const int64_t id : result.inserted) {

@@ -16,6 +16,17 @@ namespace {
 bool moved(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b, double metres, double degrees) {
   return se3::translation_distance(a, b) > metres || se3::rotation_distance(a, b) > degrees * kDegree;
 }
+// A keyframe of a SLAM graph as the store keeps it, with its decimated frame.
+StoredKeyframe stored(const GraphKeyframe& g, RgbdFrame decimated) {
+  StoredKeyframe kf;
+  kf.id = g.id;
+  kf.utime = g.utime;
+  kf.T_world_camera = g.T_world_camera;
+  kf.T_camera_depth = g.T_camera_depth;
+  kf.frame = std::move(decimated);
+  return kf;
+}
+
 }  // namespace
 
 void MapperOptions::validate() const {
@@ -144,13 +155,7 @@ size_t Mapper::move_stored(const std::vector<GraphKeyframe>& graph, std::vector<
 
 void Mapper::restore_keyframe(const GraphKeyframe& keyframe, RgbdFrame decimated) {
   decimated.validate("restored keyframe");
-  StoredKeyframe kf;
-  kf.id = keyframe.id;
-  kf.utime = keyframe.utime;
-  kf.T_world_camera = keyframe.T_world_camera;
-  kf.T_camera_depth = keyframe.T_camera_depth;
-  kf.frame = std::move(decimated);
-  keyframes_.add(std::move(kf));
+  keyframes_.add(stored(keyframe, std::move(decimated)));
   map_is_sequence_ = false;  // the map does not hold it until the rebuild
 }
 
@@ -177,12 +182,7 @@ GraphResult Mapper::apply_graph(const std::vector<GraphKeyframe>& graph) {
       ++result.missing;
       continue;
     }
-    StoredKeyframe kf;
-    kf.id = g.id;
-    kf.utime = g.utime;
-    kf.T_world_camera = g.T_world_camera;
-    kf.T_camera_depth = g.T_camera_depth;
-    kf.frame = *frame;
+    StoredKeyframe kf = stored(g, *frame);
     // A keyframe older than a stored one breaks the live map's time order (a rebuild would
     // insert it earlier), so the live map is no longer a checkpointable sequence.
     const auto order = keyframes_.in_time_order();

@@ -106,7 +106,10 @@ TEST(ProcessSets, TheShippedFileIsValidAndHasBothSides) {
 TEST(ProcessSets, RunDirIsPutIntoTheArgumentsThatNameIt) {
   ProcessSet set = {{"mapper", {"mapper", "--journal", "{run_dir}/m.journal", "--x={run_dir}:{run_dir}"}, "offboard"},
                     {"vo", {"vo", "--name", "run_dir"}, "onboard"}};
+  EXPECT_TRUE(names_run_dir(set));
+  EXPECT_FALSE(names_run_dir({set[1]}));  // no folder made for a set that never names it
   set = with_run_dir(set, "/tmp/r");
+  EXPECT_FALSE(names_run_dir(set));
   EXPECT_EQ(set[0].argv, (std::vector<std::string>{"mapper", "--journal", "/tmp/r/m.journal", "--x=/tmp/r:/tmp/r"}));
   EXPECT_EQ(set[1].argv, (std::vector<std::string>{"vo", "--name", "run_dir"}));
   // The shipped set journals the mapper's keyframes in the launch's own folder.

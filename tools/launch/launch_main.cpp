@@ -117,7 +117,7 @@ int launch(const Options& o) {
   // This launch's own folder (its start time and pid), so that a log folder given again does
   // not hand a new launch the journal of an earlier one.
   const fs::path run_dir = so.log_dir / fmt::format("run-{:%Y%m%dT%H%M%S}-{}", fmt::gmtime(std::time(nullptr)), ::getpid());
-  fs::create_directories(run_dir);
+  if (names_run_dir(set)) fs::create_directories(run_dir);
   set = with_run_dir(std::move(set), run_dir);
   Supervisor supervisor(set, executables, so);
   HealthBoard board;

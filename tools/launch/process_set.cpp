@@ -48,15 +48,27 @@ std::vector<std::string> split_command(const std::string& command) {
   return words;
 }
 
+namespace {
+const std::string kRunDirKey = "{run_dir}";
+}  // namespace
+
 ProcessSet with_run_dir(ProcessSet set, const std::filesystem::path& run_dir) {
-  static const std::string kKey = "{run_dir}";
   for (ProcessSpec& p : set) {
     for (std::string& arg : p.argv) {
-      for (size_t at = arg.find(kKey); at != std::string::npos; at = arg.find(kKey, at + run_dir.string().size()))
-        arg.replace(at, kKey.size(), run_dir.string());
+      for (size_t at = arg.find(kRunDirKey); at != std::string::npos;
+           at = arg.find(kRunDirKey, at + run_dir.string().size()))
+        arg.replace(at, kRunDirKey.size(), run_dir.string());
     }
   }
   return set;
+}
+
+bool names_run_dir(const ProcessSet& set) {
+  for (const ProcessSpec& p : set) {
+    for (const std::string& arg : p.argv)
+      if (arg.find(kRunDirKey) != std::string::npos) return true;
+  }
+  return false;
 }
 
 ProcessSet read_process_sets(const std::filesystem::path& file) {

@@ -37,6 +37,8 @@ std::vector<std::string> split_command(const std::string& command);
 /// files that must outlive a restarted process but not the launch (the mapper's journal: a
 /// restarted mapper gets its map back, a new launch starts a new map).
 ProcessSet with_run_dir(ProcessSet set, const std::filesystem::path& run_dir);
+/// Whether an argument of `set` names `{run_dir}` (the launch makes the folder only then).
+bool names_run_dir(const ProcessSet& set);
 
 /// Where argv[0] runs from: a path is used as given; a bare name `x` is `kestrel-x` in
 /// `tool_dir` if present there, else `x` itself looked up in `tool_dir` and then on PATH.
