@@ -6,8 +6,9 @@
 // slam_adapter.h). Before these, the restarted filter started with velocity zero and SLAM's
 // corrections pulled it about by up to 0.6 m for seconds. Then SLAM is killed the same way
 // while the estimator and the mapper run on: the new SLAM session's map lies in the same world
-// and the mapper keeps both sessions' keyframes (slam/slam_messages.h). Last, the mapper is
-// killed: it comes back with its map from its journal (mapper/keyframe_journal.h).
+// and the mapper keeps both sessions' keyframes (slam/slam_messages.h). Then the mapper is
+// killed: it comes back with its map from its journal (mapper/keyframe_journal.h). Last, the
+// VO is killed: the estimator and SLAM carry on across its silence.
 //
 // Live and timed: the simulator's recording is replayed at its own pace (lock-step replay
 // would stall on the dead process), so the figures vary a little from run to run; the bounds
@@ -22,6 +23,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <regex>
 #include <set>
 #include <string>
@@ -57,6 +59,16 @@ double rigid_fit_rms(const std::vector<Eigen::Vector3d>& from, const std::vector
   const Eigen::Matrix4d T = Eigen::umeyama(a, b, false);
   const Eigen::Matrix3Xd moved = (T.topLeftCorner<3, 3>() * a).colwise() + T.topRightCorner<3, 1>();
   return std::sqrt((moved - b).colwise().squaredNorm().mean());
+}
+
+// The true camera position at `utime`, linearly between the truth's samples around it.
+std::optional<Eigen::Vector3d> true_camera_position(const std::map<int64_t, Eigen::Isometry3d>& truth, int64_t utime,
+                                                    const Eigen::Isometry3d& T_body_camera) {
+  const auto hi = truth.lower_bound(utime);
+  if (hi == truth.end() || hi == truth.begin()) return std::nullopt;
+  const auto lo = std::prev(hi);
+  const double s = static_cast<double>(utime - lo->first) / static_cast<double>(hi->first - lo->first);
+  return (1.0 - s) * (lo->second * T_body_camera).translation() + s * (hi->second * T_body_camera).translation();
 }
 
 // Flies the room's figure-eight (16 s, replayed at its own pace) through `processes` under
@@ -192,13 +204,9 @@ TEST(System, ASlamKilledInFlightStartsANewSessionInTheSameWorldAndTheMapKeepsBot
   std::vector<Eigen::Vector3d> est, gt;
   for (const auto* g : {before, after}) {
     for (const auto& k : g->keyframes) {
-      const auto hi = truth.lower_bound(k.utime);
-      if (hi == truth.end() || hi == truth.begin()) continue;
-      const auto lo = std::prev(hi);
-      const double s = static_cast<double>(k.utime - lo->first) / static_cast<double>(hi->first - lo->first);
-      const Eigen::Vector3d a = (lo->second * T_body_camera).translation();
-      const Eigen::Vector3d b = (hi->second * T_body_camera).translation();
-      gt.push_back((1.0 - s) * a + s * b);
+      const auto p = true_camera_position(truth, k.utime, T_body_camera);
+      if (!p) continue;
+      gt.push_back(*p);
       est.push_back(transport::from_message(k.T_world_camera, "SLAM_GRAPH").translation());
     }
   }
@@ -261,6 +269,119 @@ TEST(System, AMapperKilledInFlightComesBackWithItsMapFromTheJournal) {
   // The first map of the restarted mapper is the map it had, published at once.
   EXPECT_GE(after.front().size, 0.9 * before.back().size);
   EXPECT_GE(after.back().size, after.front().size);
+}
+
+// The VO killed in flight: the estimator carries the state on the IMU alone (DEGRADED) until
+// the new VO's first motion, and SLAM bridges the new VO's chain to the old one by the
+// estimator's motion over the gap (slam_adapter.h), so the state and the graph stay in one
+// world. (On this figure-eight the loop closures after the restart would also pull an
+// unbridged segment back; the bridge count says which one did it.)
+TEST(System, AVoKilledInFlightLeavesTheStateAndTheGraphInOneWorld) {
+  if (!test::can_isolate_network()) GTEST_SKIP() << "no network namespace available";
+  if (!std::filesystem::exists("/usr/bin/lcm-logger")) GTEST_SKIP() << "lcm-logger is not installed";
+  test::TempDir dir;
+  ASSERT_NO_FATAL_FAILURE(fly_and_kill(dir, "vo,estimator,slam", "vo", "STATE|GROUND_TRUTH|SLAM_GRAPH|VO_UPDATE"));
+  const std::string slam = test::read_file(dir / "logs" / "slam.log");
+  EXPECT_NE(slam.find("1 VO restarts bridged by the estimator"), std::string::npos) << slam;
+
+  std::map<int64_t, Eigen::Isometry3d> truth;
+  struct State {
+    int64_t utime;
+    Eigen::Vector3d p;
+    int status;
+  };
+  std::vector<State> states;
+  std::vector<int64_t> vo_utimes;
+  kestrel::slam_graph_t last_graph;
+  Eigen::Isometry3d T_body_camera = Eigen::Isometry3d::Identity();
+  transport::LogReader log((dir / "live.lcmlog").string());
+  while (auto e = log.next()) {
+    const auto& data = e->data;
+    if (e->channel == channel::kGroundTruth) {
+      const auto m = transport::decode_message<kestrel::ground_truth_t>(data.data(), data.size(), "GROUND_TRUTH");
+      truth[m.utime] = transport::from_message(m.T_world_frame, "GROUND_TRUTH");
+    } else if (e->channel == channel::kState) {
+      const auto m = transport::decode_message<kestrel::state_t>(data.data(), data.size(), "STATE");
+      if (m.status == kestrel::state_t::STATUS_INITIALIZING) continue;
+      states.push_back({m.utime, transport::from_message(m.T_world_body, "STATE").translation(), m.status});
+    } else if (e->channel == channel::kSlamGraph) {
+      last_graph = transport::decode_message<kestrel::slam_graph_t>(data.data(), data.size(), "SLAM_GRAPH");
+    } else if (e->channel == channel::kVoUpdate) {
+      const auto m = transport::decode_message<kestrel::vo_update_t>(data.data(), data.size(), "VO_UPDATE");
+      T_body_camera = transport::from_message(m.T_body_camera, "VO_UPDATE");
+      vo_utimes.push_back(m.utime);
+    }
+  }
+  ASSERT_FALSE(truth.empty());
+  ASSERT_GT(vo_utimes.size(), 100u);
+  ASSERT_GT(states.size(), 1000u);
+  const int64_t t0 = truth.begin()->first;
+  const auto seconds = [&](int64_t utime) { return 1e-6 * static_cast<double>(utime - t0); };
+  // The kill: the longest silence on VO_UPDATE.
+  size_t gap = 1;
+  for (size_t i = 1; i < vo_utimes.size(); ++i)
+    if (vo_utimes[i] - vo_utimes[i - 1] > vo_utimes[gap] - vo_utimes[gap - 1]) gap = i;
+  const int64_t silent_from = vo_utimes[gap - 1], silent_to = vo_utimes[gap];
+  std::printf("VO silent from %.2f to %.2f s\n", seconds(silent_from), seconds(silent_to));
+  ASSERT_GT(seconds(silent_to) - seconds(silent_from), 1.0) << "the VO was killed and restarted";
+
+  // STATE went on through the silence, on the IMU alone, and came back to OK after it.
+  int degraded = 0, ok_after = 0;
+  double longest_state_gap = 0.0;
+  for (size_t i = 0; i < states.size(); ++i) {
+    if (i > 0) longest_state_gap = std::max(longest_state_gap, seconds(states[i].utime) - seconds(states[i - 1].utime));
+    degraded += states[i].utime > silent_from && states[i].utime < silent_to &&
+                states[i].status == kestrel::state_t::STATUS_DEGRADED;
+    ok_after += states[i].utime > silent_to + 1'000'000 && states[i].status == kestrel::state_t::STATUS_OK;
+  }
+  std::printf("STATE: longest silence %.3f s, %d DEGRADED while the VO was down, %d OK from 1 s after\n",
+              longest_state_gap, degraded, ok_after);
+  EXPECT_LT(longest_state_gap, 0.1);
+  EXPECT_GT(degraded, 50) << "predicting on the IMU alone is DEGRADED";
+  EXPECT_GT(ok_after, 1000);
+
+  // The states against the truth under one rigid fit: the IMU-only stretch drifts centimetres,
+  // and the new VO's motions carry on from where the filter is.
+  std::vector<Eigen::Vector3d> est, gt;
+  for (const State& s : states) {
+    const auto it = truth.find(s.utime);  // both at the IMU's times
+    if (it == truth.end()) continue;
+    est.push_back(s.p);
+    gt.push_back(it->second.translation());
+  }
+  ASSERT_GT(est.size(), 1000u);
+  Eigen::Matrix3Xd a(3, est.size()), b(3, gt.size());
+  for (size_t i = 0; i < est.size(); ++i) {
+    a.col(static_cast<Eigen::Index>(i)) = est[i];
+    b.col(static_cast<Eigen::Index>(i)) = gt[i];
+  }
+  const Eigen::Matrix4d fit = Eigen::umeyama(a, b, false);
+  const Eigen::Matrix3Xd errors = ((fit.topLeftCorner<3, 3>() * a).colwise() + fit.topRightCorner<3, 1>()) - b;
+  const double rms = std::sqrt(errors.colwise().squaredNorm().mean());
+  const double worst = errors.colwise().norm().maxCoeff();
+  std::printf("states under one rigid fit: RMS %.4f m, worst %.4f m over %zu states\n", rms, worst, est.size());
+  EXPECT_LT(rms, 0.02);
+  EXPECT_LT(worst, 0.08);
+
+  // SLAM's graph holds keyframes from both sides of the silence, in one world.
+  std::vector<Eigen::Vector3d> kest, kgt;
+  int before = 0, after = 0;
+  for (const auto& k : last_graph.keyframes) {
+    before += k.utime < silent_from;
+    after += k.utime > silent_to;
+    const auto p = true_camera_position(truth, k.utime, T_body_camera);
+    if (!p) continue;
+    kgt.push_back(*p);
+    kest.push_back(transport::from_message(k.T_world_camera, "SLAM_GRAPH").translation());
+  }
+  std::printf("SLAM's final graph: %d keyframes before the silence, %d after; %zu against the truth\n", before,
+              after, kest.size());
+  EXPECT_GE(before, 6);
+  EXPECT_GE(after, 6);
+  ASSERT_GE(kest.size(), static_cast<size_t>(before + after));
+  const double keyframe_rms = rigid_fit_rms(kest, kgt);
+  std::printf("keyframes under one rigid fit: RMS %.4f m\n", keyframe_rms);
+  EXPECT_LT(keyframe_rms, 0.03);
 }
 
 }  // namespace
