@@ -1,9 +1,11 @@
 // kestrel-goto: sends the vehicle somewhere. Asks the planner for a path from the vehicle's
 // current STATE to --goal (PLAN_REQUEST), prints the answer and, with --wait, follows STATE
 // until the vehicle is within --arrive-radius of the goal (kestrel-follow flies the PLAN).
-// A "no path" answer (no map yet, start or goal not in known free space, no way) is asked again
-// every second for --retry-for seconds: at start-up the map changes fast. Exit 0: planned (and arrived); 1: no path, or no answer / no arrival within
-// --timeout.
+// A "no path" answer (no map yet, start or goal not in known free space, no way) is asked
+// again every second for --retry-for seconds from the first answer: at start-up the map
+// changes fast. A request without an answer is sent again every --resend-after seconds (a
+// planner restarted since never saw it; a UDP datagram can be lost). Exit 0: planned (and
+// arrived); 1: no path, or no answer / no arrival within --timeout.
 #include <spdlog/spdlog.h>
 
 #include <chrono>
@@ -32,6 +34,7 @@ struct Options {
   double arrive_radius_m = 0.15;
   double timeout_s = 60.0;
   double retry_s = 5.0;
+  double resend_s = 2.0;
 };
 
 int run(const Options& o) {
@@ -45,19 +48,29 @@ int run(const Options& o) {
   std::optional<kestrel::plan_t> plan;
   bool sent = false;
   double sent_at = 0.0;
+  std::optional<double> first_answer_at;  // --retry-for counts from the planner's first answer
   node.subscribe<kestrel::state_t>(channel::kState, [&](const kestrel::state_t& m) {
     if (m.status == kestrel::state_t::STATUS_OK || m.status == kestrel::state_t::STATUS_DEGRADED) state = m;
   });
   node.subscribe<kestrel::plan_t>(channel::kPlan, [&](const kestrel::plan_t& m) {
-    if (m.request_id == request_id) plan = m;
+    if (m.request_id != request_id) return;
+    plan = m;
+    if (!first_answer_at) first_answer_at = elapsed();
   });
+  const auto no_path_yet = [&] {
+    return plan && plan->status != kestrel::plan_t::STATUS_OK && plan->status != kestrel::plan_t::STATUS_BAD_REQUEST &&
+           elapsed() - *first_answer_at < o.retry_s;
+  };
   while (elapsed() < o.timeout_s && node.spin_once(100)) {
     // No map yet, or no way on it yet: at start-up the map changes fast (the first keyframes,
     // SLAM moving it into the estimator's world), so ask again each second for --retry-for.
-    if (plan && plan->status != kestrel::plan_t::STATUS_OK && plan->status != kestrel::plan_t::STATUS_BAD_REQUEST &&
-        elapsed() - sent_at >= 1.0 && elapsed() < o.retry_s) {
+    if (no_path_yet() && elapsed() - sent_at >= 1.0) {
       spdlog::info("no path yet ({}); asking again", plan->message);
       plan.reset();
+      sent = false;
+    }
+    if (sent && !plan && elapsed() - sent_at >= o.resend_s) {
+      spdlog::info("no answer after {:.1f} s (is the planner running?); asking again", elapsed() - sent_at);
       sent = false;
     }
     if (!sent && state) {
@@ -79,9 +92,7 @@ int run(const Options& o) {
                    state->T_world_body.position[0], state->T_world_body.position[1],
                    state->T_world_body.position[2], o.goal[0], o.goal[1], o.goal[2]);
     }
-    const bool retrying = plan && plan->status != kestrel::plan_t::STATUS_OK &&
-                          plan->status != kestrel::plan_t::STATUS_BAD_REQUEST && elapsed() < o.retry_s;
-    if (retrying) continue;
+    if (no_path_yet()) continue;
     if (plan && (plan->status != kestrel::plan_t::STATUS_OK || !o.wait)) break;
     if (plan && state) {
       const auto& p = state->T_world_body.position;
@@ -131,7 +142,9 @@ int main(int argc, char** argv) {
   app.add_flag("--wait", o.wait, "Wait until the vehicle is at the goal");
   app.add_option("--arrive-radius", o.arrive_radius_m, "Arrived within this of the goal (m)")->check(cli::Positive)->capture_default_str();
   app.add_option("--timeout", o.timeout_s, "Give up after this many wall seconds")->check(cli::Positive)->capture_default_str();
-  app.add_option("--retry-for", o.retry_s, "Ask again each second while the answer is no path, for this many wall seconds")
+  app.add_option("--resend-after", o.resend_s, "Send the request again after this many wall seconds without an answer")
+      ->check(cli::Positive)->capture_default_str();
+  app.add_option("--retry-for", o.retry_s, "Ask again each second while the answer is no path, for this many wall seconds from the first answer")
       ->check(CLI::NonNegativeNumber)->capture_default_str();
   return app.run(argc, argv, [&] {
     for (double v : o.goal)

@@ -76,8 +76,8 @@ int serve(Options& o) {
                o.pose_source == "slam" ? "SLAM_GRAPH" : "GROUND_TRUTH", o.node.mapper.map.resolution_m);
   const int status = node->spin();
   const auto& s = map.stats();
-  spdlog::info("{} frames ({} inserted, {} without pose), {} graphs, {} rebuilds, {} maps published, {} rejected",
-               s.frames, s.frames_inserted, s.frames_without_pose, s.graphs, s.rebuilds, s.published,
+  spdlog::info("{} frames ({} inserted, {} without pose), {} graphs, {} rebuilds, {} maps published ({} sent again), {} rejected",
+               s.frames, s.frames_inserted, s.frames_without_pose, s.graphs, s.rebuilds, s.published, s.repeated,
                node->counters().messages_rejected);
   if (!o.save.empty()) {
     mapper::write_map_file(map.mapper().map(), o.save);

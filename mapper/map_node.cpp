@@ -76,6 +76,8 @@ void MapNode::reset() {
   last_published_utime_ = -1;
   revision_ = 0;
   last_graph_revision_ = -1;
+  last_map_.reset();
+  last_map_frame_utime_ = 0;
   pending_.clear();
   poses_ = Trajectory();
 }
@@ -92,6 +94,8 @@ kestrel::octomap_t MapNode::map_message() {
   msg.size = static_cast<int32_t>(msg.data.size());
   last_published_utime_ = map.utime();
   ++stats_.published;
+  last_map_ = msg;
+  last_map_frame_utime_ = last_frame_utime_;
   return msg;
 }
 
@@ -102,6 +106,14 @@ std::optional<kestrel::octomap_t> MapNode::maybe_publish(bool now) {
                    1e-6 * static_cast<double>(utime - last_published_utime_) >= options_.publish_period_s;
   if (!now && !due) return std::nullopt;
   return map_message();
+}
+
+std::optional<kestrel::octomap_t> MapNode::repeat_map(int64_t frame_utime) {
+  if (!last_map_ || 1e-6 * static_cast<double>(frame_utime - last_map_frame_utime_) < options_.publish_period_s)
+    return std::nullopt;
+  last_map_frame_utime_ = frame_utime;
+  ++stats_.repeated;
+  return last_map_;
 }
 
 std::optional<kestrel::octomap_t> MapNode::on_frame(const kestrel::rgbd_frame_t& msg, const char* channel) {
@@ -115,7 +127,7 @@ std::optional<kestrel::octomap_t> MapNode::on_frame(const kestrel::rgbd_frame_t&
   ++stats_.frames;
   if (options_.pose_source == PoseSource::kSlamGraph) {
     mapper_.buffer_frame(frame, channel);
-    return std::nullopt;
+    return repeat_map(frame.utime);
   }
   pending_.push_back(std::move(frame));
   while (static_cast<int>(pending_.size()) > options_.max_pending_frames) {

@@ -18,7 +18,9 @@
 // journal_error() says why and mapping goes on.
 //
 // MAP_OCTOMAP is produced at most once per publish_period_s of sensor time, and at once after
-// a rebuild. Everything is driven by the messages' utime, so a lock-step replay publishes the
+// a rebuild. In kSlamGraph mode the map changes only with SLAM's keyframes, and a hovering
+// vehicle makes none: the last map then goes out again (same revision) each publish_period_s
+// of frames, so a process started since (a restarted planner) is not left without one. Everything is driven by the messages' utime, so a lock-step replay publishes the
 // same maps at the same points every time. Bad messages throw InputError naming the channel
 // (the Node counts and drops them); a frame older than the previous one is one of those.
 
@@ -57,7 +59,8 @@ struct NodeStats {
   int64_t frames_without_pose = 0;
   int64_t graphs = 0;
   int64_t rebuilds = 0;
-  int64_t published = 0;
+  int64_t published = 0;          ///< maps made (repeats not counted)
+  int64_t repeated = 0;           ///< the last map sent again (kSlamGraph, no new map for a period)
   double last_rebuild_keyframes = 0;
   int64_t keyframes_restored = 0;  ///< from the journal at start
 };
@@ -87,6 +90,7 @@ class MapNode {
 
  private:
   std::optional<kestrel::octomap_t> maybe_publish(bool now);
+  std::optional<kestrel::octomap_t> repeat_map(int64_t frame_utime);
   void insert_pending();
   void write_journal(const kestrel::slam_graph_t& msg, const GraphResult& result);
 
@@ -97,6 +101,8 @@ class MapNode {
   int64_t last_published_utime_ = -1;
   int64_t revision_ = 0;
   int64_t last_graph_revision_ = -1;
+  std::optional<kestrel::octomap_t> last_map_;  // as last sent
+  int64_t last_map_frame_utime_ = 0;            // the newest frame when it was last sent
   std::deque<RgbdFrame> pending_;  // kGroundTruth: frames waiting for their pose
   Trajectory poses_;               // kGroundTruth: T_world_camera, recent
   std::unique_ptr<JournalWriter> journal_;

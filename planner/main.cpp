@@ -5,6 +5,8 @@
 #include <Eigen/Geometry>
 #include <chrono>
 #include <cmath>
+#include <optional>
+#include <utility>
 
 #include "common/cli.h"
 #include "common/error.h"
@@ -84,13 +86,18 @@ int main(int argc, char** argv) {
     transport::Node node("planner", lcm_url);
     node.advertise(channel::kPlan);
     node.set_health(kestrel::process_status_t::STATE_DEGRADED, "no map yet");
+    // The mapper sends its last map again while it has no new one (for a planner started since):
+    // the one held already is not projected again.
+    std::optional<std::pair<int64_t, int64_t>> held_map;  // revision, utime
     node.subscribe<kestrel::octomap_t>(channel::kMapOctomap, [&](const kestrel::octomap_t& m) {
+      if (held_map == std::pair{m.revision, m.utime}) return;
       if (m.size != static_cast<int32_t>(m.data.size())) throw InputError("MAP_OCTOMAP: size disagrees with data");
       const auto tree = mapper::read_octree(
           m.data.data(), m.data.size(),
           m.format == kestrel::octomap_t::FORMAT_BINARY ? mapper::OctreeFormat::kBinary : mapper::OctreeFormat::kFull,
           "MAP_OCTOMAP");
       planner.set_map(project_octomap(*tree, o.map_z_min_m, o.map_z_max_m, "MAP_OCTOMAP"));
+      held_map = std::pair{m.revision, m.utime};
       node.set_health(kestrel::process_status_t::STATE_RUNNING, "map revision " + std::to_string(m.revision));
     }, 2);
     node.subscribe<kestrel::state_t>(channel::kState, [&](const kestrel::state_t& s) {
@@ -136,7 +143,10 @@ int main(int argc, char** argv) {
       out.planning_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
       node.publish(channel::kPlan, out);
     });
-    node.on_reset([&] { planner.reset(); });
+    node.on_reset([&] {
+      planner.reset();
+      held_map.reset();
+    });
     return node.spin();
   });
 }

@@ -133,6 +133,39 @@ TEST(MapNode, SlamGraphInsertsKeyframesAndPublishesRebuildsAtOnce) {
   EXPECT_THROW(node.on_graph(graph, "SLAM_GRAPH"), InputError);
 }
 
+// A hovering vehicle makes no keyframes, so the map stops changing: the last map goes out
+// again each publish period of frames, unchanged (revision and bytes), so that a process
+// started since (a restarted planner) gets it; never before the first map, never after RESET.
+TEST(MapNode, WithoutNewKeyframesTheLastMapIsSentAgainEachPeriodOfFrames) {
+  const test::Scene scene = test::room_with_a_box();
+  NodeOptions options;
+  options.publish_period_s = 0.5;
+  MapNode node(options);
+  for (int64_t t = 100000; t <= 1000000; t += 100000)
+    EXPECT_FALSE(node.on_frame(frame_message(scene, t), "CAMERA_RGBD").has_value()) << "no map yet at " << t;
+  kestrel::slam_graph_t graph{};
+  graph.keyframes = {keyframe_message(0, 1000000)};
+  graph.num_keyframes = 1;
+  graph.revision = 1;
+  const auto first = node.on_graph(graph, "SLAM_GRAPH");
+  ASSERT_TRUE(first.has_value());
+  std::vector<int64_t> sent_at;
+  for (int64_t t = 1100000; t <= 2600000; t += 100000) {
+    if (const auto again = node.on_frame(frame_message(scene, t), "CAMERA_RGBD")) {
+      sent_at.push_back(t);
+      EXPECT_EQ(again->revision, first->revision);
+      EXPECT_EQ(again->utime, first->utime);
+      EXPECT_EQ(again->data, first->data);
+    }
+  }
+  EXPECT_EQ(sent_at, (std::vector<int64_t>{1500000, 2000000, 2500000})) << "0.5 s of frames after the last";
+  EXPECT_EQ(node.stats().published, 1);
+  EXPECT_EQ(node.stats().repeated, 3);
+  node.reset();
+  for (int64_t t = 100000; t <= 1000000; t += 100000)
+    EXPECT_FALSE(node.on_frame(frame_message(scene, t), "CAMERA_RGBD").has_value()) << "a map sent after RESET";
+}
+
 // A SLAM process restarted in flight publishes a graph of its own keyframes only, with ids
 // and revisions counted from its first keyframe's utime (slam/slam_messages.h): the map keeps
 // the first session's keyframes where they were and adds the new session's, without a rebuild.

@@ -7,8 +7,9 @@
 // corrections pulled it about by up to 0.6 m for seconds. Then SLAM is killed the same way
 // while the estimator and the mapper run on: the new SLAM session's map lies in the same world
 // and the mapper keeps both sessions' keyframes (slam/slam_messages.h). Then the mapper is
-// killed: it comes back with its map from its journal (mapper/keyframe_journal.h). Last, the
-// VO is killed: the estimator and SLAM carry on across its silence.
+// killed: it comes back with its map from its journal (mapper/keyframe_journal.h). Then the
+// VO is killed: the estimator and SLAM carry on across its silence. Last, the planner is killed
+// while the vehicle hovers, and a goal asked for meanwhile is still flown.
 //
 // Live and timed: the simulator's recording is replayed at its own pace (lock-step replay
 // would stall on the dead process), so the figures vary a little from run to run; the bounds
@@ -35,6 +36,7 @@
 #include "common/transport/message.h"
 #include "kestrel/ground_truth_t.hpp"
 #include "kestrel/octomap_t.hpp"
+#include "kestrel/plan_t.hpp"
 #include "kestrel/slam_graph_t.hpp"
 #include "kestrel/state_t.hpp"
 #include "kestrel/vo_update_t.hpp"
@@ -243,8 +245,8 @@ TEST(System, AMapperKilledInFlightComesBackWithItsMapFromTheJournal) {
       last_graph = transport::decode_message<kestrel::slam_graph_t>(data.data(), data.size(), "SLAM_GRAPH");
     } else if (e->channel == channel::kMapOctomap) {
       auto m = transport::decode_message<kestrel::octomap_t>(data.data(), data.size(), "MAP_OCTOMAP");
-      // A new process counts its revisions from 1 again.
-      if (!after.empty() || (!before.empty() && m.revision <= before.back().revision)) {
+      // A new process counts its revisions from 1 again (a map sent again keeps its revision).
+      if (!after.empty() || (!before.empty() && m.revision < before.back().revision)) {
         after.push_back(std::move(m));
       } else {
         before.push_back(std::move(m));
@@ -382,6 +384,65 @@ TEST(System, AVoKilledInFlightLeavesTheStateAndTheGraphInOneWorld) {
   const double keyframe_rms = rigid_fit_rms(kest, kgt);
   std::printf("keyframes under one rigid fit: RMS %.4f m\n", keyframe_rms);
   EXPECT_LT(keyframe_rms, 0.03);
+}
+
+// The planner killed while the vehicle hovers, and `kestrel goto` asking while it is down (the
+// closed-loop room of autonomy_test.cpp). The request nobody heard is sent again, and the new
+// planner gets the map although a hover makes no new keyframes: the mapper sends its last map
+// again each second of frames. Before, goto waited out its timeout for an answer, and the new
+// planner answered "no map yet" for as long as the vehicle stood still, which was for ever.
+TEST(System, APlannerKilledWhileTheVehicleHoversPlansAgainOnceRestarted) {
+  if (!test::can_isolate_network()) GTEST_SKIP() << "no network namespace available";
+  if (!std::filesystem::exists("/usr/bin/lcm-logger")) GTEST_SKIP() << "lcm-logger is not installed";
+  test::TempDir dir;
+  const auto bin = [](const char* name) { return test::quoted(test::tool(name).string()); };
+  const std::string out = test::quoted(dir.path().string());
+  const std::string planner = bin("planner") + " --height 1.3 --sensor kinect";
+  const std::string script =
+      "cd " + out + "; lcm-logger -q -c 'PLAN|MAP_OCTOMAP|GROUND_TRUTH' flight.lcmlog & L=$!; " +
+      bin("vo") + " -q & V=$!; " + bin("estimator") + " -q --init-position 8,3.5,1.3 & E=$!; " + bin("slam") +
+      " -q & S=$!; " + bin("mapper") + " --publish-period 1 > mapper.txt 2>&1 & M=$!; " + planner +
+      " > planner1.txt 2>&1 & P=$!; " + bin("follow") + " > follow.txt 2>&1 & F=$!; sleep 1; " + bin("sim") +
+      " -q --world room --flight vehicle --rate 0 --lockstep 5 --duration 30 > sim.txt 2>&1 & X=$!; "
+      "sleep 4; kill -KILL $P; " +
+      bin("goto") + " --goal 9.5 3.5 1.3 0 --wait --arrive-radius 0.1 --timeout 90 > goto.txt 2>&1 & G=$!; "
+      "sleep 3; " + planner + " > planner2.txt 2>&1 & Q=$!; "
+      "wait $X; SIM=$?; sleep 1; kill $G 2>/dev/null; wait $G; GOTO=$?; "
+      "kill -INT $V $E $S $M $Q $F $L; wait; echo \"$SIM $GOTO\" > status.txt";
+  const auto r = test::run_isolated(script, 300.0);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string go = test::read_file(dir / "goto.txt");
+  EXPECT_EQ(test::read_file(dir / "status.txt"), "0 0\n")
+      << "sim, goto exit codes; goto said:\n" << go << "\nplanner said:\n" << test::read_file(dir / "planner2.txt")
+      << "\nsim said:\n" << test::read_file(dir / "sim.txt");
+  EXPECT_NE(go.find("no answer after"), std::string::npos) << "the first request went to the dead planner\n" << go;
+  EXPECT_NE(go.find("arrived"), std::string::npos) << go;
+
+  int ok_plans = 0;
+  std::optional<Eigen::Vector3d> truth;
+  std::map<std::pair<int64_t, int64_t>, int> sent;  // MAP_OCTOMAP (revision, utime): times sent
+  transport::LogReader log((dir / "flight.lcmlog").string());
+  while (auto e = log.next()) {
+    const auto& data = e->data;
+    if (e->channel == channel::kPlan) {
+      ok_plans += transport::decode_message<kestrel::plan_t>(data.data(), data.size(), "PLAN").status ==
+                  kestrel::plan_t::STATUS_OK;
+    } else if (e->channel == channel::kMapOctomap) {
+      const auto m = transport::decode_message<kestrel::octomap_t>(data.data(), data.size(), "MAP_OCTOMAP");
+      ++sent[{m.revision, m.utime}];
+    } else if (e->channel == channel::kGroundTruth) {
+      const auto m = transport::decode_message<kestrel::ground_truth_t>(data.data(), data.size(), "GROUND_TRUTH");
+      truth = transport::from_message(m.T_world_frame, "GROUND_TRUTH").translation();
+    }
+  }
+  int repeats = 0;
+  for (const auto& [key, n] : sent) repeats += n - 1;
+  std::printf("%d plans, %zu maps, %d sent again; the vehicle ended at (%.3f, %.3f, %.3f)\n", ok_plans, sent.size(),
+              repeats, truth ? truth->x() : 0.0, truth ? truth->y() : 0.0, truth ? truth->z() : 0.0);
+  EXPECT_GE(ok_plans, 1);
+  EXPECT_GE(repeats, 1) << "the hover's map went out again\n" << test::read_file(dir / "mapper.txt");
+  ASSERT_TRUE(truth.has_value());
+  EXPECT_LT((*truth - Eigen::Vector3d(9.5, 3.5, 1.3)).norm(), 0.10) << "where the vehicle really ended";
 }
 
 }  // namespace
