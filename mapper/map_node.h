@@ -20,8 +20,9 @@
 // MAP_OCTOMAP is produced at most once per publish_period_s of sensor time, and at once after
 // a rebuild. In kSlamGraph mode the map changes only with SLAM's keyframes, and a hovering
 // vehicle makes none: the last map then goes out again (same revision) each publish_period_s
-// of frames, so a process started since (a restarted planner) is not left without one. Everything is driven by the messages' utime, so a lock-step replay publishes the
-// same maps at the same points every time. Bad messages throw InputError naming the channel
+// of frames, so a process started since (a restarted planner) is not left without one.
+// Everything is driven by the messages' utime, so a lock-step replay publishes the same maps
+// at the same points every time. Bad messages throw InputError naming the channel
 // (the Node counts and drops them); a frame older than the previous one is one of those.
 
 #include <cstdint>

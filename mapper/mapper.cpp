@@ -16,6 +16,7 @@ namespace {
 bool moved(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b, double metres, double degrees) {
   return se3::translation_distance(a, b) > metres || se3::rotation_distance(a, b) > degrees * kDegree;
 }
+
 // A keyframe of a SLAM graph as the store keeps it, with its decimated frame.
 StoredKeyframe stored(const GraphKeyframe& g, RgbdFrame decimated) {
   StoredKeyframe kf;
