@@ -9,7 +9,9 @@
 //   CRC-32 of kind, size and payload (u32, little-endian).
 // A keyframe's payload is the keyframe as SLAM_GRAPH gave it and the frame the mapper stored
 // (decimated; raw colour and zstd depth, so lossless), both LCM-encoded, the first with its
-// size (u32) in front. A graph's payload is the SLAM_GRAPH message (its keyframes' poses).
+// size (u32) in front. A graph's payload is a SLAM_GRAPH message holding only the stored
+// keyframes that graph moved (their new poses; no edges), so the journal grows with what moved,
+// not with the whole graph at each loop closure.
 // Records are written whole and flushed to the kernel at once, so a process killed at any
 // point leaves every earlier record intact.
 //

@@ -42,15 +42,19 @@ MapNode::MapNode(const NodeOptions& options)
 
 void MapNode::write_journal(const kestrel::slam_graph_t& msg, const GraphResult& result) {
   try {
-    // In apply_graph's order: the graph, if it moved stored keyframes (one that moved none
-    // changed nothing stored), then the new keyframes as the message gave them, so a restore
-    // replays the same steps and ends with the same poses, bit for bit.
-    if (result.moved > 0) {
-      kestrel::slam_graph_t poses;  // the keyframes alone: a restore needs no edges
+    // In apply_graph's order: the keyframes the graph moved, if any (the others kept their
+    // stored poses, and a restore moves a keyframe only where its pose differs by more than the
+    // thresholds, as apply_graph did), then the new keyframes as the message gave them, so a
+    // restore replays the same steps and ends with the same poses, bit for bit.
+    if (!result.moved.empty()) {
+      kestrel::slam_graph_t poses;  // no edges: a restore needs none
       poses.utime = msg.utime;
       poses.revision = msg.revision;
-      poses.num_keyframes = msg.num_keyframes;
-      poses.keyframes = msg.keyframes;
+      for (const kestrel::slam_keyframe_t& k : msg.keyframes) {
+        if (std::find(result.moved.begin(), result.moved.end(), k.id) != result.moved.end())
+          poses.keyframes.push_back(k);
+      }
+      poses.num_keyframes = static_cast<int32_t>(poses.keyframes.size());
       poses.num_edges = 0;
       journal_->graph(poses);
     }

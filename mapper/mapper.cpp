@@ -138,20 +138,21 @@ const RgbdFrame* Mapper::buffered(int64_t utime) const {
   return it != buffer_.end() && it->utime == utime ? &*it : nullptr;
 }
 
-size_t Mapper::move_stored(const std::vector<GraphKeyframe>& graph, std::vector<GraphKeyframe>* fresh) {
-  size_t count = 0;
+std::vector<int64_t> Mapper::move_stored(const std::vector<GraphKeyframe>& graph,
+                                         std::vector<GraphKeyframe>* fresh) {
+  std::vector<int64_t> moved_ids;
   for (const GraphKeyframe& g : graph) {
     if (const StoredKeyframe* kf = keyframes_.find(g.id)) {
       if (moved(kf->T_world_camera, g.T_world_camera, options_.rebuild_translation_m,
                 options_.rebuild_rotation_deg)) {
         keyframes_.set_pose(g.id, g.T_world_camera);
-        ++count;
+        moved_ids.push_back(g.id);
       }
     } else if (fresh != nullptr) {
       fresh->push_back(g);
     }
   }
-  return count;
+  return moved_ids;
 }
 
 void Mapper::restore_keyframe(const GraphKeyframe& keyframe, RgbdFrame decimated) {
@@ -161,7 +162,7 @@ void Mapper::restore_keyframe(const GraphKeyframe& keyframe, RgbdFrame decimated
 }
 
 size_t Mapper::restore_poses(const std::vector<GraphKeyframe>& keyframes) {
-  return move_stored(keyframes, nullptr);
+  return move_stored(keyframes, nullptr).size();
 }
 
 GraphResult Mapper::apply_graph(const std::vector<GraphKeyframe>& graph) {
@@ -172,7 +173,7 @@ GraphResult Mapper::apply_graph(const std::vector<GraphKeyframe>& graph) {
   result.moved = move_stored(graph, &fresh);
   std::sort(fresh.begin(), fresh.end(),
             [](const GraphKeyframe& a, const GraphKeyframe& b) { return a.utime < b.utime; });
-  if (result.moved > 0) rebuild_pending_ = true;
+  if (!result.moved.empty()) rebuild_pending_ = true;
   const bool may_rebuild =
       last_rebuild_utime_ < 0 ||
       1e-6 * static_cast<double>(newest - last_rebuild_utime_) >= options_.rebuild_interval_s;

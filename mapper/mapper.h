@@ -63,7 +63,7 @@ struct GraphKeyframe {
 
 struct GraphResult {
   std::vector<int64_t> inserted;  ///< ids of the new keyframes stored and put into the map
-  size_t moved = 0;      ///< stored keyframes that moved beyond the threshold
+  std::vector<int64_t> moved;  ///< ids of the stored keyframes that moved beyond the threshold
   size_t missing = 0;    ///< new keyframes whose frame was not (or no longer) buffered
   bool rebuilt = false;  ///< the map was rebuilt from the stored keyframes
   size_t rebuild_keyframes = 0;
@@ -120,8 +120,9 @@ class Mapper {
   };
   void integrate_keyframe(const StoredKeyframe& kf);
   // Moves the stored keyframes of `graph` that moved beyond the rebuild thresholds; the others
-  // go to `fresh` when given. Returns how many moved.
-  size_t move_stored(const std::vector<GraphKeyframe>& graph, std::vector<GraphKeyframe>* fresh);
+  // go to `fresh` when given. Returns the ids of those that moved.
+  std::vector<int64_t> move_stored(const std::vector<GraphKeyframe>& graph,
+                                   std::vector<GraphKeyframe>* fresh);
   void maybe_checkpoint();
   size_t rebuild_from(bool use_checkpoints);
 

@@ -58,7 +58,7 @@ TEST(Mapper, RebuildAfterLoopClosureEqualsTheMapAtTheCorrectedPoses) {
   ASSERT_GT(direct.map().num_occupied(), 100u);
   // The loop closes: SLAM moves every keyframe back to the truth.
   const GraphResult r = drifted.apply_graph(true_graph);
-  EXPECT_EQ(r.moved, truth.size() - 1);  // keyframe 0 did not drift
+  EXPECT_EQ(r.moved.size(), truth.size() - 1);  // keyframe 0 did not drift
   EXPECT_TRUE(r.rebuilt);
   EXPECT_EQ(r.rebuild_keyframes, truth.size());
   expect_same_maps(drifted.map(), direct.map());
@@ -120,7 +120,7 @@ TEST(Mapper, RebuildStartsFromTheLastCheckpointBeforeTheFirstMovedKeyframe) {
   for (size_t i = 9; i < corrected.size(); ++i) corrected[i].T_world_camera.translation().x() += 0.05;
   const GraphResult r = mapper.apply_graph(corrected);
   EXPECT_TRUE(r.rebuilt);
-  EXPECT_EQ(r.moved, 3u);
+  EXPECT_EQ(r.moved, (std::vector<int64_t>{9, 10, 11}));
   EXPECT_EQ(r.reinserted, 4u) << "keyframes 8 to 11 again, 0 to 7 from the checkpoint";
   EXPECT_EQ(mapper.checkpoints(), 3u) << "the stale third checkpoint is replaced";
   direct.apply_graph(corrected);
@@ -163,7 +163,7 @@ TEST(Mapper, RebuildsAreRateLimitedAndMissingFramesCounted) {
   EXPECT_TRUE(r.rebuilt);  // the first rebuild is always allowed
   graph[1].T_world_camera.translation().x() += 0.1;
   r = mapper.apply_graph(graph);
-  EXPECT_EQ(r.moved, 1u);
+  EXPECT_EQ(r.moved, std::vector<int64_t>{1});
   EXPECT_FALSE(r.rebuilt) << "a second rebuild within 1 s of sensor time waits";
   EXPECT_EQ(mapper.rebuilds(), 1u);
 }

@@ -6,6 +6,7 @@
 
 #include <sys/resource.h>
 
+#include <algorithm>
 #include <csignal>
 #include <filesystem>
 #include <fstream>
@@ -255,6 +256,15 @@ TEST(MapNode, ARestartedMapperRestoresItsKeyframesAndMapFromTheJournal) {
   before.on_graph(closed, "SLAM_GRAPH");
   ASSERT_EQ(before.stats().rebuilds, 1);
   ASSERT_EQ(before.mapper().keyframes().size(), 6u);
+  // The journal's graph record holds the keyframe that moved, and only it.
+  const JournalContents written = read_journal(options.journal_path);
+  const auto graph = std::find_if(written.records.begin(), written.records.end(), [](const JournalRecord& r) {
+    return r.kind == JournalRecord::Kind::kGraph;
+  });
+  ASSERT_NE(graph, written.records.end());
+  ASSERT_EQ(graph->graph.keyframes.size(), 1u);
+  EXPECT_EQ(graph->graph.keyframes[0].id, closed.keyframes[1].id);
+  EXPECT_EQ(graph->graph.num_edges, 0);
 
   MapNode after(options);
   EXPECT_EQ(after.stats().keyframes_restored, 6);
