@@ -75,6 +75,10 @@ void add_estimator_options(CLI::App& app, EstimatorOptions& o) {
                  "A first SLAM correction further than this (chi-square, 6 dof) moves the filter's "
                  "world onto SLAM's: a filter restarted while SLAM ran on (0 = never)")
       ->check(non_negative)->capture_default_str();
+  app.add_option("--await-world", o.await_world_s,
+                 "After the start, STATE is INITIALIZING until a SLAM correction sets the world or "
+                 "this long has passed, s (0 = usable at once; kestrel launch sets 1)")
+      ->check(CLI::Range(0.0, 60.0))->capture_default_str();
   app.add_option("--correction-sigma-position", o.correction_sigma_position,
                  "m, for a correction without covariance")->check(positive)->capture_default_str();
   app.add_option("--correction-sigma-rotation", o.correction_sigma_rotation,

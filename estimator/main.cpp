@@ -42,6 +42,9 @@ void report_health(transport::Node& node, const StateEstimator& estimator) {
     node.set_health(kestrel::process_status_t::STATE_STARTING,
                     visual ? "visual only (no gyro): waiting for the first VO update"
                            : "initialising: waiting for a still IMU (or --init-moving-after)");
+  } else if (out->status == Status::kInitializing) {
+    node.set_health(kestrel::process_status_t::STATE_STARTING,
+                    "awaiting SLAM's world (--await-world): STATE is INITIALIZING");
   } else if (out->status == Status::kDegraded) {
     node.set_health(kestrel::process_status_t::STATE_DEGRADED,
                     visual ? "visual only, no VO fused recently: predicting"

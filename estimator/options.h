@@ -107,6 +107,12 @@ struct EstimatorOptions {
   /// SLAM's (a turn about z and a shift) instead of fusing the correction; 0 = never. A filter
   /// that started with SLAM shares its world and is within a few units of chi^2.
   double world_align_chi2 = 1000.0;
+  /// After the start, states are published as INITIALIZING (a pose in this filter's own world,
+  /// not to be flown on) until a SLAM correction has been taken or this long (s, sensor time)
+  /// has passed since the first: a filter restarted in flight flies on the map's world from its
+  /// first usable state (kestrel-slam sends it for the next frame on seeing the new filter's
+  /// first state). 0 = publish usable states at once (no SLAM, or offline runs).
+  double await_world_s = 0.0;
   /// Used for a correction that carries no covariance (all zero): sigmas of [dp; dtheta].
   double correction_sigma_position = 0.05;  ///< m
   double correction_sigma_rotation = 0.02;  ///< rad

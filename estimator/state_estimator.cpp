@@ -10,6 +10,22 @@ void StateEstimator::reset() {
   imu_filter_.reset();
   visual_.reset();
   first_vo_utime_ = -1;
+  first_state_utime_ = -1;
+  world_taken_ = false;
+}
+
+void StateEstimator::note_first_state(const std::optional<EstimatorOutput>& state) {
+  if (state && first_state_utime_ < 0) first_state_utime_ = state->utime;
+}
+
+bool StateEstimator::awaits_world(int64_t utime) const {
+  return options_.await_world_s > 0.0 && !world_taken_ &&
+         (first_state_utime_ < 0 || 1e-6 * static_cast<double>(utime - first_state_utime_) < options_.await_world_s);
+}
+
+std::optional<EstimatorOutput> StateEstimator::awaited(std::optional<EstimatorOutput> state) const {
+  if (state && awaits_world(state->utime)) state->status = Status::kInitializing;
+  return state;
 }
 
 StepResult StateEstimator::add_imu(const ImuReading& r) {
@@ -27,7 +43,10 @@ StepResult StateEstimator::add_imu(const ImuReading& r) {
   }
   result.verdict = imu_filter_.add_imu(r.sample());
   if (result.verdict == Verdict::kAccepted) {
-    if (auto out = imu_filter_.output(); out && out->utime == r.utime) result.state = std::move(out);
+    if (auto out = imu_filter_.output(); out && out->utime == r.utime) {
+      note_first_state(out);
+      result.state = awaited(std::move(out));
+    }
   }
   return result;
 }
@@ -50,26 +69,30 @@ StepResult StateEstimator::add_vo(const VoUpdate& u) {
     case EstimatorMode::kVisualOnly:
       result.verdict = visual_.add_vo(u);
       if (auto out = visual_.output(); out && out->utime == u.utime &&
-          (result.verdict == Verdict::kAccepted || result.verdict == Verdict::kNoMeasurement))
-        result.state = std::move(out);
+          (result.verdict == Verdict::kAccepted || result.verdict == Verdict::kNoMeasurement)) {
+        note_first_state(out);
+        result.state = awaited(std::move(out));
+      }
       return result;
   }
   return result;
 }
 
 Verdict StateEstimator::add_correction(const PoseCorrection& c) {
+  Verdict verdict = Verdict::kNotInitialized;
   switch (mode_) {
-    case EstimatorMode::kImu: return imu_filter_.add_correction(c);
-    case EstimatorMode::kVisualOnly: return visual_.add_correction(c);
+    case EstimatorMode::kImu: verdict = imu_filter_.add_correction(c); break;
+    case EstimatorMode::kVisualOnly: verdict = visual_.add_correction(c); break;
     case EstimatorMode::kAuto: break;
   }
-  return Verdict::kNotInitialized;
+  if (verdict == Verdict::kAccepted) world_taken_ = true;
+  return verdict;
 }
 
 std::optional<EstimatorOutput> StateEstimator::output() const {
   switch (mode_) {
-    case EstimatorMode::kImu: return imu_filter_.output();
-    case EstimatorMode::kVisualOnly: return visual_.output();
+    case EstimatorMode::kImu: return awaited(imu_filter_.output());
+    case EstimatorMode::kVisualOnly: return awaited(visual_.output());
     case EstimatorMode::kAuto: break;
   }
   return std::nullopt;

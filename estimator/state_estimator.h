@@ -12,6 +12,9 @@
 //
 // States to publish: the IMU filter gives one after every IMU sample once initialised, the
 // visual-only estimator one after every VO update (a failed one included) once started.
+// With await_world_s, they are INITIALIZING from the first until a SLAM correction is taken
+// or await_world_s of sensor time has passed (options.h): a filter restarted while SLAM's map
+// lives on is in a world of its own until SLAM's correction moves it (estimator.h).
 
 #include <optional>
 
@@ -38,7 +41,8 @@ class StateEstimator {
 
   /// kAuto while undecided, else the estimator that runs.
   EstimatorMode mode() const { return mode_; }
-  /// The newest state; empty while undecided, initialising or settling.
+  /// The newest state; empty while undecided, initialising or settling; INITIALIZING while
+  /// it awaits SLAM's world.
   std::optional<EstimatorOutput> output() const;
   /// The IMU filter started on the move and waits for the VO (Estimator::settling()).
   bool settling() const { return mode_ == EstimatorMode::kImu && imu_filter_.settling(); }
@@ -51,7 +55,15 @@ class StateEstimator {
   EstimatorMode mode_;
   Estimator imu_filter_;
   VisualOnlyEstimator visual_;
+  // A state at utime awaits SLAM's world: no correction taken yet, and not yet await_world_s
+  // since the first state.
+  bool awaits_world(int64_t utime) const;
+  std::optional<EstimatorOutput> awaited(std::optional<EstimatorOutput> state) const;
+  void note_first_state(const std::optional<EstimatorOutput>& state);
+
   int64_t first_vo_utime_ = -1;  // while undecided (the first IMU reading decides at once)
+  int64_t first_state_utime_ = -1;  // of the first state given out
+  bool world_taken_ = false;        // a SLAM correction was taken since the start
   int64_t vo_before_decision_ = 0;
   int64_t incomplete_imu_ = 0;
 };

@@ -101,6 +101,9 @@ int main(int argc, char** argv) {
       node.set_health(kestrel::process_status_t::STATE_RUNNING, "map revision " + std::to_string(m.revision));
     }, 2);
     node.subscribe<kestrel::state_t>(channel::kState, [&](const kestrel::state_t& s) {
+      // An initialising (or awaiting SLAM's world: --await-world) or failed filter's pose is
+      // not where the vehicle is.
+      if (s.status != kestrel::state_t::STATUS_OK && s.status != kestrel::state_t::STATUS_DEGRADED) return;
       const auto [q, cov] = from_state(s);
       planner.set_state(q, cov);
     });

@@ -101,6 +101,7 @@ AdapterOutputs SlamAdapter::on_state(const kestrel::state_t& state) {
     // filter's states are no use for bridges, and the next keyframe sends that correction.
     states_.clear();
     restart_correction_due_ = anchored_;
+    restart_state_utime_ = state.utime;
     ++estimator_restarts_;
   }
   last_state_seq_ = state.seq;
@@ -217,6 +218,7 @@ AdapterOutputs SlamAdapter::process(const kestrel::rgbd_frame_t& message, const 
   if (!slam_.wants_keyframe(pose.T_odom_camera, link)) {
     remember(*last_pose_, false);
     try_anchor(out);
+    correct_new_estimator(message.utime, waiting, link, out);
     return out;
   }
   const RgbdFrame frame = transport::decode_rgbd(message, options_.camera_channel.c_str());
@@ -249,6 +251,19 @@ AdapterOutputs SlamAdapter::process(const kestrel::rgbd_frame_t& message, const 
     restart_correction_due_ = false;
   }
   return out;
+}
+
+void SlamAdapter::correct_new_estimator(int64_t utime, const ChainedPose& chained, OdometryLink link,
+                                        AdapterOutputs& out) {
+  // The new filter's history must hold the frame's time (it started before its first state).
+  if (!restart_correction_due_ || !anchored_ || utime < restart_state_utime_) return;
+  if (link != OdometryLink::kContinuous || !keyframe_pose_ || !last_pose_) return;
+  const std::optional<Matrix6d> odometry = chain_.relative_covariance(*keyframe_pose_, chained.pose);
+  if (!odometry) return;
+  out.correction = correction_message(
+      slam_, options_.correction_sigma_m, options_.correction_sigma_rad,
+      FrameSinceKeyframe{utime, last_pose_->T_odom_camera, last_pose_->T_body_camera, *odometry});
+  restart_correction_due_ = false;
 }
 
 }  // namespace kestrel::slam

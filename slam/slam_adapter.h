@@ -18,9 +18,12 @@
 // pose in its own world.
 //
 // Estimator restarts: a restarted estimator (its STATE seq starts again) begins a world of its
-// own; SLAM keeps the map's, drops the old filter's states, and sends a SLAM_CORRECTION for its
-// next keyframe, which the new filter takes as the map's world (estimator.h) without waiting
-// for a loop closure.
+// own; SLAM keeps the map's, drops the old filter's states, and sends a SLAM_CORRECTION for the
+// next frame it processes that is not older than the new filter's first state (the pose of
+// the newest keyframe composed with the odometry since, Slam::world_pose), which the new
+// filter takes as the map's world (estimator.h) without waiting for a loop closure, nor for a
+// keyframe, which a hovering vehicle never makes. Where the odometry since the keyframe has
+// no covariance (the VO restarted since), the correction waits for the next keyframe.
 //
 // VO restarts: when the visual odometry loses its reference (a blank wall, a fast turn) its
 // new segment is unrelated to the old one, and the heading turned in the gap would be lost for
@@ -124,6 +127,9 @@ class SlamAdapter {
   void remember(const FramePose& frame, bool keyframe);
   /// Anchors the graph at the newest remembered frame that STATE brackets; fills `out`.
   void try_anchor(AdapterOutputs& out);
+  /// The correction a new estimator waits for, at the frame just processed (not a keyframe;
+  /// last_pose_), when it may be sent there; fills `out`.
+  void correct_new_estimator(int64_t utime, const ChainedPose& chained, OdometryLink link, AdapterOutputs& out);
 
   AdapterOptions options_;
   Slam slam_;
@@ -148,6 +154,7 @@ class SlamAdapter {
   int bridges_ = 0;
   int64_t last_state_seq_ = -1;
   bool restart_correction_due_ = false;  ///< a new estimator waits for the map's world
+  int64_t restart_state_utime_ = 0;      ///< the new estimator's first state
   int estimator_restarts_ = 0;
   std::deque<FramePose> recent_;  ///< frames since the newest keyframe, until anchored
 };

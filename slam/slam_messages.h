@@ -3,8 +3,9 @@
 // vo_update_t -> VoMotion, and the library's graph -> slam_graph_t / slam_correction_t.
 //
 // Frames: SLAM_GRAPH carries T_world_camera of each keyframe; SLAM_CORRECTION carries
-// T_world_body = T_world_camera * T_body_camera^-1 of the newest keyframe, world being the
-// body frame at the first keyframe (odometry_chain.h).
+// T_world_body = T_world_camera * T_body_camera^-1 of the newest keyframe (or of a frame since
+// it, for a restarted estimator: slam_adapter.h), world being the body frame at the first
+// keyframe (odometry_chain.h).
 //
 // Published keyframe ids and graph revisions count from the session's first keyframe: its
 // utime (µs) plus the library's own index or revision. A SLAM process restarted in flight
@@ -12,6 +13,8 @@
 // revision, so the mapper keeps the old session's keyframes where they were and adds the new
 // ones (the library's indices restart at 0; a session has fewer keyframes and revisions than
 // microseconds).
+
+#include <optional>
 
 #include "kestrel/slam_correction_t.hpp"
 #include "kestrel/slam_graph_t.hpp"
@@ -36,11 +39,26 @@ kestrel::slam_graph_t graph_message(const Slam& slam);
 Matrix6d body_covariance(const Eigen::Isometry3d& T_world_body, const Eigen::Isometry3d& T_body_camera,
                          const Matrix6d& camera_covariance);
 
-/// The correction for the newest keyframe; the slam must have a keyframe. Its covariance is
-/// the optimiser's marginal of that keyframe (Slam::newest_covariance) carried to the body
-/// frame in pose_t's convention; when there is none, a diagonal one of the given standard
-/// deviations (metres, radians).
+/// A frame after the newest keyframe, for a correction at that frame: its pose in SLAM's
+/// odometry frame (the one the keyframes have), its camera mounting, and the covariance of the
+/// odometry's motion from the newest keyframe to it (right perturbation [rho; phi],
+/// OdometryChain::relative_covariance).
+struct FrameSinceKeyframe {
+  int64_t utime = 0;
+  Eigen::Isometry3d T_odom_camera = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d T_body_camera = Eigen::Isometry3d::Identity();
+  Matrix6d odometry_covariance = Matrix6d::Zero();
+};
+
+/// The correction for the newest keyframe, or, given `frame`, for that frame (Slam::world_pose:
+/// the keyframe's optimised pose composed with the odometry since); the slam must have a
+/// keyframe. keyframe_id names the newest keyframe either way. Its covariance is the
+/// optimiser's marginal of that keyframe (Slam::newest_covariance), carried along the odometry
+/// to the frame with the odometry's own covariance added, then to the body frame in pose_t's
+/// convention; when there is no marginal, a diagonal one of the given standard deviations
+/// (metres, radians) stands for the keyframe's.
 kestrel::slam_correction_t correction_message(const Slam& slam, double sigma_translation_m,
-                                              double sigma_rotation_rad);
+                                              double sigma_rotation_rad,
+                                              const std::optional<FrameSinceKeyframe>& frame = std::nullopt);
 
 }  // namespace kestrel::slam

@@ -493,5 +493,53 @@ TEST(StateEstimator, VoWithNoImuAtAllSelectsTheVisualOnlyEstimatorAfterASecond) 
   EXPECT_EQ(e.counters().vo_before_init, 31);
 }
 
+// --await-world: a filter (re)started beside SLAM publishes INITIALIZING states, not to be
+// flown on, until SLAM's correction has given it the map's world, or for await_world_s of
+// sensor time at most; then usable ones. Both estimators, through StateEstimator.
+TEST(StateEstimator, StatesAwaitSlamsWorldUntilACorrectionIsTakenOrTheTimeGiven) {
+  EstimatorOptions o;
+  o.await_world_s = 1.0;
+  PoseCorrection c;  // where the still vehicle is: the start's origin
+  c.covariance = Matrix6d::Identity() * 1e-4;
+  for (const bool corrected : {false, true}) {
+    SCOPED_TRACE(corrected ? "a correction at 0.3 s" : "no correction");
+    StateEstimator e(o);
+    int64_t first = -1, usable = -1;
+    for (int i = 0; i <= 600; ++i) {  // a still IMU, 3 s
+      const int64_t t = kT0 + i * 5000;
+      const StepResult step = e.add_imu(reading(t, true));
+      if (!step.state) continue;
+      if (first < 0) first = t;
+      EXPECT_EQ(e.output()->status, step.state->status) << t;
+      if (step.state->status == Status::kInitializing) {
+        EXPECT_LT(usable, 0) << "usable, then not at " << t;
+      } else if (usable < 0) {
+        usable = t;
+      }
+      if (corrected && t == first + 300000) {
+        c.utime = t - 20000;
+        ASSERT_EQ(e.add_correction(c), Verdict::kAccepted);
+      }
+    }
+    ASSERT_GE(first, 0);
+    EXPECT_EQ(usable - first, corrected ? 305000 : 1000000) << "the first usable state after the first";
+    e.reset();
+    int64_t restarted = -1;  // a reset (a lock-step replay starting again) awaits again
+    for (int i = 0; i <= 200 && restarted < 0; ++i)
+      if (const StepResult step = e.add_imu(reading(kT0 + 10'000'000 + i * 5000, true)); step.state)
+        restarted = step.state->status == Status::kInitializing;
+    EXPECT_EQ(restarted, 1);
+  }
+  // The visual-only estimator (no gyro) alike; 0 (the default) publishes usable states at once.
+  for (const double await : {1.0, 0.0}) {
+    o.await_world_s = await;
+    StateEstimator e(o);
+    e.add_imu(reading(kT0 - 10000, false));
+    const StepResult step = e.add_vo(still_update(1));
+    ASSERT_TRUE(step.state);
+    EXPECT_EQ(step.state->status == Status::kInitializing, await > 0.0);
+  }
+}
+
 }  // namespace
 }  // namespace kestrel::estimator
