@@ -98,7 +98,8 @@ AdapterOutputs SlamAdapter::on_state(const kestrel::state_t& state) {
   if (last_state_seq_ >= 0 && state.seq < last_state_seq_) {
     // A new estimator (its seq starts again): its world is its own until SLAM's first
     // correction moves it onto the map's (estimator.h), so the map's world stays, the old
-    // filter's states are no use for bridges, and the next keyframe sends that correction.
+    // filter's states are no use for bridges, and the next frame its history holds (not older
+    // than this state: it started before it) gets that correction.
     states_.clear();
     restart_correction_due_ = anchored_;
     restart_state_utime_ = state.utime;
@@ -246,16 +247,16 @@ AdapterOutputs SlamAdapter::process(const kestrel::rgbd_frame_t& message, const 
   try_anchor(out);
   // A correction is a pose in the estimator's world: none before the graph is anchored in it
   // (in SLAM's odometry frame it would pull the state by the frames' difference).
-  if ((step.optimisation || restart_correction_due_) && anchored_) {
+  const bool new_estimator_waits = restart_correction_due_ && message.utime >= restart_state_utime_;
+  if ((step.optimisation || new_estimator_waits) && anchored_) {
     out.correction = correction_message(slam_, options_.correction_sigma_m, options_.correction_sigma_rad);
-    restart_correction_due_ = false;
+    if (new_estimator_waits) restart_correction_due_ = false;
   }
   return out;
 }
 
 void SlamAdapter::correct_new_estimator(int64_t utime, const ChainedPose& chained, OdometryLink link,
                                         AdapterOutputs& out) {
-  // The new filter's history must hold the frame's time (it started before its first state).
   if (!restart_correction_due_ || !anchored_ || utime < restart_state_utime_) return;
   if (link != OdometryLink::kContinuous || !keyframe_pose_ || !last_pose_) return;
   const std::optional<Matrix6d> odometry = chain_.relative_covariance(*keyframe_pose_, chained.pose);
