@@ -468,7 +468,7 @@ TEST(System, AnEstimatorKilledWhileTheVehicleHoversTakesTheMapsWorldAtOnce) {
       estimator + " > estimator1.txt 2>&1 & E=$!; " + bin("slam") + " > slam.txt 2>&1 & S=$!; " + bin("mapper") +
       " -q --publish-period 1 & M=$!; " + bin("planner") + " -q --height 1.3 --sensor kinect & P=$!; " +
       bin("follow") + " -q & F=$!; sleep 1; " + bin("sim") +
-      " --world room --flight vehicle --rate 0 --lockstep 5 --duration 40 > sim.txt 2>&1 & X=$!; "
+      " --world room --flight vehicle --rate 0 --lockstep 5 --duration 60 > sim.txt 2>&1 & X=$!; "
       "sleep 3; " + go + "9.5 3.5 1.3 0 > goto1.txt 2>&1; G1=$?; sleep 2; kill -KILL $E; sleep 1; " + estimator +
       " > estimator2.txt 2>&1 & E=$!; sleep 4; " + go + "10 3 1.3 0 > goto2.txt 2>&1; G2=$?; "
       "wait $X; SIM=$?; kill -INT $V $E $S $M $P $F $L; wait; echo \"$SIM $G1 $G2\" > status.txt";
