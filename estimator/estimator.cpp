@@ -185,19 +185,24 @@ Verdict Estimator::add_correction(const PoseCorrection& c) {
       ++counters_.corrections_duplicate;
       return Verdict::kDuplicate;
     }
-    e.correction = c;  // a newer graph revision replaces the pose for the same time
+    // A newer graph revision replaces the pose for the same time, and is fused (even where
+    // the one it replaces aligned the world: that one's share is then counted twice).
+    e.correction = c;
     e.outcome = Outcome::kPending;
     replay_from(c.utime);
     return Verdict::kAccepted;
-  }
-  if (!correction_since_start_) {
-    correction_since_start_ = true;
-    if (align_world(c)) ++counters_.world_alignments;
   }
   Event e;
   e.utime = c.utime;
   e.kind = EventKind::kCorrection;
   e.correction = c;
+  if (!correction_since_start_) {
+    correction_since_start_ = true;
+    if (align_world(c)) {
+      ++counters_.world_alignments;
+      e.outcome = Outcome::kAligned;
+    }
+  }
   insert_event(e);
   replay_from(c.utime);
   return Verdict::kAccepted;
@@ -205,22 +210,36 @@ Verdict Estimator::add_correction(const PoseCorrection& c) {
 
 bool Estimator::align_world(const PoseCorrection& c) {
   if (!(options_.world_align_chi2 > 0.0)) return false;
-  // The state at the correction's time, to the IMU period (the correction, fused after the
-  // change of world, takes up the rest).
   size_t k = history_.size() - 1;
   while (k > 0 && history_[k].imu.utime > c.utime) --k;
   const FilterState& s = history_[k].state;
-  const AbsolutePoseMeasurement m(c.T_world_body, correction_noise(options_, c));
+  const Matrix6d noise = correction_noise(options_, c);
+  const AbsolutePoseMeasurement m(c.T_world_body, noise);
   if (innovation(m, s).mahalanobis2() <= options_.world_align_chi2) return false;
-  const Eigen::Isometry3d change = world_change(s.mean.nav.T_world_body(), c.T_world_body);
-  for (size_t i = 0; i < history_.size(); ++i) change_world(history_[i].state, change);
+  // The pose at the correction's time, between the IMU samples either side, is put on the
+  // correction's position and yaw exactly: the correction is not fused afterwards (kAligned).
+  Eigen::Isometry3d T = s.mean.nav.T_world_body();
+  if (k + 1 < history_.size() && history_[k].imu.utime < c.utime) {
+    const int64_t t0 = history_[k].imu.utime, t1 = history_[k + 1].imu.utime;
+    T = se3::interpolate(T, history_[k + 1].state.mean.nav.T_world_body(),
+                         static_cast<double>(c.utime - t0) / static_cast<double>(t1 - t0));
+  }
+  const Eigen::Isometry3d change = world_change(T, c.T_world_body);
+  // The change is as uncertain as SLAM's pose; the filter's own uncertainty in its old world
+  // stays in P too (a new filter's millimetres: conservative by that much).
+  const Eigen::Matrix4d sigma = world_change_covariance(c.T_world_body, noise);
+  for (size_t i = 0; i < history_.size(); ++i) {
+    change_world(history_[i].state, change);
+    widen_for_world_change(history_[i].state, sigma);
+  }
   return true;
 }
 
 EstimatorCounters Estimator::counters() const {
   EstimatorCounters c = counters_;
   for (const Event& e : events_) {
-    const bool applied = e.outcome == Outcome::kApplied || e.outcome == Outcome::kForced;
+    const bool applied = e.outcome == Outcome::kApplied || e.outcome == Outcome::kForced ||
+                         e.outcome == Outcome::kAligned;
     const bool gated = e.outcome == Outcome::kGated;
     if (e.kind == EventKind::kVo) {
       c.vo_forced += e.outcome == Outcome::kForced;

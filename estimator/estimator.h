@@ -117,7 +117,11 @@ class Estimator {
     Matrix6d anchor_covariance = Matrix6d::Zero();
   };
   enum class EventKind { kCorrection = 0, kVo = 1, kClone = 2 };  // order at equal utime
-  enum class Outcome { kPending, kApplied, kForced, kGated, kUnreferenced };
+  // kAligned: a correction that moved the filter onto SLAM's world (align_world). Its position
+  // and yaw are the change of world's, and its covariance went into P with it: fusing it as
+  // well would count it twice, so replays pass it by (its tilt, which gravity observes, goes
+  // unused).
+  enum class Outcome { kPending, kApplied, kForced, kGated, kUnreferenced, kAligned };
   struct Event {
     int64_t utime = 0;
     EventKind kind = EventKind::kVo;

@@ -56,6 +56,7 @@ void Estimator::apply(Event& e, FilterState& s) {
       return;
     }
     case EventKind::kCorrection: {
+      if (e.outcome == Outcome::kAligned) return;
       const AbsolutePoseMeasurement m(e.correction.T_world_body, correction_noise(options_, e.correction));
       const UpdateResult r = filter_->update(s, m, options_.correction_gate_chi2);
       e.outcome = r.applied ? Outcome::kApplied : Outcome::kGated;

@@ -108,7 +108,7 @@ void Estimator::retire(const Event& e) {
     if (e.outcome == Outcome::kGated) ++counters_.vo_gated;
     if (e.outcome == Outcome::kUnreferenced) ++counters_.vo_unreferenced;
   } else if (e.kind == EventKind::kCorrection) {
-    if (e.outcome == Outcome::kApplied) ++counters_.corrections_applied;
+    if (e.outcome == Outcome::kApplied || e.outcome == Outcome::kAligned) ++counters_.corrections_applied;
     if (e.outcome == Outcome::kGated) ++counters_.corrections_gated;
   }
 }

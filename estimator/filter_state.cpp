@@ -130,4 +130,41 @@ void change_world(FilterState& s, const Eigen::Isometry3d& change) {
   }
 }
 
+Eigen::Matrix4d world_change_covariance(const Eigen::Isometry3d& theirs, const Matrix6d& covariance) {
+  // (dp, dyaw) of `theirs`, then the change's (dt, dyaw): an error dyaw turns the world about
+  // `theirs`, not about the origin, so dt = dp - dyaw e_z x p.
+  Eigen::Matrix<double, 4, 6> A = Eigen::Matrix<double, 4, 6>::Zero();
+  A.topLeftCorner<3, 3>().setIdentity();
+  A.block<1, 3>(3, 3) = (theirs.linear().transpose() * Eigen::Vector3d::UnitZ()).transpose();
+  Eigen::Matrix4d B = Eigen::Matrix4d::Identity();
+  B.block<3, 1>(0, 3) = -Eigen::Vector3d::UnitZ().cross(theirs.translation());
+  return B * A * covariance * A.transpose() * B.transpose();
+}
+
+Eigen::Matrix<double, 6, 4> world_change_jacobian(const Eigen::Vector3d& p_world_body,
+                                                  const Eigen::Matrix3d& R_world_body) {
+  Eigen::Matrix<double, 6, 4> J = Eigen::Matrix<double, 6, 4>::Zero();
+  J.topLeftCorner<3, 3>().setIdentity();
+  J.block<3, 1>(0, 3) = Eigen::Vector3d::UnitZ().cross(p_world_body);
+  J.block<3, 1>(3, 3) = R_world_body.transpose() * Eigen::Vector3d::UnitZ();
+  return J;
+}
+
+void widen_for_world_change(FilterState& s, const Eigen::Matrix4d& sigma) {
+  const int n = s.mean.dim();
+  Eigen::Matrix<double, Eigen::Dynamic, 4, Eigen::ColMajor, kMaxDim, 4> J =
+      Eigen::MatrixXd::Zero(n, 4);
+  const NavState& nav = s.mean.nav;
+  const Eigen::Matrix<double, 6, 4> J_pose = world_change_jacobian(nav.p_world_body, nav.R_world_body);
+  J.middleRows<3>(idx::kP) = J_pose.topRows<3>();
+  J.middleRows<3>(idx::kTheta) = J_pose.bottomRows<3>();
+  J.block<3, 1>(idx::kV, 3) = Eigen::Vector3d::UnitZ().cross(nav.v_world_body);
+  for (int i = 0; i < s.mean.num_clones; ++i) {
+    const Clone& c = s.mean.clones[static_cast<size_t>(i)];
+    J.middleRows<6>(FilterMean::clone_offset(i)) = world_change_jacobian(c.p_world_body, c.R_world_body);
+  }
+  s.P.noalias() += J * sigma * J.transpose();
+  symmetrize(s.P);
+}
+
 }  // namespace kestrel::estimator

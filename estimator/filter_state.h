@@ -16,6 +16,7 @@
 #include <array>
 #include <cstdint>
 
+#include "common/geometry/se3.h"
 #include "estimator/nav_state.h"
 
 namespace kestrel::estimator {
@@ -95,6 +96,23 @@ void turn_world_block(Matrix& P, int block, const Eigen::Matrix3d& R_z) {
 /// attitudes of the mean, and the world blocks of P (position and velocity errors; rotation
 /// errors are in the body frame).
 void change_world(FilterState& s, const Eigen::Isometry3d& change);
+
+/// The uncertainty of a change of world taken onto `theirs` (world_change) when `theirs` is
+/// known to `covariance` ([dp (world); dtheta (body)]), over the change's (translation, yaw
+/// about the vertical): the pose changed onto `theirs` is then exactly as uncertain as
+/// `theirs` in position and yaw, and others more so with their distance from it.
+Eigen::Matrix4d world_change_covariance(const Eigen::Isometry3d& theirs, const Matrix6d& covariance);
+
+/// How a pose's error [dp (world); dtheta (body)] moves under a small error (dt, dyaw) of a
+/// change of world, at the pose after the change: dp = dt + dyaw e_z x p, dtheta = dyaw R^T e_z.
+Eigen::Matrix<double, 6, 4> world_change_jacobian(const Eigen::Vector3d& p_world_body,
+                                                  const Eigen::Matrix3d& R_world_body);
+
+/// Adds the uncertainty `sigma` of the change of world just made (change_world) to P: the
+/// position, velocity and attitude errors and every clone's move together with the world,
+/// so measurements between them (VO) are unaffected and absolute ones (SLAM) are weighed
+/// against the world's uncertainty rather than the old world's.
+void widen_for_world_change(FilterState& s, const Eigen::Matrix4d& sigma);
 
 /// Makes P exactly symmetric (rounding in the updates breaks it slowly).
 void symmetrize(Covariance& P);

@@ -250,22 +250,29 @@ Verdict VisualOnlyEstimator::add_correction(const PoseCorrection& c) {
   const Matrix6d Q = correction_noise(options_, c);
   Vector6d innovation = se3::boxminus(c.T_world_body, T);
   // A first correction a world away: SLAM's map outlived the estimator before this one (as
-  // in Estimator::align_world): move every kept frame and the velocity onto SLAM's world.
+  // in Estimator::align_world): move every kept frame and the velocity onto SLAM's world, as
+  // uncertain as SLAM's pose there. The correction is then used up, not fused as well.
   if (!correction_since_start_) {
     correction_since_start_ = true;
     if (options_.world_align_chi2 > 0.0 &&
         innovation.dot((P + Q).ldlt().solve(innovation)) > options_.world_align_chi2) {
       const Eigen::Isometry3d change = world_change(T, c.T_world_body);
+      const Eigen::Matrix4d sigma = world_change_covariance(c.T_world_body, Q);
       for (Frame& f : frames_) {
         f.T_world_body = change * f.T_world_body;
         turn_world_block(f.covariance, idx::kP, change.linear());
         turn_world_block(f.vo_noise, idx::kP, change.linear());
+        const Eigen::Matrix<double, 6, 4> J = world_change_jacobian(f.T_world_body.translation(), f.T_world_body.linear());
+        f.covariance += J * sigma * J.transpose();
+        symmetrize(f.covariance);
       }
       v_world_ = change.linear() * v_world_;
       turn_world_block(rate_covariance_, 0, change.linear());
+      const Eigen::Vector3d dv_dyaw = Eigen::Vector3d::UnitZ().cross(v_world_);
+      rate_covariance_.topLeftCorner<3, 3>() += sigma(3, 3) * dv_dyaw * dv_dyaw.transpose();
       counters_.world_alignments++;
-      pose_there();
-      innovation = se3::boxminus(c.T_world_body, T);
+      counters_.corrections_applied++;
+      return Verdict::kAccepted;
     }
   }
   if (options_.correction_gate_chi2 > 0.0 &&

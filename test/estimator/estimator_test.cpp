@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -474,6 +475,15 @@ TEST(Estimator, ARestartedFilterMovesOntoSlamsWorldAtItsFirstCorrection) {
   struct Outcome {
     EstimatorCounters counters;
     double position_error = 0.0, yaw_error = 0.0;  // at the end, against the truth in SLAM's world
+    // Just after the first correction arrived: the smallest position variance and the yaw
+    // variance reported, and the position error's squared Mahalanobis distance under them.
+    double position_variance = 0.0, yaw_variance = 0.0, position_nees = 0.0;
+    double end_position_nees = 0.0;  // at the end
+  };
+  const auto position_nees = [](const test::ScenarioStep& step, const Eigen::Isometry3d& slam_world) {
+    const Eigen::Vector3d error = step.output.nav.p_world_body - slam_world * step.truth.p_world_body;
+    const Eigen::Matrix3d P = step.output.covariance.block<3, 3>(idx::kP, idx::kP);
+    return error.dot(P.ldlt().solve(error));
   };
   const auto run = [&](FilterKind kind, const Eigen::Isometry3d& slam_world, double align_chi2) {
     EstimatorOptions options;
@@ -496,6 +506,18 @@ TEST(Estimator, ARestartedFilterMovesOntoSlamsWorldAtItsFirstCorrection) {
     });
     Outcome out;
     out.counters = e.counters();
+    const auto first = std::find_if(steps.begin(), steps.end(), [&](const test::ScenarioStep& step) {
+      return step.output.utime >= arrivals.begin()->first;
+    });
+    EXPECT_NE(first, steps.end());
+    if (first != steps.end()) {
+      const Matrix15d& P = first->output.covariance;
+      const Eigen::Vector3d up_body = first->output.nav.R_world_body.transpose() * Eigen::Vector3d::UnitZ();
+      out.position_variance = P.block<3, 3>(idx::kP, idx::kP).diagonal().minCoeff();
+      out.yaw_variance = up_body.dot(P.block<3, 3>(idx::kTheta, idx::kTheta) * up_body);
+      out.position_nees = position_nees(*first, slam_world);
+    }
+    out.end_position_nees = position_nees(steps.back(), slam_world);
     const Eigen::Isometry3d truth = slam_world * steps.back().truth.T_world_body();
     const Eigen::Isometry3d est = steps.back().output.nav.T_world_body();
     out.position_error = (est.translation() - truth.translation()).norm();
@@ -511,12 +533,23 @@ TEST(Estimator, ARestartedFilterMovesOntoSlamsWorldAtItsFirstCorrection) {
                 "%.4f rad, restarted without alignment %.3f m / %.4f rad\n",
                 restarted.position_error, restarted.yaw_error, shared.position_error, shared.yaw_error,
                 fused.position_error, fused.yaw_error);
+    std::printf("restarted, after its first correction: position sigma >= %.4f m, yaw sigma %.4f rad, "
+                "position NEES %.2f (at the end %.2f)\n",
+                std::sqrt(restarted.position_variance), std::sqrt(restarted.yaw_variance),
+                restarted.position_nees, restarted.end_position_nees);
     EXPECT_EQ(restarted.counters.world_alignments, 1);
     EXPECT_EQ(restarted.counters.corrections_applied, 2);
     // The new world is where SLAM put the vehicle: within the corrections' own error (2.4 cm,
     // 0.012 rad; correction_at) and a centimetre, where the shared world fuses them with its own.
     EXPECT_LT(restarted.position_error, 0.034);
     EXPECT_LT(restarted.yaw_error, 0.022);
+    // Its position and yaw in the new world are as uncertain as SLAM's pose (1 cm, 0.01 rad),
+    // not as its own start in the old one (1 mm, 1 mrad: InitOptions), and its error is
+    // within that (3 dof, 99.7 %: 14.2).
+    EXPECT_GT(restarted.position_variance, 0.9e-4);
+    EXPECT_GT(restarted.yaw_variance, 0.9e-4);
+    EXPECT_LT(restarted.position_nees, 14.2);
+    EXPECT_LT(restarted.end_position_nees, 14.2);
     EXPECT_EQ(shared.counters.world_alignments, 0);
     EXPECT_EQ(shared.counters.corrections_applied, 2);
     EXPECT_EQ(fused.counters.world_alignments, 0);

@@ -218,5 +218,46 @@ TEST(FilterState, ChangingTheWorldTurnsItsBlocksAndLeavesTheBodysAlone) {
   EXPECT_TRUE(found.isApprox(T, 1e-12));
 }
 
+// A change of world known only as well as the SLAM pose it was taken onto: that pose is then
+// exactly as uncertain as SLAM's in position and yaw, a pose 3 m from it more so by the yaw's
+// lever arm, the velocity turns with the yaw, and poses move together (their relative yaw
+// stays certain, so relative measurements such as VO are unaffected). By hand.
+TEST(FilterState, AnUncertainChangeOfWorldWidensEachPoseByItsDistanceFromTheOneTakenOnto) {
+  const Eigen::Isometry3d theirs =
+      se3::make(Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ()).toRotationMatrix(), Eigen::Vector3d(2.0, 1.0, 1.0));
+  Matrix6d sigma_theirs = Matrix6d::Zero();
+  sigma_theirs.diagonal() << 1e-4, 1e-4, 1e-4, 4e-4, 4e-4, 4e-4;
+  FilterState s;
+  s.mean.nav.p_world_body = theirs.translation();
+  s.mean.nav.R_world_body = theirs.linear();
+  s.mean.nav.v_world_body = Eigen::Vector3d(1.0, 0.0, 0.0);
+  s.mean.num_clones = 1;
+  s.mean.clones[0].utime = 1;
+  s.mean.clones[0].p_world_body = theirs.translation() + Eigen::Vector3d(3.0, 0.0, 0.0);
+  s.mean.clones[0].R_world_body = theirs.linear();
+  s.P = Covariance::Zero(s.mean.dim(), s.mean.dim());
+  widen_for_world_change(s, world_change_covariance(theirs, sigma_theirs));
+
+  const int c = FilterMean::clone_offset(0);
+  EXPECT_LT((s.P.block<3, 3>(idx::kP, idx::kP) - 1e-4 * Eigen::Matrix3d::Identity()).norm(), 1e-15);
+  EXPECT_NEAR(s.P(idx::kTheta + 2, idx::kTheta + 2), 4e-4, 1e-15) << "yaw (level: the body z)";
+  EXPECT_NEAR(s.P(idx::kTheta, idx::kTheta), 0.0, 1e-15) << "no tilt";
+  EXPECT_NEAR(s.P(c + 1, c + 1), 1e-4 + 4e-4 * 9.0, 1e-15) << "3 m from it along x: y gets the yaw's lever";
+  EXPECT_NEAR(s.P(c, c), 1e-4, 1e-15);
+  EXPECT_NEAR(s.P(idx::kV + 1, idx::kV + 1), 4e-4, 1e-15) << "1 m/s along x turns into y";
+  const double relative_yaw = s.P(idx::kTheta + 2, idx::kTheta + 2) + s.P(c + 5, c + 5) - 2.0 * s.P(idx::kTheta + 2, c + 5);
+  EXPECT_NEAR(relative_yaw, 0.0, 1e-15);
+
+  // The Jacobian against a small change of world made by hand, at a tilted pose.
+  const Eigen::Isometry3d pose = se3::make(
+      (Eigen::AngleAxisd(0.4, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(0.2, Eigen::Vector3d::UnitX())).toRotationMatrix(),
+      Eigen::Vector3d(-1.0, 4.0, 0.5));
+  const Eigen::Vector4d d(1e-6, -2e-6, 3e-6, 1e-6);
+  const Eigen::Isometry3d small =
+      se3::make(Eigen::AngleAxisd(d[3], Eigen::Vector3d::UnitZ()).toRotationMatrix(), d.head<3>());
+  const Vector6d moved = se3::boxminus(small * pose, pose);
+  EXPECT_LT((moved - world_change_jacobian(pose.translation(), pose.linear()) * d).norm(), 1e-11);
+}
+
 }  // namespace
 }  // namespace kestrel::estimator

@@ -298,9 +298,20 @@ TEST(VisualOnly, ARestartedEstimatorMovesOntoSlamsWorldAtItsFirstCorrection) {
     c.utime = frame_utime(40);
     c.T_world_body = slam_world * truth.pose(40);
     c.covariance = Matrix6d::Identity() * 1e-4;
+    const Matrix15d P_before = e.output()->covariance;
     EXPECT_EQ(e.add_correction(c), Verdict::kAccepted);
     EXPECT_EQ(e.counters().world_alignments, aligned ? 1 : 0);
     EXPECT_EQ(e.counters().corrections_applied, 1);
+    const Matrix15d P_after = e.output()->covariance;
+    const auto yaw_variance = [&](const Matrix15d& P) {
+      const Eigen::Vector3d up_body = e.output()->nav.R_world_body.transpose() * Eigen::Vector3d::UnitZ();
+      return up_body.dot(P.block<3, 3>(idx::kTheta, idx::kTheta) * up_body);
+    };
+    const double position_growth = P_after.block<3, 3>(idx::kP, idx::kP).trace() -
+                                   P_before.block<3, 3>(idx::kP, idx::kP).trace();
+    const double yaw_growth = yaw_variance(P_after) - yaw_variance(P_before);
+    std::printf("frame 59's variance grew by %.3g m^2 (position trace), %.3g rad^2 (yaw)\n",
+                position_growth, yaw_growth);
     const Eigen::Isometry3d expected = slam_world * truth.pose(59);
     const double error = (e.output()->nav.p_world_body - expected.translation()).norm();
     const Eigen::Vector3d v_error = e.output()->nav.v_world_body - slam_world.linear() * truth.velocity(59);
@@ -309,6 +320,10 @@ TEST(VisualOnly, ARestartedEstimatorMovesOntoSlamsWorldAtItsFirstCorrection) {
       // The noisy chain's own drift over the 19 frames since (up to 1.5 m/s) is a few cm.
       EXPECT_LT(error, 0.05);
       EXPECT_LT(v_error.norm(), 0.2) << "the velocity turned with the world";
+      // The newest frame is now as uncertain as SLAM's pose (1e-4 per axis) on top of what it
+      // was in the old world: at least the correction's position trace and yaw variance.
+      EXPECT_GT(position_growth, 3e-4 * 0.99);
+      EXPECT_GT(yaw_growth, 1e-4 * 0.99);
       // Later frames chain on in SLAM's world.
       for (int k = 60; k < 70; ++k) e.add_vo(vo.next(frame_utime(k), truth.pose(k)));
       EXPECT_LT((e.output()->nav.p_world_body - (slam_world * truth.pose(69)).translation()).norm(), 0.06);

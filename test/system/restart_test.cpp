@@ -18,6 +18,7 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Cholesky>
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
@@ -487,7 +488,13 @@ TEST(System, AnEstimatorKilledWhileTheVehicleHoversTakesTheMapsWorldAtOnce) {
   // STATE against the truth (the body's position, at the same utime): the new filter's
   // states from its first one on.
   std::map<int64_t, Eigen::Vector3d> truth;
-  std::vector<std::pair<int64_t, double>> errors;  // STATE utime, its distance from the truth
+  struct Error {
+    int64_t utime = 0;
+    double distance = 0.0;  // from the truth
+    double sigma = 0.0;     // the largest position standard deviation STATE reports
+    double nees = 0.0;      // the position error's squared Mahalanobis distance under it
+  };
+  std::vector<Error> errors;
   std::optional<Eigen::Vector3d> last_truth;
   transport::LogReader log((dir / "flight.lcmlog").string());
   while (auto e = log.next()) {
@@ -502,25 +509,35 @@ TEST(System, AnEstimatorKilledWhileTheVehicleHoversTakesTheMapsWorldAtOnce) {
       // The truth nearest in time, within a millisecond (both come at the IMU's 200 Hz).
       const auto t = truth.lower_bound(m.utime - 1000);
       if (t == truth.end() || std::abs(t->first - m.utime) > 1000) continue;
-      errors.emplace_back(m.utime, (transport::from_message(m.T_world_body, "STATE").translation() - t->second).norm());
+      const Eigen::Vector3d error = transport::from_message(m.T_world_body, "STATE").translation() - t->second;
+      ASSERT_EQ(m.cov_dim, 15);
+      Eigen::Matrix3d P;
+      for (int row = 0; row < 3; ++row)
+        for (int col = 0; col < 3; ++col)
+          P(row, col) = m.covariance[static_cast<size_t>(row)][static_cast<size_t>(col)];
+      errors.push_back({m.utime, error.norm(), std::sqrt(P.diagonal().maxCoeff()), error.dot(P.ldlt().solve(error))});
     }
   }
   ASSERT_GT(errors.size(), 100u);
   // The kill: the longest silence on STATE; the new filter's states follow it.
   size_t restart = 1;
   for (size_t i = 1; i < errors.size(); ++i)
-    if (errors[i].first - errors[i - 1].first > errors[restart].first - errors[restart - 1].first) restart = i;
-  ASSERT_GT(errors[restart].first - errors[restart - 1].first, 200'000) << "the estimator was killed";
+    if (errors[i].utime - errors[i - 1].utime > errors[restart].utime - errors[restart - 1].utime) restart = i;
+  ASSERT_GT(errors[restart].utime - errors[restart - 1].utime, 200'000) << "the estimator was killed";
   // When the new filter's states came into the map's world: the first after which every one
   // is within 10 cm of the truth.
   size_t aligned = errors.size();
-  while (aligned > restart && errors[aligned - 1].second < 0.10) --aligned;
-  ASSERT_LT(aligned, errors.size()) << "the new filter's last state is " << errors.back().second << " m off";
-  const double first_error = errors[restart].second;
-  const double delay = aligned == restart ? 0.0 : 1e-6 * static_cast<double>(errors[aligned].first - errors[restart].first);
-  std::printf("the new filter's first state %.3f m off, in the map's world %.3f s later (%zu states after)\n",
-              first_error, delay, errors.size() - aligned);
+  while (aligned > restart && errors[aligned - 1].distance < 0.10) --aligned;
+  ASSERT_LT(aligned, errors.size()) << "the new filter's last state is " << errors.back().distance << " m off";
+  const Error& first = errors[restart];
+  const double delay = aligned == restart ? 0.0 : 1e-6 * static_cast<double>(errors[aligned].utime - first.utime);
+  std::printf("the new filter's first state %.3f m off (sigma %.4f m, NEES %.2f), in the map's world %.3f s later "
+              "(%zu states after)\n",
+              first.distance, first.sigma, first.nees, delay, errors.size() - aligned);
   EXPECT_LT(delay, 0.5) << "a hover makes no keyframe: the world must not wait for one";
+  // It is as uncertain as SLAM's pose in the map's world, not as its own start in its old
+  // one (1 mm): its error lies within what it reports (3 dof, chi2 at 1e-3: 16.3).
+  EXPECT_LT(first.nees, 16.3) << first.distance << " m off, reporting sigma " << first.sigma << " m";
   ASSERT_TRUE(last_truth.has_value());
   std::printf("the vehicle ended at (%.3f, %.3f, %.3f)\n", last_truth->x(), last_truth->y(), last_truth->z());
   EXPECT_LT((*last_truth - Eigen::Vector3d(10.0, 3.0, 1.3)).norm(), 0.10) << "where the vehicle really ended";
