@@ -54,7 +54,7 @@ std::string wait_for_lcm_listener_sh(double timeout_s = 20.0);
 bool can_isolate_network();
 
 /// Runs `script` with sh in a private network namespace whose loopback carries multicast
-/// (kestrel-isolated, DESIGN.md), so the LCM traffic of the processes it starts stays there.
+/// (kestrel-isolated, tools/launch/README.md), so the LCM traffic of the processes it starts stays there.
 RunResult run_isolated(const std::string& script, double timeout_s = 120.0);
 
 /// `s` in single quotes for sh.
