@@ -39,11 +39,16 @@ set(_KESTREL_STD_HEADERS <algorithm> <cmath> <cstdint> <functional> <limits> <me
 set(_KESTREL_LIBRARY_PCH_DEPS Eigen3::Eigen opencv_core)
 set(_KESTREL_TOOL_PCH_DEPS Eigen3::Eigen opencv_core CLI11::CLI11 spdlog::spdlog)
 
-# kestrel_library(name SOURCES ... [DEPS ...]) — a component library; headers are included
-# from the repository root ("vo/feature_detector.h").
+# kestrel_library(name [ALGORITHM] SOURCES ... [DEPS ...]) — a component library; headers are
+# included from the repository root ("vo/feature_detector.h"). ALGORITHM marks a library that
+# knows nothing of LCM, files or clocks: the layering test (test/common/layering_test.cpp)
+# fails on any include of it into LCM, tools/, drivers/ or common/transport/, and on any
+# library's include of a component it does not link.
 function(kestrel_library name)
-  cmake_parse_arguments(ARG "" "" "SOURCES;DEPS" ${ARGN})
+  cmake_parse_arguments(ARG "ALGORITHM" "" "SOURCES;DEPS" ${ARGN})
   add_library(${name} STATIC ${ARG_SOURCES})
+  set_property(GLOBAL APPEND PROPERTY KESTREL_LIBRARIES ${name})
+  set_target_properties(${name} PROPERTIES KESTREL_ALGORITHM ${ARG_ALGORITHM})
   target_include_directories(${name} PUBLIC ${PROJECT_SOURCE_DIR})
   target_link_libraries(${name} PUBLIC ${ARG_DEPS} PRIVATE kestrel_options)
   set_target_properties(${name} PROPERTIES POSITION_INDEPENDENT_CODE ON)
@@ -63,6 +68,53 @@ function(kestrel_tool name)
             <chrono> <filesystem> <fstream> <iostream> ${_KESTREL_STD_HEADERS})
   _kestrel_use_pch(kestrel-${name} kestrel_tool_pch "${_KESTREL_TOOL_PCH_DEPS}")
   set_property(GLOBAL APPEND PROPERTY KESTREL_TOOLS kestrel-${name})
+endfunction()
+
+# kestrel_write_layering_manifest(FILE): what the layering test checks, as JSON — every
+# library's folder, sources, the kestrel libraries it links and whether it is an ALGORITHM
+# library, and every tool's sources (so that a header beside a main belongs to the tool).
+# Called once, after every folder is added.
+function(kestrel_write_layering_manifest file)
+  get_property(libraries GLOBAL PROPERTY KESTREL_LIBRARIES)
+  get_property(tools GLOBAL PROPERTY KESTREL_TOOLS)
+  set(entries "")
+  foreach(target IN LISTS libraries tools)
+    get_target_property(dir ${target} SOURCE_DIR)
+    file(RELATIVE_PATH dir ${PROJECT_SOURCE_DIR} ${dir})
+    get_target_property(sources ${target} SOURCES)
+    set(source_list "")
+    foreach(source IN LISTS sources)
+      cmake_path(ABSOLUTE_PATH source BASE_DIRECTORY ${PROJECT_SOURCE_DIR}/${dir} NORMALIZE)
+      cmake_path(IS_PREFIX PROJECT_SOURCE_DIR "${source}" NORMALIZE in_tree)
+      if(in_tree)  # generated sources (the sim's built-in worlds) are not checked
+        file(RELATIVE_PATH source ${PROJECT_SOURCE_DIR} ${source})
+        list(APPEND source_list "\"${source}\"")
+      endif()
+    endforeach()
+    get_target_property(links ${target} LINK_LIBRARIES)
+    set(link_list "")
+    foreach(link IN LISTS links)
+      string(REGEX REPLACE "^\\$<LINK_ONLY:(.*)>$" "\\1" link "${link}")
+      if(link MATCHES "^kestrel_")
+        list(APPEND link_list "\"${link}\"")
+      endif()
+    endforeach()
+    list(JOIN source_list ", " source_json)
+    list(JOIN link_list ", " link_json)
+    set(kind library)
+    if(target IN_LIST tools)
+      set(kind tool)
+    endif()
+    get_target_property(algorithm ${target} KESTREL_ALGORITHM)
+    if(algorithm)
+      set(algorithm true)
+    else()
+      set(algorithm false)
+    endif()
+    list(APPEND entries "  {\"name\": \"${target}\", \"kind\": \"${kind}\", \"dir\": \"${dir}\", \"algorithm\": ${algorithm},\n   \"sources\": [${source_json}],\n   \"links\": [${link_json}]}")
+  endforeach()
+  list(JOIN entries ",\n" body)
+  file(WRITE ${file} "[\n${body}\n]\n")
 endfunction()
 
 function(_kestrel_test_definitions target)

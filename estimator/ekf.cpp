@@ -93,7 +93,7 @@ UpdateResult Ekf::update(FilterState& s, const Measurement& m, double gate_chi2)
 }
 
 std::unique_ptr<Filter> make_filter(FilterKind kind, const ImuNoise& noise, double gravity,
-                                    const UnscentedParams& params) {
+                                    const gaussian::UnscentedParams& params) {
   if (kind == FilterKind::kUkf) return std::make_unique<Ukf>(noise, gravity, params);
   return std::make_unique<Ekf>(noise, gravity);
 }

@@ -10,7 +10,7 @@
 #include "estimator/imu.h"
 #include "estimator/measurements.h"
 #include "estimator/propagation.h"
-#include "estimator/unscented.h"
+#include "common/gaussian/unscented.h"
 
 namespace kestrel::estimator {
 
@@ -47,7 +47,7 @@ class Ekf final : public Filter {
 
 class Ukf final : public Filter {
  public:
-  Ukf(const ImuNoise& noise, double gravity, const UnscentedParams& params)
+  Ukf(const ImuNoise& noise, double gravity, const gaussian::UnscentedParams& params)
       : noise_(noise), gravity_(gravity), params_(params) {}
   FilterKind kind() const override { return FilterKind::kUkf; }
   void predict(FilterState& s, const ImuInterval& u) const override;
@@ -56,11 +56,11 @@ class Ukf final : public Filter {
  private:
   ImuNoise noise_;
   double gravity_;
-  UnscentedParams params_;
+  gaussian::UnscentedParams params_;
 };
 
 std::unique_ptr<Filter> make_filter(FilterKind kind, const ImuNoise& noise, double gravity,
-                                    const UnscentedParams& params);
+                                    const gaussian::UnscentedParams& params);
 
 /// P <- Phi P Phi^T for a state whose first 15 entries are the navigation error (clones
 /// after them do not move): Phi's block structure makes this O(n) 3x3 products, not O(n^3).

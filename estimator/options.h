@@ -6,7 +6,7 @@
 
 #include "estimator/filter.h"
 #include "estimator/imu.h"
-#include "estimator/unscented.h"
+#include "common/gaussian/unscented.h"
 
 namespace kestrel::estimator {
 
@@ -87,7 +87,7 @@ struct EstimatorOptions {
   EstimatorMode mode = EstimatorMode::kAuto;
   VisualOnlyOptions visual_only;
   FilterKind filter = FilterKind::kEkf;
-  UnscentedParams unscented;
+  gaussian::UnscentedParams unscented;
   ImuNoise imu;
   double gravity = kStandardGravity;  ///< m/s^2
   VoNoiseOptions vo_noise;

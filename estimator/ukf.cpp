@@ -33,7 +33,7 @@ Covariance square_root(Covariance& P) {
   }
 }
 
-SigmaMatrix offsets(Covariance& P, const UnscentedWeights& w) {
+SigmaMatrix offsets(Covariance& P, const gaussian::UnscentedWeights& w) {
   const Covariance L = square_root(P);
   const int n = static_cast<int>(P.rows());
   SigmaMatrix X(n, 2 * n + 1);
@@ -43,15 +43,15 @@ SigmaMatrix offsets(Covariance& P, const UnscentedWeights& w) {
   return X;
 }
 
-double weight_mean(const UnscentedWeights& w, int i) { return i == 0 ? w.mean0 : w.other; }
-double weight_cov(const UnscentedWeights& w, int i) { return i == 0 ? w.cov0 : w.other; }
+double weight_mean(const gaussian::UnscentedWeights& w, int i) { return i == 0 ? w.mean0 : w.other; }
+double weight_cov(const gaussian::UnscentedWeights& w, int i) { return i == 0 ? w.cov0 : w.other; }
 
 }  // namespace
 
 void Ukf::predict(FilterState& s, const ImuInterval& u) const {
   const int n = s.mean.dim();
   const int count = 2 * n + 1;
-  const UnscentedWeights w = unscented_weights(n, params_);
+  const gaussian::UnscentedWeights w = gaussian::unscented_weights(n, params_);
   const SigmaMatrix X = offsets(s.P, w);
 
   // The centre is propagated with its Jacobians only for the additive process noise.
@@ -84,7 +84,7 @@ void Ukf::predict(FilterState& s, const ImuInterval& u) const {
 UpdateResult Ukf::update(FilterState& s, const Measurement& m, double gate_chi2) const {
   const int n = s.mean.dim();
   const int count = 2 * n + 1;
-  const UnscentedWeights w = unscented_weights(n, params_);
+  const gaussian::UnscentedWeights w = gaussian::unscented_weights(n, params_);
   UpdateResult result;
   SigmaMatrix X;
   try {

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <map>
 
-#include "estimator/information.h"
+#include "common/gaussian/information.h"
 
 namespace kestrel::planner {
 
@@ -25,7 +25,7 @@ std::vector<BeliefStep> BeliefModel::steps(const Config& a, const Config& b) con
     q << position(a) + d * f, wrap_angle(a[3] + f * turn);
     BeliefStep s;
     s.G = Mat4::Identity();
-    s.R = estimator::process_noise_diagonal(Mat4::Identity(), variances);
+    s.R = gaussian::process_noise_diagonal(Mat4::Identity(), variances);
     s.M = information_(q);
     out.push_back(s);
   }

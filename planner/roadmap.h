@@ -7,7 +7,7 @@
 // plan: the position moves linearly and the yaw turns from one node's yaw to the other's the
 // shortest way round, so a node's sampled yaw is where its sensor looks. The line is cut
 // into steps of at most `step_m` and `step_rad`; each step adds process noise
-// R = V W V^T with W proportional to the distance flown (estimator/information.h), G = I for
+// R = V W V^T with W proportional to the distance flown (common/gaussian/information.h), G = I for
 // the holonomic model, and gathers the sensor's information at the step's end.
 
 #include <functional>

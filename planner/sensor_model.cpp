@@ -6,7 +6,7 @@
 #include <stdexcept>
 
 #include "common/numbers.h"
-#include "estimator/information.h"
+#include "common/gaussian/information.h"
 
 namespace kestrel::planner {
 namespace {
@@ -16,14 +16,14 @@ namespace {
 constexpr double kFovMargin_rad = 1e-9;
 constexpr double kFastFovLimit_rad = 1e-3;
 
-// estimator::measurement_information(H, diag(variances)), H^T Q^-1 H, for a diagonal Q in the
+// gaussian::measurement_information(H, diag(variances)), H^T Q^-1 H, for a diagonal Q in the
 // arithmetic Eigen's LLT solve and product perform there (Q's factor is diag(sqrt(v)), each
 // triangular solve multiplies by its reciprocal, the product sums k = 0, 1, 2 in order): the
 // same values (test InformationTermEqualsTheEstimators) without a 3 x 3 factorisation and a
 // general matrix product per feature. A Q the estimator would reject goes to it (and throws).
 Mat4 diagonal_information(const Eigen::Matrix<double, 3, 4>& H, const Eigen::Vector3d& variances) {
   if (!(variances.array() > 0.0).all() || !variances.allFinite())
-    return estimator::measurement_information(H, Eigen::Matrix3d(variances.asDiagonal()));
+    return gaussian::measurement_information(H, Eigen::Matrix3d(variances.asDiagonal()));
   Eigen::Matrix<double, 3, 4> X;
   for (int k = 0; k < 3; ++k) {
     const double inv = 1.0 / std::sqrt(variances[k]);
@@ -267,14 +267,14 @@ Mat4 FeatureSensor::ukf_information(const Config& q, const Mat4& prior) const {
   // covariance weights). Q is diagonal, so with G = D^T Q^-1 D (9 x 9) the push-through
   // identity gives D^T S^-1 D = (I + G W)^-1 G, hence K S K^T = X W (I + G W)^-1 G W X^T:
   // linear in the number of measurements instead of cubic, and the same value as
-  // estimator::ukf_measurement_information (test UkfInformationEqualsTheGenericUkf).
+  // gaussian::ukf_measurement_information (test UkfInformationEqualsTheGenericUkf).
   const std::vector<int> seen = visible(q);
   if (seen.empty()) return Mat4::Zero();
   const auto prior_llt = prior.llt();
   if (prior_llt.info() != Eigen::Success || !prior.allFinite())
     throw std::invalid_argument("ukf_information: prior covariance is not positive definite");
-  const estimator::UnscentedWeights w = estimator::unscented_weights(4, {});
-  const Eigen::Matrix<double, 4, Eigen::Dynamic> X = estimator::sigma_offsets(prior, w);
+  const gaussian::UnscentedWeights w = gaussian::unscented_weights(4, {});
+  const Eigen::Matrix<double, 4, Eigen::Dynamic> X = gaussian::sigma_offsets(prior, w);
   constexpr int kPoints = 9;
   Eigen::Matrix<double, kPoints, 1> wc;
   wc.setConstant(w.other);
@@ -305,7 +305,7 @@ Mat4 FeatureSensor::ukf_information(const Config& q, const Mat4& prior) const {
 
 double FeatureSensor::ukf_information_gain(const Config& q, const Mat4& prior) const {
   const Mat4 M = ukf_information(q, prior);
-  const Mat4 posterior = estimator::update_covariance(prior, M);
+  const Mat4 posterior = gaussian::update_covariance(prior, M);
   return 0.5 * (std::log(prior.determinant()) - std::log(posterior.determinant()));
 }
 

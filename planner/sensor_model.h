@@ -4,7 +4,7 @@
 // FeatureSensor observes the environment's point features that are within range, inside the
 // field of view (centred on the vehicle's yaw, level), facing the sensor and in line of sight.
 // Each gives z = (range, azimuth, elevation) with independent noise; its information
-// H^T Q^-1 H (H = dz/dq, 3 x 4) goes through estimator/information.h, so the planner and the
+// H^T Q^-1 H (H = dz/dq, 3 x 4) goes through common/gaussian/information.h, so the planner and the
 // filter share one definition of M. Presets cover the paper's three sensors:
 //   paper_camera  2 m, 30 deg, range variance 1 m^2, bearing variance 1 rad^2 (§4 simulation)
 //   kinect        4 m, 57 x 43 deg, range sigma 1.4e-3 d^2 m (Khoshelham), bearing 1e-3 rad
@@ -55,7 +55,7 @@ class FeatureSensor {
   FeatureMeasurement measure(const Config& q, int index) const;
   /// Predicted measurement of feature `index` from q, azimuth wrapped near `reference`.
   Eigen::Vector3d predict(const Config& q, int index, double reference_azimuth) const;
-  /// One feature's H^T Q^-1 H: estimator::measurement_information's values, for the diagonal Q.
+  /// One feature's H^T Q^-1 H: gaussian::measurement_information's values, for the diagonal Q.
   static Mat4 information_term(const FeatureMeasurement& m);
   /// EKF information M(q) = sum over visible features of H^T Q^-1 H.
   Mat4 information(const Config& q) const;

@@ -4,7 +4,7 @@
 
 #include <Eigen/LU>
 
-#include "estimator/information.h"
+#include "common/gaussian/information.h"
 
 namespace kestrel::planner {
 namespace {
@@ -14,7 +14,7 @@ Mat4 sym(const Mat4& A) { return 0.5 * (A + A.transpose()); }
 Mat4 propagate_ekf(const Mat4& Sigma, const std::vector<BeliefStep>& steps) {
   Mat4 S = Sigma;
   for (const BeliefStep& s : steps)
-    S = estimator::update_covariance(estimator::predict_covariance(s.G, S, s.R), s.M);
+    S = gaussian::update_covariance(gaussian::predict_covariance(s.G, S, s.R), s.M);
   return S;
 }
 

@@ -30,7 +30,7 @@ struct BeliefStep {
   Mat4 M = Mat4::Zero();
 };
 
-/// Step-by-step EKF covariance propagation (estimator/information.h): the reference.
+/// Step-by-step EKF covariance propagation (common/gaussian/information.h): the reference.
 Mat4 propagate_ekf(const Mat4& Sigma, const std::vector<BeliefStep>& steps);
 
 class SymplecticTransfer {

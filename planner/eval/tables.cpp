@@ -9,7 +9,7 @@
 #include <numeric>
 #include <sstream>
 
-#include "estimator/information.h"
+#include "common/gaussian/information.h"
 #include "planner/grid_environment.h"
 
 namespace kestrel::planner::eval {
@@ -227,8 +227,8 @@ std::string fig7_ukf_transfer(const Scenario& sc, const ExperimentOptions& o) {
       Mat4 A;
       for (int i = 0; i < 16; ++i) A(i) = n(rng);
       const Mat4 prior = 0.02 * A * A.transpose() + 0.02 * Mat4::Identity();  // tr about 0.4, as on paths
-      const Mat4 transfer = estimator::update_covariance(prior, M);
-      const Mat4 full = estimator::update_covariance(prior, sensor.ukf_information(q, prior));
+      const Mat4 transfer = gaussian::update_covariance(prior, M);
+      const Mat4 full = gaussian::update_covariance(prior, sensor.ukf_information(q, prior));
       errors.push_back(std::abs(transfer.trace() - full.trace()) / full.trace());
     }
   }

@@ -43,8 +43,8 @@ kestrel::plan_t plan(int64_t utime, bool ok) {
 }
 
 TEST(FollowTool, TurnsAPlanAndStatesIntoCommandsUnderLockStepReplay) {
-  if (!test::can_isolate_network()) GTEST_SKIP() << "no network namespace available";
-  if (!std::filesystem::exists(test::tool("replay"))) GTEST_SKIP() << test::tool("replay") << " is not built";
+  if (!test::can_isolate_network()) KESTREL_SKIP_ENVIRONMENT() << "no network namespace available";
+  if (!std::filesystem::exists(test::tool("replay"))) KESTREL_SKIP_ENVIRONMENT() << test::tool("replay") << " is not built";
   test::TempDir dir;
   const std::string in = (dir / "in.lcmlog").string(), out = (dir / "out.lcmlog").string();
   {

@@ -70,10 +70,10 @@ double last_second_mean_x(const std::vector<kestrel::ground_truth_t>& truth) {
 }
 
 TEST(HoldProcess, VehicleFliesOnTheEstimatorsStateInLockStep) {
-  if (!kestrel::test::can_isolate_network()) GTEST_SKIP() << "no network namespace available";
+  if (!kestrel::test::can_isolate_network()) KESTREL_SKIP_ENVIRONMENT() << "no network namespace available";
   for (const char* t : {"sim", "vo", "estimator", "hold", "isolated"})
-    if (!fs::exists(kestrel::test::tool(t))) GTEST_SKIP() << kestrel::test::tool(t) << " is not built";
-  if (std::system("command -v lcm-logger > /dev/null 2>&1") != 0) GTEST_SKIP() << "lcm-logger not found";
+    if (!fs::exists(kestrel::test::tool(t))) KESTREL_SKIP_ENVIRONMENT() << kestrel::test::tool(t) << " is not built";
+  if (std::system("command -v lcm-logger > /dev/null 2>&1") != 0) KESTREL_SKIP_ENVIRONMENT() << "lcm-logger not found";
   kestrel::test::TempDir dir;
 
   const Hold right = fly(dir / "right", "3", {});

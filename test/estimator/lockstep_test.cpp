@@ -29,9 +29,9 @@ namespace kestrel::estimator {
 namespace {
 
 TEST(EstimatorProcess, LockStepReplayIsDeterministicResetsAndEqualsTheLibrary) {
-  if (!kestrel::test::can_isolate_network()) GTEST_SKIP() << "no network namespace available";
+  if (!kestrel::test::can_isolate_network()) KESTREL_SKIP_ENVIRONMENT() << "no network namespace available";
   if (!std::filesystem::exists(kestrel::test::tool("replay")))
-    GTEST_SKIP() << kestrel::test::tool("replay") << " is not built (tools/replay)";
+    KESTREL_SKIP_ENVIRONMENT() << kestrel::test::tool("replay") << " is not built (tools/replay)";
   kestrel::test::TempDir dir;
   const std::string in = (dir / "in.lcmlog").string();
   test::write_log(in, 3.0, true);
@@ -74,10 +74,10 @@ TEST(EstimatorProcess, LockStepReplayIsDeterministicResetsAndEqualsTheLibrary) {
 // With --mode imu every sample is refused, no STATE is published, and the heartbeat says why
 // instead of "initialising".
 TEST(EstimatorProcess, AnImuWithoutAGyroRunsVisualOnlyOrIsRefusedInImuModeAndTheHealthSaysSo) {
-  if (!kestrel::test::can_isolate_network()) GTEST_SKIP() << "no network namespace available";
+  if (!kestrel::test::can_isolate_network()) KESTREL_SKIP_ENVIRONMENT() << "no network namespace available";
   if (!std::filesystem::exists(kestrel::test::tool("replay")))
-    GTEST_SKIP() << kestrel::test::tool("replay") << " is not built (tools/replay)";
-  if (std::system("command -v lcm-logger > /dev/null 2>&1") != 0) GTEST_SKIP() << "lcm-logger not found";
+    KESTREL_SKIP_ENVIRONMENT() << kestrel::test::tool("replay") << " is not built (tools/replay)";
+  if (std::system("command -v lcm-logger > /dev/null 2>&1") != 0) KESTREL_SKIP_ENVIRONMENT() << "lcm-logger not found";
   kestrel::test::TempDir dir;
   const std::string in = (dir / "in.lcmlog").string();
   constexpr int kUpdates = 20;

@@ -8,7 +8,7 @@
 
 #include "common/geometry/so3.h"
 #include "estimator/filter.h"
-#include "estimator/information.h"
+#include "common/gaussian/information.h"
 #include "estimator/propagation.h"
 
 namespace kestrel::estimator {
@@ -89,7 +89,7 @@ TEST(Propagation, ProcessNoiseIsVWVt) {
   for (bool gap : {false, true}) {
     const ImuStep step = propagate(random_state(rng), random_interval(rng, 0.005), kStandardGravity);
     const Matrix15d structured = process_noise(step.phi, noise, gap);
-    const Matrix15d generic = process_noise_diagonal(noise_jacobian(step.phi),
+    const Matrix15d generic = gaussian::process_noise_diagonal(noise_jacobian(step.phi),
                                                      noise_variances(noise, step.phi.dt, gap));
     EXPECT_LT((structured - generic).cwiseAbs().maxCoeff(), 1e-18 + 1e-12 * generic.norm());
   }

@@ -33,6 +33,6 @@ inline RunResult run_kinect(const std::filesystem::path& dump, const std::vector
 /// Skips the current test when Debian's fakenect library is not installed.
 #define KESTREL_REQUIRE_FAKENECT()                                                         \
   if (!::kestrel::test::fakenect_available())                                              \
-  GTEST_SKIP() << ::kestrel::test::fakenect_library_dir()                                  \
+  KESTREL_SKIP_ENVIRONMENT() << ::kestrel::test::fakenect_library_dir()                                  \
                << "/libfreenect.so.0.5 is absent: these tests replay recordings through "  \
                   "Debian's fakenect (package libfreenect0.5)"

@@ -114,7 +114,7 @@ TEST(KinectTool, ADroppedFrameIsCountedAndTheRestPublished) {
 
 TEST(KinectTool, PublishesLiveWithHeartbeatsInsideANetworkNamespace) {
   KESTREL_REQUIRE_FAKENECT();
-  if (!test::can_isolate_network()) GTEST_SKIP() << "cannot create a network namespace here";
+  if (!test::can_isolate_network()) KESTREL_SKIP_ENVIRONMENT() << "cannot create a network namespace here";
   test::TempDir dir;
   const TumFixture fx(dir.path(), 3);
   const auto dump = dir / "dump";
@@ -149,7 +149,7 @@ TEST(KinectTool, NoDeviceExitsUnavailable) {
   // The real libfreenect, and no Kinect on this machine.
   test::TempDir dir;
   const auto r = test::run({test::tool("kinect").string(), "--log", (dir / "k.lcmlog").string()});
-  if (r.exit_code == 0) GTEST_SKIP() << "a Kinect is plugged in here";
+  if (r.exit_code == 0) KESTREL_SKIP_ENVIRONMENT() << "a Kinect is plugged in here";
   EXPECT_EQ(r.exit_code, 4) << r.err;
   EXPECT_NE(r.err.find("kestrel-kinect: error: "), std::string::npos) << r.err;
   EXPECT_TRUE(r.err.find("no Kinect found") != std::string::npos ||

@@ -17,7 +17,7 @@ namespace {
 class LaunchTool : public ::testing::Test {
  protected:
   void SetUp() override {
-    if (!can_isolate_network()) GTEST_SKIP() << "cannot create a private network namespace here";
+    if (!can_isolate_network()) KESTREL_SKIP_ENVIRONMENT() << "cannot create a private network namespace here";
     std::ofstream(sets) << "processes:\n"
                            "  - {name: codec-a, command: rgbd-codec --name codec-a --out A, side: onboard}\n"
                            "  - {name: codec-b, command: rgbd-codec --name codec-b --in A --out B, side: offboard}\n";

@@ -28,7 +28,7 @@ Eigen::Isometry3d pose_at(int64_t utime) {
 }
 
 TEST(MapperProcess, LockStepReplayIsDeterministicAndResets) {
-  if (!kestrel::test::can_isolate_network()) GTEST_SKIP() << "no network namespace available";
+  if (!kestrel::test::can_isolate_network()) KESTREL_SKIP_ENVIRONMENT() << "no network namespace available";
   kestrel::test::TempDir dir;
   test::Scene scene(Eigen::Vector3d(-2.0, -2.0, 0.0), Eigen::Vector3d(3.0, 2.0, 2.5));
   scene.add_box(Eigen::Vector3d(0.8, -0.4, 0.0), Eigen::Vector3d(1.4, 0.3, 0.9));

@@ -14,7 +14,7 @@ namespace {
 TEST(LogPlayerMonitorData, TumSequenceThroughLcmLogplayer) {
   KESTREL_REQUIRE_TUM(sequence, "rgbd_dataset_freiburg1_rpy");
   if (!std::filesystem::exists(tool("tum-play")))
-    GTEST_SKIP() << tool("tum-play") << " is not built";
+    KESTREL_SKIP_ENVIRONMENT() << tool("tum-play") << " is not built";
   KESTREL_REQUIRE_ISOLATION();
   TempDir dir;
   const RunResult made = run({tool("tum-play"), sequence.string(), "--log", (dir / "x.lcmlog").string()}, 300.0);

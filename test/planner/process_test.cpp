@@ -119,7 +119,7 @@ double check_path(const kestrel::plan_t& p, double clearance) {
 }
 
 TEST(PlannerProcess, AnswersEveryRequestOverLcmAndRepeatsAfterReset) {
-  if (!kestrel::test::can_isolate_network()) GTEST_SKIP() << "cannot create a network namespace here";
+  if (!kestrel::test::can_isolate_network()) KESTREL_SKIP_ENVIRONMENT() << "cannot create a network namespace here";
   kestrel::test::TempDir dir;
   const std::string in = (dir / "in.lcmlog").string();
   write_input_log(in);

@@ -2,7 +2,7 @@
 #include <gtest/gtest.h>
 
 #include "common/numbers.h"
-#include "estimator/information.h"
+#include "common/gaussian/information.h"
 #include "planner/grid_environment.h"
 #include "planner/sensor_model.h"
 #include "test_environments.h"
@@ -137,7 +137,7 @@ TEST(FeatureSensor, UkfInformationEqualsTheGenericUkf) {
         return z;
       };
       const Mat4 generic =
-          estimator::ukf_measurement_information(q, prior, h, Eigen::MatrixXd(variances.asDiagonal()));
+          gaussian::ukf_measurement_information(q, prior, h, Eigen::MatrixXd(variances.asDiagonal()));
       const Mat4 fast = sensor.ukf_information(q, prior);
       // Both subtract K S K^T from the prior; with the Kinect the posterior is ~1e-6 of the
       // prior, so both carry ~1e-10 relative rounding: agreement to 1e-7 is all there is.
@@ -147,7 +147,7 @@ TEST(FeatureSensor, UkfInformationEqualsTheGenericUkf) {
 }
 
 TEST(FeatureSensor, InformationTermEqualsTheEstimators) {
-  // The diagonal-Q form of H^T Q^-1 H against estimator::measurement_information (LLT of Q):
+  // The diagonal-Q form of H^T Q^-1 H against gaussian::measurement_information (LLT of Q):
   // the same values, not merely close, for Jacobians of every scale and the presets' noise.
   Rng rng(19);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
@@ -160,7 +160,7 @@ TEST(FeatureSensor, InformationTermEqualsTheEstimators) {
     const double r2 = 0.25 + 16.0 * std::abs(u(rng));
     const double sr = t % 3 == 0 ? 1.4e-3 * r2 : t % 3 == 1 ? 1.0 : 0.01, sb = t % 3 == 0 ? 1e-3 : t % 3 == 1 ? 1.0 : 0.0087;
     m.variances = {sr * sr, sb * sb, sb * sb};
-    const Mat4 expected = estimator::measurement_information(m.H, Eigen::Matrix3d(m.variances.asDiagonal()));
+    const Mat4 expected = gaussian::measurement_information(m.H, Eigen::Matrix3d(m.variances.asDiagonal()));
     ASSERT_TRUE((FeatureSensor::information_term(m).array() == expected.array()).all()) << "case " << t;
   }
   FeatureMeasurement bad;
@@ -214,7 +214,7 @@ TEST(FeatureSensor, FastVisibilityEqualsTheDefinition) {
       Mat4 M = Mat4::Zero();
       for (int i : seen) {
         const FeatureMeasurement m = sensor.measure(q, i);
-        M += estimator::measurement_information(m.H, Eigen::Matrix3d(m.variances.asDiagonal()));
+        M += gaussian::measurement_information(m.H, Eigen::Matrix3d(m.variances.asDiagonal()));
       }
       EXPECT_TRUE((sensor.information(q).array() == M.array()).all()) << "yaw " << q[3];
     }

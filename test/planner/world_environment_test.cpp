@@ -158,7 +158,7 @@ TEST(WorldEnvironment, FastLineOfSightEqualsTheSimsRaycast) {
 TEST(WorldEnvironment, FastLineOfSightEqualsTheSimsRaycastInStata) {
   const auto map = kestrel::test::shared_data() / "maps" / "stata_basement.yaml";
   auto stata = stata_experiment_world(map.string(), {4.0, 1}, 0.3);
-  if (!stata) GTEST_SKIP() << map << " is absent";
+  if (!stata) KESTREL_SKIP_ENVIRONMENT() << map << " is absent";
   expect_fast_sight_equals_raycast(*stata->env, 300, 22);
 }
 

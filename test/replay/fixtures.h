@@ -20,6 +20,7 @@
 #include "common/rgbd_frame.h"
 #include "common/transport/log_file.h"
 #include "kestrel/process_status_t.hpp"
+#include "test/support/test_support.h"
 
 namespace kestrel::test {
 
@@ -55,8 +56,8 @@ bool isolate_this_process();
 /// Skips the current test unless it could be isolated (never sends multicast outside).
 #define KESTREL_REQUIRE_ISOLATION()                                                       \
   if (!::kestrel::test::isolate_this_process())                                           \
-  GTEST_SKIP() << "cannot create a private network namespace here (needs root or "        \
-                  "unprivileged user namespaces)"
+  KESTREL_SKIP_ENVIRONMENT() << "cannot create a private network namespace here (needs "  \
+                                "root or unprivileged user namespaces)"
 
 /// A child process running in the background, in its own process group, with stdout and
 /// stderr going to files; killed (with its group) at destruction.

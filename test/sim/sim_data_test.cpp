@@ -20,7 +20,7 @@ namespace {
 TEST(StataTest, LoopThroughTheBasementIsLongCollisionFreeAndComesBack) {
   const auto data = kestrel::test::shared_data();
   const auto map = data / "maps" / "stata_basement.yaml";
-  if (data.empty() || !std::filesystem::exists(map)) GTEST_SKIP() << "../shared/data/maps/stata_basement.yaml is absent";
+  if (data.empty() || !std::filesystem::exists(map)) KESTREL_SKIP_ENVIRONMENT() << "../shared/data/maps/stata_basement.yaml is absent";
   const World world = load_world("stata", map.string());
   EXPECT_GT(world.surfaces().size(), 100u);
   EXPECT_GT(world.bounds().sizes().x(), 50.0);  // the map is 87 x 65 m

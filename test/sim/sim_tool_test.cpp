@@ -54,7 +54,7 @@ TEST(SimToolTest, TumExportOfTwentySecondsScoresZeroAgainstItsOwnGroundTruth) {
   EXPECT_EQ(data_lines(tum / "imu.txt"), 4001);  // 0 .. 20 s at 200 Hz
   EXPECT_EQ(data_lines(tum / "accelerometer.txt"), 4001);
   EXPECT_EQ(std::distance(fs::directory_iterator(tum / "rgb"), fs::directory_iterator{}), 61);
-  if (!fs::exists(tool("eval"))) GTEST_SKIP() << "kestrel-eval is not built";
+  if (!fs::exists(tool("eval"))) KESTREL_SKIP_ENVIRONMENT() << "kestrel-eval is not built";
   const auto eval = run({tool("eval").string(), "--gt", (tum / "groundtruth.txt").string(), "--est",
                          (tum / "groundtruth.txt").string(), "--frames", (tum / "rgb.txt").string(), "--json"});
   ASSERT_EQ(eval.exit_code, 0) << eval.err;
@@ -91,7 +91,7 @@ TEST(SimToolTest, SameSeedGivesTheSameLogBytes) {
 // Live: published inside a private network namespace, recorded by the stock lcm-logger, and
 // read back by kestrel-eval (GROUND_TRUTH at 200 Hz).
 TEST(SimToolTest, LivePublishingReachesAnLcmLogger) {
-  if (!kestrel::test::can_isolate_network()) GTEST_SKIP() << "cannot create a network namespace here";
+  if (!kestrel::test::can_isolate_network()) KESTREL_SKIP_ENVIRONMENT() << "cannot create a network namespace here";
   TempDir dir;
   const std::string log = (dir / "live.lcmlog").string();
   const std::string script =
@@ -103,7 +103,7 @@ TEST(SimToolTest, LivePublishingReachesAnLcmLogger) {
   const auto r = kestrel::test::run_isolated(script, 200.0);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("frames: 31"), std::string::npos) << r.out;
-  if (!fs::exists(tool("eval"))) GTEST_SKIP() << "kestrel-eval is not built";
+  if (!fs::exists(tool("eval"))) KESTREL_SKIP_ENVIRONMENT() << "kestrel-eval is not built";
   const auto eval = run({tool("eval").string(), "--est", log + ":GROUND_TRUTH", "--to-tum", (dir / "gt.txt").string()});
   ASSERT_EQ(eval.exit_code, 0) << eval.err;
   // 201 sent (0 .. 1 s at 200 Hz); UDP may drop a few when the logger falls behind.
@@ -115,8 +115,8 @@ TEST(SimToolTest, LivePublishingReachesAnLcmLogger) {
 // stock lcm-logplayer half a second into the flight) moves the simulated vehicle, as its
 // GROUND_TRUTH recorded by lcm-logger shows; before it the vehicle holds its start.
 TEST(SimToolTest, VehicleFliesAVehicleCommandReceivedOverLcm) {
-  if (!kestrel::test::can_isolate_network()) GTEST_SKIP() << "cannot create a network namespace here";
-  if (!fs::exists(tool("eval"))) GTEST_SKIP() << "kestrel-eval is not built";
+  if (!kestrel::test::can_isolate_network()) KESTREL_SKIP_ENVIRONMENT() << "cannot create a network namespace here";
+  if (!fs::exists(tool("eval"))) KESTREL_SKIP_ENVIRONMENT() << "kestrel-eval is not built";
   TempDir dir;
   const std::string log = (dir / "live.lcmlog").string(), commands = (dir / "command.lcmlog").string();
   {
@@ -164,7 +164,7 @@ TEST(SimToolTest, VehicleFliesAVehicleCommandReceivedOverLcm) {
 // finishes; it never waits for a STATE, since none ever flowed (a STATE wait would be a
 // second timeout).
 TEST(SimToolTest, LockstepWithoutConsumersWaitsOnceThenFinishes) {
-  if (!kestrel::test::can_isolate_network()) GTEST_SKIP() << "cannot create a network namespace here";
+  if (!kestrel::test::can_isolate_network()) KESTREL_SKIP_ENVIRONMENT() << "cannot create a network namespace here";
   const std::string script =
       lcm_url_export() + "'" + tool("sim").string() +
       "' --world room --flight vehicle --duration 0.5 --rate 0 --lockstep 1.5 -q";

@@ -19,9 +19,9 @@ class PoseGraphData : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(PoseGraphData, FinalChi2IsNoWorseThanCeres) {
   const auto root = ::kestrel::test::shared_data();
-  if (root.empty()) GTEST_SKIP() << "../shared/data is absent: this test needs the g2o benchmarks";
+  if (root.empty()) KESTREL_SKIP_ENVIRONMENT() << "../shared/data is absent: this test needs the g2o benchmarks";
   const auto path = root / "posegraph" / (std::string(GetParam()) + ".g2o");
-  if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " is absent";
+  if (!std::filesystem::exists(path)) KESTREL_SKIP_ENVIRONMENT() << path << " is absent";
   const AnyPoseGraph graph = read_g2o(path);
   std::visit(
       [&](const auto& original) {

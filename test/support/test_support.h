@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -60,11 +61,32 @@ RunResult run_isolated(const std::string& script, double timeout_s = 120.0);
 /// `s` in single quotes for sh.
 std::string quoted(const std::string& s);
 
+/// Whether a test that cannot run here (no network namespace, no ../shared/data, a tool or a
+/// system program missing) fails instead of skipping. Under CI=true every environment the
+/// suite needs is provided, so a skip there is a set-up step that went missing, not a pass.
+inline bool environmental_skips_fail() {
+  const char* ci = std::getenv("CI");
+  return ci != nullptr && std::string(ci) == "true";
+}
+
 }  // namespace kestrel::test
+
+/// Skips the current test because its environment is missing, with the message streamed after
+/// it; under CI=true (environmental_skips_fail) the same line is a fatal failure instead.
+/// Spelled like GTEST_SKIP (GoogleTest's own message helper), so it streams the same way and,
+/// like it, only returns from a function returning void.
+#define KESTREL_SKIP_ENVIRONMENT()                                                              \
+  return ::testing::internal::AssertHelper(                                                     \
+             ::kestrel::test::environmental_skips_fail() ? ::testing::TestPartResult::kFatalFailure \
+                                                         : ::testing::TestPartResult::kSkip,     \
+             __FILE__, __LINE__,                                                                 \
+             ::kestrel::test::environmental_skips_fail()                                         \
+                 ? "CI=true, where a missing environment fails the test"                        \
+                 : "Skipped") = ::testing::Message()
 
 /// Skips the current test with a clear message when ../shared/data/tum/<name> is absent.
 #define KESTREL_REQUIRE_TUM(var, name)                                                    \
   const std::filesystem::path var = ::kestrel::test::tum_sequence(name);                  \
   if (var.empty())                                                                         \
-  GTEST_SKIP() << "../shared/data/tum/" << (name)                                          \
+  KESTREL_SKIP_ENVIRONMENT() << "../shared/data/tum/" << (name)                                          \
                << " is absent: this test needs the real TUM RGB-D sequence"

@@ -31,8 +31,8 @@ namespace kestrel {
 namespace {
 
 TEST(System, TheVehicleFliesToAGoalOnItsOwnMap) {
-  if (!test::can_isolate_network()) GTEST_SKIP() << "no network namespace available";
-  if (!std::filesystem::exists("/usr/bin/lcm-logger")) GTEST_SKIP() << "lcm-logger is not installed";
+  if (!test::can_isolate_network()) KESTREL_SKIP_ENVIRONMENT() << "no network namespace available";
+  if (!std::filesystem::exists("/usr/bin/lcm-logger")) KESTREL_SKIP_ENVIRONMENT() << "lcm-logger is not installed";
   test::TempDir dir;
   // The scenario the demo flies (tools/demo/fly_to_goal): goal 1.5 m ahead of the take-off pose.
   const auto r = test::run({"bash", (test::source_dir() / "tools/demo/fly_to_goal").string(),

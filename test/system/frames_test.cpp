@@ -128,7 +128,7 @@ void fly_figure_eight(const std::string& vo_options, bool with_mapper) {
 }
 
 TEST(System, SlamKeyframesAndCorrectionsAreInTheEstimatorsWorld) {
-  if (!test::can_isolate_network()) GTEST_SKIP() << "no network namespace available";
+  if (!test::can_isolate_network()) KESTREL_SKIP_ENVIRONMENT() << "no network namespace available";
   fly_figure_eight("", /*with_mapper=*/true);
 }
 
@@ -136,7 +136,7 @@ TEST(System, SlamKeyframesAndCorrectionsAreInTheEstimatorsWorld) {
 // SLAM's odometry edges took the VO's covariance, two verified but weak loop closures bent the
 // last keyframes 6.1 cm from STATE (slam/README.md, odometry): both configurations stay tested.
 TEST(System, SlamKeyframesAreInTheEstimatorsWorldWithoutTheVoDenseTerm) {
-  if (!test::can_isolate_network()) GTEST_SKIP() << "no network namespace available";
+  if (!test::can_isolate_network()) KESTREL_SKIP_ENVIRONMENT() << "no network namespace available";
   fly_figure_eight("--set dense.enabled=false", /*with_mapper=*/false);
 }
 

@@ -104,8 +104,8 @@ void fly_and_kill(const test::TempDir& dir, const std::string& processes, const 
 }
 
 TEST(System, AnEstimatorKilledInFlightRestartsInTheMapsWorld) {
-  if (!test::can_isolate_network()) GTEST_SKIP() << "no network namespace available";
-  if (!std::filesystem::exists("/usr/bin/lcm-logger")) GTEST_SKIP() << "lcm-logger is not installed";
+  if (!test::can_isolate_network()) KESTREL_SKIP_ENVIRONMENT() << "no network namespace available";
+  if (!std::filesystem::exists("/usr/bin/lcm-logger")) KESTREL_SKIP_ENVIRONMENT() << "lcm-logger is not installed";
   test::TempDir dir;
   ASSERT_NO_FATAL_FAILURE(fly_and_kill(dir, "vo,estimator,slam", "estimator", "STATE|GROUND_TRUTH"));
   const std::string live = (dir / "live.lcmlog").string();
@@ -159,8 +159,8 @@ TEST(System, AnEstimatorKilledInFlightRestartsInTheMapsWorld) {
 }
 
 TEST(System, ASlamKilledInFlightStartsANewSessionInTheSameWorldAndTheMapKeepsBoth) {
-  if (!test::can_isolate_network()) GTEST_SKIP() << "no network namespace available";
-  if (!std::filesystem::exists("/usr/bin/lcm-logger")) GTEST_SKIP() << "lcm-logger is not installed";
+  if (!test::can_isolate_network()) KESTREL_SKIP_ENVIRONMENT() << "no network namespace available";
+  if (!std::filesystem::exists("/usr/bin/lcm-logger")) KESTREL_SKIP_ENVIRONMENT() << "lcm-logger is not installed";
   test::TempDir dir;
   ASSERT_NO_FATAL_FAILURE(fly_and_kill(dir, "vo,estimator,slam,mapper", "slam", "GROUND_TRUTH|SLAM_GRAPH|VO_UPDATE"));
   const std::string live = (dir / "live.lcmlog").string();
@@ -233,8 +233,8 @@ TEST(System, ASlamKilledInFlightStartsANewSessionInTheSameWorldAndTheMapKeepsBot
 // the map it had at once and carries on adding SLAM's keyframes; only those SLAM made while it
 // was down are missing. Without the journal it would start from nothing.
 TEST(System, AMapperKilledInFlightComesBackWithItsMapFromTheJournal) {
-  if (!test::can_isolate_network()) GTEST_SKIP() << "no network namespace available";
-  if (!std::filesystem::exists("/usr/bin/lcm-logger")) GTEST_SKIP() << "lcm-logger is not installed";
+  if (!test::can_isolate_network()) KESTREL_SKIP_ENVIRONMENT() << "no network namespace available";
+  if (!std::filesystem::exists("/usr/bin/lcm-logger")) KESTREL_SKIP_ENVIRONMENT() << "lcm-logger is not installed";
   test::TempDir dir;
   ASSERT_NO_FATAL_FAILURE(fly_and_kill(dir, "vo,estimator,slam,mapper", "mapper", "SLAM_GRAPH|MAP_OCTOMAP"));
   const std::string mapper = test::read_file(dir / "logs" / "mapper.log");
@@ -282,8 +282,8 @@ TEST(System, AMapperKilledInFlightComesBackWithItsMapFromTheJournal) {
 // world. (On this figure-eight the loop closures after the restart would also pull an
 // unbridged segment back; the bridge count says which one did it.)
 TEST(System, AVoKilledInFlightLeavesTheStateAndTheGraphInOneWorld) {
-  if (!test::can_isolate_network()) GTEST_SKIP() << "no network namespace available";
-  if (!std::filesystem::exists("/usr/bin/lcm-logger")) GTEST_SKIP() << "lcm-logger is not installed";
+  if (!test::can_isolate_network()) KESTREL_SKIP_ENVIRONMENT() << "no network namespace available";
+  if (!std::filesystem::exists("/usr/bin/lcm-logger")) KESTREL_SKIP_ENVIRONMENT() << "lcm-logger is not installed";
   test::TempDir dir;
   ASSERT_NO_FATAL_FAILURE(fly_and_kill(dir, "vo,estimator,slam", "vo", "STATE|GROUND_TRUTH|SLAM_GRAPH|VO_UPDATE"));
   const std::string slam = test::read_file(dir / "logs" / "slam.log");
@@ -395,8 +395,8 @@ TEST(System, AVoKilledInFlightLeavesTheStateAndTheGraphInOneWorld) {
 // again each second of frames. Before, goto waited out its timeout for an answer, and the new
 // planner answered "no map yet" for as long as the vehicle stood still, which was for ever.
 TEST(System, APlannerKilledWhileTheVehicleHoversPlansAgainOnceRestarted) {
-  if (!test::can_isolate_network()) GTEST_SKIP() << "no network namespace available";
-  if (!std::filesystem::exists("/usr/bin/lcm-logger")) GTEST_SKIP() << "lcm-logger is not installed";
+  if (!test::can_isolate_network()) KESTREL_SKIP_ENVIRONMENT() << "no network namespace available";
+  if (!std::filesystem::exists("/usr/bin/lcm-logger")) KESTREL_SKIP_ENVIRONMENT() << "lcm-logger is not installed";
   test::TempDir dir;
   const auto bin = [](const char* name) { return test::quoted(test::tool(name).string()); };
   const std::string out = test::quoted(dir.path().string());
@@ -457,8 +457,8 @@ TEST(System, APlannerKilledWhileTheVehicleHoversPlansAgainOnceRestarted) {
 // nobody flies on it. Before, the new filter stayed 1.5 m off for as long as the vehicle
 // hovered, and the next goal was planned and flown from where the vehicle was not.
 TEST(System, AnEstimatorKilledWhileTheVehicleHoversTakesTheMapsWorldAtOnce) {
-  if (!test::can_isolate_network()) GTEST_SKIP() << "no network namespace available";
-  if (!std::filesystem::exists("/usr/bin/lcm-logger")) GTEST_SKIP() << "lcm-logger is not installed";
+  if (!test::can_isolate_network()) KESTREL_SKIP_ENVIRONMENT() << "no network namespace available";
+  if (!std::filesystem::exists("/usr/bin/lcm-logger")) KESTREL_SKIP_ENVIRONMENT() << "lcm-logger is not installed";
   test::TempDir dir;
   const auto bin = [](const char* name) { return test::quoted(test::tool(name).string()); };
   const std::string out = test::quoted(dir.path().string());

@@ -87,7 +87,7 @@ void expect_visual_only_state(const std::string& recorded, const Trajectory& tru
 
 TEST(System, ReplayedTumRecordingRunsWithItsCamerasProfileAndMapsTheScene) {
   KESTREL_REQUIRE_TUM(folder, "rgbd_dataset_freiburg1_xyz");
-  if (!test::can_isolate_network()) GTEST_SKIP() << "no network namespace available";
+  if (!test::can_isolate_network()) KESTREL_SKIP_ENVIRONMENT() << "no network namespace available";
   test::TempDir dir;
   const std::string source = (dir / "source.lcmlog").string();
   const std::string recorded = (dir / "system.lcmlog").string();

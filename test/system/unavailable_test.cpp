@@ -12,7 +12,7 @@ namespace kestrel::test {
 namespace {
 
 TEST(Unavailable, EveryProcessExitsFourNamingLcmWhenThereIsNoNetwork) {
-  if (!can_isolate_network()) GTEST_SKIP() << "cannot create a network namespace here (needs root or user namespaces)";
+  if (!can_isolate_network()) KESTREL_SKIP_ENVIRONMENT() << "cannot create a network namespace here (needs root or user namespaces)";
   struct Case {
     std::string tool;
     std::vector<std::string> args;

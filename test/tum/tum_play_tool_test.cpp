@@ -146,7 +146,7 @@ TEST(TumPlayTool, BadOptionsExitTwo) {
 }
 
 TEST(TumPlayTool, PublishesLiveWithHeartbeatsInsideANetworkNamespace) {
-  if (!test::can_isolate_network()) GTEST_SKIP() << "cannot create a network namespace here";
+  if (!test::can_isolate_network()) KESTREL_SKIP_ENVIRONMENT() << "cannot create a network namespace here";
   test::TempDir dir;
   const TumFixture fx(dir.path(), 3);
   const auto log = dir / "live.lcmlog";
@@ -175,7 +175,7 @@ TEST(TumPlayTool, PublishesLiveWithHeartbeatsInsideANetworkNamespace) {
 }
 
 TEST(TumPlayTool, SigintEndsALoopedPlaybackWithCode130) {
-  if (!test::can_isolate_network()) GTEST_SKIP() << "cannot create a network namespace here";
+  if (!test::can_isolate_network()) KESTREL_SKIP_ENVIRONMENT() << "cannot create a network namespace here";
   test::TempDir dir;
   const TumFixture fx(dir.path(), 2);
   const auto r = test::run_isolated("'" + play() + "' '" + fx.folder().string() +

@@ -47,7 +47,7 @@ std::vector<kestrel::vo_update_t> updates(const std::string& path) {
 }
 
 TEST(VoProcess, LockStepReplayGivesOneUpdatePerFrameAndRepeats) {
-  if (!kestrel::test::can_isolate_network()) GTEST_SKIP() << "cannot create a network namespace here";
+  if (!kestrel::test::can_isolate_network()) KESTREL_SKIP_ENVIRONMENT() << "cannot create a network namespace here";
   kestrel::test::TempDir dir;
   const std::string in = (dir / "in.lcmlog").string();
   write_input_log(in);
@@ -97,7 +97,7 @@ TEST(VoProcess, LockStepReplayGivesOneUpdatePerFrameAndRepeats) {
 // and the change of camera restarts the odometry (frame 3 has no reference). With --sensor
 // every frame gets that profile and nothing restarts.
 TEST(VoProcess, TakesTheCameraProfileTheFramesName) {
-  if (!kestrel::test::can_isolate_network()) GTEST_SKIP() << "cannot create a network namespace here";
+  if (!kestrel::test::can_isolate_network()) KESTREL_SKIP_ENVIRONMENT() << "cannot create a network namespace here";
   kestrel::test::TempDir dir;
   const std::string in = (dir / "in.lcmlog").string();
   {

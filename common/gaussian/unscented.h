@@ -13,7 +13,7 @@
 #include <cmath>
 #include <stdexcept>
 
-namespace kestrel::estimator {
+namespace kestrel::gaussian {
 
 struct UnscentedParams {
   double alpha = 1.0;  ///< spread; 1 puts the points at sqrt(n + kappa) sigma
@@ -77,4 +77,4 @@ Eigen::Matrix<double, Derived::RowsAtCompileTime, Eigen::Dynamic> sigma_offsets(
   return X;
 }
 
-}  // namespace kestrel::estimator
+}  // namespace kestrel::gaussian

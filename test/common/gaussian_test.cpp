@@ -7,10 +7,10 @@
 #include <cmath>
 #include <random>
 
-#include "estimator/information.h"
-#include "estimator/unscented.h"
+#include "common/gaussian/information.h"
+#include "common/gaussian/unscented.h"
 
-namespace kestrel::estimator {
+namespace kestrel::gaussian {
 namespace {
 
 template <int N>
@@ -186,4 +186,4 @@ TEST(Unscented, SigmaPointsReproduceMeanAndCovariance) {
 }
 
 }  // namespace
-}  // namespace kestrel::estimator
+}  // namespace kestrel::gaussian

@@ -18,9 +18,9 @@
 #include <stdexcept>
 #include <string>
 
-#include "estimator/unscented.h"
+#include "common/gaussian/unscented.h"
 
-namespace kestrel::estimator {
+namespace kestrel::gaussian {
 
 template <int Rows, int Cols = Rows>
 using Mat = Eigen::Matrix<double, Rows, Cols>;
@@ -134,4 +134,4 @@ Mat<DS::RowsAtCompileTime> ukf_measurement_information(const Eigen::MatrixBase<D
   return detail::symmetric((post_llt.solve(I) - prior.solve(I)).eval());
 }
 
-}  // namespace kestrel::estimator
+}  // namespace kestrel::gaussian
