@@ -20,7 +20,7 @@ using SigmaMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen:
 // A P negative beyond rounding (|lambda_min| > 1e-6 max|P|) is an error, not repaired.
 Covariance square_root(Covariance& P) {
   try {
-    return psd_square_root(P);
+    return gaussian::psd_square_root(P);
   } catch (const std::invalid_argument&) {
     if (!P.allFinite()) throw;
     const Eigen::SelfAdjointEigenSolver<Covariance> eig(P);
