@@ -52,7 +52,7 @@ GridEnvironment::GridEnvironment(OccupancyGrid grid, double z_min, double z_max)
   clearance_m_.resize(grid_.cells.size());
   for (int r = 0; r < grid_.height; ++r)
     for (int c = 0; c < grid_.width; ++c) {
-      const double d = dist.at<float>(r + 1, c + 1);
+      const double d = static_cast<double>(dist.at<float>(r + 1, c + 1));
       clearance_m_[static_cast<size_t>(r) * grid_.width + c] =
           d <= 0.0 ? 0.f : static_cast<float>((d - 0.5) * grid_.resolution);
     }

@@ -44,12 +44,12 @@ MotionEstimate MotionEstimator::estimate(const Frame& ref, const Frame& cur,
     c.cur_point = m.cur_point.cast<double>();
     c.ref_pixel = fr.ideal.cast<double>();
     c.cur_pixel = m.cur_ideal.cast<double>();
-    c.ref_sigma_z = fr.sigma_z;
-    c.cur_sigma_z = fc.sigma_z;
+    c.ref_sigma_z = static_cast<double>(fr.sigma_z);
+    c.cur_sigma_z = static_cast<double>(fc.sigma_z);
     correspondences_.push_back(c);
     ref_points_.push_back(fr.p_camera);
     cur_points_.push_back(m.cur_point);
-    const double zr = fr.p_camera.z(), zc = m.cur_point.z();
+    const double zr = static_cast<double>(fr.p_camera.z()), zc = static_cast<double>(m.cur_point.z());
     variances_.push_back(static_cast<float>(c.ref_sigma_z * c.ref_sigma_z + c.cur_sigma_z * c.cur_sigma_z +
                                             lateral * lateral * (zr * zr + zc * zc)));
   }

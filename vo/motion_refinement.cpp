@@ -220,7 +220,7 @@ DenseQuadratic linearise_dense(const DenseTerm& d, const PinholeCamera& cam, con
       if (!(X.z() > 1e-3f)) continue;
       float u = fx * X.x() / X.z() + cx, v = fy * X.y() / X.z() + cy;
       if (d.use_distortion) {
-        const Eigen::Vector2d raw = cam.distort(u, v);
+        const Eigen::Vector2d raw = cam.distort(static_cast<double>(u), static_cast<double>(v));
         u = static_cast<float>(raw.x());
         v = static_cast<float>(raw.y());
       }
@@ -238,8 +238,9 @@ DenseQuadratic linearise_dense(const DenseTerm& d, const PinholeCamera& cam, con
       // d r / d[dp; dtheta] = [n^T, -n^T R [q]x] = [n^T, (q x R^T n)^T].
       const Eigen::Vector3f m = q.cross(R.transpose() * n);
       Eigen::Matrix<double, 1, 6> Jw;
-      Jw << n.x() * inv_sigma, n.y() * inv_sigma, n.z() * inv_sigma, m.x() * inv_sigma, m.y() * inv_sigma,
-          m.z() * inv_sigma;
+      Jw << static_cast<double>(n.x() * inv_sigma), static_cast<double>(n.y() * inv_sigma),
+          static_cast<double>(n.z() * inv_sigma), static_cast<double>(m.x() * inv_sigma),
+          static_cast<double>(m.y() * inv_sigma), static_cast<double>(m.z() * inv_sigma);
       const float e = std::abs(rw);
       double weight = o.weight, rho = double(e) * double(e);
       if (huber > 0.0f && e > huber) {

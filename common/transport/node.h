@@ -55,7 +55,7 @@ class Node {
   void subscribe(const std::string& channel, Handler handler, int queue_capacity = 30) {
     add_subscription(
         channel,
-        [this, channel, handler](const void* data, size_t size) -> int64_t {
+        [channel, handler](const void* data, size_t size) -> int64_t {
           const Msg msg = decode_message<Msg>(data, size, channel);
           handler(msg);
           return message_utime(msg);

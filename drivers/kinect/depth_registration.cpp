@@ -48,7 +48,7 @@ cv::Mat DepthRegistration::unregister_mm(const cv::Mat& depth_rgb_mm) const {
   for (int v = 0; v < raw.rows; ++v) {
     const float* in = ir_metres.ptr<float>(v);
     uint16_t* out = raw.ptr<uint16_t>(v);
-    for (int u = 0; u < raw.cols; ++u) out[u] = model.raw(in[u]);
+    for (int u = 0; u < raw.cols; ++u) out[u] = model.raw(static_cast<double>(in[u]));
   }
   return raw;
 }

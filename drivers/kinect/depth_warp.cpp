@@ -21,7 +21,7 @@ cv::Mat DepthWarp::operator()(const cv::Mat& depth_from) const {
   CV_Assert(depth_from.type() == CV_32FC1 && depth_from.cols == from_.width &&
             depth_from.rows == from_.height);
   constexpr float kEmpty = std::numeric_limits<float>::infinity();
-  cv::Mat out(to_.height, to_.width, CV_32FC1, cv::Scalar(kEmpty));
+  cv::Mat out(to_.height, to_.width, CV_32FC1, cv::Scalar(static_cast<double>(kEmpty)));
   const float fx = static_cast<float>(to_.fx), fy = static_cast<float>(to_.fy);
   const float cx = static_cast<float>(to_.cx), cy = static_cast<float>(to_.cy);
   // Pixel centres are at integer coordinates, so a pixel covers [u - 0.5, u + 0.5).

@@ -32,16 +32,16 @@ double cell_random(uint64_t key, int64_t i, int64_t j) {
 // Painted wall: faint undulation and roller stipple, nearly featureless by design.
 cv::Mat plaster(const MaterialSpec& spec, int size, Rng& rng) {
   const float k = static_cast<float>(spec.contrast);
-  cv::Mat lum = fractal_noise(size, 4, size / 4, 0.6, rng) * (0.03f * k) +
-                fractal_noise(size, size / 2, size, 0.7, rng) * (0.015f * k) + 1.0f;
+  cv::Mat lum = fractal_noise(size, 4, size / 4, 0.6, rng) * static_cast<double>(0.03f * k) +
+                fractal_noise(size, size / 2, size, 0.7, rng) * static_cast<double>(0.015f * k) + 1.0;
   return tint(lum, spec.color);
 }
 
 // Concrete: blotchy multi-octave variation, stains and dark pores of a few millimetres.
 cv::Mat concrete(const MaterialSpec& spec, int size, Rng& rng) {
   const float k = static_cast<float>(spec.contrast);
-  cv::Mat lum = fractal_noise(size, 2, size / 2, 0.62, rng) * (0.11f * k) +
-                fractal_noise(size, size / 2, size, 0.5, rng) * (0.05f * k) + 1.0f;
+  cv::Mat lum = fractal_noise(size, 2, size / 2, 0.62, rng) * static_cast<double>(0.11f * k) +
+                fractal_noise(size, size / 2, size, 0.5, rng) * static_cast<double>(0.05f * k) + 1.0;
   const cv::Mat pores = fractal_noise(size, size / 4, size / 2, 0.8, rng);
   const cv::Mat stains = smooth_noise(size, 8, rng);
   for (int r = 0; r < size; ++r) {
@@ -100,7 +100,7 @@ cv::Mat fabric(const MaterialSpec& spec, int size, Rng& rng) {
 // Switched-off monitor or glossy black panel: dark, almost uniform (Kinect depth drops out).
 cv::Mat screen(const MaterialSpec& spec, int size, Rng& rng) {
   const float k = static_cast<float>(spec.contrast);
-  cv::Mat lum = fractal_noise(size, 2, 16, 0.6, rng) * (0.15f * k) + 1.0f;
+  cv::Mat lum = fractal_noise(size, 2, 16, 0.6, rng) * static_cast<double>(0.15f * k) + 1.0;
   return tint(lum, spec.color);
 }
 

@@ -176,7 +176,9 @@ cv::Mat books(const MaterialSpec& spec, int size, Rng& rng) {
     const int y0 = static_cast<int>(s * shelf_h);
     const int y1 = static_cast<int>((s + 1) * shelf_h);
     const int yb = y0 + static_cast<int>(board);
-    rgb.rowRange(y0, yb).setTo(cv::Scalar(board_color[0], board_color[1], board_color[2]));
+    rgb.rowRange(y0, yb).setTo(cv::Scalar(static_cast<double>(board_color[0]),
+                                          static_cast<double>(board_color[1]),
+                                          static_cast<double>(board_color[2])));
     // Books fill [0, size) exactly: the last one takes what is left.
     int x = 0;
     while (x < size) {

@@ -121,7 +121,7 @@ FrameFeatures FeatureExtractor::extract(const cv::Mat& grey, const cv::Mat& dept
       ideal = lens->ideal(pt.x, pt.y).cast<double>();
       f.keypoints[i].pt = cv::Point2f(static_cast<float>(ideal.x()), static_cast<float>(ideal.y()));
     }
-    double z = reliable_depth(depth_m, pt.x, pt.y);
+    double z = reliable_depth(depth_m, static_cast<double>(pt.x), static_cast<double>(pt.y));
     if (!(z > 0.0)) continue;
     if (!timed) {
       f.points[i] = camera.backproject(ideal.x(), ideal.y(), z);

@@ -50,7 +50,7 @@ TEST(Messages, ImuReadingKeepsThePartsItHasAndRefusesNanOrNothingNamingTheChanne
     EXPECT_NE(std::string(e.what()).find("IMU"), std::string::npos);
   }
   m = imu_message(s);
-  m.linear_acceleration[2] = INFINITY;
+  m.linear_acceleration[2] = static_cast<double>(INFINITY);
   EXPECT_THROW(imu_from_message(m, "IMU"), InputError);
   m = imu_message(s);
   m.fields = kestrel::imu_t::HAS_ACCEL;

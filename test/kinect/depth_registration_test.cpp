@@ -47,8 +47,8 @@ TEST(DepthWarp, IdentityChangesNothing) {
 TEST(DepthWarp, NearestSurfaceWinsAndHolesStayEmpty) {
   PinholeCamera c;  // fx = 525
   // Background at 3 m, a 40x40 px square at 1 m around the centre.
-  cv::Mat depth(480, 640, CV_32FC1, cv::Scalar(3.0f));
-  depth(cv::Rect(300, 220, 40, 40)).setTo(1.0f);
+  cv::Mat depth(480, 640, CV_32FC1, cv::Scalar(3.0));
+  depth(cv::Rect(300, 220, 40, 40)).setTo(1.0);
   // The target camera sits 0.1 m to the +x side: points move left by f b / z pixels,
   // 52.5 px at 1 m and 17.5 px at 3 m.
   Eigen::Isometry3d T_to_from = Eigen::Isometry3d::Identity();

@@ -175,7 +175,7 @@ TEST(Mapper, OutOfOrderFramesAndBadPosesAreInputErrors) {
   mapper.buffer_frame(frame);
   EXPECT_THROW(mapper.buffer_frame(frame), InputError);  // same utime again
   Eigen::Isometry3d nan_pose = Eigen::Isometry3d::Identity();
-  nan_pose.translation().x() = NAN;
+  nan_pose.translation().x() = static_cast<double>(NAN);
   EXPECT_THROW(mapper.insert(frame, nan_pose), InputError);
   RgbdFrame no_depth = frame;
   no_depth.depth_mm = cv::Mat();

@@ -130,7 +130,7 @@ TEST(MapNode, SlamGraphInsertsKeyframesAndPublishesRebuildsAtOnce) {
   graph.num_keyframes = 5;
   EXPECT_THROW(node.on_graph(graph, "SLAM_GRAPH"), InputError);
   graph.num_keyframes = 4;
-  graph.keyframes[0].T_world_camera.orientation[0] = NAN;
+  graph.keyframes[0].T_world_camera.orientation[0] = static_cast<double>(NAN);
   EXPECT_THROW(node.on_graph(graph, "SLAM_GRAPH"), InputError);
 }
 

@@ -52,7 +52,7 @@ TEST(MapQueries, SegmentsPassingTheBlock) {
   // Straight through the block.
   EXPECT_FALSE(q.segment_free({-0.5, 0.0, 0.0}, {0.8, 0.0, 0.0}, 0.0));
   // NaN endpoints are never free.
-  EXPECT_FALSE(q.segment_free({NAN, 0.0, 0.0}, {0.0, 0.0, 0.0}, 0.1));
+  EXPECT_FALSE(q.segment_free({static_cast<double>(NAN), 0.0, 0.0}, {0.0, 0.0, 0.0}, 0.1));
 }
 
 TEST(MapQueries, UnknownBlocksUnlessToldOtherwise) {

@@ -125,7 +125,9 @@ TEST(RealData, DiscretizedFreeCellsDifferFromExactAtSurfacesAndTheFrustumEdge) {
                            static_cast<size_t>(std::lround(px.x()));
       if (!scan.valid[pixel]) return 4;
       const octomap::point3d& p = scan.points[pixel];
-      const Eigen::Vector3d reading = T_camera_world * Eigen::Vector3d(p.x(), p.y(), p.z());
+      const Eigen::Vector3d reading =
+          T_camera_world *
+          Eigen::Vector3d(static_cast<double>(p.x()), static_cast<double>(p.y()), static_cast<double>(p.z()));
       return c.z() > reading.z() ? 3 : 2;
     };
     for (const Key& k : discrete.free)

@@ -24,7 +24,7 @@ TEST(GridEnvironment, FreeSpaceRespectsClearanceRadiusAndHeight) {
   EXPECT_FALSE(env.is_free({2.0, 2.0, 2.8}, 0.3));   // ceiling
   EXPECT_FALSE(env.is_free({-1.0, 2.0, 1.0}, 0.1));  // outside the map
   EXPECT_FALSE(env.is_free({0.05, 2.0, 1.0}, 0.1));  // map edge: beyond it is unknown
-  EXPECT_FALSE(env.is_free({NAN, 2.0, 1.0}, 0.1));
+  EXPECT_FALSE(env.is_free({static_cast<double>(NAN), 2.0, 1.0}, 0.1));
   EXPECT_NEAR(env.clearance({3.0, 2.0, 1.0}), 1.9, 0.1);
 }
 

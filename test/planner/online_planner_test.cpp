@@ -28,7 +28,7 @@ TEST(OnlinePlanner, AnswersWithStatusesForEveryBadCase) {
   EXPECT_EQ(none.plan(q).status, PlanAnswer::kNoMap);
   const OnlinePlanner p = floor_planner();
   PlanQuery bad = q;
-  bad.goal[0] = NAN;
+  bad.goal[0] = static_cast<double>(NAN);
   EXPECT_EQ(p.plan(bad).status, PlanAnswer::kBadRequest);
   bad = q;
   bad.start.reset();  // from the state, but there is none

@@ -96,7 +96,7 @@ TEST(RenderTest, PixelsBackProjectOntoTheSurfacesTheyShow) {
         if (id < 0) continue;
         ++seen;
         const Surface& s = world.surfaces()[id];
-        const double z = ideal.at<float>(v, u);
+        const double z = static_cast<double>(ideal.at<float>(v, u));
         const Eigen::Vector3d p = T * c.backproject(u, v, z);
         ASSERT_LT(std::abs(s.plane_distance(p)), 1e-4 * z + 1e-5) << "pixel " << u << ", " << v;
         const double ss = s.axis_s.dot(p - s.origin), tt = s.axis_t.dot(p - s.origin);

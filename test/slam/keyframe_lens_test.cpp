@@ -57,10 +57,11 @@ TEST(KeyframeLens, PointOnTheIdealRayWithDepthReadAtTheRawPixel) {
     const cv::Point2f raw = plain.keypoints[i].pt, ideal = f.keypoints[i].pt;
     // Zero distortion: the detected pixel and the pinhole ray through it, as always.
     if (plain.has_point(i)) {
-      EXPECT_EQ(plain.points[i], raw_camera.backproject(raw.x, raw.y, plain.points[i].z()));
+      EXPECT_EQ(plain.points[i], raw_camera.backproject(static_cast<double>(raw.x), static_cast<double>(raw.y),
+                                                        plain.points[i].z()));
     }
     // The ideal pixel is the one the lens maps to the raw keypoint (vo::Lens: within 0.01 px).
-    const Eigen::Vector2d back = camera.distort(ideal.x, ideal.y);
+    const Eigen::Vector2d back = camera.distort(static_cast<double>(ideal.x), static_cast<double>(ideal.y));
     EXPECT_NEAR(back.x(), raw.x, 1e-2) << "keypoint " << i;
     EXPECT_NEAR(back.y(), raw.y, 1e-2) << "keypoint " << i;
     largest_shift_px = std::max(largest_shift_px, double(std::hypot(ideal.x - raw.x, ideal.y - raw.y)));
@@ -100,7 +101,8 @@ TEST(KeyframeLens, RollingShutterTakesTheRawRowsTime) {
     ASSERT_EQ(still.has_point(i), timed.has_point(i));
     if (!timed.has_point(i)) continue;
     const Eigen::Vector3d expected =
-        test::carried_to_middle_row(still.points[i], plain.keypoints[i].pt.y, camera.height, readout, w);
+        test::carried_to_middle_row(still.points[i], static_cast<double>(plain.keypoints[i].pt.y), camera.height,
+                                    readout, w);
     EXPECT_NEAR((timed.points[i] - expected).norm(), 0.0, 5e-6) << "keypoint " << i;
     const Eigen::Vector2d pixel = camera.project(expected);
     EXPECT_NEAR(timed.keypoints[i].pt.x, pixel.x(), 2e-3);

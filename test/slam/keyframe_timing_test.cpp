@@ -78,7 +78,8 @@ TEST(KeyframeTiming, RollingShutterCarriesPointAndPixelToTheMiddleRow) {
     ASSERT_EQ(still.has_point(i), timed.has_point(i));
     if (!timed.has_point(i)) continue;
     const Eigen::Vector3d expected =
-        carried_to_middle_row(still.points[i], still.keypoints[i].pt.y, camera.height, readout, w);
+        carried_to_middle_row(still.points[i], static_cast<double>(still.keypoints[i].pt.y), camera.height,
+                              readout, w);
     EXPECT_NEAR((timed.points[i] - expected).norm(), 0.0, 2e-6) << "keypoint " << i;
     const Eigen::Vector2d pixel = camera.project(expected);
     EXPECT_NEAR(timed.keypoints[i].pt.x, pixel.x(), 2e-3);

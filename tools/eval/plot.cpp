@@ -107,7 +107,8 @@ void top_view(cv::Mat& img, const cv::Rect& area, const Evaluation& e, bool alig
     gt.emplace_back(p_gt.x(), p_gt.y());
     est.emplace_back(p_est.x(), p_est.y());
   }
-  double x0 = INFINITY, x1 = -INFINITY, y0 = INFINITY, y1 = -INFINITY;
+  double x0 = static_cast<double>(INFINITY), x1 = static_cast<double>(-INFINITY);
+  double y0 = static_cast<double>(INFINITY), y1 = static_cast<double>(-INFINITY);
   for (size_t i = 0; i < gt.size(); ++i) {
     if (!keep[i]) continue;
     for (const cv::Point2d& p : {gt[i], est[i]}) {
@@ -177,7 +178,7 @@ void time_series(cv::Mat& img, const cv::Rect& area, int64_t t0_us, double durat
     points.emplace_back(to_seconds(utimes[i] - t0_us), values[i]);
     keep.push_back(true);
   }
-  double frame_s = INFINITY;
+  double frame_s = static_cast<double>(INFINITY);
   for (size_t i = 1; i < points.size(); ++i)
     frame_s = std::min(frame_s, points[i].x - points[i - 1].x);
   for (size_t i = 1; i < points.size(); ++i) {
@@ -220,7 +221,7 @@ cv::Mat render_plot(const Evaluation& e, const EvalOptions& options, const std::
     if (is_gross(e.velocity.verdicts[k])) failures.push_back(frames[k].utime);
   }
   time_series(img, cv::Rect(90, 880, 860, 190), t0, duration, e.ate.utimes, e.ate.errors_m, {},
-              kEstimate, "ATE position error (m)", NAN);
+              kEstimate, "ATE position error (m)", static_cast<double>(NAN));
   time_series(img, cv::Rect(90, 1140, 860, 190), t0, duration, e.velocity.utimes,
               e.velocity.errors_mps, failures, kVelocity, "velocity error (m/s)",
               options.gross_velocity_mps);
