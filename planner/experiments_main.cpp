@@ -29,15 +29,15 @@ using namespace kestrel::planner;
 
 // All five pairs planned by PRM-uniform (red) and BRM-SU (blue) on the first trial's seed,
 // with 1-sigma ellipses at the nodes; the samples drawn are BRM-SU's of pair 1.
-cv::Mat draw_paths(const ExperimentWorld& w, const eval::Scenario& sc, const eval::ExperimentOptions& o) {
+cv::Mat draw_paths(const ExperimentWorld& w, const planner::eval::Scenario& sc, const planner::eval::ExperimentOptions& o) {
   const FeatureSensor fs(*w.env, sc.sensor);
   const BeliefModel model(sc.motion, [&](const Config& q) { return fs.information(q); });
-  std::vector<eval::DrawnPath> drawn;
+  std::vector<planner::eval::DrawnPath> drawn;
   std::vector<Config> samples;
   for (size_t p = 0; p < w.pairs.size(); ++p)
     for (const char* planner : {"prm", "brm"}) {
       const bool brm = planner[0] == 'b';
-      const eval::Trial t = eval::run_trial(sc, eval::Setting{planner, brm ? "su" : "uniform", o.samples},
+      const planner::eval::Trial t = planner::eval::run_trial(sc, planner::eval::Setting{planner, brm ? "su" : "uniform", o.samples},
                                             w.pairs[p].first, w.pairs[p].second, o.seed * 1000003ull + p * 1009ull);
       std::vector<Mat4> cov{sc.start_covariance};
       for (size_t i = 1; i < t.path.size(); ++i)
@@ -47,7 +47,7 @@ cv::Mat draw_paths(const ExperimentWorld& w, const eval::Scenario& sc, const eva
     }
   const Eigen::AlignedBox3d b = w.env->bounds();
   const double extent = std::max(b.sizes().x(), b.sizes().y());
-  return eval::draw_plans(*w.env, samples, drawn, sc.space.z_min_m, std::min(30.0, 2400.0 / extent));
+  return planner::eval::draw_plans(*w.env, samples, drawn, sc.space.z_min_m, std::min(30.0, 2400.0 / extent));
 }
 
 }  // namespace
@@ -55,10 +55,10 @@ cv::Mat draw_paths(const ExperimentWorld& w, const eval::Scenario& sc, const eva
 int main(int argc, char** argv) {
   cli::App app("plan-experiments",
                "Reproduces the paper's planner tables (BRM vs PRM, samplers) in the sim's floor, atrium and stata worlds");
-  eval::ExperimentOptions o;
+  planner::eval::ExperimentOptions o;
   std::string only = "all", out_path, which = "all", map_yaml = KESTREL_DEFAULT_STATA_MAP, png_dir;
   WorldFeatureOptions features;
-  eval::Scenario base;
+  planner::eval::Scenario base;
   app.add_option("--trials", o.trials, "Trials per start/goal pair and setting")->check(cli::Positive);
   app.add_option("--samples", o.samples, "Samples per roadmap")->check(cli::Positive);
   app.add_option("--seed", o.seed, "Seed of every random draw (features, samplers)");
@@ -113,7 +113,7 @@ int main(int argc, char** argv) {
          std::to_string(o.seed) + ".\n\n");
     // Table 3 is about the weight's cost per measurement count, not about a world.
     section("table3", "Table 3: cost of the sensor-uncertainty weight per sample",
-            [&] { return eval::table3_weight_cost(o.seed); });
+            [&] { return planner::eval::table3_weight_cost(o.seed); });
 
     std::vector<ExperimentWorld> worlds;
     if (which == "all" || which == "floor") worlds.push_back(floor_experiment_world(features, base.space.radius_m));
@@ -124,9 +124,9 @@ int main(int argc, char** argv) {
       else emit("## World stata\n\nSkipped: the map " + map_yaml + " is absent.\n\n");
     }
     for (const ExperimentWorld& w : worlds) {
-      eval::Scenario sc = base;
+      planner::eval::Scenario sc = base;
       sc.env = w.env.get();
-      const eval::Pairs pairs(w.pairs.begin(), w.pairs.end());
+      const planner::eval::Pairs pairs(w.pairs.begin(), w.pairs.end());
       const Eigen::AlignedBox3d b = w.env->bounds();
       std::ostringstream head;
       head << std::fixed << std::setprecision(1) << "## World " << w.name << "\n\n" << w.world->source() << ", "
@@ -137,22 +137,22 @@ int main(int argc, char** argv) {
       head << " m.\n\n";
       emit(head.str());
       section("table4", "Table 4: BRM success % · final tr(Σ) per sampler and path",
-              [&] { return eval::table4_samplers(sc, pairs, o); });
+              [&] { return planner::eval::table4_samplers(sc, pairs, o); });
       section("table5", "Table 5: planners and samplers (all five paths)",
-              [&] { return eval::table5_planners(sc, pairs, o); });
+              [&] { return planner::eval::table5_planners(sc, pairs, o); });
       section("fig7", "Fig. 7: one-step transfer with the UKF's M vs the full UKF update",
-              [&] { return eval::fig7_ukf_transfer(sc, o); });
+              [&] { return planner::eval::fig7_ukf_transfer(sc, o); });
       section("fig12", "Figs. 12/13: BRM-SU against the number of samples (paper camera)",
-              [&] { return eval::fig12_sample_counts(sc, pairs, o, {10, 30, 100, 300, 500}); });
+              [&] { return planner::eval::fig12_sample_counts(sc, pairs, o, {10, 30, 100, 300, 500}); });
       section("fig13", "Fig. 13: BRM-SU against the number of samples (Kinect model: 4 m, 57 x 43 deg)", [&] {
-        eval::Scenario kinect = sc;
+        planner::eval::Scenario kinect = sc;
         kinect.sensor = FeatureSensorOptions::kinect();
-        return eval::fig12_sample_counts(kinect, pairs, o, {10, 30, 100, 300});
+        return planner::eval::fig12_sample_counts(kinect, pairs, o, {10, 30, 100, 300});
       });
       section("laser", "Laser validation: shorter range, longer but localisable paths",
-              [&] { return eval::laser_experiment(sc, pairs, o, laser_ranges[0], laser_ranges[1], 1.0); });
+              [&] { return planner::eval::laser_experiment(sc, pairs, o, laser_ranges[0], laser_ranges[1], 1.0); });
       section("precision", "Transfer precision on every roadmap edge (relative tr(Σ) error vs step-by-step EKF)",
-              [&] { return eval::transfer_precision(sc, pairs, o); });
+              [&] { return planner::eval::transfer_precision(sc, pairs, o); });
       if (!png_dir.empty()) {
         const std::string path = (std::filesystem::path(png_dir) / (w.name + "_paths.png")).string();
         if (!cv::imwrite(path, draw_paths(w, sc, o))) throw InputError(path + ": cannot write");

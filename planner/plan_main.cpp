@@ -27,7 +27,7 @@ int main(int argc, char** argv) {
   cli::App app("plan", "Plans a well-localised path offline (Belief Roadmap, or PRM for comparison)");
   std::string map = "floor", planner = "brm", sampler = "su", sensor = "camera", png;
   std::vector<double> start{2.5, 2.5, 1.0, 0.0}, goal{10.5, 20.0, 1.0, 0.0};
-  eval::Scenario sc;
+  planner::eval::Scenario sc;
   int samples = 300;  // more than the paper's 100: BRM finds better-localised paths with more
   sc.roadmap = RoadmapOptions{};  // 6 m / 20 neighbours: the grown roadmap reaches 3000 samples
   sc.roadmap.max_samples = 3000;
@@ -89,7 +89,7 @@ int main(int argc, char** argv) {
     const ConfigurationSpace space(env, sc.space);
     if (!space.is_valid(q0)) throw CLI::ValidationError("--start", "start is not in free space");
     if (!space.is_valid(q1)) throw CLI::ValidationError("--goal", "goal is not in free space");
-    const eval::Trial t = eval::run_trial(sc, eval::Setting{planner, sampler, samples, dominance_slack}, q0, q1, seed);
+    const planner::eval::Trial t = planner::eval::run_trial(sc, planner::eval::Setting{planner, sampler, samples, dominance_slack}, q0, q1, seed);
     spdlog::info("{} features, build {:.3f} s, search {:.2f} ms", env.features().size(), t.build_s, 1e3 * t.search_s);
     if (!t.found) {
       std::cerr << "kestrel-plan: no path found with " << t.samples.size() << " samples\n";
@@ -106,8 +106,8 @@ int main(int argc, char** argv) {
       std::cout << t.path[i][0] << " " << t.path[i][1] << " " << t.path[i][2] << " " << t.path[i][3] << " "
                 << covariances[i].trace() << "\n";
     if (!png.empty()) {
-      eval::DrawnPath drawn{t.path, covariances, planner != "prm" ? cv::Scalar(200, 0, 0) : cv::Scalar(0, 0, 220)};
-      if (!cv::imwrite(png, eval::draw_plans(env, t.samples, {drawn}, sc.space.z_min_m))) throw InputError(png + ": cannot write");
+      planner::eval::DrawnPath drawn{t.path, covariances, planner != "prm" ? cv::Scalar(200, 0, 0) : cv::Scalar(0, 0, 220)};
+      if (!cv::imwrite(png, planner::eval::draw_plans(env, t.samples, {drawn}, sc.space.z_min_m))) throw InputError(png + ": cannot write");
     }
     return kExitOk;
   });
