@@ -108,9 +108,9 @@ TEST(EstimatorProcess, AnImuWithoutAGyroRunsVisualOnlyOrIsRefusedInImuModeAndThe
       "lcm-logger -q --lcm-url='" + std::string(transport::kDefaultLcmUrl) + "' -f " + logged +
       " & L=$!; " + kestrel::test::wait_for_lcm_listener_sh() + "; " + estimator + " -q & P=$!; " + replay + " " + in +
       " --expect estimator --record " + (dir / "visual.lcmlog").string() +
-      " >/dev/null || exit 11; sleep 0.3; kill -INT $P; wait $P; " + estimator + " -q --mode imu & P=$!; " +
+      " >/dev/null || exit 11; sleep 1.2; kill -INT $P; wait $P; " + estimator + " -q --mode imu & P=$!; " +
       replay + " " + in + " --expect estimator --record " + (dir / "imu.lcmlog").string() +
-      " >/dev/null; R=$?; sleep 0.3; kill -INT $P $L; wait $P; wait $L; exit $R";
+      " >/dev/null; R=$?; sleep 1.2; kill -INT $P $L; wait $P; wait $L; exit $R";
   const auto r = kestrel::test::run_isolated(script, 120.0);
   ASSERT_EQ(r.exit_code, 0) << r.err;
 
@@ -131,16 +131,20 @@ TEST(EstimatorProcess, AnImuWithoutAGyroRunsVisualOnlyOrIsRefusedInImuModeAndThe
   EXPECT_NEAR(p[2], 0.0, 1e-6);
 
   EXPECT_TRUE(transport::read_messages<kestrel::state_t>((dir / "imu.lcmlog").string(), channel::kState).empty());
+  // The health is announced when it changes and repeated every heartbeat period (1 s): a
+  // datagram lost on a loaded machine is made good by the next period's, which the 1.2 s
+  // before each stop leaves room for.
   bool ran_visual = false;
-  std::string last_degraded;
+  std::string last_degraded, heard;
   for (const auto& s : transport::read_messages<kestrel::process_status_t>(logged, channel::kProcessStatus)) {
     if (s.name != "estimator") continue;
+    heard += "\n  state " + std::to_string(s.state) + " '" + s.message + "'";
     if (s.state == kestrel::process_status_t::STATE_RUNNING && s.message.find("visual only") != std::string::npos)
       ran_visual = true;
     if (s.state == kestrel::process_status_t::STATE_DEGRADED) last_degraded = s.message;
   }
-  EXPECT_TRUE(ran_visual) << "no RUNNING heartbeat saying 'visual only'";
-  EXPECT_NE(last_degraded.find("lack the gyro"), std::string::npos) << "'" << last_degraded << "'";
+  EXPECT_TRUE(ran_visual) << "no RUNNING heartbeat saying 'visual only'; heard:" << heard;
+  EXPECT_NE(last_degraded.find("lack the gyro"), std::string::npos) << "'" << last_degraded << "'; heard:" << heard;
 }
 
 }  // namespace
