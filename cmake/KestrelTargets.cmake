@@ -120,6 +120,9 @@ function(kestrel_add_tools_executable)
     # the conditionals of the code come along as empty blocks.
     file(STRINGS ${main} includes
       REGEX "^[ \t]*#[ \t]*(include[ \t]*[<\"]|if|ifdef|ifndef|elif|else|endif)")
+    # The batch copies these lines: an edited main re-runs CMake, so that a new #include
+    # reaches the batch instead of failing inside the tool's namespace.
+    set_property(DIRECTORY APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS ${main})
     foreach(line IN LISTS includes)
       string(STRIP "${line}" line)
       string(APPEND batch_includes "${line}\n")

@@ -6,6 +6,7 @@
 #include <iomanip>
 #include <stdexcept>
 
+#include "common/atomic_file.h"
 #include "common/error.h"
 #include "common/geometry/se3.h"
 #include "common/text.h"
@@ -81,8 +82,9 @@ Trajectory read_tum_trajectory(const std::string& path) {
 }
 
 void write_tum_trajectory(const std::string& path, const Trajectory& trajectory) {
-  std::ofstream out(path);
-  if (!out) throw InputError(path + ": cannot write trajectory file");
+  // Atomically: a run that fails half-way leaves the previous trajectory, not a cut one.
+  AtomicFile file(path);
+  std::ostream& out = file.stream();
   out << "# timestamp tx ty tz qx qy qz qw\n" << std::setprecision(9);
   for (const StampedPose& p : trajectory.poses()) {
     const Eigen::Quaterniond q(p.T.linear());
@@ -90,8 +92,7 @@ void write_tum_trajectory(const std::string& path, const Trajectory& trajectory)
     out << format_seconds(p.utime) << ' ' << t.x() << ' ' << t.y() << ' ' << t.z() << ' ' << q.x()
         << ' ' << q.y() << ' ' << q.z() << ' ' << q.w() << '\n';
   }
-  out.flush();
-  if (!out) throw InputError(path + ": write failed");
+  file.commit();
 }
 
 }  // namespace kestrel

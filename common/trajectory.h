@@ -44,7 +44,8 @@ class Trajectory {
 /// value, a quaternion far from unit length, or a timestamp not after the previous one.
 Trajectory read_tum_trajectory(const std::string& path);
 
-/// Writes `trajectory` in TUM format; throws InputError if the file cannot be written.
+/// Writes `trajectory` in TUM format, atomically (common/atomic_file.h); throws InputError if
+/// the file cannot be written.
 void write_tum_trajectory(const std::string& path, const Trajectory& trajectory);
 
 }  // namespace kestrel

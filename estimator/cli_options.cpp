@@ -89,6 +89,29 @@ void add_estimator_options(CLI::App& app, EstimatorOptions& o) {
       ->check(positive)->capture_default_str();
   app.add_option("--vo-timeout", o.vo_timeout_s, "DEGRADED after this long without VO, s")
       ->check(positive)->capture_default_str();
+  app.add_option("--imu-max-accel", o.gates.max_accel,
+                 "Accelerometer range per axis, m/s^2 (16 g): a reading beyond it is refused")
+      ->check(positive)->capture_default_str();
+  app.add_option("--imu-max-rate", o.gates.max_gyro,
+                 "Gyro range per axis, rad/s (2000 deg/s): a reading beyond it is refused")
+      ->check(positive)->capture_default_str();
+  app.add_option("--max-time-jump", o.gates.max_time_jump_s,
+                 "A stamp further than this from the newest of its stream, ahead or back, is held "
+                 "as an outlier or a new time base, s")
+      ->check(CLI::Range(0.01, 1e6))->capture_default_str();
+  app.add_option("--resync-samples", o.gates.resync_samples,
+                 "Held stamps in a row, each within --max-time-jump of the one before, that restart "
+                 "the estimator on their new time base (at least 2: one is the outlier it guards against)")
+      ->check(CLI::Range(2, 100000))->capture_default_str();
+  app.add_option("--vo-max-speed", o.gates.vo_max_speed,
+                 "A VO motion faster than this over the time between its frames is refused, m/s")
+      ->check(positive)->capture_default_str();
+  app.add_option("--vo-max-rate", o.gates.vo_max_rate,
+                 "A VO rotation faster than this over the time between its frames is refused, rad/s")
+      ->check(positive)->capture_default_str();
+  app.add_option("--correction-max-jump", o.gates.correction_max_jump_m,
+                 "A SLAM correction further than this from the state at its time is refused, m")
+      ->check(positive)->capture_default_str();
   app.add_option("--gyro-noise", o.imu.gyro_noise_density, "rad/s/sqrt(Hz)")->check(positive)->capture_default_str();
   app.add_option("--accel-noise", o.imu.accel_noise_density, "m/s^2/sqrt(Hz)")->check(positive)->capture_default_str();
   app.add_option("--gyro-bias-walk", o.imu.gyro_bias_random_walk, "rad/s^2/sqrt(Hz)")->check(positive)->capture_default_str();

@@ -50,6 +50,13 @@ int run(const Options& o) {
             << "SLAM corrections: " << r.correction_messages << " (" << c.corrections_applied
             << " applied, " << c.corrections_too_old << " too old, " << c.world_alignments
             << " moved the world onto SLAM's)\n"
+            << "refused by the gates: IMU " << c.imu_accel_range + c.imu_gyro_range << " beyond the sensor's range, "
+            << c.imu_time_jumps << " time jumps (" << c.imu_resyncs << " new time bases); VO "
+            << c.vo_implausible << " implausible motion, " << c.vo_unknown_reference << " unknown reference, "
+            << c.vo_bad_covariance << " bad covariance, " << c.vo_time_jumps << " time jumps ("
+            << c.vo_resyncs << " new time bases); corrections " << c.corrections_implausible
+            << " implausible, " << c.corrections_bad_covariance << " bad covariance, "
+            << c.corrections_time_jumps << " time jumps\n"
             << "messages skipped: " << r.skips.rejected << "\n"
             << "filter restarts: " << c.filter_failures << "\n"
             << "started: " << (visual ? "on the first VO update" : c.moving_starts > 0 ? "on the move" : "still") << " at "

@@ -11,27 +11,38 @@ namespace kestrel::estimator {
 Estimator::Estimator(const EstimatorOptions& options)
     : options_(options),
       filter_(make_filter(options.filter, options.imu, options.gravity, options.unscented)),
-      initializer_(options.init, options.gravity) {}
+      initializer_(options.init, options.gravity),
+      imu_clock_(options.gates) {}
 
 Estimator::~Estimator() = default;
 
 void Estimator::reset() {
+  clear_state();
+  imu_clock_.reset();
+  last_vo_utime_ = -1;
+  last_rejection_.reset();  // a replay's new session must not show the last one's refusals
+  last_resync_.clear();
+  ++counters_.resets;
+}
+
+void Estimator::clear_state() {
   history_.clear();
   events_.clear();
   clone_specs_.clear();
   initializer_.reset();
-  last_imu_utime_ = -1;
-  last_vo_utime_ = -1;
   last_retired_vo_applied_ = -1;
   settling_ = false;
   correction_since_start_ = false;
-  ++counters_.resets;
+  first_vo_utime_ = -1;
+  references_.clear();
+  newest_reference_ = -1;
 }
 
 void Estimator::initialize(const NavState& nav, const Matrix15d& P, const ImuSample& sample) {
   reset();
   --counters_.resets;  // not a reset the user asked for
   start(nav, P, sample);
+  imu_clock_.start_at(sample.utime);
 }
 
 void Estimator::start(const NavState& nav, const Matrix15d& P, const ImuSample& sample) {
@@ -41,26 +52,35 @@ void Estimator::start(const NavState& nav, const Matrix15d& P, const ImuSample& 
   s.state.mean.nav = nav;
   s.state.P = P;
   history_.push_back() = s;
-  last_imu_utime_ = sample.utime;
 }
 
 Verdict Estimator::add_imu(const ImuSample& sample) {
   try {
     validate_imu(sample, "IMU");
-  } catch (const InputError&) {
-    ++counters_.imu_invalid;
-    return Verdict::kInvalid;
+  } catch (const InputError& e) {
+    return refuse(Verdict::kInvalid, Reason::kImuInvalid, e.what());
   }
-  if (last_imu_utime_ >= 0 && sample.utime <= last_imu_utime_) {
-    if (sample.utime == last_imu_utime_) {
-      ++counters_.imu_duplicate;
-      return Verdict::kDuplicate;
-    }
-    ++counters_.imu_out_of_order;
-    return Verdict::kOutOfOrder;
+  const int64_t newest = imu_clock_.newest();
+  switch (imu_clock_.check(sample.utime, sample)) {
+    case TimeBase<ImuSample>::Step::kNext: return take_imu(sample);
+    case TimeBase<ImuSample>::Step::kDuplicate: ++counters_.imu_duplicate; return Verdict::kDuplicate;
+    case TimeBase<ImuSample>::Step::kOutOfOrder: ++counters_.imu_out_of_order; return Verdict::kOutOfOrder;
+    case TimeBase<ImuSample>::Step::kResync: ++counters_.imu_time_jumps; return resync_imu(newest);
+    case TimeBase<ImuSample>::Step::kJump: break;
   }
+  return refuse(Verdict::kTimeJump, Reason::kImuTimeJump,
+                time_jump(options_.gates, "IMU: sample", sample.utime, newest) + ": held as a possible new time base (" +
+                    std::to_string(imu_clock_.resync_samples()) + " in a row restart the filter on it)");
+}
+
+Verdict Estimator::take_imu(const ImuSample& sample) {
+  // The clock has moved to this sample's stamp whatever its reading: a spike does not make
+  // the next sample look like a jump.
+  if (std::string why = accel_beyond_range(options_.gates, sample.accel, sample.utime, "IMU"); !why.empty())
+    return refuse(Verdict::kImplausible, Reason::kImuAccelRange, std::move(why));
+  if (std::string why = gyro_beyond_range(options_.gates, sample.gyro, sample.utime, "IMU"); !why.empty())
+    return refuse(Verdict::kImplausible, Reason::kImuGyroRange, std::move(why));
   ++counters_.imu_accepted;
-  last_imu_utime_ = sample.utime;
   if (!initialized()) {
     const auto init = initializer_.add(sample);
     counters_.init_restarts = initializer_.restarts();
@@ -82,10 +102,8 @@ Verdict Estimator::add_imu(const ImuSample& sample) {
     history_.pop_back();
     // Divergence (absurd input or a bug): start over rather than publish garbage.
     ++counters_.filter_failures;
-    const int64_t keep = last_imu_utime_;
-    reset();
-    --counters_.resets;
-    last_imu_utime_ = keep;
+    clear_state();
+    last_vo_utime_ = -1;
     return Verdict::kAccepted;
   }
   trim();
@@ -103,15 +121,19 @@ Verdict Estimator::add_imu(const ImuSample& sample) {
 
 Verdict Estimator::add_vo(const VoUpdate& u) {
   ++counters_.vo_received;
+  if (const InputFault f = check_vo(u, options_.vo_noise.source == VoNoiseOptions::Source::kReported, "VO_UPDATE"))
+    return refuse(Verdict::kInvalid,
+                  f.kind == InputFault::Kind::kCovariance ? Reason::kVoCovariance : Reason::kVoInvalid, f.what);
+  // The IMU is the clock: VO from beyond the jump bound ahead of it would otherwise wait
+  // there, and every later update be out of order against it.
+  const int64_t now = imu_clock_.newest();
+  if (now >= 0 && too_far_ahead(u.utime, now, imu_clock_.max_jump_us()))
+    return refuse(Verdict::kTimeJump, Reason::kVoTimeJump,
+                  time_jump(options_.gates, "VO_UPDATE: update", u.utime, now) + " (the IMU's)");
+  if (first_vo_utime_ < 0) first_vo_utime_ = u.utime;  // a failed frame is a frame too
   if (!u.ok) {
     ++counters_.vo_failed;
     return Verdict::kNoMeasurement;
-  }
-  try {
-    validate_vo(u, options_.vo_noise.source == VoNoiseOptions::Source::kReported, "VO_UPDATE");
-  } catch (const InputError&) {
-    ++counters_.vo_invalid;
-    return Verdict::kInvalid;
   }
   if (last_vo_utime_ >= 0 && u.utime <= last_vo_utime_) {
     if (u.utime == last_vo_utime_) {
@@ -121,16 +143,26 @@ Verdict Estimator::add_vo(const VoUpdate& u) {
     ++counters_.vo_out_of_order;
     return Verdict::kOutOfOrder;
   }
+  if (std::string why = implausible_motion(options_.gates, u, "VO_UPDATE"); !why.empty())
+    return refuse(Verdict::kImplausible, Reason::kVoImplausible, std::move(why));
   last_vo_utime_ = u.utime;
   if (!initialized()) {
     ++counters_.vo_before_init;
     initializer_.add_vo(u);  // motion the IMU cannot see rules a still start out
+    remember_reference(u.reference_utime);
     return Verdict::kNotInitialized;
   }
   if (u.utime <= oldest_utime()) {
     ++counters_.vo_too_old;
     return Verdict::kTooOld;
   }
+  if (!reference_known(u.reference_utime))
+    return refuse(Verdict::kUnknownReference, Reason::kVoUnknownReference,
+                  "VO_UPDATE: update at utime " + std::to_string(u.utime) + " is against frame " +
+                      std::to_string(u.reference_utime) +
+                      ", which this estimator cannot place: older than its history, not a frame the VO "
+                      "referenced before, nor its keyframe from before this estimator's first update");
+  remember_reference(u.reference_utime);
   int64_t replay_time = u.utime;
   if (clone_specs_.find(u.reference_utime) == clone_specs_.end()) {
     CloneSpec spec;
@@ -165,12 +197,15 @@ Verdict Estimator::add_vo(const VoUpdate& u) {
 
 Verdict Estimator::add_correction(const PoseCorrection& c) {
   ++counters_.corrections_received;
-  try {
-    validate_correction(c, "SLAM_CORRECTION");
-  } catch (const InputError&) {
-    ++counters_.corrections_invalid;
-    return Verdict::kInvalid;
-  }
+  if (const InputFault f = check_correction(c, "SLAM_CORRECTION"))
+    return refuse(Verdict::kInvalid,
+                  f.kind == InputFault::Kind::kCovariance ? Reason::kCorrectionCovariance
+                                                          : Reason::kCorrectionInvalid,
+                  f.what);
+  const int64_t now = imu_clock_.newest();
+  if (now >= 0 && too_far_ahead(c.utime, now, imu_clock_.max_jump_us()))
+    return refuse(Verdict::kTimeJump, Reason::kCorrectionTimeJump,
+                  time_jump(options_.gates, "SLAM_CORRECTION: correction", c.utime, now) + " (the IMU's)");
   if (!initialized()) {
     ++counters_.corrections_before_init;
     return Verdict::kNotInitialized;
@@ -179,6 +214,15 @@ Verdict Estimator::add_correction(const PoseCorrection& c) {
     ++counters_.corrections_too_old;
     return Verdict::kTooOld;
   }
+  // The first correction since a start may be anywhere: it is how a restarted filter moves
+  // onto SLAM's world (align below), which in a large map is far from its own origin.
+  const bool first_takes_slams_world = !correction_since_start_ && options_.world_align_chi2 > 0.0;
+  if (const double jump_m = (c.T_world_body.translation() - pose_at(c.utime).translation()).norm();
+      !first_takes_slams_world && !(jump_m <= options_.gates.correction_max_jump_m))
+    return refuse(Verdict::kImplausible, Reason::kCorrectionImplausible,
+                  "SLAM_CORRECTION: correction at utime " + std::to_string(c.utime) + " is " +
+                      short_number(jump_m) + " m from the state there, beyond --correction-max-jump " +
+                      short_number(options_.gates.correction_max_jump_m) + " m");
   for (Event& e : events_) {
     if (e.kind != EventKind::kCorrection || e.utime != c.utime) continue;
     if (c.revision <= e.correction.revision) {
@@ -210,21 +254,13 @@ Verdict Estimator::add_correction(const PoseCorrection& c) {
 
 bool Estimator::align_world(const PoseCorrection& c) {
   if (!(options_.world_align_chi2 > 0.0)) return false;
-  size_t k = history_.size() - 1;
-  while (k > 0 && history_[k].imu.utime > c.utime) --k;
-  const FilterState& s = history_[k].state;
+  const FilterState& s = history_[snapshot_before(c.utime)].state;
   const Matrix6d noise = correction_noise(options_, c);
   const AbsolutePoseMeasurement m(c.T_world_body, noise);
   if (innovation(m, s).mahalanobis2() <= options_.world_align_chi2) return false;
   // The pose at the correction's time, between the IMU samples either side, is put on the
   // correction's position and yaw exactly: the correction is not fused afterwards (kAligned).
-  Eigen::Isometry3d T = s.mean.nav.T_world_body();
-  if (k + 1 < history_.size() && history_[k].imu.utime < c.utime) {
-    const int64_t t0 = history_[k].imu.utime, t1 = history_[k + 1].imu.utime;
-    T = se3::interpolate(T, history_[k + 1].state.mean.nav.T_world_body(),
-                         static_cast<double>(c.utime - t0) / static_cast<double>(t1 - t0));
-  }
-  const Eigen::Isometry3d change = world_change(T, c.T_world_body);
+  const Eigen::Isometry3d change = world_change(pose_at(c.utime), c.T_world_body);
   // The change is as uncertain as SLAM's pose; the filter's own uncertainty in its old world
   // stays in P too (a new filter's millimetres: conservative by that much).
   const Eigen::Matrix4d sigma = world_change_covariance(c.T_world_body, noise);

@@ -24,6 +24,18 @@
 // (the filter, not the VO, is then the likely culprit); IMU samples that repeat or go
 // back in time are dropped; VO failures only count (the filter keeps predicting and its
 // covariance grows); gaps in the IMU add noise; everything is counted in counters().
+//
+// Gates (input_gate.h, InputGateOptions), before any input reaches the filter: IMU readings
+// beyond the sensor's range; stamps beyond max_time_jump_s of the IMU's clock (an isolated
+// one is dropped; resync_samples in a row on a new base restart the filter there with the
+// samples held, unless they are ahead by no more than the history: a gap, bridged); VO and
+// corrections stamped that far ahead of the IMU; VO motions faster than vo_max_speed /
+// vo_max_rate over the time between their frames; corrections further than
+// correction_max_jump_m from the state at their time; and VO updates against a reference the
+// estimator cannot place: one older than the history that is neither a frame referenced
+// before nor the keyframe the VO held before this estimator's first VO update. A refused
+// input leaves the state as it was; it is counted by its reason and kept as
+// last_rejection() for the operator.
 
 #include <cmath>
 #include <cstdint>
@@ -31,11 +43,13 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "common/geometry/se3.h"
 #include "estimator/filter.h"
 #include "estimator/initializer.h"
+#include "estimator/input_gate.h"
 #include "estimator/inputs.h"
 #include "estimator/options.h"
 #include "estimator/ring.h"
@@ -63,7 +77,11 @@ enum class Verdict {
   kTooOld,           ///< before the kept history
   kNotInitialized,   ///< arrived before the filter had a state
   kNoMeasurement,    ///< a VO failure: nothing to fuse, counted
+  kImplausible,      ///< beyond the sensor's range, or a motion or correction no vehicle makes
+  kTimeJump,         ///< stamped beyond max_time_jump_s of the estimator's clock
+  kUnknownReference, ///< a VO update against a frame the estimator cannot place
 };
+
 
 struct EstimatorCounters {
   int64_t imu_accepted = 0, imu_invalid = 0, imu_duplicate = 0, imu_out_of_order = 0;
@@ -79,6 +97,14 @@ struct EstimatorCounters {
   int64_t moving_starts = 0;  ///< initialisations on the move (no still window)
   int64_t world_alignments = 0;  ///< first corrections that moved the filter's world onto SLAM's
   int64_t gravity_updates = 0;  ///< visual only: frames levelled by the accelerometer
+  // Refused by the gates (input_gate.h), by reason; the *_invalid above count all malformed
+  // inputs (non-finite, not rigid), the *_bad_covariance below those of them for the covariance.
+  int64_t imu_accel_range = 0, imu_gyro_range = 0;  ///< beyond the sensor's range
+  int64_t imu_time_jumps = 0;  ///< stamps held as beyond max_time_jump_s (a new base's, a bridged gap's included)
+  int64_t imu_resyncs = 0;     ///< restarts on a new time base of the IMU
+  int64_t vo_bad_covariance = 0, vo_time_jumps = 0, vo_unknown_reference = 0, vo_implausible = 0;
+  int64_t vo_resyncs = 0;      ///< visual only: restarts on a new time base of the VO
+  int64_t corrections_bad_covariance = 0, corrections_time_jumps = 0, corrections_implausible = 0;
 };
 
 class Estimator {
@@ -108,6 +134,14 @@ class Estimator {
   const FilterState* filter_state() const;
   EstimatorCounters counters() const;
   const EstimatorOptions& options() const { return options_; }
+  /// The newest IMU stamp taken (the estimator's time); -1 before the first.
+  int64_t now_utime() const { return imu_clock_.newest(); }
+  /// The latest refused input, and how many were refused in all (never reset).
+  const std::optional<Rejection>& last_rejection() const { return last_rejection_; }
+  int64_t refusals() const { return refusals_; }
+  /// Restarts on a new time base of the IMU so far, and what the latest was ("" before one).
+  int64_t resyncs() const { return counters_.imu_resyncs; }
+  const std::string& last_resync() const { return last_resync_; }
 
  private:
   struct CloneSpec {
@@ -136,6 +170,19 @@ class Estimator {
   };
 
   void start(const NavState& nav, const Matrix15d& P, const ImuSample& sample);
+  /// Drops the filter's states, events and references, keeping the clocks and counters.
+  void clear_state();
+  /// A sample past the clock's gate: the range gate, then the filter.
+  Verdict take_imu(const ImuSample& sample);
+  /// Restarts the filter on the IMU's new time base, with the samples held on it.
+  Verdict resync_imu(int64_t old_newest);
+  Verdict refuse(Verdict verdict, Reason reason, std::string what);
+  bool reference_known(int64_t reference_utime) const;
+  void remember_reference(int64_t reference_utime);
+  /// The snapshot at or before `utime` (the oldest if all are after), and the body pose there,
+  /// interpolated to `utime` between it and the next.
+  size_t snapshot_before(int64_t utime) const;
+  Eigen::Isometry3d pose_at(int64_t utime) const;
   void insert_event(Event event);
   void replay_from(int64_t utime);
   void step(const Snapshot& previous, Snapshot& next);
@@ -156,8 +203,14 @@ class Estimator {
   std::deque<Event> events_;
   std::map<int64_t, CloneSpec> clone_specs_;  // by VO reference utime
   int64_t next_seq_ = 0;
-  int64_t last_imu_utime_ = -1;
+  TimeBase<ImuSample> imu_clock_;  // the estimator's time
   int64_t last_vo_utime_ = -1;
+  int64_t first_vo_utime_ = -1;  // of the first VO update since the start (its keyframe may be older)
+  std::deque<int64_t> references_;  // the latest VO references taken, newest last
+  int64_t newest_reference_ = -1;
+  std::optional<Rejection> last_rejection_;
+  int64_t refusals_ = 0;
+  std::string last_resync_;
   int64_t last_retired_vo_applied_ = -1;
   bool settling_ = false;
   bool correction_since_start_ = false;  // only the first correction may align the world

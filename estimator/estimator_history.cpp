@@ -29,11 +29,7 @@ void Estimator::replay_from(int64_t utime) {
   counters_.replayed_steps += static_cast<int64_t>(history_.size() - j - 1);
   if (!history_.back().state.is_valid()) {
     ++counters_.filter_failures;
-    const int64_t keep_imu = last_imu_utime_, keep_vo = last_vo_utime_;
-    reset();
-    --counters_.resets;
-    last_imu_utime_ = keep_imu;
-    last_vo_utime_ = keep_vo;
+    clear_state();  // the clocks stay: the inputs go on
   }
 }
 

@@ -42,24 +42,35 @@ void validate_imu(const ImuSample& s, const std::string& what) {
   if (s.utime < 0) throw InputError(what + ": negative utime " + std::to_string(s.utime));
 }
 
-void validate_vo(const VoUpdate& u, bool need_covariance, const std::string& what) {
-  if (!u.ok) return;  // a failure carries nothing to check
+InputFault check_vo(const VoUpdate& u, bool need_covariance, const std::string& what) {
+  using Kind = InputFault::Kind;
+  if (!u.ok) return {};  // a failure carries nothing to check
+  const std::string at = what + ": update at utime " + std::to_string(u.utime);
   if (!finite_pose(u.T_refcam_curcam) || !finite_pose(u.T_body_camera))
-    throw InputError(what + ": non-finite or non-rigid pose at utime " + std::to_string(u.utime));
+    return {Kind::kPose, at + ": non-finite or non-rigid pose"};
   if (u.reference_utime >= u.utime)
-    throw InputError(what + ": reference utime " + std::to_string(u.reference_utime) +
-                     " is not before the frame's " + std::to_string(u.utime));
+    return {Kind::kPose, at + ": reference utime " + std::to_string(u.reference_utime) +
+                             " is not before the frame's"};
   if (!symmetric_psd(u.covariance, !need_covariance))
-    throw InputError(what + ": covariance is not symmetric positive definite at utime " +
-                     std::to_string(u.utime));
+    return {Kind::kCovariance, at + ": covariance is not symmetric positive definite"};
+  return {};
+}
+
+InputFault check_correction(const PoseCorrection& c, const std::string& what) {
+  using Kind = InputFault::Kind;
+  const std::string at = what + ": correction at utime " + std::to_string(c.utime);
+  if (!finite_pose(c.T_world_body)) return {Kind::kPose, at + ": non-finite or non-rigid pose"};
+  if (!symmetric_psd(c.covariance, true))
+    return {Kind::kCovariance, at + ": covariance is not symmetric positive definite"};
+  return {};
+}
+
+void validate_vo(const VoUpdate& u, bool need_covariance, const std::string& what) {
+  if (const InputFault f = check_vo(u, need_covariance, what)) throw InputError(f.what);
 }
 
 void validate_correction(const PoseCorrection& c, const std::string& what) {
-  if (!finite_pose(c.T_world_body))
-    throw InputError(what + ": non-finite or non-rigid pose at utime " + std::to_string(c.utime));
-  if (!symmetric_psd(c.covariance, true))
-    throw InputError(what + ": covariance is not symmetric positive definite at utime " +
-                     std::to_string(c.utime));
+  if (const InputFault f = check_correction(c, what)) throw InputError(f.what);
 }
 
 }  // namespace kestrel::estimator

@@ -37,6 +37,18 @@ Matrix6d vo_noise(const VoNoiseOptions& options, const VoUpdate& update);
 /// carries none (all zero).
 Matrix6d correction_noise(const EstimatorOptions& options, const PoseCorrection& correction);
 
+/// What makes an input unusable, for counting by reason: its pose (non-finite, not rigid, a
+/// reference not before its frame) or its covariance (non-finite, not symmetric positive
+/// definite). `what` is the one-line reason, naming the stream and the input's utime.
+struct InputFault {
+  enum class Kind { kNone, kPose, kCovariance };
+  Kind kind = Kind::kNone;
+  std::string what;
+  explicit operator bool() const { return kind != Kind::kNone; }
+};
+InputFault check_vo(const VoUpdate& update, bool need_covariance, const std::string& what);
+InputFault check_correction(const PoseCorrection& correction, const std::string& what);
+
 /// Throws InputError (naming `what`) unless the input is usable: finite values, a proper
 /// rotation, a symmetric positive semi-definite covariance (all zero allowed where noted).
 void validate_imu(const ImuSample& sample, const std::string& what);

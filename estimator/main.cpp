@@ -28,6 +28,8 @@ struct Options {
 
 // Health follows the estimator: RUNNING while VO is being fused, DEGRADED without it (the IMU
 // filter on the IMU alone, the visual-only one predicting), or on an IMU the mode cannot use.
+// A refused input is rethrown to the Node, which counts it and shows DEGRADED with its reason
+// (common/transport/node.h), as for every process.
 void report_health(transport::Node& node, const StateEstimator& estimator) {
   const auto out = estimator.output();
   const bool visual = estimator.mode() == EstimatorMode::kVisualOnly;
@@ -71,30 +73,44 @@ int run(const Options& o) {
       node->publish(channel::kState,
                     state_to_message(*r.state, estimator.mode(), o.estimator.filter, seq++));
   };
+  // After each input: the health, and an input the gates refused goes back to Node as bad
+  // input, which counts it in PROCESS_STATUS and logs it, rate-limited per channel. A restart
+  // on a new time base is logged (the first few, then one in a hundred).
+  int64_t refusals = 0, resyncs = 0;
+  auto after_input = [&] {
+    report_health(*node, estimator);
+    if (estimator.resyncs() > resyncs) {
+      resyncs = estimator.resyncs();
+      if (resyncs <= 5 || resyncs % 100 == 0)
+        spdlog::warn("restart #{} on a new time base: {}", resyncs, estimator.last_resync());
+    }
+    if (estimator.refusals() > refusals) {
+      refusals = estimator.refusals();
+      if (const auto& refused = estimator.last_rejection()) throw InputError(refused->what);
+    }
+  };
 
   node->subscribe<kestrel::imu_t>(channel::kImu, [&](const kestrel::imu_t& m) {
     const ImuReading r = imu_from_message(m, channel::kImu);  // throws: Node counts and logs
     const StepResult step = estimator.add_imu(r);
     if (step.verdict == Verdict::kDuplicate || step.verdict == Verdict::kOutOfOrder)
       spdlog::debug("IMU: sample at utime {} dropped (duplicate or out of order)", r.utime);
-    report_health(*node, estimator);
     publish(step);
+    after_input();
   }, 400);
   node->subscribe<kestrel::vo_update_t>(channel::kVoUpdate, [&](const kestrel::vo_update_t& m) {
+    // The library checks the update (and counts what it refuses, by reason).
     const VoUpdate u = vo_from_message(m, channel::kVoUpdate);
-    validate_vo(u, o.estimator.vo_noise.source == VoNoiseOptions::Source::kReported,
-                channel::kVoUpdate);
     const StepResult step = estimator.add_vo(u);
     if (step.verdict == Verdict::kDuplicate || step.verdict == Verdict::kOutOfOrder ||
         step.verdict == Verdict::kTooOld)
       spdlog::debug("VO_UPDATE: update at utime {} dropped (duplicate, out of order or too old)", u.utime);
-    if (estimator.mode() == EstimatorMode::kVisualOnly) report_health(*node, estimator);
     publish(step);
+    after_input();
   });
   node->subscribe<kestrel::slam_correction_t>(channel::kSlamCorrection,
                                               [&](const kestrel::slam_correction_t& m) {
     const PoseCorrection c = correction_from_message(m, channel::kSlamCorrection);
-    validate_correction(c, channel::kSlamCorrection);
     const int64_t aligned = estimator.counters().world_alignments;
     if (estimator.add_correction(c) == Verdict::kTooOld)
       spdlog::warn("SLAM_CORRECTION: correction for utime {} is outside the {} s history; dropped",
@@ -102,6 +118,7 @@ int run(const Options& o) {
     if (estimator.counters().world_alignments > aligned)
       spdlog::warn("SLAM_CORRECTION: the first correction is far from this filter's world (a "
                    "restart while SLAM ran on?): the filter moved its world onto SLAM's");
+    after_input();
   });
 
   const int code = node->spin();
@@ -112,6 +129,14 @@ int run(const Options& o) {
                c.imu_accepted, c.imu_duplicate, c.imu_out_of_order, c.imu_gaps, c.vo_applied,
                c.vo_failed, c.vo_gated, c.vo_forced, c.vo_duplicate + c.vo_out_of_order + c.vo_too_old,
                c.corrections_applied, c.corrections_too_old, c.world_alignments, c.filter_failures);
+  spdlog::info("refused: IMU {} invalid, {} beyond the accelerometer's range, {} beyond the gyro's, "
+               "{} time jumps ({} new time bases); VO {} invalid, {} bad covariance, {} implausible "
+               "motion, {} unknown reference, {} time jumps ({} new time bases); corrections {} "
+               "invalid, {} bad covariance, {} implausible, {} time jumps",
+               c.imu_invalid, c.imu_accel_range, c.imu_gyro_range, c.imu_time_jumps, c.imu_resyncs,
+               c.vo_invalid, c.vo_bad_covariance, c.vo_implausible, c.vo_unknown_reference,
+               c.vo_time_jumps, c.vo_resyncs, c.corrections_invalid, c.corrections_bad_covariance,
+               c.corrections_implausible, c.corrections_time_jumps);
   return code;
 }
 

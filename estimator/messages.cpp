@@ -34,7 +34,8 @@ VoUpdate vo_from_message(const kestrel::vo_update_t& m, const std::string& chann
   u.reference_utime = m.reference_utime;
   u.ok = m.status == kestrel::vo_update_t::STATUS_OK;
   if (!u.ok) return u;  // a failure's pose and covariance are meaningless
-  const std::string what = channel + " (utime " + std::to_string(m.utime) + ")";
+  // "CHANNEL: ..." as every rejection reads (Node drops the channel it names first).
+  const std::string what = channel + ": update at utime " + std::to_string(m.utime);
   u.T_refcam_curcam = transport::from_message(m.T_reference_current, what.c_str());
   u.T_body_camera = transport::from_message(m.T_body_camera, what.c_str());
   u.covariance = transport::covariance_from(m.covariance);
@@ -43,7 +44,7 @@ VoUpdate vo_from_message(const kestrel::vo_update_t& m, const std::string& chann
 
 PoseCorrection correction_from_message(const kestrel::slam_correction_t& m,
                                        const std::string& channel) {
-  const std::string what = channel + " (utime " + std::to_string(m.utime) + ")";
+  const std::string what = channel + ": correction at utime " + std::to_string(m.utime);
   PoseCorrection c;
   c.utime = m.utime;
   c.revision = m.graph_revision;

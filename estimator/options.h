@@ -83,8 +83,30 @@ struct VisualOnlyOptions {
   double no_imu_after_s = 1.0;  ///< s
 };
 
+/// What an input may say before either estimator takes it (estimator/input_gate.h). The
+/// sensor bounds are a typical MEMS IMU's full scale; a reading beyond them is no measurement
+/// (a spike, a corrupt sample) and is refused, not clipped.
+struct InputGateOptions {
+  double max_accel = 16.0 * kStandardGravity;  ///< m/s^2 per axis: +-16 g (156.9 m/s^2)
+  double max_gyro = 2000.0 * 3.14159265358979323846 / 180.0;  ///< rad/s per axis: +-2000 deg/s (34.9 rad/s)
+  /// s: a stamp further than this from the newest of its stream, ahead or back, is held
+  /// rather than taken: an outlier, or the first of a new time base (a driver restarted).
+  double max_time_jump_s = 1.0;
+  /// Held stamps in a row, each within max_time_jump_s after the one before, that make a new
+  /// time base: the estimator then restarts on it (its old states mean nothing there).
+  int resync_samples = 10;
+  /// The body's motion in a VO update, over the time between its frames: faster than this
+  /// is no vehicle's (the tests' aggressive motion stays under 3 m/s and 2 rad/s).
+  double vo_max_speed = 25.0;  ///< m/s
+  double vo_max_rate = 10.0;   ///< rad/s
+  /// m: a SLAM correction further than this from the state at its time is refused (a loop
+  /// closure moves metres; a first correction moving the world moves across the map).
+  double correction_max_jump_m = 100.0;
+};
+
 struct EstimatorOptions {
   EstimatorMode mode = EstimatorMode::kAuto;
+  InputGateOptions gates;
   VisualOnlyOptions visual_only;
   FilterKind filter = FilterKind::kEkf;
   gaussian::UnscentedParams unscented;

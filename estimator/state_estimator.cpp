@@ -1,5 +1,8 @@
 #include "estimator/state_estimator.h"
 
+#include <cmath>
+#include <cstdlib>
+
 namespace kestrel::estimator {
 
 StateEstimator::StateEstimator(const EstimatorOptions& options)
@@ -10,8 +13,23 @@ void StateEstimator::reset() {
   imu_filter_.reset();
   visual_.reset();
   first_vo_utime_ = -1;
+  last_undecided_vo_utime_ = -1;
   first_state_utime_ = -1;
   world_taken_ = false;
+}
+
+void StateEstimator::note_resync(int64_t resyncs_before) {
+  if (resyncs() == resyncs_before) return;
+  first_state_utime_ = -1;
+  world_taken_ = false;
+}
+
+const std::optional<Rejection>& StateEstimator::last_rejection() const {
+  return mode_ == EstimatorMode::kVisualOnly ? visual_.last_rejection() : imu_filter_.last_rejection();
+}
+
+const std::string& StateEstimator::last_resync() const {
+  return mode_ == EstimatorMode::kVisualOnly ? visual_.last_resync() : imu_filter_.last_resync();
 }
 
 void StateEstimator::note_first_state(const std::optional<EstimatorOutput>& state) {
@@ -41,7 +59,9 @@ StepResult StateEstimator::add_imu(const ImuReading& r) {
     result.verdict = Verdict::kInvalid;
     return result;
   }
+  const int64_t resyncs_before = resyncs();
   result.verdict = imu_filter_.add_imu(r.sample());
+  note_resync(resyncs_before);
   if (result.verdict == Verdict::kAccepted) {
     if (auto out = imu_filter_.output(); out && out->utime == r.utime) {
       note_first_state(out);
@@ -54,8 +74,13 @@ StepResult StateEstimator::add_imu(const ImuReading& r) {
 StepResult StateEstimator::add_vo(const VoUpdate& u) {
   StepResult result;
   if (mode_ == EstimatorMode::kAuto) {  // still undecided: no IMU reading has come
-    if (first_vo_utime_ < 0) first_vo_utime_ = u.utime;
-    const double span_s = static_cast<double>(u.utime - first_vo_utime_) * 1e-6;
+    // The span counts on one time base: a stamp jumping beyond the bound starts it again, so
+    // one outlier cannot decide.
+    if (first_vo_utime_ < 0 ||
+        std::abs(seconds_between(last_undecided_vo_utime_, u.utime)) > options_.gates.max_time_jump_s)
+      first_vo_utime_ = u.utime;
+    last_undecided_vo_utime_ = u.utime;
+    const double span_s = seconds_between(first_vo_utime_, u.utime);
     if (span_s >= options_.visual_only.no_imu_after_s) mode_ = EstimatorMode::kVisualOnly;
   }
   switch (mode_) {
@@ -66,14 +91,17 @@ StepResult StateEstimator::add_vo(const VoUpdate& u) {
     case EstimatorMode::kImu:
       result.verdict = imu_filter_.add_vo(u);
       return result;
-    case EstimatorMode::kVisualOnly:
+    case EstimatorMode::kVisualOnly: {
+      const int64_t resyncs_before = resyncs();
       result.verdict = visual_.add_vo(u);
+      note_resync(resyncs_before);
       if (auto out = visual_.output(); out && out->utime == u.utime &&
           (result.verdict == Verdict::kAccepted || result.verdict == Verdict::kNoMeasurement)) {
         note_first_state(out);
         result.state = awaited(std::move(out));
       }
       return result;
+    }
   }
   return result;
 }

@@ -14,7 +14,11 @@
 // visual-only estimator one after every VO update (a failed one included) once started.
 // With await_world_s, they are INITIALIZING from the first until a SLAM correction is taken
 // or await_world_s of sensor time has passed (options.h): a filter restarted while SLAM's map
-// lives on is in a world of its own until SLAM's correction moves it (estimator.h).
+// lives on is in a world of its own until SLAM's correction moves it (estimator.h). A restart
+// on a new time base (input_gate.h) is a start like any other: its states await the world again.
+//
+// Refused inputs (input_gate.h): last_rejection() is the latest, for the operator; the process
+// rethrows it to its Node, which shows DEGRADED while inputs are refused.
 
 #include <optional>
 
@@ -22,6 +26,7 @@
 #include "estimator/visual_only.h"
 
 namespace kestrel::estimator {
+
 
 /// What an input did, and the state to publish after it, if any.
 struct StepResult {
@@ -49,6 +54,12 @@ class StateEstimator {
   EstimatorCounters counters() const;
   /// IMU readings refused for a missing part (the IMU filter's mode only).
   int64_t incomplete_imu() const { return incomplete_imu_; }
+  /// Inputs refused by the gates so far (both estimators; never reset), and the latest of them.
+  int64_t refusals() const { return imu_filter_.refusals() + visual_.refusals(); }
+  const std::optional<Rejection>& last_rejection() const;
+  /// Restarts on a new time base so far (both estimators), and what the latest was.
+  int64_t resyncs() const { return imu_filter_.resyncs() + visual_.resyncs(); }
+  const std::string& last_resync() const;
 
  private:
   EstimatorOptions options_;
@@ -60,10 +71,13 @@ class StateEstimator {
   bool awaits_world(int64_t utime) const;
   std::optional<EstimatorOutput> awaited(std::optional<EstimatorOutput> state) const;
   void note_first_state(const std::optional<EstimatorOutput>& state);
+  /// After a restart on a new time base: the states await SLAM's world again.
+  void note_resync(int64_t resyncs_before);
 
   int64_t first_vo_utime_ = -1;  // while undecided (the first IMU reading decides at once)
   int64_t first_state_utime_ = -1;  // of the first state given out
   bool world_taken_ = false;        // a SLAM correction was taken since the start
+  int64_t last_undecided_vo_utime_ = -1;
   int64_t vo_before_decision_ = 0;
   int64_t incomplete_imu_ = 0;
 };

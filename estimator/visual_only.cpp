@@ -26,21 +26,33 @@ void symmetrize(Matrix6d& P) { P = 0.5 * (P + P.transpose()).eval(); }
 
 }  // namespace
 
-VisualOnlyEstimator::VisualOnlyEstimator(const EstimatorOptions& options) : options_(options) {}
+VisualOnlyEstimator::VisualOnlyEstimator(const EstimatorOptions& options)
+    : options_(options), vo_clock_(options.gates), accel_clock_(options.gates) {}
 
 void VisualOnlyEstimator::reset() {
+  clear_state();
   accel_.clear();
+  vo_clock_.reset();
+  accel_clock_.reset();
+  last_rejection_.reset();  // a replay's new session must not show the last one's refusals
+  last_resync_.clear();
+  counters_.resets++;
+}
+
+void VisualOnlyEstimator::clear_state() {
   frames_.clear();
   v_world_.setZero();
   omega_body_.setZero();
   rate_covariance_.setZero();
-  newest_reference_ = last_applied_utime_ = last_vo_utime_ = -1;
+  newest_reference_ = last_applied_utime_ = -1;
   correction_since_start_ = false;
-  counters_.resets++;
 }
 
-void VisualOnlyEstimator::add_accel(int64_t utime, const Eigen::Vector3d& f) {
-  if (!f.allFinite() || (!accel_.empty() && utime <= accel_.back().first)) return;
+void VisualOnlyEstimator::take_accel(int64_t utime, const Eigen::Vector3d& f) {
+  if (std::string why = accel_beyond_range(options_.gates, f, utime, "IMU"); !why.empty()) {
+    refuse(Verdict::kImplausible, Reason::kImuAccelRange, std::move(why));
+    return;
+  }
   if (initialized() && utime <= frames_.back().utime) return;  // its frame has been levelled
   accel_.emplace_back(utime, f);
   // Before the start only the last init.duration_s count; after it, the readings since the
@@ -148,30 +160,14 @@ void VisualOnlyEstimator::trim() {
   while (frames_.size() > 1 && frames_.front().utime < keep_from) frames_.pop_front();
 }
 
-Verdict VisualOnlyEstimator::add_vo(const VoUpdate& u) {
-  counters_.vo_received++;
-  if (u.ok) {
-    try {
-      validate_vo(u, options_.vo_noise.source == VoNoiseOptions::Source::kReported, "VO_UPDATE");
-    } catch (const InputError&) {
-      counters_.vo_invalid++;
-      return Verdict::kInvalid;
-    }
-  }
-  if (u.utime == last_vo_utime_) {
-    counters_.vo_duplicate++;
-    return Verdict::kDuplicate;
-  }
-  if (u.utime < last_vo_utime_) {
-    counters_.vo_out_of_order++;
-    return Verdict::kOutOfOrder;
-  }
-  last_vo_utime_ = u.utime;
+Verdict VisualOnlyEstimator::take_vo(const VoUpdate& u) {
   if (!u.ok) {
     counters_.vo_failed++;
     if (initialized() && u.utime > frames_.back().utime) push(predict(u.utime));
     return Verdict::kNoMeasurement;
   }
+  if (std::string why = implausible_motion(options_.gates, u, "VO_UPDATE"); !why.empty())
+    return refuse(Verdict::kImplausible, Reason::kVoImplausible, std::move(why));
   if (!initialized()) start(u);
   if (u.utime <= frames_.back().utime) {  // an update for a frame already predicted past
     counters_.vo_too_old++;
@@ -179,6 +175,11 @@ Verdict VisualOnlyEstimator::add_vo(const VoUpdate& u) {
   }
 
   const Frame* reference = find(u.reference_utime);
+  if (reference == nullptr && u.reference_utime < frames_.front().utime)
+    return refuse(Verdict::kUnknownReference, Reason::kVoUnknownReference,
+                  "VO_UPDATE: update at utime " + std::to_string(u.utime) + " is against frame " +
+                      std::to_string(u.reference_utime) + ", older than every frame kept (utime " +
+                      std::to_string(frames_.front().utime) + " on): its pose cannot be placed");
   if (reference == nullptr) {
     // Never seen (the VO restarted on a frame that failed here, or before this estimator
     // started): its pose is predicted and kept, so later updates against it agree.
@@ -216,16 +217,19 @@ Verdict VisualOnlyEstimator::add_vo(const VoUpdate& u) {
 
 Verdict VisualOnlyEstimator::add_correction(const PoseCorrection& c) {
   counters_.corrections_received++;
-  try {
-    validate_correction(c, "SLAM_CORRECTION");
-  } catch (const InputError&) {
-    counters_.corrections_invalid++;
-    return Verdict::kInvalid;
-  }
+  if (const InputFault f = check_correction(c, "SLAM_CORRECTION"))
+    return refuse(Verdict::kInvalid,
+                  f.kind == InputFault::Kind::kCovariance ? Reason::kCorrectionCovariance
+                                                          : Reason::kCorrectionInvalid,
+                  f.what);
   if (!initialized()) {
     counters_.corrections_before_init++;
     return Verdict::kNotInitialized;
   }
+  if (too_far_ahead(c.utime, frames_.back().utime, vo_clock_.max_jump_us()))
+    return refuse(Verdict::kTimeJump, Reason::kCorrectionTimeJump,
+                  time_jump(options_.gates, "SLAM_CORRECTION: correction", c.utime, frames_.back().utime) +
+                      " (the newest frame's)");
   if (c.utime < frames_.front().utime || c.utime > frames_.back().utime) {
     counters_.corrections_too_old++;
     return Verdict::kTooOld;
@@ -247,6 +251,15 @@ Verdict VisualOnlyEstimator::add_correction(const PoseCorrection& c) {
     }
   };
   pose_there();
+  // The first correction since a start may be anywhere: it is how a restarted filter moves
+  // onto SLAM's world (align below), which in a large map is far from its own origin.
+  const bool first_takes_slams_world = !correction_since_start_ && options_.world_align_chi2 > 0.0;
+  if (const double jump_m = (c.T_world_body.translation() - T.translation()).norm();
+      !first_takes_slams_world && !(jump_m <= options_.gates.correction_max_jump_m))
+    return refuse(Verdict::kImplausible, Reason::kCorrectionImplausible,
+                  "SLAM_CORRECTION: correction at utime " + std::to_string(c.utime) + " is " +
+                      short_number(jump_m) + " m from the pose there, beyond --correction-max-jump " +
+                      short_number(options_.gates.correction_max_jump_m) + " m");
   const Matrix6d Q = correction_noise(options_, c);
   Vector6d innovation = se3::boxminus(c.T_world_body, T);
   // A first correction a world away: SLAM's map outlived the estimator before this one (as

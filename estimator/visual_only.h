@@ -48,13 +48,26 @@
 // whose size is off gravity by more than 2 gravity_sigma is an acceleration, and skipped.
 //
 // Outputs carry zero biases, with the prior sigmas of InitOptions: they are not estimated.
+//
+// Gates (input_gate.h), as in the IMU filter: the VO's stamps are this estimator's clock, so
+// one beyond max_time_jump_s of the newest is held, and resync_samples in a row on a new base
+// restart the estimator there (unless they go on from a kept frame, or are ahead by no more
+// than the history: a gap, taken in order); motions faster than vo_max_speed / vo_max_rate, accelerometer readings
+// beyond the sensor's range, corrections stamped that far ahead or further than
+// correction_max_jump_m from the pose at their time are refused; so is an update against a
+// frame older than every kept one that is not kept itself: predicting its pose would extrapolate
+// the velocity over any time at all (a reference at utime 1 against TUM's stamps put STATE
+// 1e8 m away).
 
 #include <cstdint>
 #include <deque>
 #include <optional>
+#include <string>
+#include <utility>
 
 #include "common/geometry/se3.h"
 #include "estimator/estimator.h"
+#include "estimator/input_gate.h"
 #include "estimator/inputs.h"
 #include "estimator/options.h"
 
@@ -77,6 +90,14 @@ class VisualOnlyEstimator {
   /// The state at the newest frame; empty before the first successful VO update.
   std::optional<EstimatorOutput> output() const;
   EstimatorCounters counters() const { return counters_; }
+  /// The newest VO stamp taken (the estimator's time); -1 before the first.
+  int64_t now_utime() const { return vo_clock_.newest(); }
+  /// As Estimator's: the latest refused input, refusals in all, the latest restart on a new
+  /// time base.
+  const std::optional<Rejection>& last_rejection() const { return last_rejection_; }
+  int64_t refusals() const { return refusals_; }
+  int64_t resyncs() const { return counters_.vo_resyncs; }
+  const std::string& last_resync() const { return last_resync_; }
 
  private:
   struct Frame {
@@ -88,6 +109,15 @@ class VisualOnlyEstimator {
   };
 
   void start(const VoUpdate& first);
+  /// A reading past the clock's gate: the range gate, then the buffer.
+  void take_accel(int64_t utime, const Eigen::Vector3d& specific_force_body);
+  /// An update past the clock's gate.
+  Verdict take_vo(const VoUpdate& update);
+  /// Restarts on the VO's new time base with the updates held on it.
+  Verdict resync_vo(int64_t old_newest);
+  /// Drops the frames, rates and readings, keeping the clocks and counters.
+  void clear_state();
+  Verdict refuse(Verdict verdict, Reason reason, std::string what);
   /// Fuses the accelerometer readings up to the newest frame as a measurement of its tilt.
   void level_with_gravity();
   /// Fuses a measurement (residual = H dx + noise, dx the pose error [dp; dtheta]) of the pose
@@ -112,9 +142,13 @@ class VisualOnlyEstimator {
   Matrix6d rate_covariance_ = Matrix6d::Zero();
   int64_t newest_reference_ = -1;
   int64_t last_applied_utime_ = -1;
-  int64_t last_vo_utime_ = -1;
+  TimeBase<VoUpdate> vo_clock_;  // the estimator's time
+  TimeBase<std::pair<int64_t, Eigen::Vector3d>> accel_clock_;
   bool correction_since_start_ = false;  // only the first correction may change the world
   EstimatorCounters counters_;
+  std::optional<Rejection> last_rejection_;
+  int64_t refusals_ = 0;
+  std::string last_resync_;
 };
 
 }  // namespace kestrel::estimator

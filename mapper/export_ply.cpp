@@ -4,6 +4,7 @@
 #include <fstream>
 #include <vector>
 
+#include "common/atomic_file.h"
 #include "common/error.h"
 
 namespace kestrel::mapper {
@@ -42,8 +43,8 @@ size_t write_ply(const KeyframeStore& keyframes, const std::string& path, double
       }
     }
   }
-  std::ofstream file(path, std::ios::binary);
-  if (!file) throw InputError(path + ": cannot open for writing");
+  AtomicFile out(path);  // a failed run leaves no cut cloud that looks whole
+  std::ostream& file = out.stream();
   file << "ply\nformat binary_little_endian 1.0\ncomment kestrel mapper: registered keyframes\n"
        << "element vertex " << points.size() << "\n"
        << "property float x\nproperty float y\nproperty float z\n"
@@ -56,8 +57,7 @@ size_t write_ply(const KeyframeStore& keyframes, const std::string& path, double
     std::memcpy(record + 12, p.rgb, 3);
     file.write(record, sizeof record);
   }
-  file.close();
-  if (!file) throw InputError(path + ": write failed");
+  out.commit();
   return points.size();
 }
 

@@ -11,7 +11,8 @@
 namespace kestrel::mapper {
 
 /// Writes every depth pixel of every stored keyframe (no reading beyond `max_range_m`); returns
-/// the number of points. Throws InputError naming `path` if it cannot be written.
+/// the number of points. Atomic (common/atomic_file.h); throws InputError naming `path` if it
+/// cannot be written.
 size_t write_ply(const KeyframeStore& keyframes, const std::string& path, double max_range_m);
 
 }  // namespace kestrel::mapper

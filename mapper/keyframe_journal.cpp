@@ -1,52 +1,22 @@
 #include "mapper/keyframe_journal.h"
 
-#include <array>
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
+#include <optional>
 #include <utility>
 
+#include "common/atomic_file.h"
 #include "common/error.h"
 #include "common/transport/convert.h"
 #include "common/transport/message.h"
 #include "common/transport/rgbd_codec.h"
+#include "mapper/journal_records.h"
 
 namespace kestrel::mapper {
 
 namespace {
-
-constexpr char kHeader[] = "kestrel mapper journal 1\n";
-constexpr size_t kHeaderSize = sizeof(kHeader) - 1;
-constexpr char kKeyframe = 'K';
-constexpr char kGraph = 'G';
-// Far above any record (a 640x480 frame stored undecimated is under 2 MB): a larger size
-// field is damage, not a record to allocate for.
-constexpr uint32_t kMaxPayload = 64u << 20;
-
-// CRC-32 (IEEE 802.3, reflected, as zlib and PNG compute it).
-uint32_t crc32(const uint8_t* data, size_t size, uint32_t crc = 0) {
-  static const std::array<uint32_t, 256> table = [] {
-    std::array<uint32_t, 256> t{};
-    for (uint32_t i = 0; i < 256; ++i) {
-      uint32_t c = i;
-      for (int k = 0; k < 8; ++k) c = (c & 1u) ? 0xEDB88320u ^ (c >> 1) : c >> 1;
-      t[i] = c;
-    }
-    return t;
-  }();
-  crc = ~crc;
-  for (size_t i = 0; i < size; ++i) crc = table[(crc ^ data[i]) & 0xFFu] ^ (crc >> 8);
-  return ~crc;
-}
-
-void put_u32(std::vector<uint8_t>& out, uint32_t v) {
-  for (int i = 0; i < 4; ++i) out.push_back(static_cast<uint8_t>(v >> (8 * i)));
-}
-
-uint32_t get_u32(const uint8_t* p) {
-  return static_cast<uint32_t>(p[0]) | static_cast<uint32_t>(p[1]) << 8 | static_cast<uint32_t>(p[2]) << 16 |
-         static_cast<uint32_t>(p[3]) << 24;
-}
 
 // The journal keeps the frame exactly: raw colour, lossless depth.
 transport::RgbdEncoding lossless() {
@@ -56,69 +26,61 @@ transport::RgbdEncoding lossless() {
   return e;
 }
 
-JournalRecord decode_record(char kind, const std::vector<uint8_t>& payload, const std::string& what) {
-  JournalRecord r;
-  if (kind == kGraph) {
-    r.kind = JournalRecord::Kind::kGraph;
-    r.graph = transport::decode_message<kestrel::slam_graph_t>(payload.data(), payload.size(), what);
-    return r;
-  }
-  if (kind != kKeyframe) throw InputError(what + ": unknown record kind " + std::to_string(kind));
-  if (payload.size() < 4) throw InputError(what + ": keyframe record too short");
-  const uint32_t size = get_u32(payload.data());
-  if (size > payload.size() - 4) throw InputError(what + ": keyframe size beyond the record");
-  r.kind = JournalRecord::Kind::kKeyframe;
-  r.keyframe = transport::decode_message<kestrel::slam_keyframe_t>(payload.data() + 4, size, what);
-  const auto frame = transport::decode_message<kestrel::rgbd_frame_t>(payload.data() + 4 + size,
-                                                                      payload.size() - 4 - size, what);
-  r.frame = transport::decode_rgbd(frame, what.c_str());
-  return r;
-}
-
 }  // namespace
 
 JournalContents read_journal(const std::string& path) {
   JournalContents contents;
   std::error_code ec;
   if (!std::filesystem::exists(path, ec) || std::filesystem::file_size(path, ec) == 0) return contents;
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path + ": cannot read the mapper journal: " + std::strerror(errno));
-  std::string header(kHeaderSize, '\0');
-  if (!in.read(header.data(), static_cast<std::streamsize>(kHeaderSize)) || header != kHeader) {
-    throw InputError(path + ": not a kestrel mapper journal (its first line is not \"" +
-                     std::string(kHeader, kHeaderSize - 1) + "\")");
+  const journal::JournalBytes file(path);
+  contents.file_bytes = file.size();
+  std::string header(journal::kHeaderSize, '\0');
+  uint64_t at = 0;
+  const bool header_ok = file.read(0, header.data(), journal::kHeaderSize) && header == journal::kHeader;
+  if (header_ok) {
+    at = journal::kHeaderSize;
+  } else {
+    // Either not a journal at all, or one whose first bytes were damaged: only an intact
+    // record after them tells the two apart.
+    const std::optional<uint64_t> next = journal::next_record(file, 0, path);
+    if (!next) {
+      throw InputError(path + ": not a kestrel mapper journal (its first line is not \"" +
+                       std::string(journal::kHeader, journal::kHeaderSize - 1) + "\" and no intact record follows)");
+    }
+    contents.damage = "its header is damaged (at byte 0)";
+    contents.skipped_bytes = *next;
+    contents.damaged_stretches = 1;
+    at = *next;
   }
-  contents.intact_bytes = kHeaderSize;
-  std::vector<uint8_t> payload;
-  for (size_t index = 0;; ++index) {
-    uint8_t head[5];
-    if (!in.read(reinterpret_cast<char*>(head), 5)) {
-      if (in.gcount() != 0) contents.damage = "record " + std::to_string(index) + " is cut short";
-      break;
+  while (at < file.size()) {
+    const size_t index = contents.records.size();
+    std::string why;
+    const std::string what = path + ": record " + std::to_string(index);
+    if (const uint64_t end = journal::record_at(file, at, what, contents.records, why)) {
+      if (!contents.spans.empty() && contents.spans.back().second == at) {
+        contents.spans.back().second = end;
+      } else {
+        contents.spans.emplace_back(at, end);
+      }
+      at = end;
+      continue;
     }
-    const char kind = static_cast<char>(head[0]);
-    const uint32_t size = get_u32(head + 1);
-    if (size > kMaxPayload) {
-      contents.damage = "record " + std::to_string(index) + " claims " + std::to_string(size) + " bytes";
-      break;
-    }
-    payload.resize(size);
-    uint8_t crc_bytes[4];
-    if (!in.read(reinterpret_cast<char*>(payload.data()), size) || !in.read(reinterpret_cast<char*>(crc_bytes), 4)) {
-      contents.damage = "record " + std::to_string(index) + " is cut short";
-      break;
-    }
-    if (crc32(payload.data(), size, crc32(head, 5)) != get_u32(crc_bytes)) {
-      contents.damage = "record " + std::to_string(index) + " fails its CRC";
-      break;
-    }
-    try {
-      contents.records.push_back(decode_record(kind, payload, path + ": record " + std::to_string(index)));
-    } catch (const InputError& e) {
-      contents.damage = e.what();
-      break;
-    }
-    contents.intact_bytes += 5 + size + 4;
+    // Damage: reading goes on at the next intact record (the header says why that is sound).
+    if (contents.damage.empty())
+      contents.damage = "record " + std::to_string(index) + " " + why + " (at byte " + std::to_string(at) + ")";
+    ++contents.damaged_stretches;
+    const std::optional<uint64_t> next = journal::next_record(file, at + 1, path);
+    contents.skipped_bytes += (next ? *next : file.size()) - at;
+    if (!next) break;
+    at = *next;
+  }
+  contents.intact_bytes = header_ok ? journal::kHeaderSize : 0;
+  for (const auto& span : contents.spans) contents.intact_bytes += span.second - span.first;
+  if (!contents.damage.empty()) {
+    contents.damage += "; " + std::to_string(contents.skipped_bytes) + " of " + std::to_string(file.size()) +
+                       " bytes unreadable in " + std::to_string(contents.damaged_stretches) + " stretch" +
+                       (contents.damaged_stretches == 1 ? "" : "es") + ", " +
+                       std::to_string(contents.records.size()) + " intact records kept";
   }
   return contents;
 }
@@ -150,27 +112,56 @@ Restored restore_journal(const JournalContents& journal, Mapper& mapper, const s
   return restored;
 }
 
-JournalWriter::JournalWriter(std::string path, uint64_t intact_bytes) : path_(std::move(path)) {
+JournalWriter::JournalWriter(std::string path, const JournalContents& contents) : path_(std::move(path)) {
   std::error_code ec;
-  if (intact_bytes == 0) {
-    out_.open(path_, std::ios::binary | std::ios::trunc);
-    out_.write(kHeader, static_cast<std::streamsize>(kHeaderSize));
-    bytes_ = kHeaderSize;
-  } else {
-    std::filesystem::resize_file(path_, intact_bytes, ec);  // the damaged tail goes
-    if (ec) throw InputError(path_ + ": cannot cut the mapper journal's damaged end: " + ec.message());
-    out_.open(path_, std::ios::binary | std::ios::app);
-    bytes_ = intact_bytes;
+  const bool exists = std::filesystem::exists(path_, ec);
+  const uintmax_t size = exists ? std::filesystem::file_size(path_, ec) : 0;
+  // What was read must still be what is there: a journal is never written over unread.
+  if (ec || size != contents.file_bytes) {
+    throw InputError(path_ + ": the mapper journal is not as it was read (" + std::to_string(size) + " bytes, read " +
+                     std::to_string(contents.file_bytes) + ")");
   }
-  out_.flush();
+  if (contents.file_bytes == 0) {
+    start_fresh("", {});
+  } else if (!contents.damage.empty()) {
+    // Kept whole under a new name first; then `path_` becomes a valid journal of the records
+    // read, copied byte for byte, so the damage is neither cut off nor appended after.
+    kept_aside_ = keep_aside(path_, "damaged");
+    start_fresh(kept_aside_, contents.spans);
+  }
+  open_for_append();
+}
+
+void JournalWriter::start_fresh(const std::string& source, const std::vector<std::pair<uint64_t, uint64_t>>& spans) {
+  AtomicFile file(path_);
+  file.stream().write(journal::kHeader, static_cast<std::streamsize>(journal::kHeaderSize));
+  if (!spans.empty()) {
+    const journal::JournalBytes from(source);
+    std::vector<char> buffer(1u << 20);
+    for (const auto& [begin, end] : spans) {
+      for (uint64_t at = begin; at < end;) {
+        const size_t n = static_cast<size_t>(std::min<uint64_t>(buffer.size(), end - at));
+        if (!from.read(at, buffer.data(), n)) throw InputError(source + ": cannot read the mapper journal back");
+        file.stream().write(buffer.data(), static_cast<std::streamsize>(n));
+        at += n;
+      }
+    }
+  }
+  file.commit();
+}
+
+void JournalWriter::open_for_append() {
+  out_.open(path_, std::ios::binary | std::ios::app);
   if (!out_) throw InputError(path_ + ": cannot write the mapper journal: " + std::strerror(errno));
+  std::error_code ec;
+  bytes_ = std::filesystem::file_size(path_, ec);
 }
 
 void JournalWriter::append(char kind, const std::vector<uint8_t>& payload) {
   std::vector<uint8_t> head{static_cast<uint8_t>(kind)};
-  put_u32(head, static_cast<uint32_t>(payload.size()));
+  journal::put_u32(head, static_cast<uint32_t>(payload.size()));
   std::vector<uint8_t> tail;
-  put_u32(tail, crc32(payload.data(), payload.size(), crc32(head.data(), head.size())));
+  journal::put_u32(tail, journal::crc32(payload.data(), payload.size(), journal::crc32(head.data(), head.size())));
   out_.write(reinterpret_cast<const char*>(head.data()), static_cast<std::streamsize>(head.size()));
   out_.write(reinterpret_cast<const char*>(payload.data()), static_cast<std::streamsize>(payload.size()));
   out_.write(reinterpret_cast<const char*>(tail.data()), static_cast<std::streamsize>(tail.size()));
@@ -184,23 +175,24 @@ void JournalWriter::keyframe(const kestrel::slam_keyframe_t& keyframe, const Rgb
   const std::vector<uint8_t> f = transport::encode_message(transport::encode_rgbd(frame, lossless()));
   std::vector<uint8_t> payload;
   payload.reserve(4 + k.size() + f.size());
-  put_u32(payload, static_cast<uint32_t>(k.size()));
+  journal::put_u32(payload, static_cast<uint32_t>(k.size()));
   payload.insert(payload.end(), k.begin(), k.end());
   payload.insert(payload.end(), f.begin(), f.end());
-  append(kKeyframe, payload);
+  append(journal::kKeyframe, payload);
 }
 
 void JournalWriter::graph(const kestrel::slam_graph_t& graph) {
-  append(kGraph, transport::encode_message(graph));
+  append(journal::kGraph, transport::encode_message(graph));
 }
 
-void JournalWriter::clear() {
+void JournalWriter::restart() {
+  kept_aside_.clear();
+  if (bytes_ <= journal::kHeaderSize) return;  // no record: nothing to keep
   out_.close();
-  out_.open(path_, std::ios::binary | std::ios::trunc);
-  out_.write(kHeader, static_cast<std::streamsize>(kHeaderSize));
-  out_.flush();
-  if (!out_) throw std::runtime_error(path_ + ": cannot write the mapper journal: " + std::strerror(errno));
-  bytes_ = kHeaderSize;
+  // keep_aside throws before anything changed; start_fresh replaces the file by a rename.
+  kept_aside_ = keep_aside(path_, "reset");
+  start_fresh("", {});
+  open_for_append();
 }
 
 }  // namespace kestrel::mapper

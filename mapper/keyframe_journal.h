@@ -15,14 +15,28 @@
 // Records are written whole and flushed to the kernel at once, so a process killed at any
 // point leaves every earlier record intact.
 //
-// Reading stops at the first record that is cut short, fails its CRC or does not decode
-// (what a kill or a full disk leaves at the end); the records before it are kept, the
-// damage is reported, and the writer cuts the file there before appending. A file that does
-// not start with the header is not a journal: InputError naming it, and nothing is touched.
+// A journal on disk is never cut, overwritten or lost (issue 38):
+//  * Reading goes past damage. A record cut short, failing its CRC or not decoding (a kill or a
+//    full disk at the end; a bad sector, a flipped bit or a zeroed block anywhere) is skipped
+//    and reading goes on at the next byte where an intact record starts (known kind, a size
+//    that fits, the LCM type's hash at the start of the payload, then its CRC and a decode), so
+//    every intact record is kept, before and after the damage. That is sound because records
+//    do not depend on the bytes around them: each keyframe record is a whole keyframe, and each
+//    graph record only moves stored keyframes; a lost graph record leaves some keyframes at
+//    their earlier poses until SLAM's next graph that holds them (each SLAM_GRAPH carries
+//    every keyframe's current pose, and Mapper::apply_graph moves them there). Only the
+//    keyframes in lost records are lost. A damaged header is damage too when intact records follow it; a file
+//    with no intact record and no header is not a journal: InputError naming it, untouched.
+//  * A damaged journal is kept whole as "<file>.damaged-<utime>" (keep_aside: a hard link, or a
+//    copy), and "<file>" is replaced (atomically) by a valid journal of the records read,
+//    copied byte for byte, which the writer then appends to.
+//  * A reset (lock-step replay's RESET) keeps the journal it ends as "<file>.reset-<utime>" and
+//    starts "<file>" again empty; a journal without records is simply kept.
 
 #include <cstdint>
 #include <fstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "common/rgbd_frame.h"
@@ -41,13 +55,18 @@ struct JournalRecord {
 };
 
 struct JournalContents {
-  std::vector<JournalRecord> records;  ///< in the order written
-  uint64_t intact_bytes = 0;           ///< the header and those records
-  std::string damage;                  ///< why reading stopped early ("" = it did not)
+  std::vector<JournalRecord> records;  ///< every intact record, in the order written
+  /// Where those records lie in the file: [begin, end) byte offsets, adjacent ones merged.
+  std::vector<std::pair<uint64_t, uint64_t>> spans;
+  uint64_t intact_bytes = 0;   ///< the header (if intact) and those records
+  uint64_t file_bytes = 0;     ///< the file's size when read (0: missing or empty)
+  uint64_t skipped_bytes = 0;  ///< in damaged stretches
+  int damaged_stretches = 0;
+  std::string damage;          ///< the first damage and a summary ("" = the file is whole)
 };
 
 /// What the journal at `path` holds; empty for a missing or empty file. Throws InputError
-/// naming `path` if it cannot be read or is not a journal.
+/// naming `path` if it cannot be read or is not a journal (no header, no intact record).
 JournalContents read_journal(const std::string& path);
 
 /// SLAM_GRAPH's keyframe as the mapper takes it; InputError naming `what` for a broken pose.
@@ -65,25 +84,36 @@ Restored restore_journal(const JournalContents& journal, Mapper& mapper, const s
 
 class JournalWriter {
  public:
-  /// Appends to `path` after its first `intact_bytes` (read_journal's figure; whatever follows
-  /// is cut off), or starts a new journal when `intact_bytes` is 0. Throws InputError naming
-  /// the file if it cannot be written.
-  JournalWriter(std::string path, uint64_t intact_bytes);
+  /// Journals to `path`, whose read_journal() is `contents` (default: a missing or empty file,
+  /// where a new journal starts): a whole journal is appended to; a damaged one is kept aside
+  /// and replaced by a fresh journal of `contents`' records (see the top of this file). Throws
+  /// InputError naming the file if it cannot be written, or if it is no longer what was read
+  /// (its size differs), so a journal is never written over unread.
+  explicit JournalWriter(std::string path, const JournalContents& contents = {});
 
   void keyframe(const kestrel::slam_keyframe_t& keyframe, const RgbdFrame& frame);
   void graph(const kestrel::slam_graph_t& graph);
-  /// Empties the journal (the map was reset).
-  void clear();
+  /// The map was reset: `path` starts again as an empty journal, the one it ends kept as
+  /// "<path>.reset-<utime>" (if it holds a record). Throws InputError (nothing changed) if the
+  /// old one cannot be kept.
+  void restart();
 
   const std::string& path() const { return path_; }
   uint64_t bytes() const { return bytes_; }
+  /// Where the journal set aside by the constructor (damaged) or the last restart() is kept
+  /// ("" = that one kept nothing).
+  const std::string& kept_aside() const { return kept_aside_; }
 
  private:
+  // `path_` replaced atomically by the header and `spans` of the file `source`.
+  void start_fresh(const std::string& source, const std::vector<std::pair<uint64_t, uint64_t>>& spans);
+  void open_for_append();
   void append(char kind, const std::vector<uint8_t>& payload);
 
   std::string path_;
   std::ofstream out_;
   uint64_t bytes_ = 0;
+  std::string kept_aside_;
 };
 
 }  // namespace kestrel::mapper

@@ -38,8 +38,13 @@ int serve(Options& o) {
   if (!o.save.empty()) mapper::format_of(o.save);  // a bad extension is an error now, not at exit
   mapper::MapNode map(o.node);
   if (!o.node.journal_path.empty()) {
-    if (!map.journal_damage().empty()) {
-      spdlog::warn("{}: read up to the damage and cut it off: {}", o.node.journal_path, map.journal_damage());
+    if (!map.journal_error().empty()) {
+      spdlog::error("{}: {}{}; the file is left as it was and the map goes on without a journal",
+                    o.node.journal_path, map.journal_damage().empty() ? "" : "damaged (" + map.journal_damage() + "), ",
+                    map.journal_error());
+    } else if (!map.journal_damage().empty()) {
+      spdlog::warn("{}: damaged ({}); the damaged file is kept as {}, journalling goes on in a fresh copy of "
+                   "what was read", o.node.journal_path, map.journal_damage(), map.journal_kept_aside());
     }
     spdlog::info("journal {}: {} keyframes restored", o.node.journal_path, map.stats().keyframes_restored);
   }
@@ -47,7 +52,18 @@ int serve(Options& o) {
   std::unique_ptr<transport::Node> node;
   node = std::make_unique<transport::Node>(o.name, o.lcm_url);  // UnavailableError: exit 4
   node->advertise(channel::kMapOctomap);
-  node->on_reset([&] { map.reset(); });
+  if (!o.node.journal_path.empty() && !map.journal_error().empty())
+    node->set_health(process_status_t::STATE_DEGRADED, "journal stopped: " + map.journal_error());
+  node->on_reset([&] {
+    const bool journalling = !o.node.journal_path.empty() && map.journal_error().empty();
+    map.reset();
+    if (!map.journal_kept_aside().empty())
+      spdlog::info("reset: the journal starts again; what it held is kept as {}", map.journal_kept_aside());
+    if (journalling && !map.journal_error().empty()) {
+      spdlog::error("journal stopped (the map goes on without it): {}", map.journal_error());
+      node->set_health(process_status_t::STATE_DEGRADED, "journal stopped: " + map.journal_error());
+    }
+  });
   auto publish = [&](const std::optional<octomap_t>& msg) {
     if (msg) node->publish(channel::kMapOctomap, *msg);
   };

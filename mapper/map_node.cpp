@@ -37,7 +37,15 @@ MapNode::MapNode(const NodeOptions& options)
   const Restored restored = restore_journal(journal, mapper_, options_.journal_path);
   stats_.keyframes_restored = restored.keyframes;
   last_graph_revision_ = restored.last_revision;
-  journal_ = std::make_unique<JournalWriter>(options_.journal_path, journal.intact_bytes);
+  // A damaged journal is kept aside whole and continued as a fresh copy of what was read. If
+  // that fails (a full disk is the usual cause of the damage), the restored map is kept and
+  // mapping goes on without a journal, as after a failed write: the file stays as it was.
+  try {
+    journal_ = std::make_unique<JournalWriter>(options_.journal_path, journal);
+    journal_kept_aside_ = journal_->kept_aside();
+  } catch (const std::exception& e) {
+    journal_error_ = e.what();
+  }
 }
 
 void MapNode::write_journal(const kestrel::slam_graph_t& msg, const GraphResult& result) {
@@ -74,7 +82,17 @@ void MapNode::write_journal(const kestrel::slam_graph_t& msg, const GraphResult&
 
 void MapNode::reset() {
   mapper_.reset();
-  if (journal_) journal_->clear();
+  journal_kept_aside_.clear();
+  if (journal_) {
+    // The journal starts again with the map; the one it ends is kept, never emptied in place.
+    try {
+      journal_->restart();
+      journal_kept_aside_ = journal_->kept_aside();
+    } catch (const std::exception& e) {
+      journal_error_ = e.what();
+      journal_.reset();
+    }
+  }
   stats_ = {};
   last_frame_utime_ = 0;
   last_published_utime_ = -1;

@@ -13,7 +13,9 @@
 // moved stored keyframes is appended to a file (keyframe_journal.h). A node started on an
 // existing journal first restores those keyframes at the poses they had and rebuilds the map
 // from them, so a mapper killed and restarted in flight carries on with its map; keyframes
-// SLAM made while it was down are missing (their frames went by). RESET empties the journal.
+// SLAM made while it was down are missing (their frames went by). A damaged journal is read
+// past the damage, kept aside whole and continued as a fresh copy; RESET starts the journal
+// again empty and keeps the old one aside (keyframe_journal.h): no journal is ever cut.
 // A journal that cannot be written mid-flight (a full disk) is given up, not the map:
 // journal_error() says why and mapping goes on.
 //
@@ -69,7 +71,8 @@ struct NodeStats {
 class MapNode {
  public:
   /// With a journal_path, restores what the journal holds (InputError naming the file if it is
-  /// not a journal; a damaged end is cut off and reported by journal_damage()).
+  /// not a journal; damage is reported by journal_damage(), the damaged file kept as
+  /// journal_kept_aside()).
   explicit MapNode(const NodeOptions& options);
 
   /// Each returns the MAP_OCTOMAP message to publish now, if one is due.
@@ -79,13 +82,17 @@ class MapNode {
                                                     const char* channel);
   /// The map as a message now, regardless of the rate limit (e.g. at shutdown).
   kestrel::octomap_t map_message();
-  /// Forgets everything (lock-step replay RESET).
+  /// Forgets everything (lock-step replay RESET); the journal starts again, the old one kept
+  /// as journal_kept_aside() if it held anything.
   void reset();
 
   const Mapper& mapper() const { return mapper_; }
   const NodeStats& stats() const { return stats_; }
   /// Why the journal was read only in part at start ("" = it was read whole, or there is none).
   const std::string& journal_damage() const { return journal_damage_; }
+  /// Where the last journal set aside is kept: the damaged one at start, or the one the last
+  /// reset() ended ("" = none was).
+  const std::string& journal_kept_aside() const { return journal_kept_aside_; }
   /// Why journalling stopped ("" = it did not).
   const std::string& journal_error() const { return journal_error_; }
 
@@ -108,6 +115,7 @@ class MapNode {
   Trajectory poses_;               // kGroundTruth: T_world_camera, recent
   std::unique_ptr<JournalWriter> journal_;
   std::string journal_damage_;
+  std::string journal_kept_aside_;
   std::string journal_error_;
 };
 

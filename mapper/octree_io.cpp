@@ -1,10 +1,12 @@
 #include "mapper/octree_io.h"
 
+#include <cerrno>
 #include <cstring>
 #include <fstream>
 #include <iostream>
 #include <sstream>
 
+#include "common/atomic_file.h"
 #include "common/error.h"
 #include "mapper/octree_stream_check.h"
 
@@ -157,11 +159,14 @@ OctreeFormat format_of(const std::string& path) {
 
 void write_map_file(const VoxelMap& map, const std::string& path) {
   const OctreeFormat format = format_of(path);
-  std::ofstream out(path, std::ios::binary);
-  if (!out) throw InputError(path + ": cannot open for writing");
-  write_stream(map, format, out);
-  out.close();
-  if (!out) throw InputError(path + ": write failed");
+  AtomicFile file(path);  // a failed run leaves the previous map, not a cut one
+  try {
+    write_stream(map, format, file.stream());
+  } catch (const std::runtime_error&) {
+    if (!file.stream()) throw InputError(path + ": write failed: " + std::strerror(errno));  // a full disk
+    throw;
+  }
+  file.commit();
 }
 
 VoxelMap read_map_file(const std::string& path, MapOptions options) {

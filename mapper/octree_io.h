@@ -43,8 +43,9 @@ std::unique_ptr<octomap::OcTree> read_octree(const uint8_t* data, size_t size, O
 VoxelMap decode_octree(const uint8_t* data, size_t size, OctreeFormat format, const char* what,
                        MapOptions options = {});
 
-/// Writes `path`, a .bt (binary) or .ot (full) file by its extension; throws InputError if
-/// the extension is neither or the file cannot be written.
+/// Writes `path`, a .bt (binary) or .ot (full) file by its extension, atomically
+/// (common/atomic_file.h); throws InputError if the extension is neither or the file cannot be
+/// written.
 void write_map_file(const VoxelMap& map, const std::string& path);
 /// Reads a .bt or .ot file; throws InputError naming the file if it is missing or not a
 /// readable OcTree.

@@ -17,6 +17,7 @@
 
 #include <opencv2/imgcodecs.hpp>
 
+#include "common/atomic_file.h"
 #include "common/cli.h"
 #include "common/error.h"
 #include "common/trajectory.h"
@@ -46,7 +47,9 @@ struct Options {
 };
 
 void write_png(const std::string& path, const cv::Mat& image) {
-  if (!cv::imwrite(path, image)) throw InputError(path + ": cannot write the PNG");
+  std::vector<uchar> png;
+  if (!cv::imencode(".png", image, png)) throw InputError(path + ": cannot write the PNG");
+  write_file_atomically(path, png.data(), png.size());  // no cut image that looks whole
   std::cout << "wrote " << path << " (" << image.cols << "x" << image.rows << ")\n";
 }
 
@@ -124,12 +127,13 @@ void map_sequence(const Options& o, mapper::Mapper& mapper, mapper::VoxelMap& su
               percentile(ms, 0.5), percentile(ms, 0.95));
 }
 
-// The keyframes a mapper journalled, at their last poses (a damaged end is left out, and said).
+// The keyframes a mapper journalled, at their last poses (damaged records are left out, and said;
+// the file is only read).
 void map_journal(const Options& o, mapper::Mapper& mapper) {
   if (!std::filesystem::exists(o.journal)) throw InputError(o.journal + ": no such file");
   const mapper::JournalContents journal = mapper::read_journal(o.journal);
   if (journal.records.empty()) throw InputError(o.journal + ": no keyframes in the journal");
-  if (!journal.damage.empty()) spdlog::warn("{}: read up to the damage: {}", o.journal, journal.damage);
+  if (!journal.damage.empty()) spdlog::warn("{}: damaged, every intact record read: {}", o.journal, journal.damage);
   const mapper::Restored restored = mapper::restore_journal(journal, mapper, o.journal);
   std::printf("keyframes restored from the journal: %lld, kept: %zu\n", static_cast<long long>(restored.keyframes),
               mapper.keyframes().size());

@@ -12,6 +12,7 @@
 #include <iostream>
 #include <opencv2/imgcodecs.hpp>
 
+#include "common/atomic_file.h"
 #include "common/cli.h"
 #include "common/error.h"
 #include "planner/eval/plot.h"
@@ -155,7 +156,9 @@ int main(int argc, char** argv) {
               [&] { return planner::eval::transfer_precision(sc, pairs, o); });
       if (!png_dir.empty()) {
         const std::string path = (std::filesystem::path(png_dir) / (w.name + "_paths.png")).string();
-        if (!cv::imwrite(path, draw_paths(w, sc, o))) throw InputError(path + ": cannot write");
+        std::vector<uchar> png;
+        if (!cv::imencode(".png", draw_paths(w, sc, o), png)) throw InputError(path + ": cannot write");
+        write_file_atomically(path, png.data(), png.size());  // no cut image that looks whole
         spdlog::info("wrote {}", path);
       }
     }

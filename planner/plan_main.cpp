@@ -6,6 +6,7 @@
 #include <iostream>
 #include <opencv2/imgcodecs.hpp>
 
+#include "common/atomic_file.h"
 #include "common/cli.h"
 #include "common/error.h"
 #include "planner/eval/experiment.h"
@@ -107,7 +108,10 @@ int main(int argc, char** argv) {
                 << covariances[i].trace() << "\n";
     if (!png.empty()) {
       planner::eval::DrawnPath drawn{t.path, covariances, planner != "prm" ? cv::Scalar(200, 0, 0) : cv::Scalar(0, 0, 220)};
-      if (!cv::imwrite(png, planner::eval::draw_plans(env, t.samples, {drawn}, sc.space.z_min_m))) throw InputError(png + ": cannot write");
+      std::vector<uchar> bytes;
+      if (!cv::imencode(".png", planner::eval::draw_plans(env, t.samples, {drawn}, sc.space.z_min_m), bytes))
+        throw InputError(png + ": cannot write");
+      write_file_atomically(png, bytes.data(), bytes.size());  // no cut image that looks whole
     }
     return kExitOk;
   });

@@ -82,12 +82,17 @@ int main(int argc, char** argv) {
       const vo::SequenceRun run = vo::run_sequence(sequence.frames, vo::with_tum_sensor(folder, v.options));
       const vo::RunFigures f = vo::score(run, sequence.ground_truth);
       const PaperRow p = paper().at(v.name);
+      // A variant that estimated nothing gets no figures, not zeros that would top the table.
+      const auto measured = [&](const char* format, double value) {
+        return f.scored ? fmt::format(fmt::runtime(format), value) : std::string("n/a");
+      };
       std::cout << "| " << v.name << " | " << p.vel << " | " << p.fail << " | " << p.ms << " | "
-                << fmt::format("{:.3f}", f.velocity_error_mps) << " | " << fmt::format("{:.2f}", f.gross_percent) << " | "
+                << measured("{:.3f}", f.velocity_error_mps) << " | " << measured("{:.2f}", f.gross_percent) << " | "
                 << fmt::format("{:.2f}", f.median_ms) << " | " << fmt::format("{:.2f}", f.p95_ms) << " | "
-                << fmt::format("{:.2f}", 100.0 * f.ate_rmse_m) << " | " << fmt::format("{:.4f}", f.rpe_translation_mps) << " | "
-                << fmt::format("{:.2f}", f.rpe_rotation_degps) << " | " << fmt::format("{:.1f}", f.mean_nees) << " |"
+                << measured("{:.2f}", 100.0 * f.ate_rmse_m) << " | " << measured("{:.4f}", f.rpe_translation_mps) << " | "
+                << measured("{:.2f}", f.rpe_rotation_degps) << " | " << measured("{:.1f}", f.mean_nees) << " |"
                 << std::endl;
+      if (!f.scored) spdlog::warn("{}: variant {}: not measured ({})", folder, v.name, f.not_scored);
     }
     return kExitOk;
   });

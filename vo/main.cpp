@@ -1,7 +1,8 @@
 // kestrel-vo: visual odometry. As a process (default) it reads CAMERA_RGBD and publishes one
 // VO_UPDATE per frame (relative motion, covariance, status and counts), with heartbeats and
 // lock-step replay. With --tum DIR it runs in process over a TUM RGB-D folder instead and
-// writes the camera trajectory (TUM format, at the RGB time stamps) and optional statistics.
+// writes the camera trajectory (TUM format, at the RGB time stamps) and optional statistics;
+// a run in which no frame gave a motion is bad input (exit 3) and writes nothing.
 // See vo/README.md.
 
 #include <spdlog/spdlog.h>
@@ -15,8 +16,10 @@
 #include <string>
 #include <vector>
 
+#include "common/atomic_file.h"
 #include "common/cli.h"
 #include "common/error.h"
+#include "common/time.h"
 #include "common/transport/channels.h"
 #include "common/transport/node.h"
 #include "common/transport/rgbd_codec.h"
@@ -67,16 +70,29 @@ vo::VoOptions configured(const Options& o, vo::SensorProfile sensor) {
   return options;
 }
 
+// Nothing is written for a run that estimated nothing: a trajectory holding only the first
+// frame's identity pose, and figures of zeros, would read as a perfect result.
 int run_offline(const Options& o, const vo::VoOptions& options) {
   if (o.out.empty()) throw CLI::RequiredError("--out (with --tum)");
   const vo::LoadedSequence sequence = vo::load_tum_sequence(o.tum);
   const vo::SequenceRun run = vo::run_sequence(sequence.frames, options);
-  write_tum_trajectory(o.out, run.trajectory);
   const vo::RunFigures f = vo::score(run, sequence.ground_truth);
-  std::cout << "frames: " << f.frames << ", with a motion: " << f.ok << "\n"
+  vo::require_usable(run, f, o.tum);  // InputError: exit 3
+  write_tum_trajectory(o.out, run.trajectory);
+  const size_t unpaired = sequence.rgb_images - f.frames;
+  std::cout << "frames: " << f.frames << " of " << sequence.rgb_images << " RGB images (" << unpaired
+            << " without a depth image within " << format_seconds(sequence.max_time_difference_us) << " s)\n"
+            << "with a motion: " << f.ok << " (" << 100.0 * double(f.ok) / double(f.frames)
+            << " %); by status: " << vo::status_summary(f) << "\n"
             << "ms per frame: median " << f.median_ms << ", p95 " << f.p95_ms << "\n";
-  if (!sequence.ground_truth.empty()) {
-    std::cout << "ATE RMSE: " << f.ate_rmse_m << " m\n"
+  // The first frame is the reference; any other frame without a motion is a gap in the output.
+  if (f.ok + 1 < f.frames)
+    spdlog::warn("{}: {} of {} frames gave no motion ({})", o.tum, f.frames - f.ok, f.frames, vo::status_summary(f));
+  if (unpaired > 0) spdlog::warn("{}: {} RGB images have no depth image and were skipped", o.tum, unpaired);
+  if (!sequence.ground_truth.empty() && !f.scored) {
+    std::cout << "accuracy: not measured (" << f.not_scored << ")\n";
+  } else if (f.scored) {
+    std::cout << "ATE RMSE: " << f.ate_rmse_m << " m (" << f.scored_frames << " frames with ground truth)\n"
               << "RPE (1 s): " << f.rpe_translation_mps << " m/s, " << f.rpe_rotation_degps << " deg/s\n"
               << "mean velocity error: " << f.velocity_error_mps << " m/s\n"
               << "gross failures: " << f.gross << " (" << f.gross_percent << " %)\n"
@@ -84,9 +100,7 @@ int run_offline(const Options& o, const vo::VoOptions& options) {
               << " % under the 95 % bound, " << f.nees_frames << " frames\n";
   }
   if (!o.stats.empty()) {
-    std::ofstream out(o.stats);
-    out << vo::stats_json(run, f, o.variant) << "\n";
-    if (!out) throw InputError(o.stats + ": cannot write");
+    kestrel::write_file_atomically(o.stats, vo::stats_json(run, f, o.variant) + "\n");
   }
   return kExitOk;
 }

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <nlohmann/json.hpp>
 
+#include "common/error.h"
+#include "common/time.h"
 #include "drivers/tum/tum_sequence.h"
 #include "tools/eval/evaluate.h"
 #include "vo/pose_chain.h"
@@ -14,6 +16,8 @@ namespace {
 
 // 95 % quantile of chi-square with 6 degrees of freedom.
 constexpr double kChi2_6_95 = 12.592;
+
+static_assert(size_t(VoStatus::kBadInput) + 1 == kVoStatusCount, "a counter per status");
 
 // CPU time of this thread: on a machine shared with other jobs it still measures the work of
 // one core, where wall time would measure the contention.
@@ -47,6 +51,8 @@ LoadedSequence load_tum_sequence(const std::string& folder) {
   const tum::TumSequence sequence(folder);
   LoadedSequence out;
   out.folder = folder;
+  out.rgb_images = sequence.association().rgb_images;
+  out.max_time_difference_us = tum::SequenceOptions{}.max_time_difference_us;
   out.frames.reserve(sequence.size());
   for (size_t i = 0; i < sequence.size(); ++i) out.frames.push_back(sequence.frame(i));
   if (sequence.has_ground_truth()) out.ground_truth = sequence.ground_truth();
@@ -80,13 +86,36 @@ SequenceRun run_sequence(const std::vector<RgbdFrame>& frames, const VoOptions& 
 RunFigures score(const SequenceRun& run, const Trajectory& gt) {
   RunFigures f;
   f.frames = run.results.size();
-  for (const VoResult& r : run.results) f.ok += r.status == VoStatus::kOk;
+  for (const VoResult& r : run.results) {
+    f.ok += r.status == VoStatus::kOk;
+    ++f.by_status.at(size_t(r.status));
+  }
   f.median_ms = percentile(run.process_ms, 0.5);
   f.p95_ms = percentile(run.process_ms, 0.95);
-  if (gt.empty() || run.trajectory.empty()) return f;
+  if (gt.empty()) {
+    f.not_scored = "no ground truth";
+    return f;
+  }
+  // The first frame's pose is the identity by definition: alone it would score a perfect 0.
+  if (f.ok == 0) {
+    f.not_scored = "no frame has a motion";
+    return f;
+  }
 
   const eval::EvalOptions options;
-  const eval::Evaluation e = eval::evaluate(run.frame_utimes, run.trajectory, gt, options);
+  eval::Evaluation e;
+  try {
+    e = eval::evaluate(run.frame_utimes, run.trajectory, gt, options);
+  } catch (const eval::NoOverlapError& error) {
+    f.not_scored = error.what();
+    return f;
+  }
+  f.scored_frames = e.association.scored;
+  if (f.scored_frames < 2) {
+    f.not_scored = std::to_string(f.scored_frames) + " frame(s) with a pose have ground truth (need 2)";
+    return f;
+  }
+  f.scored = true;
   f.ate_rmse_m = e.ate.error_m.rmse;
   f.rpe_translation_mps = e.rpe.translation_mps.rmse;
   f.rpe_rotation_degps = e.rpe.rotation_degps.rmse;
@@ -116,18 +145,49 @@ RunFigures score(const SequenceRun& run, const Trajectory& gt) {
   return f;
 }
 
+std::string status_summary(const RunFigures& f) {
+  std::string out;
+  for (size_t i = 0; i < kVoStatusCount; ++i) {
+    if (f.by_status[i] == 0) continue;
+    out += (out.empty() ? "" : ", ") + std::string(to_string(VoStatus(i))) + " " + std::to_string(f.by_status[i]);
+  }
+  return out.empty() ? "no frames" : out;
+}
+
+void require_usable(const SequenceRun& run, const RunFigures& f, const std::string& folder) {
+  if (f.ok > 0) return;
+  std::string first;  // the first frame that failed for a reason other than being the reference
+  for (const VoResult& r : run.results) {
+    if (r.status == VoStatus::kNoReference) continue;
+    first = "; first failure at " + format_seconds(r.utime) + " s: " + (r.message.empty() ? to_string(r.status) : r.message);
+    break;
+  }
+  throw InputError(folder + ": nothing usable: 0 of " + std::to_string(f.frames) +
+                   " frames gave a motion (" + status_summary(f) + ")" + first);
+}
+
 std::string stats_json(const SequenceRun& run, const RunFigures& f, const std::string& variant) {
   nlohmann::json j;
   j["variant"] = variant;
   j["frames"] = f.frames;
   j["ok"] = f.ok;
+  nlohmann::json by_status = nlohmann::json::object();
+  for (size_t i = 0; i < kVoStatusCount; ++i) by_status[to_string(VoStatus(i))] = f.by_status[i];
+  j["by_status"] = std::move(by_status);
   j["ms"] = {{"median", f.median_ms}, {"p95", f.p95_ms}};
-  j["accuracy"] = {{"ate_rmse_m", f.ate_rmse_m},
-                   {"rpe_translation_mps", f.rpe_translation_mps},
-                   {"rpe_rotation_degps", f.rpe_rotation_degps},
-                   {"velocity_error_mps", f.velocity_error_mps},
-                   {"gross_percent", f.gross_percent},
-                   {"gross", f.gross}};
+  // null, not zeros, when nothing was measured: a reader must not mistake it for a perfect run.
+  if (f.scored) {
+    j["accuracy"] = {{"ate_rmse_m", f.ate_rmse_m},
+                     {"rpe_translation_mps", f.rpe_translation_mps},
+                     {"rpe_rotation_degps", f.rpe_rotation_degps},
+                     {"velocity_error_mps", f.velocity_error_mps},
+                     {"gross_percent", f.gross_percent},
+                     {"gross", f.gross},
+                     {"scored_frames", f.scored_frames}};
+  } else {
+    j["accuracy"] = nullptr;
+    j["not_scored"] = f.not_scored;
+  }
   j["nees"] = {{"mean", f.mean_nees}, {"within_95", f.nees_within_95}, {"frames", f.nees_frames}};
   nlohmann::json per_frame = nlohmann::json::array();
   for (size_t i = 0; i < run.results.size(); ++i) {

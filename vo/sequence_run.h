@@ -6,7 +6,10 @@
 //
 // Invariants: frames are fed in sequence order; the trajectory holds T_world_camera (world =
 // first frame's camera) at exactly the frames whose status is ok, plus the first frame.
+// Accuracy figures exist only when measured (RunFigures::scored): a run that estimated nothing
+// has none, never zeros that read as a perfect score, and require_usable() refuses it.
 
+#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -25,9 +28,19 @@ struct SequenceRun {
   Trajectory trajectory;             ///< T_world_camera where the odometry gave one
 };
 
+/// One counter per VoStatus value (vo/status.h: kOk = 0 .. kBadInput = 7).
+constexpr size_t kVoStatusCount = 8;
+
 struct RunFigures {
   size_t frames = 0;
   size_t ok = 0;                    ///< frames with status ok
+  std::array<size_t, kVoStatusCount> by_status{};  ///< frames per status, indexed by its value
+  /// The accuracy figures below (ATE .. gross) were measured: ground truth exists, some frame
+  /// has a motion and at least two frames with a pose have ground truth. Otherwise they are 0
+  /// and `not_scored` says why.
+  bool scored = false;
+  std::string not_scored;
+  size_t scored_frames = 0;         ///< frames with both an estimate and ground truth
   double ate_rmse_m = 0.0;
   double rpe_translation_mps = 0.0; ///< RMSE over 1 s pairs
   double rpe_rotation_degps = 0.0;
@@ -44,9 +57,13 @@ struct RunFigures {
 /// Decoded frames of a TUM sequence folder (all of them; about 1.5 MB each at VGA).
 struct LoadedSequence {
   std::string folder;
-  std::vector<RgbdFrame> frames;
-  Trajectory ground_truth;  ///< empty if the folder has none
+  std::vector<RgbdFrame> frames;  ///< the RGB images with a depth image (never empty)
+  Trajectory ground_truth;        ///< empty if the folder has none
+  size_t rgb_images = 0;          ///< listed in rgb.txt; those without depth are not in frames
+  int64_t max_time_difference_us = 0;  ///< the RGB-depth association tolerance used
 };
+/// Throws InputError for a folder that cannot be read or whose lists pair no frame
+/// (tum::TumSequence).
 LoadedSequence load_tum_sequence(const std::string& folder);
 
 /// The sensor profile of the recording in `folder`: kKinect1 for a freiburg1 recording (named
@@ -63,6 +80,15 @@ SequenceRun run_sequence(const std::vector<RgbdFrame>& frames, const VoOptions& 
 
 /// The figures of ../shared/BASELINES.md (tools/eval with its defaults) plus timing and NEES.
 RunFigures score(const SequenceRun& run, const Trajectory& ground_truth);
+
+/// "ok 187, no reference 1, too little valid depth 2": the frames by status, in the order of
+/// the statuses, the ones no frame had left out.
+std::string status_summary(const RunFigures& figures);
+
+/// Throws InputError naming `folder` when the run produced nothing usable: no frame with a
+/// motion (no valid depth anywhere, no features, a single frame...). The message counts the
+/// frames by status and quotes the first failure, so the user learns what to fix.
+void require_usable(const SequenceRun& run, const RunFigures& figures, const std::string& folder);
 
 /// Per-frame status and counts, the figures and the options as JSON text.
 std::string stats_json(const SequenceRun& run, const RunFigures& figures, const std::string& variant);

@@ -5,9 +5,11 @@
 
 #include <atomic>
 #include <csignal>
+#include <iterator>
 #include <stdexcept>
 
 #include "common/error.h"
+#include "common/text.h"
 #include "common/transport/channels.h"
 #include "common/transport/lcm_url.h"
 #include "kestrel/replay_ack_t.hpp"
@@ -41,6 +43,29 @@ int64_t wall_utime() {
 // messages cannot flood the terminal while the count stays exact.
 bool should_log(int64_t nth) { return nth <= 5 || nth % 100 == 0; }
 
+// `why` usually starts with the channel already (decode errors); avoid saying it twice.
+std::string without_channel(const std::string& channel, const std::string& why) {
+  const bool named = why.compare(0, channel.size(), channel) == 0 && why.size() > channel.size() &&
+                     why[channel.size()] == ':';
+  return named ? why.substr(std::min(why.size(), channel.size() + 2)) : why;
+}
+
+// A heartbeat's reason is shown on an operator's terminal: bytes from a damaged message must
+// not reach it raw (escape_bytes), and one reason must not fill the screen.
+std::string printable_reason(const std::string& text) {
+  constexpr size_t kMaxChars = 200;
+  std::string out = escape_bytes(text);
+  if (out.size() > kMaxChars) {
+    // Cut before a character, not inside one (a UTF-8 sequence or an escape).
+    size_t cut = kMaxChars;
+    while (cut > 0 && (static_cast<unsigned char>(out[cut]) & 0xC0) == 0x80) --cut;
+    const size_t escape = out.rfind('\\', cut);
+    if (escape != std::string::npos && cut - escape < 4) cut = escape;
+    out = out.substr(0, cut) + "...";
+  }
+  return out;
+}
+
 }  // namespace
 
 Node::Node(std::string name, const std::string& lcm_url, double heartbeat_period_s)
@@ -62,7 +87,7 @@ Node::Node(std::string name, const std::string& lcm_url, double heartbeat_period
 }
 
 Node::~Node() {
-  health_ = kestrel::process_status_t::STATE_STOPPING;
+  own_health_.state = kestrel::process_status_t::STATE_STOPPING;
   publish_heartbeat();
 }
 
@@ -88,6 +113,7 @@ void Node::handle(Subscription& s, const lcm::ReceiveBuffer& rbuf) {
   if (s.is_control) {
     try {
       s.dispatch(rbuf.data, rbuf.data_size);
+      accepted(s.channel);
     } catch (const std::exception& e) {
       reject(s.channel, e.what());
     }
@@ -100,6 +126,7 @@ void Node::handle(Subscription& s, const lcm::ReceiveBuffer& rbuf) {
   try {
     utime = s.dispatch(rbuf.data, rbuf.data_size);
     if (utime > counters_.last_input_utime) counters_.last_input_utime = utime;
+    accepted(s.channel);
   } catch (const InputError& e) {
     reject(s.channel, e.what());
   } catch (const std::exception& e) {
@@ -123,12 +150,58 @@ void Node::handle(Subscription& s, const lcm::ReceiveBuffer& rbuf) {
 void Node::reject(const std::string& channel, const std::string& why) {
   ++counters_.messages_rejected;
   const int64_t nth = ++rejections_per_channel_[channel];
-  if (should_log(nth)) {
-    // `why` usually starts with the channel already (decode errors); avoid saying it twice.
-    const bool named = why.compare(0, channel.size(), channel) == 0;
-    spdlog::warn("rejected message #{} on {}: {}", nth, channel,
-                 named ? why.substr(std::min(why.size(), channel.size() + 2)) : why);
+  // Printable in the log as in the heartbeat: a damaged message's bytes may be terminal codes.
+  const std::string reason = printable_reason(without_channel(channel, why));
+  if (should_log(nth)) spdlog::warn("rejected message #{} on {}: {}", nth, channel, reason);
+  rejecting_[channel] = Rejection{std::chrono::steady_clock::now(), reason, false};
+  publish_heartbeat_if_state_changed();
+}
+
+void Node::accepted(const std::string& channel) {
+  const auto it = rejecting_.find(channel);
+  if (it == rejecting_.end()) return;
+  it->second.accepted_since = true;
+  publish_heartbeat_if_state_changed();
+}
+
+bool Node::still_rejecting(const Rejection& r, std::chrono::steady_clock::time_point now) const {
+  return !r.accepted_since || now - r.at < heartbeat_period_;
+}
+
+Node::Health Node::health() const {
+  const int8_t own = own_health_.state;
+  if (own == kestrel::process_status_t::STATE_STOPPING || own == kestrel::process_status_t::STATE_FAILED)
+    return own_health_;
+  const auto now = std::chrono::steady_clock::now();
+  const std::pair<const std::string, Rejection>* last = nullptr;
+  std::vector<std::string> others;
+  for (const auto& entry : rejecting_) {
+    if (!still_rejecting(entry.second, now)) continue;
+    if (last && entry.second.at <= last->second.at) {
+      others.push_back(entry.first);
+      continue;
+    }
+    if (last) others.push_back(last->first);
+    last = &entry;
   }
+  if (!last) return own_health_;
+  Health h;
+  h.state = kestrel::process_status_t::STATE_DEGRADED;
+  h.message = "rejecting " + last->first + ": " + last->second.why;
+  if (!others.empty()) {
+    h.message += " (also rejecting";
+    for (const auto& c : others) h.message += " " + c;
+    h.message += ")";
+  }
+  if (!own_health_.message.empty()) h.message += "; " + own_health_.message;
+  return h;
+}
+
+void Node::publish_heartbeat_if_state_changed() {
+  const auto now = std::chrono::steady_clock::now();
+  for (auto it = rejecting_.begin(); it != rejecting_.end();)
+    it = still_rejecting(it->second, now) ? std::next(it) : rejecting_.erase(it);
+  if (health().state != reported_state_) publish_heartbeat();
 }
 
 void Node::on_control(const kestrel::replay_control_t& control) {
@@ -165,9 +238,9 @@ void Node::publish_bytes(const std::string& channel, const std::vector<uint8_t>&
 }
 
 void Node::set_health(int8_t state, const std::string& message) {
-  const bool changed = state != health_ || message != health_message_;
-  health_ = state;
-  health_message_ = message;
+  const bool changed = state != own_health_.state || message != own_health_.message;
+  own_health_.state = state;
+  own_health_.message = message;
   if (changed) publish_heartbeat();
 }
 
@@ -186,7 +259,7 @@ bool Node::spin_once(int timeout_ms) {
 }
 
 int Node::spin() {
-  if (health_ == kestrel::process_status_t::STATE_STARTING)
+  if (own_health_.state == kestrel::process_status_t::STATE_STARTING)
     set_health(kestrel::process_status_t::STATE_RUNNING, "");
   while (spin_once(100)) {
   }
@@ -194,6 +267,8 @@ int Node::spin() {
 }
 
 void Node::maybe_heartbeat() {
+  // A rejected channel recovers without an event: its period ends while the process waits.
+  publish_heartbeat_if_state_changed();
   const auto now = std::chrono::steady_clock::now();
   if (now < next_heartbeat_) return;
   next_heartbeat_ = now + heartbeat_period_;
@@ -205,8 +280,10 @@ void Node::publish_heartbeat() {
   s.utime = wall_utime();
   s.name = name_;
   s.pid = static_cast<int32_t>(::getpid());
-  s.state = health_;
-  s.message = health_message_;
+  const Health reported = health();
+  s.state = reported.state;
+  s.message = reported.message;
+  reported_state_ = reported.state;
   for (const Subscription& sub : subscriptions_)
     if (!sub.is_control) s.subscriptions.push_back(sub.channel);
   s.num_subscriptions = static_cast<int32_t>(s.subscriptions.size());

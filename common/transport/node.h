@@ -9,7 +9,18 @@
 //    InputError, is dropped, counted in the heartbeat and logged as one line naming the
 //    channel (rate-limited); the process carries on.
 //  * PROCESS_STATUS is published about once per heartbeat period with the counters, the
-//    subscribed and advertised channels, and the health set by set_health().
+//    subscribed and advertised channels, and the health set by set_health() - except while
+//    input is being rejected: then the state is DEGRADED and the message names the last
+//    rejection ("rejecting CHANNEL: why"), so that a process blinded by bad input never shows
+//    RUNNING (issue 38). The state set by set_health() is kept apart and reported again once
+//    input is accepted; STOPPING and FAILED are always reported as set.
+//  * A channel is being rejected from a rejection on it until both a message on it has been
+//    accepted since and one heartbeat period has passed without another rejection on it.
+//    One period, because the launcher sees one heartbeat per period: even a single bad
+//    message shows in a heartbeat (one is sent at once when the state changes). Per channel
+//    and until an acceptance, because a busy good channel (IMU at 200 Hz) must not hide a
+//    slower one that is rejected (VO at 30 Hz), nor a channel whose last message was bad
+//    before its sender went quiet.
 //  * Lock-step: between REPLAY_CONTROL BEGIN and END of a session, after every input handled
 //    (accepted or rejected) the node publishes REPLAY_ACK listing the channels it published
 //    on meanwhile; RESET calls the reset handler. See tools/replay/README.md.
@@ -74,8 +85,16 @@ class Node {
 
   /// Called on REPLAY_CONTROL RESET: drop all algorithm state.
   void on_reset(std::function<void()> reset) { reset_ = std::move(reset); }
-  /// Health reported in heartbeats (process_status_t::STATE_*), with a reason.
+  /// The process's own health (process_status_t::STATE_*), with a reason; heartbeats report
+  /// it unless input is being rejected (see above).
   void set_health(int8_t state, const std::string& message);
+
+  struct Health {
+    int8_t state = kestrel::process_status_t::STATE_STARTING;
+    std::string message;
+  };
+  /// What the next heartbeat reports: the own health, or DEGRADED while input is rejected.
+  Health health() const;
 
   /// Handles messages until stop() or SIGINT/SIGTERM; returns kExitOk.
   int spin();
@@ -96,6 +115,13 @@ class Node {
     Dispatch dispatch;
     bool is_control;  // REPLAY_CONTROL: not an input, never acknowledged
   };
+  // Per channel with a rejection: when the last one was, and whether a message was accepted
+  // after it. Entries leave once the channel is no longer being rejected.
+  struct Rejection {
+    std::chrono::steady_clock::time_point at;
+    std::string why;  // printable, without the channel's name
+    bool accepted_since = false;
+  };
   static void on_message(const lcm::ReceiveBuffer* rbuf, const std::string& channel,
                          Subscription* subscription);
   void add_subscription(const std::string& channel, Dispatch dispatch, int queue_capacity,
@@ -103,6 +129,9 @@ class Node {
   void handle(Subscription& s, const lcm::ReceiveBuffer& rbuf);
   void on_control(const kestrel::replay_control_t& control);
   void reject(const std::string& channel, const std::string& why);
+  void accepted(const std::string& channel);
+  bool still_rejecting(const Rejection& r, std::chrono::steady_clock::time_point now) const;
+  void publish_heartbeat_if_state_changed();
   void maybe_heartbeat();
   void publish_heartbeat();
 
@@ -114,10 +143,11 @@ class Node {
   std::deque<Subscription> subscriptions_;
   std::vector<std::string> advertised_;
   std::function<void()> reset_;
-  int8_t health_ = kestrel::process_status_t::STATE_STARTING;
-  std::string health_message_;
+  Health own_health_;  // as set_health() left it, whatever the input does
+  int8_t reported_state_ = kestrel::process_status_t::STATE_STARTING;  // in the last heartbeat
   NodeCounters counters_;
   std::map<std::string, int64_t> rejections_per_channel_;
+  std::map<std::string, Rejection> rejecting_;  // channels being rejected
   bool stopping_ = false;
 
   // Lock-step state: the active replay session, and what was published while handling the

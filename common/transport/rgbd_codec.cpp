@@ -3,6 +3,8 @@
 #include <turbojpeg.h>
 #include <zstd.h>
 
+#include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <memory>
 
@@ -14,44 +16,79 @@ namespace {
 
 using kestrel::rgbd_frame_t;
 
+// One TurboJPEG handle per thread and direction (creating one costs more than compressing a
+// small image), lent out for one call and thrown away unless that call succeeded.
+// libjpeg-turbo 2.1 leaves a handle whose header read failed part-way (e.g. "Bogus Huffman
+// table definition") in the middle of that read, and every later header read on it fails
+// the same way: one corrupt frame then blinded vo, the mapper and rgbd-codec to every good
+// frame after it (issue 38). No state of a failed call is reused, whatever the failure.
 struct TjDeleter {
   void operator()(void* h) const { tjDestroy(h); }
 };
 using TjHandle = std::unique_ptr<void, TjDeleter>;
 
+class TjLease {
+ public:
+  TjLease(TjHandle& slot, tjhandle (*init)()) : slot_(slot) {
+    if (!slot_) slot_.reset(init());
+    if (!slot_) throw std::runtime_error(std::string("TurboJPEG: ") + tjGetErrorStr2(nullptr));
+  }
+  ~TjLease() {
+    if (!succeeded_) slot_.reset();  // a fresh handle is made on the next call
+  }
+  TjLease(const TjLease&) = delete;
+  TjLease& operator=(const TjLease&) = delete;
+  tjhandle get() const { return slot_.get(); }
+  /// libjpeg's reason for the last failure, printable ASCII.
+  std::string error() const { return tjGetErrorStr2(slot_.get()); }
+  void succeeded() { succeeded_ = true; }
+
+ private:
+  TjHandle& slot_;
+  bool succeeded_ = false;
+};
+
 std::vector<uint8_t> jpeg_compress(const cv::Mat& rgb, int quality) {
-  // One handle per thread: creating one costs more than compressing a small image.
-  thread_local TjHandle handle(tjInitCompress());
+  thread_local TjHandle slot;
+  TjLease handle(slot, tjInitCompress);
   unsigned char* out = nullptr;
   unsigned long size = 0;
   const int rc = tjCompress2(handle.get(), rgb.data, rgb.cols, static_cast<int>(rgb.step), rgb.rows,
                              TJPF_RGB, &out, &size, TJSAMP_420, quality, TJFLAG_ACCURATEDCT);
   if (rc != 0) {
-    const std::string why = tjGetErrorStr2(handle.get());
+    const std::string why = handle.error();
     tjFree(out);
     throw std::runtime_error("JPEG compression failed: " + why);
   }
   std::vector<uint8_t> bytes(out, out + size);
   tjFree(out);
+  handle.succeeded();
   return bytes;
 }
 
 cv::Mat jpeg_decompress(const std::vector<uint8_t>& data, int width, int height, const char* what) {
-  thread_local TjHandle handle(tjInitDecompress());
+  thread_local TjHandle slot;
+  TjLease handle(slot, tjInitDecompress);
+  auto corrupt = [&] {
+    return InputError(std::string(what) + ": corrupt JPEG colour image (" + handle.error() + ")");
+  };
   int w = 0, h = 0, subsamp = 0, colorspace = 0;
   // libjpeg-turbo 2.1 takes a non-const source buffer but never writes to it.
   auto* src = const_cast<unsigned char*>(data.data());
   if (tjDecompressHeader3(handle.get(), src, data.size(), &w, &h, &subsamp, &colorspace) != 0)
-    throw InputError(std::string(what) + ": corrupt JPEG colour image");
+    throw corrupt();
   if (w != width || h != height) {
     throw InputError(std::string(what) + ": JPEG is " + std::to_string(w) + "x" +
                      std::to_string(h) + " but the camera is " + std::to_string(width) + "x" +
                      std::to_string(height));
   }
   cv::Mat rgb(height, width, CV_8UC3);
+  // A warning (a truncated or damaged scan, filled in grey) fails the call as well: the image
+  // would not be the scene.
   if (tjDecompress2(handle.get(), src, data.size(), rgb.data, width, static_cast<int>(rgb.step),
                     height, TJPF_RGB, TJFLAG_ACCURATEDCT) != 0)
-    throw InputError(std::string(what) + ": corrupt JPEG colour image");
+    throw corrupt();
+  handle.succeeded();
   return rgb;
 }
 
@@ -60,6 +97,44 @@ std::vector<uint8_t> raw_bytes(const cv::Mat& m) {
   const size_t row = m.cols * m.elemSize();
   for (int r = 0; r < m.rows; ++r) std::memcpy(bytes.data() + r * row, m.ptr(r), row);
   return bytes;
+}
+
+std::string shortest(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", v);
+  return text;
+}
+
+// What a frame on the wire may claim about its camera, beyond PinholeCamera::validate (finite,
+// positive, at most 16384 pixels a side). These are values no pinhole camera has (a field of
+// view beyond 0.01..170 degrees, a principal point more than an image away from the image, a
+// camera mounted 100 m from the body); they are finite, so without this gate the consumers'
+// back-projection would turn them into garbage points and poses rather than fail. The bounds
+// are deliberately loose: they reject impossible cameras, not unusual ones.
+void check_plausible_camera(const PinholeCamera& c, const Eigen::Isometry3d& T_body_camera,
+                            const char* what) {
+  auto fail = [&](const std::string& why) {
+    throw InputError(std::string(what) + ": implausible camera: " + why);
+  };
+  const double max_half_fov_rad = 85.0 * M_PI / 180.0, min_half_fov_rad = 0.005 * M_PI / 180.0;
+  auto check_focal = [&](const char* name, double f_px, int pixels, const char* side) {
+    if (f_px < 0.5 * pixels / std::tan(max_half_fov_rad) || f_px > 0.5 * pixels / std::tan(min_half_fov_rad))
+      fail(std::string(name) + " = " + shortest(f_px) + " px for images " + std::to_string(pixels) +
+           " px " + side + " (a field of view outside 0.01..170 deg)");
+  };
+  check_focal("fx", c.fx, c.width, "wide");
+  check_focal("fy", c.fy, c.height, "high");
+  auto check_centre = [&](const char* name, double centre_px, int pixels, const char* side) {
+    if (centre_px < -pixels || centre_px > 2.0 * pixels)
+      fail(std::string(name) + " = " + shortest(centre_px) + " px, more than an image outside images " +
+           std::to_string(pixels) + " px " + side);
+  };
+  check_centre("cx", c.cx, c.width, "wide");
+  check_centre("cy", c.cy, c.height, "high");
+  for (double k : c.distortion)
+    if (std::abs(k) > 1e3) fail("lens distortion coefficient " + shortest(k) + " (beyond +-1000)");
+  const double offset_m = T_body_camera.translation().norm();
+  if (offset_m > 100.0) fail("mounted " + shortest(offset_m) + " m from the body (more than 100 m)");
 }
 
 static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__,
@@ -112,6 +187,7 @@ RgbdFrame decode_rgbd(const rgbd_frame_t& m, const char* what) {
   f.camera = from_message(m.camera, what);
   f.T_body_camera = from_message(m.camera.T_body_camera, what);
   f.sensor = m.camera.sensor;
+  check_plausible_camera(f.camera, f.T_body_camera, what);
   const int w = f.camera.width;
   const int h = f.camera.height;
   const size_t pixels = static_cast<size_t>(w) * static_cast<size_t>(h);
@@ -145,12 +221,14 @@ RgbdFrame decode_rgbd(const rgbd_frame_t& m, const char* what) {
       std::memcpy(f.depth_mm.data, m.depth.data(), m.depth.size());
       break;
     case rgbd_frame_t::DEPTH_U16_MM_ZSTD: {
+      // ZSTD_decompress makes a fresh context for each call: nothing outlives a corrupt frame.
       const unsigned long long n = ZSTD_getFrameContentSize(m.depth.data(), m.depth.size());
       if (n == ZSTD_CONTENTSIZE_ERROR || n == ZSTD_CONTENTSIZE_UNKNOWN || n != pixels * 2)
         fail("zstd depth image is corrupt or not " + std::to_string(w) + "x" + std::to_string(h));
       f.depth_mm = cv::Mat(h, w, CV_16UC1);
       const size_t got = ZSTD_decompress(f.depth_mm.data, pixels * 2, m.depth.data(), m.depth.size());
-      if (ZSTD_isError(got) || got != pixels * 2) fail("zstd depth image is corrupt");
+      if (ZSTD_isError(got)) fail(std::string("zstd depth image is corrupt (") + ZSTD_getErrorName(got) + ")");
+      if (got != pixels * 2) fail("zstd depth image is corrupt (shorter than its header says)");
       break;
     }
     default:

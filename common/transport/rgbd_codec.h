@@ -3,6 +3,11 @@
 //
 // Raw encodings are for onboard links; JPEG colour and zstd depth (lossless) cut a 640x480
 // frame from 1.5 MB to about 100 kB for the link to the ground station.
+//
+// Invariants: decoding is a pure function of the message. A failed decode keeps no state (a
+// decoder handle whose call failed is discarded), so the frames after a corrupt one decode
+// exactly as they would alone; bad input, including a camera no pinhole camera can be
+// (rgbd_codec.cpp, check_plausible_camera), only ever throws InputError.
 
 #include "common/rgbd_frame.h"
 #include "kestrel/rgbd_frame_t.hpp"
@@ -20,7 +25,8 @@ struct RgbdEncoding {
 kestrel::rgbd_frame_t encode_rgbd(const RgbdFrame& frame, const RgbdEncoding& encoding = {});
 
 /// Decodes a message; throws InputError naming `what` (usually the channel) if the encoding
-/// is unknown, the data is corrupt or its size does not match the camera.
+/// is unknown, the data is corrupt, truncated or of another size than the camera, or the
+/// camera or its mounting is invalid or implausible.
 RgbdFrame decode_rgbd(const kestrel::rgbd_frame_t& message, const char* what);
 
 }  // namespace kestrel::transport

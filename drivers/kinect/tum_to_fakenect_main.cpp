@@ -18,6 +18,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "common/atomic_file.h"
 #include "common/cli.h"
 #include "common/error.h"
 #include "drivers/kinect/calibration_options.h"
@@ -75,7 +76,8 @@ struct Entry {
 
 // The calibration as kestrel-kinect options, so the driver undoes exactly this conversion.
 void write_driver_config(const std::string& path, const kinect::KinectCalibration& c, bool identity) {
-  std::ofstream out(path);
+  AtomicFile file(path);  // a failed run leaves no cut configuration that looks whole
+  std::ostream& out = file.stream();
   out << std::setprecision(17);
   auto list = [&](const char* key, std::initializer_list<double> v) {
     out << key << "=[";
@@ -95,8 +97,7 @@ void write_driver_config(const std::string& path, const kinect::KinectCalibratio
   list("rgb-in-ir-translation", {t.x(), t.y(), t.z()});
   list("disparity", {c.disparity.a, c.disparity.b});
   out << "identity-calibration=" << (identity ? "true" : "false") << "\n";
-  out.flush();
-  if (!out) throw InputError(path + ": write failed");
+  file.commit();
 }
 
 int run(const Options& o, bool rgb_intrinsics_given) {

@@ -2,8 +2,12 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -24,6 +28,80 @@ double number(const YAML::Node& root, const std::string& path, const char* key) 
   } catch (const YAML::Exception&) {
     throw InputError(at_line(path, line_of(n), std::string("'") + key + "' must be a number"));
   }
+}
+
+// A number as %g, for messages.
+std::string number_text(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", v);
+  return text;
+}
+
+// What an image's header says, read without decoding the image.
+struct ImageHeader {
+  enum Kind { kUnreadable, kUnknownFormat, kKnown } kind = kUnreadable;
+  int64_t width = 0, height = 0;
+};
+
+// PNG: the signature, then the IHDR chunk with width and height (big-endian, 4 bytes each).
+// PNM: "P1".."P6", then width and height as decimal fields among whitespace and '#' comments.
+ImageHeader read_image_header(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return {};
+  std::string head(4096, '\0');  // room for a PNM's comment lines (GIMP writes one)
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
+  head.resize(static_cast<size_t>(in.gcount()));
+  ImageHeader unknown{ImageHeader::kUnknownFormat, 0, 0};
+  const auto byte = [&](size_t at) { return static_cast<unsigned char>(head[at]); };
+  const bool png =
+      head.size() >= 24 && head.compare(0, 8, "\x89PNG\r\n\x1a\n") == 0 && head.compare(12, 4, "IHDR") == 0;
+  if (png) {
+    const auto be32 = [&](size_t at) {
+      return static_cast<int64_t>(uint32_t{byte(at)} << 24 | uint32_t{byte(at + 1)} << 16 |
+                                  uint32_t{byte(at + 2)} << 8 | uint32_t{byte(at + 3)});
+    };
+    return {ImageHeader::kKnown, be32(16), be32(20)};
+  }
+  if (head.size() < 3 || head[0] != 'P' || head[1] < '1' || head[1] > '6' || !std::isspace(byte(2))) return unknown;
+  size_t at = 2;
+  int64_t dims[2] = {0, 0};
+  for (int64_t& d : dims) {
+    while (at < head.size() && (std::isspace(byte(at)) || head[at] == '#')) {
+      if (head[at] == '#')
+        while (at < head.size() && head[at] != '\n' && head[at] != '\r') ++at;
+      else
+        ++at;
+    }
+    // Twelve digits are already far beyond any bound; more would overflow.
+    int digits = 0;
+    for (; at < head.size() && std::isdigit(byte(at)); ++at)
+      if (++digits <= 12) d = d * 10 + (head[at] - '0');
+    if (digits == 0) return unknown;
+  }
+  return {ImageHeader::kKnown, dims[0], dims[1]};
+}
+
+// The image's size against the bounds (occupancy_map.h), before it is decoded.
+void check_image_size(const OccupancyMap& map, const ImageHeader& header, int image_line, int resolution_line) {
+  const std::string& path = map.yaml_path;
+  const std::string image = "map image '" + map.image_path + "'";
+  if (header.kind == ImageHeader::kUnreadable)
+    throw InputError(at_line(path, image_line, "cannot read " + image));
+  if (header.kind == ImageHeader::kUnknownFormat)
+    throw InputError(at_line(path, image_line, image + " is not a PNG or PNM (PGM, PPM, PBM) file"));
+  const std::string size = std::to_string(header.width) + " x " + std::to_string(header.height) + " pixels";
+  if (header.width <= 0 || header.height <= 0)
+    throw InputError(at_line(path, image_line, image + " has no pixels (" + size + ")"));
+  if (static_cast<double>(header.width) * static_cast<double>(header.height) > static_cast<double>(kMaxMapPixels))
+    throw InputError(at_line(path, image_line, image + " is " + size + ", more than the " +
+                                                   std::to_string(kMaxMapPixels) + " a map may have"));
+  const double width_m = static_cast<double>(header.width) * map.resolution;
+  const double height_m = static_cast<double>(header.height) * map.resolution;
+  if (std::max(width_m, height_m) > kMaxMapSide_m)
+    throw InputError(at_line(path, resolution_line,
+                             "'resolution' " + number_text(map.resolution) + " m per pixel makes the " + size +
+                                 " of " + image + " " + number_text(width_m) + " x " + number_text(height_m) +
+                                 " m; a map spans at most " + number_text(kMaxMapSide_m) + " m"));
 }
 
 }  // namespace
@@ -68,7 +146,11 @@ OccupancyMap read_occupancy_map(const std::string& yaml_path) {
   OccupancyMap map;
   map.yaml_path = yaml_path;
   map.resolution = number(root, yaml_path, "resolution");
-  if (map.resolution <= 0) throw InputError(at_line(yaml_path, line_of(root["resolution"]), "'resolution' must be > 0"));
+  if (!(map.resolution >= kMinMapResolution_m && map.resolution <= kMaxMapResolution_m))
+    throw InputError(at_line(yaml_path, line_of(root["resolution"]),
+                             "'resolution' must be in [" + number_text(kMinMapResolution_m) + ", " +
+                                 number_text(kMaxMapResolution_m) + "] m per pixel, got " +
+                                 number_text(map.resolution)));
   const YAML::Node origin = root["origin"];
   if (!origin.IsSequence() || origin.size() != 3)
     throw InputError(at_line(yaml_path, line_of(origin), "'origin' must be a list [x, y, yaw]"));
@@ -81,6 +163,10 @@ OccupancyMap read_occupancy_map(const std::string& yaml_path) {
     if (!std::isfinite(map.origin[static_cast<int>(i)]))
       throw InputError(at_line(yaml_path, line_of(origin), "'origin' values must be finite"));
   }
+  if (std::max(std::abs(map.origin.x()), std::abs(map.origin.y())) > kMaxMapOrigin_m)
+    throw InputError(at_line(yaml_path, line_of(origin),
+                             "'origin' x and y must be within +-" + number_text(kMaxMapOrigin_m) + " m, got [" +
+                                 number_text(map.origin.x()) + ", " + number_text(map.origin.y()) + "]"));
   if (root["negate"]) map.negate = number(root, yaml_path, "negate") != 0;
   if (root["occupied_thresh"]) map.occupied_thresh = number(root, yaml_path, "occupied_thresh");
   if (root["free_thresh"]) map.free_thresh = number(root, yaml_path, "free_thresh");
@@ -101,9 +187,14 @@ OccupancyMap read_occupancy_map(const std::string& yaml_path) {
   std::filesystem::path image_path(image);
   if (image_path.is_relative()) image_path = std::filesystem::path(yaml_path).parent_path() / image_path;
   map.image_path = image_path.string();
+  const ImageHeader header = read_image_header(map.image_path);
+  check_image_size(map, header, line_of(root["image"]), line_of(root["resolution"]));
   const cv::Mat raw = cv::imread(map.image_path, cv::IMREAD_UNCHANGED);
   if (raw.empty())
     throw InputError(at_line(yaml_path, line_of(root["image"]), "cannot read map image '" + map.image_path + "'"));
+  if (raw.cols != header.width || raw.rows != header.height)
+    throw InputError(at_line(yaml_path, line_of(root["image"]),
+                             "map image '" + map.image_path + "' is not the size its header states"));
   if (raw.depth() != CV_8U)
     throw InputError(at_line(yaml_path, line_of(root["image"]), "map image '" + map.image_path + "' is not 8-bit"));
   if (raw.channels() == 1) map.image = raw;

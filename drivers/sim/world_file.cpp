@@ -1,6 +1,7 @@
 #include "drivers/sim/world_file.h"
 
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <optional>
 #include <stdexcept>
@@ -15,6 +16,12 @@
 
 namespace kestrel::sim {
 namespace {
+
+std::string format_metres(double m) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g m", m);
+  return text;
+}
 
 // One statement: its fields and where it came from, with checked accessors.
 class Statement {
@@ -34,6 +41,14 @@ class Statement {
     const auto v = parse_double(fields_[i]);
     if (!v || !std::isfinite(*v)) fail(keyword() + ": " + what + " '" + word(i) + "' is not a finite number");
     return *v;
+  }
+  /// A position or length in metres, within the world's bounds on size (world_file.h).
+  double coordinate(size_t i, const char* what) const {
+    const double v = number(i, what);
+    if (std::abs(v) > kMaxWorldCoordinate_m)
+      fail(keyword() + ": " + what + " '" + word(i) + "' is beyond +-" + format_metres(kMaxWorldCoordinate_m) +
+           " (a world spans at most " + format_metres(2 * kMaxWorldCoordinate_m) + ")");
+    return v;
   }
   /// Positional fields 1..n must all be there, before any option.
   void need(size_t n, const char* usage) const {
@@ -68,13 +83,13 @@ Options parse_options(const Statement& st, size_t first, const std::vector<std::
       o.fit = true;
       i += 1;
     } else if (key == "z") {
-      o.z = std::make_pair(st.number(i + 1, "z0"), st.number(i + 2, "z1"));
+      o.z = std::make_pair(st.coordinate(i + 1, "z0"), st.coordinate(i + 2, "z1"));
       i += 3;
     } else if (key == "color") {
       o.color = Eigen::Vector3d(st.number(i + 1, "red"), st.number(i + 2, "green"), st.number(i + 3, "blue"));
       i += 4;
     } else {
-      const double v = st.number(i + 1, key.c_str());
+      const double v = key == "thick" ? st.coordinate(i + 1, "thick") : st.number(i + 1, key.c_str());
       if (key == "texture") o.texture = v;
       if (key == "yaw") o.yaw_deg = v;
       if (key == "thick") o.thick = v;
@@ -143,8 +158,8 @@ class Parser {
   void bounds(const Statement& st) {
     st.need(6, "bounds <x0> <y0> <z0> <x1> <y1> <z1>");
     if (st.size() != 7) st.fail("bounds: too many values");
-    const Eigen::Vector3d lo(st.number(1, "x0"), st.number(2, "y0"), st.number(3, "z0"));
-    const Eigen::Vector3d hi(st.number(4, "x1"), st.number(5, "y1"), st.number(6, "z1"));
+    const Eigen::Vector3d lo(st.coordinate(1, "x0"), st.coordinate(2, "y0"), st.coordinate(3, "z0"));
+    const Eigen::Vector3d hi(st.coordinate(4, "x1"), st.coordinate(5, "y1"), st.coordinate(6, "z1"));
     if (!(hi.array() > lo.array()).all()) st.fail("bounds: the second corner must exceed the first in x, y and z");
     bounds_ = Eigen::AlignedBox3d(lo, hi);
     builder_.set_bounds(*bounds_);
@@ -152,7 +167,7 @@ class Parser {
   void start(const Statement& st) {
     st.need(4, "start <x> <y> <z> <yaw_deg>");
     if (st.size() != 5) st.fail("start: too many values");
-    builder_.set_start({st.number(1, "x"), st.number(2, "y"), st.number(3, "z"), st.number(4, "yaw") * kDegree});
+    builder_.set_start({st.coordinate(1, "x"), st.coordinate(2, "y"), st.coordinate(3, "z"), st.number(4, "yaw") * kDegree});
   }
   void ambient(const Statement& st) {
     if (st.size() != 2) st.fail("ambient: expected 'ambient <share in [0, 1]>'");
@@ -192,9 +207,9 @@ class Parser {
   void horizontal(const Statement& st, bool is_floor) {
     st.need(6, is_floor ? "floor <material> <x0> <y0> <x1> <y1> <z>" : "ceiling <material> <x0> <y0> <x1> <y1> <z>");
     const int m = material_of(st);
-    const Eigen::Vector2d lo(st.number(2, "x0"), st.number(3, "y0")), hi(st.number(4, "x1"), st.number(5, "y1"));
+    const Eigen::Vector2d lo(st.coordinate(2, "x0"), st.coordinate(3, "y0")), hi(st.coordinate(4, "x1"), st.coordinate(5, "y1"));
     if (!(hi.array() > lo.array()).all()) st.fail(st.keyword() + ": the second corner must exceed the first");
-    const double z = st.number(6, "z");
+    const double z = st.coordinate(6, "z");
     const Options o = parse_options(st, 7, {"texture"});
     const Eigen::AlignedBox2d area(lo, hi);
     if (is_floor) builder_.add_floor(m, area, z, o.texture.value_or(1.0));
@@ -211,7 +226,7 @@ class Parser {
   void wall(const Statement& st) {
     st.need(5, "wall <material> <x0> <y0> <x1> <y1> [z z0 z1] [thick t] [texture d]");
     const int m = material_of(st);
-    const Eigen::Vector2d a(st.number(2, "x0"), st.number(3, "y0")), b(st.number(4, "x1"), st.number(5, "y1"));
+    const Eigen::Vector2d a(st.coordinate(2, "x0"), st.coordinate(3, "y0")), b(st.coordinate(4, "x1"), st.coordinate(5, "y1"));
     if ((b - a).norm() < 1e-6) st.fail("wall: its two ends coincide");
     const Options o = parse_options(st, 6, {"z", "thick", "texture"});
     const auto [z0, z1] = heights(st, o);
@@ -222,8 +237,8 @@ class Parser {
   void panel(const Statement& st) {
     st.need(7, "panel <material> <x0> <y0> <x1> <y1> <z0> <z1> [texture d]");
     const int m = material_of(st);
-    const Eigen::Vector2d a(st.number(2, "x0"), st.number(3, "y0")), b(st.number(4, "x1"), st.number(5, "y1"));
-    const double z0 = st.number(6, "z0"), z1 = st.number(7, "z1");
+    const Eigen::Vector2d a(st.coordinate(2, "x0"), st.coordinate(3, "y0")), b(st.coordinate(4, "x1"), st.coordinate(5, "y1"));
+    const double z0 = st.coordinate(6, "z0"), z1 = st.coordinate(7, "z1");
     if ((b - a).norm() < 1e-6) st.fail("panel: its two ends coincide");
     if (!(z1 > z0)) st.fail("panel: z1 must exceed z0");
     const Options o = parse_options(st, 8, {"texture"});
@@ -232,8 +247,8 @@ class Parser {
   void box(const Statement& st) {
     st.need(7, "box <material> <x0> <y0> <z0> <x1> <y1> <z1> [yaw deg] [texture d]");
     const int m = material_of(st);
-    const Eigen::Vector3d lo(st.number(2, "x0"), st.number(3, "y0"), st.number(4, "z0"));
-    const Eigen::Vector3d hi(st.number(5, "x1"), st.number(6, "y1"), st.number(7, "z1"));
+    const Eigen::Vector3d lo(st.coordinate(2, "x0"), st.coordinate(3, "y0"), st.coordinate(4, "z0"));
+    const Eigen::Vector3d hi(st.coordinate(5, "x1"), st.coordinate(6, "y1"), st.coordinate(7, "z1"));
     if (!(hi.array() > lo.array()).all()) st.fail("box: the second corner must exceed the first in x, y and z");
     const Options o = parse_options(st, 8, {"yaw", "texture"});
     Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
@@ -246,7 +261,7 @@ class Parser {
     if (st.size() > 5) st.fail("light: too many values");
     const double power = st.size() == 5 ? st.number(4, "power") : 1.0;
     if (power <= 0) st.fail("light: power must be > 0");
-    builder_.add_light({{st.number(1, "x"), st.number(2, "y"), st.number(3, "z")}, power});
+    builder_.add_light({{st.coordinate(1, "x"), st.coordinate(2, "y"), st.coordinate(3, "z")}, power});
   }
 
   const std::string& source_;

@@ -4,10 +4,20 @@
 #include <stdexcept>
 
 #include "common/error.h"
+#include "common/time.h"
 #include "drivers/tum/association.h"
 
 namespace kestrel::tum {
 namespace fs = std::filesystem;
+namespace {
+
+// "3 RGB images from 1305031229.528748 to 1305031229.595414 s", for an association that failed.
+std::string span(const std::vector<ImageEntry>& list, const char* what) {
+  return std::to_string(list.size()) + " " + what + " images from " + format_seconds(list.front().utime) +
+         " to " + format_seconds(list.back().utime) + " s";
+}
+
+}  // namespace
 
 TumSequence::TumSequence(const std::string& folder, SequenceOptions options)
     : folder_(folder), to_mm_(options.depth_scale_correction) {
@@ -46,6 +56,13 @@ TumSequence::TumSequence(const std::string& folder, SequenceOptions options)
   for (const auto& e : rgb_) rgb_times.push_back(e.utime);
   for (const auto& e : depth_) depth_times.push_back(e.utime);
   const Association association = associate(rgb_times, depth_times, options.max_time_difference_us);
+  if (association.pairs.empty()) {
+    // Every reader of the folder would run over nothing and finish as if all were well. Both
+    // lists are non-empty here (read_image_list), so their spans say how far apart they are.
+    throw InputError(folder_ + ": no RGB image has a depth image within the association tolerance of " +
+                     format_seconds(options.max_time_difference_us) + " s (" + span(rgb_, "RGB") + ", " +
+                     span(depth_, "depth") + ")");
+  }
   frames_.reserve(association.pairs.size());
   for (const auto& p : association.pairs) frames_.push_back({p.a, p.b});
   stats_.rgb_images = rgb_.size();

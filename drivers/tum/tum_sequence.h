@@ -5,7 +5,8 @@
 // The folder holds rgb.txt and depth.txt (required), groundtruth.txt and accelerometer.txt
 // (optional: TUM's validation sequences have no ground truth), and the PNGs they list. On
 // construction all text files are read and checked, every listed image is checked to exist,
-// and RGB frames are associated one-to-one with depth frames (association.h). Images are only
+// and RGB frames are associated one-to-one with depth frames (association.h); at least one
+// pair must result. Images are only
 // decoded by frame(i), so opening a sequence is cheap and frame(i) may be called from several
 // threads at once.
 //
@@ -50,8 +51,9 @@ struct AssociationStats {
 class TumSequence {
  public:
   /// Reads `folder`; throws InputError (naming the file and line) for a missing folder or list,
-  /// a malformed or out-of-order line, a non-finite value or a listed image that is missing;
-  /// std::invalid_argument for unusable options.
+  /// a malformed or out-of-order line, a non-finite value or a listed image that is missing,
+  /// and (naming the folder and the tolerance) when no RGB image pairs with a depth image, so
+  /// a sequence is never empty; std::invalid_argument for unusable options.
   explicit TumSequence(const std::string& folder, SequenceOptions options = {});
 
   size_t size() const { return frames_.size(); }

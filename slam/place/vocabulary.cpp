@@ -8,6 +8,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "common/atomic_file.h"
 #include "common/error.h"
 
 namespace kestrel::slam {
@@ -214,8 +215,8 @@ void Vocabulary::set_idf(const std::vector<std::vector<int>>& documents) {
 }
 
 void Vocabulary::save(const std::string& path) const {
-  std::ofstream out(path, std::ios::binary);
-  if (!out) throw InputError(path + ": cannot open for writing");
+  AtomicFile file(path);  // a failed run leaves no cut vocabulary that looks whole
+  std::ostream& out = file.stream();
   out.write(kMagic, sizeof(kMagic) - 1);
   const int32_t header[4] = {branching_, depth_, static_cast<int32_t>(nodes_.size()),
                              static_cast<int32_t>(words_.size())};
@@ -226,8 +227,7 @@ void Vocabulary::save(const std::string& path) const {
     out.write(reinterpret_cast<const char*>(fields), sizeof(fields));
   }
   out.write(reinterpret_cast<const char*>(idf_.data()), static_cast<std::streamsize>(idf_.size() * sizeof(double)));
-  out.flush();
-  if (!out) throw InputError(path + ": write failed");
+  file.commit();
 }
 
 Vocabulary Vocabulary::load(const std::string& path) {

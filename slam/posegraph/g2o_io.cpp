@@ -5,11 +5,13 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <map>
 #include <optional>
 #include <vector>
 
+#include "common/atomic_file.h"
 #include "common/error.h"
 #include "common/text.h"
 
@@ -25,7 +27,8 @@ struct RawEdge {
 
 class Parser {
  public:
-  Parser(std::string name, G2oStats* stats) : name_(std::move(name)), stats_(stats) {}
+  Parser(std::string name, G2oStats* stats, const G2oReadOptions& options)
+      : name_(std::move(name)), stats_(stats), options_(options) {}
 
   AnyPoseGraph parse(std::istream& in) {
     std::string text;
@@ -65,10 +68,15 @@ class Parser {
            std::to_string(fields_.size() - 1));
     }
   }
-  double number(size_t k) const {
+  // Field k as a finite number of magnitude at most `limit`.
+  double number(size_t k, double limit = kMaxG2oMagnitude) const {
     const auto v = parse_double(fields_[k]);
     if (!v) fail("field " + std::to_string(k + 1) + " '" + std::string(fields_[k]) + "' is not a number");
     if (!std::isfinite(*v)) fail("field " + std::to_string(k + 1) + " is not finite");
+    if (std::abs(*v) > limit) {
+      fail("field " + std::to_string(k + 1) + " " + fmt::format("{:.6g}", *v) + " is beyond " +
+           fmt::format("{:g}", limit) + " in magnitude");
+    }
     return *v;
   }
   int64_t integer(size_t k) const {
@@ -86,16 +94,32 @@ class Parser {
     if (std::abs(norm - 1.0) > 1e-3) fail("quaternion of norm " + fmt::format("{:.6g}", norm) + " is not a rotation");
     return q.normalized();
   }
+  // The edge being read, for messages: "edge 3 -> 7" (the file's ids).
+  std::string edge_name() const {
+    return "edge " + std::to_string(raw_.back().from) + " -> " + std::to_string(raw_.back().to);
+  }
   template <int N>
   Eigen::Matrix<double, N, N> information(size_t first) {
     Eigen::Matrix<double, N, N> I;
     size_t k = first;
     for (int r = 0; r < N; ++r) {
-      for (int c = r; c < N; ++c) I(r, c) = I(c, r) = number(k++);
+      for (int c = r; c < N; ++c) I(r, c) = I(c, r) = number(k++, kMaxG2oInformation);
     }
     const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, N, N>> eig(I);
-    const double largest = eig.eigenvalues().cwiseAbs().maxCoeff();
-    if (eig.eigenvalues().minCoeff() < -1e-9 * std::max(largest, 1.0)) {
+    const double smallest = eig.eigenvalues().minCoeff();
+    const double largest = eig.eigenvalues().maxCoeff();
+    // Nothing positive: zero, or a matrix whose projection would be zero. The edge would
+    // constrain nothing while the file claims a measurement (chi2 0 on any poses).
+    if (!(largest > 0.0)) {
+      fail(edge_name() + ": information matrix has no positive eigenvalue (largest " +
+           fmt::format("{:.6g}", largest) + "): the edge would constrain nothing");
+    }
+    if (smallest < -1e-9 * std::max(std::abs(largest), 1.0)) {
+      if (!options_.project_information) {
+        fail(edge_name() + ": information matrix is not positive semi-definite (eigenvalue " +
+             fmt::format("{:.6g}", smallest) + ", largest " + fmt::format("{:.6g}", largest) +
+             "), so chi2 would be unbounded below (kestrel-posegraph --repair-information projects it)");
+      }
       I = eig.eigenvectors() * eig.eigenvalues().cwiseMax(0.0).asDiagonal() *
           eig.eigenvectors().transpose();
       I = 0.5 * (I + I.transpose()).eval();
@@ -185,7 +209,8 @@ class Parser {
       try {
         initialize_by_chaining(graph);
       } catch (const std::invalid_argument& e) {
-        throw InputError(name_ + ": " + e.what());
+        // Refused rather than anchored: a file of edges only gives no pose to place it by.
+        throw InputError(name_ + ": " + e.what() + " (a file of edges only gives no pose to place it by)");
       }
     }
     return std::move(graph);
@@ -193,6 +218,7 @@ class Parser {
 
   std::string name_;
   G2oStats* stats_;
+  G2oReadOptions options_;
   int line_ = 0;
   std::vector<std::string_view> fields_;
   Kind kind_ = Kind::kUnknown;
@@ -218,24 +244,23 @@ void write_fixes(std::ostream& out, const std::vector<int64_t>& ids, const std::
 
 template <class Graph>
 void write_file(const std::string& path, const Graph& graph) {
-  std::ofstream out(path);
-  if (!out) throw InputError(path + ": cannot open for writing");
-  write_g2o(out, graph);
-  out.flush();
-  if (!out) throw InputError(path + ": write failed");
+  AtomicFile file(path);  // a failed write leaves no half graph that reads as whole
+  write_g2o(file.stream(), graph);
+  file.commit();
 }
 
 }  // namespace
 
-AnyPoseGraph parse_g2o(std::istream& in, const std::string& name, G2oStats* stats) {
+AnyPoseGraph parse_g2o(std::istream& in, const std::string& name, G2oStats* stats,
+                       const G2oReadOptions& options) {
   if (stats != nullptr) *stats = G2oStats{};
-  return Parser(name, stats).parse(in);
+  return Parser(name, stats, options).parse(in);
 }
 
-AnyPoseGraph read_g2o(const std::string& path, G2oStats* stats) {
+AnyPoseGraph read_g2o(const std::string& path, G2oStats* stats, const G2oReadOptions& options) {
   std::ifstream in(path);
   if (!in) throw InputError(path + ": cannot open");
-  return parse_g2o(in, path, stats);
+  return parse_g2o(in, path, stats, options);
 }
 
 void write_g2o(std::ostream& out, const PoseGraph2d& graph) {

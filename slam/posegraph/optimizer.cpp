@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include "slam/posegraph/chordal_init.h"
 #include "slam/posegraph/gauge_preconditioner.h"
@@ -61,6 +62,31 @@ OptimizerSummary optimize(PoseGraph<Space>& graph, const OptimizerOptions& optio
   summary.initial_chi2 = summary.start_chi2 = summary.final_chi2 = chi2(graph);
   summary.final_cost = robust_cost(graph, options.kernel);
   if (graph.edges.empty()) return summary;
+
+  // Each unanchored component is held at its first vertex for the solve (see the header); the
+  // given flags come back however this function ends. Marking more than the implicit anchor
+  // needs the implicit one marked too, or vertex 0 would lose it.
+  class RestoreFixed {
+   public:
+    explicit RestoreFixed(PoseGraph<Space>& graph) : graph_(graph), given_(graph.fixed) {}
+    RestoreFixed(const RestoreFixed&) = delete;
+    RestoreFixed& operator=(const RestoreFixed&) = delete;
+    ~RestoreFixed() { graph_.fixed = std::move(given_); }
+
+   private:
+    PoseGraph<Space>& graph_;
+    std::vector<char> given_;
+  };
+  const std::vector<std::vector<int>> unanchored = unanchored_components(graph);
+  std::optional<RestoreFixed> restore;
+  if (!unanchored.empty()) {
+    restore.emplace(graph);
+    if (std::find(graph.fixed.begin(), graph.fixed.end(), 1) == graph.fixed.end()) graph.fixed[0] = 1;
+    for (const std::vector<int>& component : unanchored) {
+      graph.fixed[component.front()] = 1;
+      summary.anchored_components.push_back({component.front(), static_cast<int>(component.size())});
+    }
+  }
 
   std::vector<std::pair<int, int>> pairs;
   pairs.reserve(graph.edges.size());

@@ -69,6 +69,45 @@ std::vector<int> unknown_indices(const PoseGraph<Space>& graph, int* num_unknown
 }
 
 template <class Space>
+std::vector<std::vector<int>> unanchored_components(const PoseGraph<Space>& graph) {
+  const int n = graph.num_vertices();
+  std::vector<std::vector<int>> neighbours(n);
+  for (const auto& e : graph.edges) {
+    neighbours[e.from].push_back(e.to);
+    neighbours[e.to].push_back(e.from);
+  }
+  // Component label per vertex, -1 until reached; the anchored vertices' components first.
+  std::vector<int> label(n, -1);
+  const auto flood = [&](int start, int id, std::vector<int>* members) {
+    std::vector<int> stack{start};
+    label[start] = id;
+    while (!stack.empty()) {
+      const int v = stack.back();
+      stack.pop_back();
+      if (members != nullptr) members->push_back(v);
+      for (const int w : neighbours[v]) {
+        if (label[w] < 0) {
+          label[w] = id;
+          stack.push_back(w);
+        }
+      }
+    }
+  };
+  const bool any_fixed = std::find(graph.fixed.begin(), graph.fixed.end(), 1) != graph.fixed.end();
+  for (int v = 0; v < n; ++v) {
+    if (label[v] < 0 && (any_fixed ? graph.fixed[v] != 0 : v == 0)) flood(v, 0, nullptr);
+  }
+  std::vector<std::vector<int>> unanchored;
+  for (int v = 0; v < n; ++v) {
+    if (label[v] >= 0) continue;
+    unanchored.emplace_back();
+    flood(v, static_cast<int>(unanchored.size()), &unanchored.back());
+    std::sort(unanchored.back().begin(), unanchored.back().end());
+  }
+  return unanchored;
+}
+
+template <class Space>
 void initialize_by_chaining(PoseGraph<Space>& graph) {
   const int n = graph.num_vertices();
   if (n == 0) return;
@@ -131,6 +170,8 @@ template double edge_chi2(const PoseGraph<Se2>&, const PoseGraph<Se2>::Edge&);
 template double edge_chi2(const PoseGraph<Se3>&, const PoseGraph<Se3>::Edge&);
 template std::vector<int> unknown_indices(const PoseGraph<Se2>&, int*);
 template std::vector<int> unknown_indices(const PoseGraph<Se3>&, int*);
+template std::vector<std::vector<int>> unanchored_components(const PoseGraph<Se2>&);
+template std::vector<std::vector<int>> unanchored_components(const PoseGraph<Se3>&);
 template void initialize_by_chaining(PoseGraph<Se2>&);
 template void initialize_by_chaining(PoseGraph<Se3>&);
 

@@ -4,7 +4,8 @@
 //
 // Invariants (check_graph() enforces them): edges refer to vertices by index; no edge joins a
 // vertex to itself; information matrices are symmetric with finite entries; poses are finite.
-// At least one vertex is fixed (the gauge); when none is marked, the optimiser fixes vertex 0.
+// At least one vertex is fixed (the gauge); when none is marked, the optimiser fixes vertex 0,
+// and it holds each component that reaches no fixed vertex at its first vertex (optimizer.h).
 
 #include <Eigen/Core>
 #include <cstdint>
@@ -73,6 +74,13 @@ double edge_chi2(const PoseGraph<Space>& graph, const typename PoseGraph<Space>:
 /// no vertex is marked fixed).
 template <class Space>
 std::vector<int> unknown_indices(const PoseGraph<Space>& graph, int* num_unknowns);
+
+/// The connected components (vertices joined by edges) that hold no anchor: no fixed vertex
+/// or, when none is marked, not vertex 0. Each is its vertex indices in increasing order; an
+/// isolated vertex is a component of one. Empty when every vertex reaches an anchor. Such a
+/// component is free to move rigidly, which no edge resists: its normal equations are singular.
+template <class Space>
+std::vector<std::vector<int>> unanchored_components(const PoseGraph<Space>& graph);
 
 /// Sets every pose not reachable yet by chaining edge measurements outward from the fixed
 /// vertices (vertex 0 when none is fixed): odometry edges (to = from + 1) first, in order,

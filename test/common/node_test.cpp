@@ -1,7 +1,11 @@
 // The process adapter on LCM's in-process transport (memq://): decoding and rejection,
-// heartbeats, and the lock-step acknowledgements the replay depends on.
+// heartbeats (and the health they report while input is rejected), and the lock-step
+// acknowledgements the replay depends on.
 
 #include <gtest/gtest.h>
+
+#include <chrono>
+#include <thread>
 
 #include "common/transport/channels.h"
 #include "common/transport/node.h"
@@ -24,8 +28,17 @@ struct Tap {
   }
 };
 
+// Handles everything queued (memq delivers one message per handle), then lets the node send
+// its heartbeat, and delivers that too. Spinning a fixed number of times is not enough with a
+// heartbeat period of 0: each spin queues a heartbeat, so the queue would never empty.
 void drain(Node& node) {
-  for (int i = 0; i < 50; ++i) node.spin_once(0);
+  for (int round = 0; round < 3; ++round) {
+    while (node.lcm().handleTimeout(0) > 0) {
+    }
+    node.spin_once(0);
+  }
+  while (node.lcm().handleTimeout(0) > 0) {
+  }
 }
 
 kestrel::imu_t imu(int64_t utime) {
@@ -112,6 +125,134 @@ TEST(Node, LockstepAcknowledgesEveryInputWithItsOutputs) {
   node.publish("IMU", imu(4));
   drain(node);
   EXPECT_EQ(acks.got.size(), 3u);
+}
+
+
+using Status = kestrel::process_status_t;
+
+// A node on IMU and CAMERA whose handlers reject a negative utime, as a library would.
+struct RejectingNode {
+  Node node;
+  Tap<Status> status;
+  explicit RejectingNode(double heartbeat_period_s)
+      : node("vo", "memq://", heartbeat_period_s), status(node.lcm(), channel::kProcessStatus) {
+    for (const char* channel : {"IMU", "CAMERA"}) {
+      const std::string name = channel;
+      node.subscribe<kestrel::imu_t>(name, [name](const kestrel::imu_t& m) {
+        if (m.utime < 0) throw InputError(name + ": utime " + std::to_string(m.utime) + " is negative");
+      });
+    }
+  }
+  const Status& last() {
+    drain(node);
+    EXPECT_FALSE(status.got.empty());
+    return status.got.back();
+  }
+};
+
+TEST(NodeHealth, RejectedInputIsDegradedWithTheReasonUntilInputIsAcceptedAgain) {
+  RejectingNode n(0.0);
+  n.node.set_health(Status::STATE_RUNNING, "tracking");
+  n.node.publish("IMU", imu(1));
+  EXPECT_EQ(n.last().state, Status::STATE_RUNNING);
+
+  n.node.publish("IMU", imu(-3));
+  EXPECT_EQ(n.last().state, Status::STATE_DEGRADED);
+  EXPECT_EQ(n.last().message, "rejecting IMU: utime -3 is negative; tracking");
+  // The process's own health, set meanwhile, is kept and not shown over the rejection.
+  n.node.set_health(Status::STATE_RUNNING, "tracking again");
+  EXPECT_EQ(n.last().state, Status::STATE_DEGRADED);
+  EXPECT_EQ(n.last().message, "rejecting IMU: utime -3 is negative; tracking again");
+  EXPECT_EQ(n.node.health().state, Status::STATE_DEGRADED);
+
+  n.node.lcm().publish("IMU", "xyz", 3);  // undecodable: the reason follows the last rejection
+  EXPECT_EQ(n.last().message.rfind("rejecting IMU: 3 bytes are too short", 0), 0u) << n.last().message;
+
+  n.node.publish("IMU", imu(2));
+  EXPECT_EQ(n.last().state, Status::STATE_RUNNING);
+  EXPECT_EQ(n.last().message, "tracking again");
+  EXPECT_EQ(n.node.counters().messages_rejected, 2);
+
+  // A process that set itself DEGRADED stays so, with its own reason, after the rejection.
+  n.node.set_health(Status::STATE_DEGRADED, "no map yet");
+  n.node.publish("IMU", imu(-1));
+  EXPECT_EQ(n.last().message, "rejecting IMU: utime -1 is negative; no map yet");
+  n.node.publish("IMU", imu(3));
+  EXPECT_EQ(n.last().state, Status::STATE_DEGRADED);
+  EXPECT_EQ(n.last().message, "no map yet");
+}
+
+// Good messages on a busy channel do not hide a channel whose last message was rejected.
+TEST(NodeHealth, EachRejectedChannelNeedsItsOwnGoodMessage) {
+  RejectingNode n(0.0);
+  n.node.set_health(Status::STATE_RUNNING, "");
+  n.node.publish("CAMERA", imu(-5));
+  for (int i = 0; i < 20; ++i) n.node.publish("IMU", imu(i));
+  EXPECT_EQ(n.last().state, Status::STATE_DEGRADED);
+  EXPECT_EQ(n.last().message, "rejecting CAMERA: utime -5 is negative");
+
+  n.node.publish("IMU", imu(-7));  // the newer rejection is named, the other listed
+  EXPECT_EQ(n.last().message, "rejecting IMU: utime -7 is negative (also rejecting CAMERA)");
+  n.node.publish("IMU", imu(30));
+  EXPECT_EQ(n.last().message, "rejecting CAMERA: utime -5 is negative");
+  n.node.publish("CAMERA", imu(31));
+  EXPECT_EQ(n.last().state, Status::STATE_RUNNING);
+  EXPECT_EQ(n.last().message, "");
+}
+
+// One bad message among good ones shows at once and for one heartbeat period, so that the
+// launcher, which sees one heartbeat a period, sees it; then the process is RUNNING again.
+TEST(NodeHealth, AnIsolatedRejectionShowsForOneHeartbeatPeriod) {
+  RejectingNode n(1.0);
+  n.node.set_health(Status::STATE_RUNNING, "");
+  EXPECT_EQ(n.last().state, Status::STATE_RUNNING);
+  const size_t before = n.status.got.size();
+  n.node.publish("CAMERA", imu(-1));
+  n.node.publish("CAMERA", imu(1));
+  n.node.publish("CAMERA", imu(2));
+  const Status& degraded = n.last();
+  EXPECT_GT(n.status.got.size(), before);  // published when the state changed, not a period later
+  EXPECT_EQ(degraded.state, Status::STATE_DEGRADED);
+  EXPECT_EQ(degraded.message, "rejecting CAMERA: utime -1 is negative");
+  std::this_thread::sleep_for(std::chrono::milliseconds(1100));
+  n.node.publish("CAMERA", imu(3));
+  EXPECT_EQ(n.last().state, Status::STATE_RUNNING);
+  // No good message needed to recover once the channel had one: only the period passing.
+  n.node.publish("CAMERA", imu(-2));
+  n.node.publish("CAMERA", imu(4));
+  EXPECT_EQ(n.last().state, Status::STATE_DEGRADED);
+  std::this_thread::sleep_for(std::chrono::milliseconds(1100));
+  EXPECT_EQ(n.last().state, Status::STATE_RUNNING);
+}
+
+TEST(NodeHealth, StartingIsDegradedByRejectionsButStoppingAndFailedAreKept) {
+  RejectingNode n(0.0);
+  EXPECT_EQ(n.node.health().state, Status::STATE_STARTING);
+  n.node.publish("IMU", imu(-1));
+  drain(n.node);
+  EXPECT_EQ(n.node.health().state, Status::STATE_DEGRADED);
+  n.node.set_health(Status::STATE_FAILED, "camera lost");
+  EXPECT_EQ(n.last().state, Status::STATE_FAILED);
+  EXPECT_EQ(n.last().message, "camera lost");
+  n.node.publish("IMU", imu(-2));
+  EXPECT_EQ(n.last().state, Status::STATE_FAILED);
+  n.node.set_health(Status::STATE_STOPPING, "");
+  EXPECT_EQ(n.node.health().state, Status::STATE_STOPPING);
+}
+
+// The reason reaches an operator's terminal: no raw bytes from a damaged message, bounded length.
+TEST(NodeHealth, TheReasonIsPrintableAndBounded) {
+  Node node("raw", "memq://", 0.0);
+  node.subscribe<kestrel::imu_t>("IMU", [](const kestrel::imu_t&) {
+    throw InputError("IMU: name '\x01\x1b[2J\xff' " + std::string(1000, 'z'));
+  });
+  node.publish("IMU", imu(1));
+  drain(node);
+  const Node::Health h = node.health();
+  EXPECT_EQ(h.state, Status::STATE_DEGRADED);
+  EXPECT_EQ(h.message.rfind("rejecting IMU: name '\\x01\\x1B[2J\\xFF' zzz", 0), 0u) << h.message;
+  EXPECT_LE(h.message.size(), 240u);
+  for (const char c : h.message) EXPECT_TRUE(c >= 0x20 && c < 0x7f) << static_cast<int>(c);
 }
 
 }  // namespace

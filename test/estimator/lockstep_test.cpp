@@ -147,5 +147,57 @@ TEST(EstimatorProcess, AnImuWithoutAGyroRunsVisualOnlyOrIsRefusedInImuModeAndThe
   EXPECT_NE(last_degraded.find("lack the gyro"), std::string::npos) << "'" << last_degraded << "'; heard:" << heard;
 }
 
+// One accelerometer spike of 500 m/s^2 (beyond a MEMS IMU's 16 g) in a replayed log: the
+// process refuses it, its heartbeat says why (DEGRADED, naming the accelerometer), and it
+// publishes exactly the states the library gives on the log without the spike.
+TEST(EstimatorProcess, AnImuSpikeIsRefusedWithTheHealthSayingWhyAndTheStatesAsWithoutIt) {
+  if (!kestrel::test::can_isolate_network()) KESTREL_SKIP_ENVIRONMENT() << "no network namespace available";
+  if (!std::filesystem::exists(kestrel::test::tool("replay")))
+    KESTREL_SKIP_ENVIRONMENT() << kestrel::test::tool("replay") << " is not built (tools/replay)";
+  if (std::system("command -v lcm-logger > /dev/null 2>&1") != 0) KESTREL_SKIP_ENVIRONMENT() << "lcm-logger not found";
+  kestrel::test::TempDir dir;
+  const std::string clean = (dir / "clean.lcmlog").string(), spiked = (dir / "spiked.lcmlog").string();
+  const test::SyntheticLog written = test::write_log(clean, 3.0, false);
+  {
+    transport::LogReader in(clean);
+    transport::LogWriter out(spiked);
+    size_t imu = 0;
+    while (auto event = in.next()) {
+      out.write(event->channel, event->timestamp, event->data);
+      if (event->channel != channel::kImu || ++imu != 500) continue;
+      ImuSample spike = written.imu[499];
+      spike.utime += 2500;  // between two samples
+      spike.accel = Eigen::Vector3d(500.0, 0.0, kStandardGravity);
+      out.write_message(channel::kImu, spike.utime, test::imu_message(spike));
+    }
+    out.close();
+  }
+  const std::string logged = (dir / "heartbeats.lcmlog").string();
+  const std::string script =
+      "lcm-logger -q --lcm-url='" + std::string(transport::kDefaultLcmUrl) + "' -f " + logged +
+      " & L=$!; " + kestrel::test::wait_for_lcm_listener_sh() + "; " + kestrel::test::tool("estimator").string() +
+      " -q & P=$!; " + kestrel::test::tool("replay").string() + " " + spiked + " --expect estimator --record " +
+      (dir / "out.lcmlog").string() + " >/dev/null; R=$?; sleep 1.2; kill -INT $P $L; wait $P; wait $L; exit $R";
+  const auto r = kestrel::test::run_isolated(script, 240.0);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+
+  const LogRunResult expected = run_log(clean, EstimatorOptions{});
+  const auto states = transport::read_messages<kestrel::state_t>((dir / "out.lcmlog").string(), channel::kState);
+  ASSERT_EQ(states.size(), expected.trajectory.size());
+  ASSERT_FALSE(states.empty());
+  const StampedPose& want = expected.trajectory.poses().back();
+  EXPECT_EQ(states.back().utime, want.utime);
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(states.back().T_world_body.position[i], want.T.translation()[i], 1e-12);
+  std::string heard;
+  bool said_why = false;
+  for (const auto& s : transport::read_messages<kestrel::process_status_t>(logged, channel::kProcessStatus)) {
+    if (s.name != "estimator") continue;
+    heard += "\n  state " + std::to_string(s.state) + " '" + s.message + "'";
+    said_why = said_why || (s.state == kestrel::process_status_t::STATE_DEGRADED &&
+                            s.message.find("accelerometer") != std::string::npos);
+  }
+  EXPECT_TRUE(said_why) << "no DEGRADED heartbeat naming the accelerometer; heard:" << heard;
+}
+
 }  // namespace
 }  // namespace kestrel::estimator

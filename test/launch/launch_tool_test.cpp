@@ -1,12 +1,16 @@
 // kestrel-launch end to end, with two rgbd-codec processes as the set (they heartbeat like
 // every kestrel process): health from heartbeats, a killed process reported and restarted,
-// clean stops, a source that ends the launch, and bad process-set files.
+// clean stops, a source that ends the launch (and is never said to restart), children that end
+// with a launcher killed by SIGKILL, and bad process-set files or process names.
 
 #include <gtest/gtest.h>
 #include <signal.h>
 
+#include <chrono>
 #include <fstream>
+#include <map>
 #include <regex>
+#include <thread>
 
 #include "test/replay/fixtures.h"
 #include "test/support/test_support.h"
@@ -84,6 +88,43 @@ TEST_F(LaunchTool, WithoutRestartADeadProcessIsAFailureAndCtrlCStopsTheRest) {
   EXPECT_NE(::kill(a, 0), 0);
 }
 
+// True while `pid` is a process that has not ended. A dead child that its new parent has not
+// reaped yet (a zombie, state Z or X in /proc) has ended.
+bool alive(pid_t pid) {
+  if (::kill(pid, 0) != 0) return false;
+  const std::string stat = read_file("/proc/" + std::to_string(pid) + "/stat");
+  const size_t paren = stat.rfind(')');
+  if (paren == std::string::npos || paren + 2 >= stat.size()) return false;
+  const char state = stat[paren + 2];
+  return state != 'Z' && state != 'X';
+}
+
+TEST_F(LaunchTool, EveryChildEndsWithALauncherKilledBySigkill) {
+  // The source too: a plain program that would otherwise sleep for ten minutes.
+  auto l = launch({"--source", "/bin/sleep 600"});
+  ASSERT_TRUE(l->wait_for_output("all processes running", 20, true)) << l->err();
+  std::map<std::string, pid_t> children;
+  for (const std::string name : {"codec-a", "codec-b", "source"}) {
+    children[name] = started_pid(*l, name);
+    ASSERT_GT(children[name], 0) << name << " was not started: " << l->err();
+    ASSERT_TRUE(alive(children[name])) << name;
+  }
+  l->signal(SIGKILL);  // no handler runs: only the kernel can end the children now
+  ASSERT_TRUE(l->wait_exit(10).has_value()) << "the launcher survived SIGKILL";
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+  const auto any_alive = [&] {
+    for (const auto& [name, pid] : children)
+      if (alive(pid)) return true;
+    return false;
+  };
+  while (any_alive() && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  for (const auto& [name, pid] : children) {
+    EXPECT_FALSE(alive(pid)) << name << " (pid " << pid << ") outlived its launcher by 5 s";
+    if (alive(pid)) ::kill(-pid, SIGKILL);  // not left behind by a failing test
+  }
+}
+
 TEST_F(LaunchTool, TheLaunchEndsWithItsSource) {
   {
     auto l = launch({"--source", "/bin/sleep 1"});
@@ -97,6 +138,24 @@ TEST_F(LaunchTool, TheLaunchEndsWithItsSource) {
     const auto code = l->wait_exit(20);
     ASSERT_TRUE(code.has_value());
     EXPECT_EQ(*code, 1) << l->err();
+  }
+}
+
+TEST_F(LaunchTool, ASourceThatEndsIsNeverSaidToRestart) {
+  auto l = launch({"--restart", "--source", "/bin/sleep 1"});  // --restart is for the processes
+  const auto code = l->wait_exit(20);
+  ASSERT_TRUE(code.has_value());
+  EXPECT_EQ(*code, 0) << l->err();
+  EXPECT_NE(l->err().find("the source exited with status 0"), std::string::npos) << l->err();
+  EXPECT_EQ(l->err().find("restarting source"), std::string::npos) << l->err();
+}
+
+TEST_F(LaunchTool, AProcessNameTheSetsDoNotHoldIsAUsageError) {
+  for (const char* option : {"--only", "--without"}) {
+    const auto r = run({tool("launch"), "all", "--sets", sets.string(), option, "codec-a,nosuch", "--list"});
+    EXPECT_EQ(r.exit_code, 2) << option << ": " << r.err;
+    EXPECT_NE(r.err.find("kestrel-launch: error: --only/--without: no process named 'nosuch'"), std::string::npos)
+        << r.err;
   }
 }
 

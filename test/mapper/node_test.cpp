@@ -1,7 +1,8 @@
 // The mapper process's logic on messages (MapNode), without LCM: ground-truth and SLAM pose
 // sources, the published stream decodes to the map the library builds, the rate limit, a
 // rebuild published at once, RESET, bad messages rejected with the channel named, and the
-// journal a restarted mapper gets its map back from (whole, cut short, corrupt, not a journal).
+// journal a restarted mapper gets its map back from (whole, after a full disk, not a journal;
+// damaged journals: journal_test.cpp), which a RESET starts again without destroying it.
 #include <gtest/gtest.h>
 
 #include <sys/resource.h>
@@ -289,56 +290,53 @@ TEST(MapNode, ARestartedMapperRestoresItsKeyframesAndMapFromTheJournal) {
   forgetful.on_graph(next, "SLAM_GRAPH");
   EXPECT_EQ(forgetful.mapper().keyframes().size(), 0u);
 
-  // RESET (a lock-step replay starting again) empties the journal.
-  after.reset();
-  EXPECT_TRUE(read_journal(options.journal_path).records.empty());
-  EXPECT_EQ(MapNode(options).stats().keyframes_restored, 0);
 }
 
-TEST(MapNode, AJournalCutShortOrCorruptKeepsTheRecordsBeforeTheDamage) {
+// RESET (a lock-step replay starting again) starts the journal again with the map, and keeps
+// the journal it ends whole beside it: a replay never destroys a flight's journal.
+TEST(MapNode, AResetStartsTheJournalAgainAndKeepsTheOldOneWhole) {
   const test::Scene scene = test::room_with_a_box();
   kestrel::test::TempDir dir;
   NodeOptions options;
   options.journal_path = (dir / "mapper.journal").string();
-  const auto size = [&] { return std::filesystem::file_size(options.journal_path); };
-  std::vector<uintmax_t> ends;  // the journal's size after each keyframe
+  const auto files = [&] {
+    return std::distance(std::filesystem::directory_iterator(dir.path()), std::filesystem::directory_iterator());
+  };
   {
-    MapNode node(options);
-    for (int i = 0; i < 3; ++i) {
-      node.on_graph(feed_keyframes(node, scene, i, i, i + 1), "SLAM_GRAPH");
-      ends.push_back(size());
-    }
+    MapNode flight(options);
+    flight.on_graph(feed_keyframes(flight, scene, 0, 2, 1), "SLAM_GRAPH");
   }
+  const std::string flown = kestrel::test::read_file(options.journal_path);
   ASSERT_EQ(read_journal(options.journal_path).records.size(), 3u);
 
-  // Killed halfway through writing the third keyframe.
-  std::filesystem::resize_file(options.journal_path, (ends[1] + ends[2]) / 2);
-  JournalContents cut = read_journal(options.journal_path);
-  EXPECT_EQ(cut.records.size(), 2u);
-  EXPECT_EQ(cut.intact_bytes, ends[1]);
-  EXPECT_NE(cut.damage.find("record 2 is cut short"), std::string::npos) << cut.damage;
-  {
-    MapNode node(options);
-    EXPECT_EQ(node.stats().keyframes_restored, 2);
-    EXPECT_NE(node.journal_damage().find("cut short"), std::string::npos);
-    EXPECT_EQ(size(), ends[1]) << "the damaged end is cut off before appending";
-    node.on_graph(feed_keyframes(node, scene, 2, 2, 3), "SLAM_GRAPH");
-  }
-  cut = read_journal(options.journal_path);
-  EXPECT_EQ(cut.records.size(), 3u) << "appended after the cut, readable again";
-  EXPECT_EQ(cut.damage, "");
+  MapNode node(options);  // a replay's mapper, started on the flight's journal
+  ASSERT_EQ(node.stats().keyframes_restored, 3);
+  node.reset();
+  EXPECT_EQ(node.mapper().keyframes().size(), 0u) << "RESET forgets the map";
+  const JournalContents started_again = read_journal(options.journal_path);
+  EXPECT_TRUE(started_again.records.empty());
+  EXPECT_EQ(started_again.damage, "");
+  const std::string kept = node.journal_kept_aside();
+  ASSERT_NE(kept, "");
+  EXPECT_EQ(std::filesystem::path(kept).filename().string().rfind("mapper.journal.reset-", 0), 0u) << kept;
+  EXPECT_TRUE(kestrel::test::read_file(kept) == flown) << "the flight's journal, byte for byte";
+  EXPECT_EQ(files(), 2);
 
-  // A flipped bit inside the second keyframe's frame: its CRC fails, the first is kept.
-  {
-    std::fstream f(options.journal_path, std::ios::in | std::ios::out | std::ios::binary);
-    f.seekg(static_cast<std::streamoff>((ends[0] + ends[1]) / 2));
-    const char c = static_cast<char>(f.peek());
-    f.seekp(static_cast<std::streamoff>((ends[0] + ends[1]) / 2));
-    f.put(static_cast<char>(c ^ 0x10));
-  }
-  cut = read_journal(options.journal_path);
-  EXPECT_EQ(cut.records.size(), 1u);
-  EXPECT_NE(cut.damage.find("record 1 fails its CRC"), std::string::npos) << cut.damage;
+  // A reset with nothing journalled since keeps nothing more; the next map is journalled, and
+  // the next reset keeps that too, apart from the first.
+  node.reset();
+  EXPECT_EQ(node.journal_kept_aside(), "");
+  EXPECT_EQ(files(), 2);
+  node.on_graph(feed_keyframes(node, scene, 0, 1, 1), "SLAM_GRAPH");
+  EXPECT_EQ(read_journal(options.journal_path).records.size(), 2u);
+  EXPECT_TRUE(kestrel::test::read_file(kept) == flown) << "the kept journal is not appended to";
+  node.reset();
+  ASSERT_NE(node.journal_kept_aside(), "");
+  EXPECT_NE(node.journal_kept_aside(), kept);
+  EXPECT_EQ(read_journal(node.journal_kept_aside()).records.size(), 2u);
+  EXPECT_EQ(files(), 3);
+  EXPECT_EQ(node.journal_error(), "");
+  EXPECT_EQ(MapNode(options).stats().keyframes_restored, 0) << "a restart after the reset has the reset's map";
 }
 
 // A disk that fills up in flight: the journal is given up with the reason, the map goes on.
@@ -365,7 +363,7 @@ TEST(MapNode, AJournalThatCannotBeWrittenIsGivenUpAndTheMapGoesOn) {
       << node.journal_error();
   EXPECT_EQ(node.mapper().keyframes().size(), 3u) << "the map went on";
   EXPECT_EQ(node.stats().frames_inserted, 3);
-  // What was written before the failure restores; the partial record is cut off.
+  // What was written before the failure is read; the partial record after it is damage.
   const JournalContents journal = read_journal(options.journal_path);
   EXPECT_EQ(journal.records.size(), 1u);
   EXPECT_NE(journal.damage, "");

@@ -116,7 +116,7 @@ TEST(MapTool, BuildsTheMapOfAMappersJournal) {
   Mapper live;
   std::vector<GraphKeyframe> graph;
   {
-    JournalWriter journal((tmp / "mapper.journal").string(), 0);
+    JournalWriter journal((tmp / "mapper.journal").string());
     for (size_t i = 0; i < frames.size(); ++i) {
       kestrel::slam_keyframe_t k{};
       k.id = static_cast<int64_t>(i);

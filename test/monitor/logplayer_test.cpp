@@ -1,6 +1,7 @@
 // The message set against the stock LCM tools: lcm-logplayer (Debian's liblcm-bin, knowing
 // nothing of kestrel) plays a log while kestrel-monitor, built from the generated types,
-// receives and decodes every message. Inside a private network namespace.
+// receives and decodes every message; and a --channels regex LCM cannot compile is a usage
+// error, not a crash. Inside a private network namespace.
 
 #include <gtest/gtest.h>
 
@@ -59,6 +60,13 @@ TEST_F(LogPlayerMonitor, WrongTypeAndTruncatedMessagesAreCountedAndNamed) {
   EXPECT_NE(m.err.find("CAMERA_RGBD: "), std::string::npos) << m.err;
   EXPECT_NE(m.err.find("do not decode as their channel's type: CAMERA_RGBD (1), IMU (1)"),
             std::string::npos) << m.err;
+}
+
+TEST_F(LogPlayerMonitor, ARegexLcmCannotUseIsAUsageError) {
+  const RunResult r = run({tool("monitor").string(), "--channels", "CAMERA_[", "--duration", "0.1"}, 20.0);
+  EXPECT_EQ(r.exit_code, 2) << r.err;  // it was a crash (SIGSEGV)
+  EXPECT_NE(r.err.find("kestrel-monitor: error: --channels: 'CAMERA_[' is not a regular expression"),
+            std::string::npos) << r.err;
 }
 
 }  // namespace

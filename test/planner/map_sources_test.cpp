@@ -62,6 +62,22 @@ TEST(RosMap, MalformedFilesGiveErrorsNamingTheFile) {
   EXPECT_NE(error_of([&] { read_ros_map(nan); }).find(nan), std::string::npos);
 }
 
+TEST(RosMap, SizesAreBoundedBeforeTheGridIsMade) {
+  // The planner's grid comes from the sim's reader, whose bounds it relies on (occupancy_map.h).
+  kestrel::test::TempDir dir;
+  cv::imwrite((dir / "m.png").string(), cv::Mat(4, 6, CV_8UC1, cv::Scalar(254)));
+  const std::string coarse = (dir / "coarse.yaml").string();
+  write(coarse, "image: m.png\nresolution: 1000\norigin: [0, 0, 0]\n");
+  EXPECT_NE(error_of([&] { read_ros_map(coarse); }).find(coarse + ":2: 'resolution' must be in"), std::string::npos)
+      << error_of([&] { read_ros_map(coarse); });
+  const std::string far = (dir / "far.yaml").string();
+  write(far, "image: m.png\nresolution: 0.05\norigin: [0, 1e15, 0]\n");
+  EXPECT_NE(error_of([&] { read_ros_map(far); }).find(far + ":3: 'origin'"), std::string::npos);
+  const std::string fine = (dir / "fine.yaml").string();
+  write(fine, "image: m.png\nresolution: 10\norigin: [0, 0, 0]\n");
+  EXPECT_EQ(read_ros_map(fine).width, 6);
+}
+
 TEST(OctoMap, ProjectsTheHeightBandOntoTheGrid) {
   octomap::OcTree tree(0.1);
   tree.updateNode(octomap::point3d(1.05f, 1.05f, 1.05f), true);    // in the band: a wall

@@ -90,6 +90,29 @@ TEST(PlanTool, BadWorldAndMapFilesAreNamedWithExitCode3) {
   }
 }
 
+TEST(PlanTool, AMapOfAbsurdSizeIsExit3NamingTheFieldNotAGrowingPlan) {
+  // resolution: 1000 once made the planner grow to gigabytes; every size is now bounded first.
+  test::TempDir dir;
+  cv::Mat img(40, 200, CV_8UC1, cv::Scalar(254));
+  for (cv::Mat wall : {img.row(0), img.row(39), img.col(0), img.col(199)}) wall.setTo(0);
+  cv::imwrite((dir / "m.png").string(), img);
+  const std::pair<std::string, std::string> cases[] = {
+      {"resolution: 1000\norigin: [0, 0, 0]\n", ":2: 'resolution' must be in [0.001, 10] m per pixel, got 1000"},
+      {"resolution: 0\norigin: [0, 0, 0]\n", ":2: 'resolution' must be in"},
+      {"resolution: .nan\norigin: [0, 0, 0]\n", ":2: 'resolution' must be a number"},
+      {"resolution: 0.05\norigin: [1e300, 0, 0]\n", ":3: 'origin' x and y must be within"},
+      {"resolution: 9\norigin: [0, 0, 0]\n", ":2: 'resolution' 9 m per pixel makes the 200 x 40 pixels"},
+  };
+  int i = 0;
+  for (const auto& [body, expected] : cases) {
+    const std::string file = (dir / ("m" + std::to_string(i++) + ".yaml")).string();
+    std::ofstream(file) << "image: m.png\n" << body;
+    const test::RunResult r = test::run({test::tool("plan").string(), "--map", file}, 60.0);
+    EXPECT_EQ(r.exit_code, 3) << body << r.err;
+    EXPECT_NE(r.err.find(file + expected), std::string::npos) << r.err;
+  }
+}
+
 TEST(PlanExperimentsTool, OneCommandWritesTheTableAndThePlot) {
   test::TempDir dir;
   const test::RunResult r =

@@ -59,6 +59,20 @@ TEST(EventFilter, KeepsTheTimeWindowRelativeToTheFirstEvent) {
   EXPECT_EQ(filter.outside_window(), 3);
 }
 
+TEST(EventFilter, WithoutAWindowNothingIsOutsideIt) {
+  EventFilter filter({}, nullptr);  // neither --start nor --duration
+  const int64_t t0 = 5'000'000;
+  EXPECT_TRUE(filter.accept(event("IMU", t0)));
+  EXPECT_TRUE(filter.accept(event("IMU", t0 - 3'600'000'000)));  // an hour before the first event
+  EXPECT_TRUE(filter.accept(event("IMU", t0 + 3'600'000'000)));
+  EXPECT_EQ(filter.outside_window(), 0);
+  EventFilter started({"", 1.0, 0.0}, nullptr);  // --start 1: earlier events are left out
+  EXPECT_FALSE(started.accept(event("IMU", t0)));
+  EXPECT_FALSE(started.accept(event("IMU", t0 - 1)));
+  EXPECT_TRUE(started.accept(event("IMU", t0 + 1'000'000)));
+  EXPECT_EQ(started.outside_window(), 2);
+}
+
 TEST(EventFilter, ChecksRegexes) {
   EXPECT_EQ(check_channel_regex("CAMERA_.*"), "");
   EXPECT_NE(check_channel_regex("CAMERA_(").find("not a valid regular expression"), std::string::npos);

@@ -46,5 +46,16 @@ TEST(ReplayReport, JsonCarriesTheSameFigures) {
   EXPECT_FALSE(to_json(empty).contains("record"));
 }
 
+TEST(ReplayReport, CappedGapsAreReportedOnlyWhenThereAreSome) {
+  ReplayReport r = sample();
+  EXPECT_EQ(format_text(r).find("--max-gap"), std::string::npos);
+  r.gaps_capped = 2;
+  r.gap_time_cut_s = 7190.0;
+  EXPECT_NE(format_text(r).find("gaps over --max-gap: 2, 7190.000 s of log time not waited for"), std::string::npos)
+      << format_text(r);
+  EXPECT_EQ(to_json(r)["gaps_capped"], 2);
+  EXPECT_DOUBLE_EQ(to_json(r)["gap_time_cut_s"].get<double>(), 7190.0);
+}
+
 }  // namespace
 }  // namespace kestrel::replay

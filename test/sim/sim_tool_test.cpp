@@ -1,5 +1,6 @@
 // kestrel-sim as a user runs it: a TUM export that kestrel-eval scores as exact against its
-// own ground truth, byte-identical logs for a seed, and bad input reported with exit code 3.
+// own ground truth, byte-identical logs for a seed, bad input reported with exit code 3 and
+// a world or flight there is not with exit code 2.
 
 #include <gtest/gtest.h>
 
@@ -188,9 +189,21 @@ TEST(SimToolTest, BadInputIsOneLineNamingTheFileWithExitCode3) {
   EXPECT_EQ(bad.exit_code, 3);
   EXPECT_NE(bad.err.find("kestrel-sim: error: " + world.string() + ":3: wall: x1 'one'"), std::string::npos) << bad.err;
 
+  // Naming no world there is, or stata without its map, is a usage error (exit 2), as is a
+  // flight there is not; a missing world file is input that is not there (exit 3).
   const auto no_map = run({tool("sim").string(), "--world", "stata", "--log", (dir / "x.lcmlog").string()});
-  EXPECT_EQ(no_map.exit_code, 3);
-  EXPECT_NE(no_map.err.find("--map"), std::string::npos) << no_map.err;
+  EXPECT_EQ(no_map.exit_code, 2);
+  EXPECT_NE(no_map.err.find("kestrel-sim: error: --world: world 'stata' needs an occupancy map (--map"),
+            std::string::npos) << no_map.err;
+  for (const std::string& name : std::vector<std::string>{"atlantis", (dir / "bad.txt").string()}) {
+    const auto unknown = run({tool("sim").string(), "--world", name, "--log", (dir / "x.lcmlog").string()});
+    EXPECT_EQ(unknown.exit_code, 2) << unknown.err;
+    EXPECT_NE(unknown.err.find("kestrel-sim: error: --world: unknown world '" + name + "'"), std::string::npos)
+        << unknown.err;
+  }
+  const auto absent = run({tool("sim").string(), "--world", (dir / "absent.world").string(), "--log",
+                           (dir / "x.lcmlog").string()});
+  EXPECT_EQ(absent.exit_code, 3) << absent.err;
 
   const auto flight = run({tool("sim").string(), "--flight", "barrel-roll", "--log", (dir / "x.lcmlog").string()});
   EXPECT_EQ(flight.exit_code, 2);

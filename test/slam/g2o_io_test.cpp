@@ -108,17 +108,56 @@ TEST(G2o, EdgesOnlyFilesAreInitialisedByChainingOdometry) {
   EXPECT_EQ(g.edges[3].kind, EdgeKind::kLoopClosure);
 }
 
-TEST(G2o, InformationThatIsNotPositiveSemiDefiniteIsRepairedAndCounted) {
+TEST(G2o, InformationThatIsNotPositiveSemiDefiniteIsRejectedNamingTheLineAndEdge) {
+  std::istringstream text(
+      "VERTEX_SE2 0 0 0 0\nVERTEX_SE2 1 1 0 0\n"
+      "EDGE_SE2 0 1 1 0 0 1 5 0 1 0 1\n");  // [[1 5][5 1]] has eigenvalue -4
+  try {
+    parse_g2o(text, "t.g2o");
+    FAIL() << "a matrix with eigenvalue -4 was accepted";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("t.g2o:3: edge 0 -> 1: information matrix is not positive "
+                                          "semi-definite (eigenvalue -4, largest 6)", 0),
+              0u)
+        << e.what();
+  }
+}
+
+TEST(G2o, InformationThatIsNotPositiveSemiDefiniteIsRepairedAndCountedWhenAsked) {
   std::istringstream text(
       "VERTEX_SE2 0 0 0 0\nVERTEX_SE2 1 1 0 0\n"
       "EDGE_SE2 0 1 1 0 0 1 5 0 1 0 1\n");  // [[1 5][5 1]] has eigenvalue -4
   G2oStats stats;
-  const auto g = std::get<PoseGraph2d>(parse_g2o(text, "t.g2o", &stats));
+  G2oReadOptions repair;
+  repair.project_information = true;
+  const auto g = std::get<PoseGraph2d>(parse_g2o(text, "t.g2o", &stats, repair));
   EXPECT_EQ(stats.repaired_information, 1);
   EXPECT_EQ(stats.first_repaired_line, 3);
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(g.edges[0].information);
   EXPECT_GT(eig.eigenvalues().minCoeff(), -1e-12);
   EXPECT_NEAR(g.edges[0].information(0, 1), 3.0, 1e-12);  // (1+5)/2 on the kept eigenvector
+
+  // Nothing would be left of a negative definite matrix: refused even so.
+  std::istringstream negative("VERTEX_SE2 0 0 0 0\nVERTEX_SE2 1 1 0 0\nEDGE_SE2 0 1 1 0 0 -1 0 0 -1 0 -1\n");
+  try {
+    parse_g2o(negative, "t.g2o", &stats, repair);
+    FAIL() << "a negative definite matrix was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("t.g2o:3: edge 0 -> 1: information matrix has no positive eigenvalue"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+// Values that parse but are absurd: squared, times the information, they overflowed chi2.
+TEST(G2o, ValuesBeyondTheBoundsAreRejectedAndTheBoundsAdmitRealGraphs) {
+  const std::string vertices = "VERTEX_SE2 0 0 0 0\nVERTEX_SE2 1 1 0 0\n";
+  std::istringstream at_bounds(vertices + "EDGE_SE2 0 1 1e9 -1e9 0 1e18 0 0 1e18 0 1\n");
+  EXPECT_NO_THROW(parse_g2o(at_bounds, "t.g2o"));
+  std::istringstream beyond(vertices + "EDGE_SE2 0 1 1.000001e9 0 0 1 0 0 1 0 1\n");
+  EXPECT_THROW(parse_g2o(beyond, "t.g2o"), InputError);
+  std::istringstream information(vertices + "EDGE_SE2 0 1 1 0 0 1.1e18 0 0 1 0 1\n");
+  EXPECT_THROW(parse_g2o(information, "t.g2o"), InputError);
 }
 
 struct Malformed {
@@ -163,7 +202,41 @@ INSTANTIATE_TEST_SUITE_P(
         Malformed{"VERTEX_SE2 0 0 0 0\nFIX 3\n", 2, "FIX of vertex 3"},
         Malformed{"EDGE_SE2 0 1 1 0 0 1 0 0 1 0 1\nEDGE_SE2 2 3 1 0 0 1 0 0 1 0 1\n", 0,
                   "is not connected"},
-        Malformed{"# nothing\n\n", 0, "no vertices or edges"}));
+        Malformed{"# nothing\n\n", 0, "no vertices or edges"},
+        Malformed{"", 0, "no vertices or edges"},
+        // Non-finite and absurd values, wherever they stand.
+        Malformed{"VERTEX_SE2 0 0 inf 0\n", 1, "field 4 is not finite"},
+        Malformed{"VERTEX_SE2 0 -inf 0 0\n", 1, "field 3 is not finite"},
+        Malformed{"VERTEX_SE2 0 1e300 0 0\n", 1, "field 3 1e+300 is beyond 1e+09 in magnitude"},
+        Malformed{"VERTEX_SE2 0 0 0 -1e300\n", 1, "field 5 -1e+300 is beyond 1e+09"},
+        Malformed{"VERTEX_SE2 0 0 0 1e400\n", 1, "field 5"},
+        Malformed{"VERTEX_SE3:QUAT 0 0 0 1e300 0 0 0 1\n", 1, "field 5 1e+300 is beyond"},
+        Malformed{"VERTEX_SE3:QUAT 0 0 0 0 0 0 0 nan\n", 1, "field 9 is not finite"},
+        Malformed{"VERTEX_SE2 0 0 0 0\nVERTEX_SE2 1 0 0 0\nEDGE_SE2 0 1 1e300 0 0 1 0 0 1 0 1\n", 3,
+                  "field 4 1e+300 is beyond 1e+09"},
+        Malformed{"VERTEX_SE2 0 0 0 0\nVERTEX_SE2 1 0 0 0\nEDGE_SE2 0 1 1 0 0 1e300 0 0 1 0 1\n", 3,
+                  "field 7 1e+300 is beyond 1e+18"},
+        Malformed{"VERTEX_SE2 0 0 0 0\nVERTEX_SE2 1 0 0 0\nEDGE_SE2 0 1 1 0 0 nan 0 0 1 0 1\n", 3,
+                  "field 7 is not finite"},
+        Malformed{"VERTEX_SE2 0 0 0 0\nVERTEX_SE2 1 0 0 0\nEDGE_SE2 0 1 1 0 0 1 0 0 1 0 inf\n", 3,
+                  "field 12 is not finite"},
+        Malformed{"EDGE_SE3:QUAT 0 1 1e300 0 0 0 0 0 1 1 0 0 0 0 0 1 0 0 0 0 1 0 0 0 1 0 0 1 0 1\n", 1,
+                  "field 4 1e+300 is beyond"},
+        // Information that is not positive semi-definite, zero or negative.
+        Malformed{"VERTEX_SE2 0 0 0 0\nVERTEX_SE2 1 0 0 0\nEDGE_SE2 0 1 1 0 0 0 0 0 0 0 0\n", 3,
+                  "edge 0 -> 1: information matrix has no positive eigenvalue"},
+        Malformed{"VERTEX_SE2 0 0 0 0\nVERTEX_SE2 1 0 0 0\nEDGE_SE2 0 1 1 0 0 -1 0 0 -1 0 -1\n", 3,
+                  "edge 0 -> 1: information matrix has no positive eigenvalue"},
+        Malformed{"VERTEX_SE2 0 0 0 0\nVERTEX_SE2 1 0 0 0\nEDGE_SE2 0 1 1 0 0 1 0 0 1 0 -0.5\n", 3,
+                  "edge 0 -> 1: information matrix is not positive semi-definite (eigenvalue -0.5, largest 1)"},
+        Malformed{"EDGE_SE3:QUAT 4 5 1 0 0 0 0 0 1 -2 0 0 0 0 0 1 0 0 0 0 1 0 0 0 1 0 0 1 0 1\n", 1,
+                  "edge 4 -> 5: information matrix is not positive semi-definite (eigenvalue -2, largest 1)"},
+        // Lines cut short, in the middle of a record or of a number.
+        Malformed{"VERTEX_SE3:QUAT 0 0 0 0 0 0 0\n", 1, "needs 8 values, found 7"},
+        Malformed{"VERTEX_SE2 0 0 0 1e\n", 1, "field 5 '1e' is not a number"},
+        Malformed{"VERTEX_SE2 0 0 0 0\nVERTEX_SE2 1 0 0 0\nEDGE_SE2 0 1 1 0 0 1 0 0 1 0 1\nEDGE_SE2 0 1 1 0\n", 4,
+                  "needs 11 values, found 4"},
+        Malformed{"VERTEX_SE2 0 0 0 0\nFIX\n", 2, "FIX needs 1 values, found 0"}));
 
 TEST(G2o, AMissingFileIsAnInputError) {
   EXPECT_THROW(read_g2o("/nonexistent/graph.g2o"), InputError);

@@ -123,6 +123,21 @@ TEST(TumPlayTool, BadInputExitsThreeWithOneLineNamingTheFileAndLine) {
   EXPECT_EQ(r.err, "kestrel-tum-play: error: " + (dir / "nowhere").string() + ": no such sequence folder\n");
 }
 
+// Nothing to play is bad input (exit 3), not a run that publishes 0 frames and exits 0.
+TEST(TumPlayTool, NoPairedFrameExitsThreeNamingTheFolderAndTolerance) {
+  test::TempDir dir;
+  const TumFixture fx(dir.path(), 2);  // depth 1 ms after RGB
+  const auto r = test::run({play(), fx.folder().string(), "--log", (dir / "x.lcmlog").string(), "--max-dt",
+                            "0.0005", "-q"});
+  EXPECT_EQ(r.exit_code, 3) << r.err;
+  EXPECT_EQ(r.err.rfind("kestrel-tum-play: error: " + fx.folder().string() + ": no RGB image has a depth image", 0),
+            0u)
+      << r.err;
+  EXPECT_NE(r.err.find("association tolerance of 0.000500 s"), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "x.lcmlog")) << "a log of nothing was written";
+}
+
 TEST(TumPlayTool, BadOptionsExitTwo) {
   test::TempDir dir;
   const TumFixture fx(dir.path(), 2);

@@ -144,9 +144,33 @@ TEST(TumSequence, CountsUnmatchedAndUnusedFrames) {
   EXPECT_EQ(s.association().unused_depth, 1u);
   EXPECT_EQ(s.depth_utime(0), TumFixture::depth_utime(0));
 
+}
+
+// A folder whose lists pair nothing is an error naming the folder and the tolerance, not an
+// empty sequence that every tool would run over and call a success.
+TEST(TumSequence, NoPairedFrameIsAnInputErrorNamingTheFolderAndTolerance) {
+  test::TempDir dir;
+  const TumFixture fx(dir.path(), 3);
   SequenceOptions tight;
   tight.max_time_difference_us = 999;  // depth is 1000 us after RGB: nothing pairs
-  EXPECT_EQ(TumSequence(fx.folder().string(), tight).size(), 0u);
+  const std::string e = input_error([&] { TumSequence(fx.folder().string(), tight); });
+  EXPECT_EQ(e.rfind(fx.folder().string() + ": no RGB image has a depth image", 0), 0u) << e;
+  EXPECT_NE(e.find("association tolerance of 0.000999 s"), std::string::npos) << e;
+  EXPECT_NE(e.find("3 RGB images from " + format_seconds(TumFixture::rgb_utime(0))), std::string::npos) << e;
+  EXPECT_NE(e.find("3 depth images from " + format_seconds(TumFixture::depth_utime(0))), std::string::npos) << e;
+  tight.max_time_difference_us = 1000;  // inclusive: every frame pairs again
+  EXPECT_EQ(TumSequence(fx.folder().string(), tight).size(), 3u);
+
+  // Depth recorded a second later than the colour (another session's list): the default 20 ms.
+  std::string depth_list = "# depth maps\n";
+  for (int k = 0; k < 3; ++k) {
+    const std::string file = "depth/" + format_seconds(TumFixture::depth_utime(k)) + ".png";
+    depth_list += format_seconds(TumFixture::depth_utime(k) + 1000000) + " " + file + "\n";
+  }
+  test::write_text(fx / "depth.txt", depth_list);
+  const std::string late = input_error([&] { TumSequence(fx.folder().string()); });
+  EXPECT_NE(late.find("association tolerance of 0.020000 s"), std::string::npos) << late;
+  EXPECT_EQ(late.find('\n'), std::string::npos) << "one line: " << late;
 }
 
 TEST(TumSequence, GroundTruthAndAccelerometerAreOptional) {

@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 #include <vector>
 
+#include "common/atomic_file.h"
 #include "common/error.h"
 #include "common/time.h"
 
@@ -229,13 +230,15 @@ cv::Mat render_plot(const Evaluation& e, const EvalOptions& options, const std::
 }
 
 void write_png(const std::string& path, const cv::Mat& image) {
+  std::vector<uchar> png;
   bool ok = false;
   try {
-    ok = cv::imwrite(path, image);
+    ok = cv::imencode(".png", image, png);
   } catch (const cv::Exception&) {
     ok = false;
   }
   if (!ok) throw InputError(path + ": cannot write the PNG image");
+  write_file_atomically(path, png.data(), png.size());  // no cut image that looks whole
 }
 
 }  // namespace kestrel::eval

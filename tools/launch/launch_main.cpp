@@ -75,7 +75,13 @@ struct HeartbeatListener {
 };
 
 int launch(const Options& o) {
-  ProcessSet set = select(read_process_sets(o.sets_file), o.set, o.only, o.without);
+  const ProcessSet declared = read_process_sets(o.sets_file);  // a bad file: InputError, exit 3
+  ProcessSet set;
+  try {
+    set = select(declared, o.set, o.only, o.without);
+  } catch (const kestrel::InputError& e) {  // a name on the command line, not in the file: usage
+    throw CLI::ValidationError("--only/--without", e.what());
+  }
   if (!o.source.empty()) {
     set.push_back({"source", split_command(o.source), "source"});
   }
@@ -150,7 +156,8 @@ int launch(const Options& o) {
           }
           break;
         case ChildEvent::kRestarting:
-          spdlog::warn("restarting {} in {:.1f} s", e.name, so.restart_delay_s);
+          // The source's end ends the launch (above), so it is never started again.
+          if (e.name != "source") spdlog::warn("restarting {} in {:.1f} s", e.name, so.restart_delay_s);
           break;
         case ChildEvent::kGaveUp:
           unexpected_end = true;

@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <signal.h>
 #include <cstring>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -10,6 +11,8 @@
 #include <cstdlib>
 #include <stdexcept>
 #include <thread>
+
+#include "common/error.h"
 
 namespace kestrel::launch {
 
@@ -58,6 +61,7 @@ ChildEvent Supervisor::start(Child& child) {
   envp.push_back(nullptr);
   const int log_fd = ::open(child.log.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
   if (log_fd < 0) throw std::runtime_error(child.log.string() + ": " + std::strerror(errno));
+  const pid_t launcher = ::getpid();
 
   const pid_t pid = ::fork();
   if (pid < 0) {
@@ -71,6 +75,14 @@ ChildEvent Supervisor::start(Child& child) {
     sigset_t none;
     sigemptyset(&none);
     ::sigprocmask(SIG_SETMASK, &none, nullptr);
+    // Die with the launcher however it dies, kill -9 included: in its own process group the
+    // child is out of reach of the launcher's group, so only the kernel can tell it. SIGTERM,
+    // not SIGKILL, so that a process ends as it does on Ctrl-C, closing its files. Set only
+    // once SIGTERM is back at its default, so that the launcher's inherited handler cannot
+    // swallow it. If the launcher died before the prctl, the signal never comes (we were
+    // reparented already): end now.
+    ::prctl(PR_SET_PDEATHSIG, SIGTERM);
+    if (::getppid() != launcher) ::_exit(kExitFailure);
     ::dup2(log_fd, STDOUT_FILENO);
     ::dup2(log_fd, STDERR_FILENO);
     const int devnull = ::open("/dev/null", O_RDONLY);

@@ -2,11 +2,14 @@
 // Starts a set of processes, notices when one ends, restarts it if asked, and stops them all.
 // Each child runs in its own process group (so a terminal's Ctrl-C reaches only the
 // launcher, which then stops the children in order) with stdout and stderr appended to
-// <log_dir>/<name>.log.
+// <log_dir>/<name>.log. Each child also gets SIGTERM from the kernel when the launcher ends,
+// however it ends (kill -9 included), so only a child that ignores SIGTERM can outlive it.
 //
 // Invariants: every child started is reaped by poll() or stop_all(); stop_all() returns only
 // when no child is left (SIGTERM, then SIGKILL after `stop_timeout_s`); a child that keeps
-// failing is restarted at most `max_restarts` times, each after `restart_delay_s`.
+// failing is restarted at most `max_restarts` times, each after `restart_delay_s`. The
+// parent-death signal follows the thread that forked the child, so start_all() and poll() are
+// called from a thread that lives as long as the launcher (its main thread).
 
 #include <sys/types.h>
 

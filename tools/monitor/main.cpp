@@ -2,6 +2,7 @@
 // each message against its channel's kestrel type (message_types.h), and shows per channel
 // the count, rate, bandwidth and decode failures; --json prints a summary on exit.
 
+#include <glib.h>
 #include <spdlog/spdlog.h>
 #include <unistd.h>
 
@@ -65,7 +66,22 @@ int monitor(const Options& o) {
   }
   kestrel::monitor::TrafficMonitor traffic(channel_types);
   Receiver receiver{&traffic, {}};
-  lcm.subscribeFunction(o.channels, &Receiver::on, &receiver)->setQueueCapacity(0);
+  // LCM anchors the pattern and compiles it with GLib; on failure its C++ API still returns a
+  // subscription, which then crashes on first use. So the same compile is tried here first.
+  GError* regex_error = nullptr;
+  GRegex* regex = g_regex_new(("^" + o.channels + "$").c_str(), static_cast<GRegexCompileFlags>(0),
+                              static_cast<GRegexMatchFlags>(0), &regex_error);
+  if (regex == nullptr) {
+    const std::string why = regex_error != nullptr ? regex_error->message : "does not compile";
+    g_clear_error(&regex_error);
+    throw CLI::ValidationError("--channels", "'" + o.channels + "' is not a regular expression LCM takes (" +
+                                                 kestrel::cli::printable(why) + ")");
+  }
+  g_regex_unref(regex);
+  lcm::Subscription* subscription = lcm.subscribeFunction(o.channels, &Receiver::on, &receiver);
+  if (subscription == nullptr)
+    throw CLI::ValidationError("--channels", "'" + o.channels + "' is not a regular expression LCM takes");
+  subscription->setQueueCapacity(0);
   kestrel::catch_interrupts();
   spdlog::info("listening on {} (channels {})", url, o.channels);
 

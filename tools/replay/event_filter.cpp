@@ -36,7 +36,9 @@ bool EventFilter::accept(const transport::LogEvent& event) {
     return false;
   }
   const double t_s = 1e-6 * static_cast<double>(event.timestamp - *first_timestamp_);
-  const bool before = t_s < options_.start_s;
+  // Without --start nothing is before the window: an event stamped earlier than the first is
+  // out of time order (the replay says so), not outside a window nobody asked for.
+  const bool before = options_.start_s > 0.0 && t_s < options_.start_s;
   const bool after = options_.duration_s > 0.0 && t_s > options_.start_s + options_.duration_s;
   if (before || after) {
     ++outside_window_;

@@ -54,6 +54,12 @@ int main(int argc, char** argv) {
   app.add_option("--speed", speed, "Timed: log seconds per wall second")
       ->check(cli::Positive)
       ->excludes(realtime_flag);
+  double max_gap_s = replay::TimedOptions{}.max_gap_s;
+  app.add_option("--max-gap", max_gap_s,
+                 "Timed: longest gap between two events that is waited out, in log seconds; a "
+                 "longer one (a bad stamp) is played as this long and said once (0 = no cap)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   app.add_option("--start", lockstep.selection.start_s, "Skip this many seconds of the log")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
@@ -76,8 +82,8 @@ int main(int argc, char** argv) {
     replay::ReplayReport report;
     try {
       if (timed) {
-        report = replay::replay_timed(log, {lockstep.lcm_url, realtime ? 1.0 : speed, lockstep.selection},
-                                      interrupted);
+        report = replay::replay_timed(
+            log, {lockstep.lcm_url, realtime ? 1.0 : speed, lockstep.selection, max_gap_s}, interrupted);
       } else {
         report = replay::replay_lockstep(log, lockstep, interrupted);
       }

@@ -5,7 +5,8 @@
 //    optionally resets them, then publishes one event at a time and waits until every
 //    process that consumes it, and everything they publish in turn, has been acknowledged
 //    (AckLedger). Optionally records every output in a canonical order (OutputRecorder).
-//  * timed (replay_timed): like lcm-logplayer, paced on the events' timestamps.
+//  * timed (replay_timed): like lcm-logplayer, paced on the events' timestamps, with no
+//    wait between two events longer than the gap cap.
 //
 // Both read the log with LogReader, so a damaged log is replayed up to (and beyond) the
 // damage, which the report states.
@@ -48,6 +49,9 @@ struct TimedOptions {
   std::string lcm_url;
   double speed = 1.0;  ///< log seconds per wall second
   SelectionOptions selection;
+  /// Longest gap between consecutive events that is waited out, in log seconds (0 = no cap).
+  /// A longer gap (an event stamped an hour ahead) is played as this long, and said once.
+  double max_gap_s = 5.0;
 };
 
 /// Throws PeerError, NetworkUnavailable, InputError (recording file). Returns early with

@@ -29,6 +29,9 @@ std::string format_text(const ReplayReport& r) {
     s += fmt::format("outside --start/--duration: {} events\n", r.outside_window);
   if (r.out_of_order > 0)
     s += fmt::format("out of time order: {} events (published without waiting)\n", r.out_of_order);
+  if (r.gaps_capped > 0)
+    s += fmt::format("gaps over --max-gap: {}, {:.3f} s of log time not waited for\n", r.gaps_capped,
+                     r.gap_time_cut_s);
   if (!r.damage.empty()) s += r.damage + " (the intact events were replayed)\n";
   if (!r.record_path.empty()) {
     s += fmt::format("recorded {} messages to {}\n", sum(r.recorded), r.record_path);
@@ -52,6 +55,8 @@ nlohmann::json to_json(const ReplayReport& r) {
                       {"skipped", skipped},
                       {"outside_window", r.outside_window},
                       {"out_of_order", r.out_of_order},
+                      {"gaps_capped", r.gaps_capped},
+                      {"gap_time_cut_s", r.gap_time_cut_s},
                       {"damage", r.damage},
                       {"data_s", r.data_s},
                       {"wall_s", r.wall_s},

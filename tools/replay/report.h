@@ -22,6 +22,8 @@ struct ReplayReport {
   std::map<std::string, SkippedChannel> skipped;      ///< channel -> events, reason
   int64_t outside_window = 0;                         ///< left out by --start/--duration
   int64_t out_of_order = 0;                           ///< events stamped before their predecessor
+  int64_t gaps_capped = 0;      ///< timed: gaps between events played shorter (--max-gap)
+  double gap_time_cut_s = 0.0;  ///< timed: log seconds those gaps were shortened by, in total
   std::string damage;                                 ///< LogReader::damage_report()
   double data_s = 0.0;                                ///< log time spanned by the replayed events
   double wall_s = 0.0;

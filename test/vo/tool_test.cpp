@@ -1,0 +1,188 @@
+// kestrel-vo --tum as a user runs it, on TUM folders written here from the synthetic room: a
+// run that produced nothing usable (no valid depth anywhere, no frame pairing with a depth
+// image, unreadable lists or images) is exit 3 with one line naming the folder or file and
+// writes no trajectory; a partly usable folder is scored and says how many frames were used.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <sstream>
+
+#include "common/error.h"
+#include "common/time.h"
+#include "test/support/test_support.h"
+#include "test/vo/synthetic_scene.h"
+
+namespace kestrel::vo {
+namespace {
+
+namespace fs = std::filesystem;
+using ::kestrel::test::run;
+using ::kestrel::test::RunResult;
+using ::kestrel::test::TempDir;
+
+constexpr int64_t kT0 = 1305031229528748;
+constexpr int64_t kPeriod = 33333;
+
+Eigen::Isometry3d truth(double k) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.translation() = Eigen::Vector3d(0.01 * k, -0.004 * k, 0.002 * k);
+  return T;
+}
+
+void write_text(const fs::path& path, const std::string& text) {
+  std::ofstream out(path);
+  out << text;
+  ASSERT_TRUE(out.good()) << path;
+}
+
+struct SequenceSpec {
+  int frames = 4;
+  int blank_depth_from = 1 << 30;  ///< frames from here on have no depth reading at all
+  int64_t depth_shift_us = 1000;   ///< depth time - RGB time
+  bool extra_rgb = false;          ///< one more RGB image, a second after the others, no depth
+};
+
+// A TUM folder with the ROS default intrinsics (its name names no freiburg camera), so the
+// run uses the simulator's profile, which the synthetic room matches.
+fs::path write_sequence(const fs::path& parent, const SequenceSpec& spec) {
+  const fs::path folder = parent / "rgbd_dataset_synthetic";
+  fs::create_directories(folder / "rgb");
+  fs::create_directories(folder / "depth");
+  static const test::SyntheticScene scene(23);
+  const PinholeCamera camera = PinholeCamera::vga(525.0, 525.0, 319.5, 239.5);
+  std::ostringstream rgb, depth, gt;
+  rgb << "# color images\n";
+  depth << "# depth maps\n";
+  gt << "# timestamp tx ty tz qx qy qz qw\n";
+  for (int k = 0; k < spec.frames + (spec.extra_rgb ? 1 : 0); ++k) {
+    const bool extra = k == spec.frames;
+    const int64_t t = extra ? kT0 + kPeriod * (k - 1) + 1000000 : kT0 + kPeriod * k;
+    const RgbdFrame f = scene.render(truth(k), camera, t);
+    cv::Mat bgr, raw;
+    cv::cvtColor(f.rgb, bgr, cv::COLOR_RGB2BGR);
+    f.depth_mm.convertTo(raw, CV_16UC1, 5.0);  // TUM's 1/5000 m
+    if (k >= spec.blank_depth_from) raw.setTo(cv::Scalar::all(0));
+    const std::string name = std::to_string(k) + ".png";
+    cv::imwrite((folder / "rgb" / name).string(), bgr);
+    rgb << format_seconds(t) << " rgb/" << name << "\n";
+    if (!extra) {
+      cv::imwrite((folder / "depth" / name).string(), raw);
+      depth << format_seconds(t + spec.depth_shift_us) << " depth/" << name << "\n";
+    }
+  }
+  for (int64_t t = kT0 - 50000; t <= kT0 + kPeriod * spec.frames + 50000; t += 10000) {
+    const Eigen::Vector3d p = truth(double(t - kT0) / double(kPeriod)).translation();
+    gt << format_seconds(t) << " " << p.x() << " " << p.y() << " " << p.z() << " 0 0 0 1\n";
+  }
+  write_text(folder / "rgb.txt", rgb.str());
+  write_text(folder / "depth.txt", depth.str());
+  write_text(folder / "groundtruth.txt", gt.str());
+  return folder;
+}
+
+RunResult run_vo(const fs::path& folder, const fs::path& out, const std::vector<std::string>& extra = {}) {
+  std::vector<std::string> argv = {::kestrel::test::tool("vo").string(), "--tum", folder.string(), "--out", out.string()};
+  argv.insert(argv.end(), extra.begin(), extra.end());
+  return run(argv);
+}
+
+TEST(VoTool, NoValidDepthAnywhereExitsThreeAndWritesNothing) {
+  TempDir dir;
+  SequenceSpec spec;
+  spec.blank_depth_from = 0;
+  const fs::path folder = write_sequence(dir.path(), spec);
+  const RunResult r = run_vo(folder, dir / "t.txt", {"--stats", (dir / "s.json").string(), "-q"});
+  EXPECT_EQ(r.exit_code, kExitBadInput) << r.out << r.err;
+  EXPECT_EQ(r.err.rfind("kestrel-vo: error: " + folder.string() +
+                            ": nothing usable: 0 of 4 frames gave a motion (too little valid depth 4)",
+                        0),
+            0u)
+      << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_EQ(r.out.find("ATE"), std::string::npos) << "no accuracy for a run that estimated nothing: " << r.out;
+  EXPECT_FALSE(fs::exists(dir / "t.txt"));
+  EXPECT_FALSE(fs::exists(dir / "s.json"));
+}
+
+TEST(VoTool, NoFramePairingWithDepthExitsThreeNamingTheFolderAndTolerance) {
+  TempDir dir;
+  SequenceSpec spec;
+  spec.depth_shift_us = 10000000;  // 10 s later: no RGB image within TUM's 20 ms of any depth image
+  const fs::path folder = write_sequence(dir.path(), spec);
+  const RunResult r = run_vo(folder, dir / "t.txt", {"-q"});
+  EXPECT_EQ(r.exit_code, kExitBadInput) << r.out << r.err;
+  EXPECT_EQ(r.err.rfind("kestrel-vo: error: " + folder.string() + ": no RGB image has a depth image", 0), 0u)
+      << r.err;
+  EXPECT_NE(r.err.find("association tolerance of 0.020000 s"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "t.txt"));
+}
+
+TEST(VoTool, APartlyUsableFolderIsScoredAndSaysHowManyFramesWereUsed) {
+  TempDir dir;
+  SequenceSpec spec;
+  spec.frames = 6;
+  spec.blank_depth_from = 4;
+  spec.extra_rgb = true;
+  const fs::path folder = write_sequence(dir.path(), spec);
+  const RunResult r = run_vo(folder, dir / "t.txt", {"--stats", (dir / "s.json").string()});
+  ASSERT_EQ(r.exit_code, kExitOk) << r.out << r.err;
+  EXPECT_NE(r.out.find("frames: 6 of 7 RGB images (1 without a depth image within 0.020000 s)\n"), std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("with a motion: 3 (50 %); by status: ok 3, no reference 1, too little valid depth 2\n"),
+            std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("ATE RMSE: "), std::string::npos) << r.out;
+  EXPECT_NE(r.err.find("3 of 6 frames gave no motion"), std::string::npos) << r.err;  // the first has no reference
+  EXPECT_NE(r.err.find("1 RGB images have no depth image"), std::string::npos) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(::kestrel::test::read_file(dir / "s.json"));
+  EXPECT_EQ(j.at("ok"), 3);
+  EXPECT_EQ(j.at("by_status").at("too little valid depth"), 2);
+  EXPECT_LT(j.at("accuracy").at("ate_rmse_m").get<double>(), 0.01);
+  EXPECT_TRUE(fs::exists(dir / "t.txt"));
+}
+
+TEST(VoTool, UnreadableListsAndImagesExitThreeNamingTheFileAndLine) {
+  struct Case {
+    const char* what;
+    std::function<void(const fs::path&)> damage;
+    std::string expect;  // after "kestrel-vo: error: <folder>/"
+  };
+  const std::vector<Case> cases = {
+      {"empty rgb.txt", [](const fs::path& f) { write_text(f / "rgb.txt", ""); }, "rgb.txt: lists no images"},
+      {"truncated line", [](const fs::path& f) { write_text(f / "rgb.txt", format_seconds(kT0) + "\n"); },
+       "rgb.txt:1: expected 'timestamp filename'"},
+      {"NaN time stamp", [](const fs::path& f) { write_text(f / "depth.txt", "nan depth/0.png\n"); },
+       "depth.txt:1: bad timestamp 'nan'"},
+      {"infinite time stamp", [](const fs::path& f) { write_text(f / "depth.txt", "inf depth/0.png\n"); },
+       "depth.txt:1: bad timestamp 'inf'"},
+      {"negative time stamp", [](const fs::path& f) { write_text(f / "rgb.txt", "-1.0 rgb/0.png\n"); },
+       "rgb.txt:1: bad timestamp '-1.0'"},
+      {"truncated image", [](const fs::path& f) { fs::resize_file(f / "depth" / "1.png", 100); }, "depth.txt:3: "},
+      {"empty image", [](const fs::path& f) { fs::resize_file(f / "rgb" / "2.png", 0); }, "rgb.txt:4: "},
+  };
+  for (const Case& c : cases) {
+    TempDir dir;
+    const fs::path folder = write_sequence(dir.path(), SequenceSpec{});
+    c.damage(folder);
+    const RunResult r = run_vo(folder, dir / "t.txt", {"-q"});
+    EXPECT_EQ(r.exit_code, kExitBadInput) << c.what << ": " << r.err;
+    // libpng prints its own "libpng error: ..." line before OpenCV returns an empty image; ours
+    // is then the one line of kestrel-vo's.
+    const size_t ours = r.err.find("kestrel-vo: ");
+    ASSERT_NE(ours, std::string::npos) << c.what << ": " << r.err;
+    const std::string line = r.err.substr(ours);
+    EXPECT_EQ(line.rfind("kestrel-vo: error: " + folder.string() + "/" + c.expect, 0), 0u) << c.what << ": " << r.err;
+    EXPECT_EQ(std::count(line.begin(), line.end(), '\n'), 1) << c.what << ": " << r.err;
+    EXPECT_FALSE(fs::exists(dir / "t.txt")) << c.what;
+  }
+}
+
+}  // namespace
+}  // namespace kestrel::vo
