@@ -227,6 +227,7 @@ function(_kestrel_test_pch)
     HEADERS <gtest/gtest.h> <gmock/gmock.h> <Eigen/Core> <Eigen/Geometry> <opencv2/core.hpp>
             <filesystem> <fstream> <map> <random> <sstream> ${_KESTREL_STD_HEADERS})
   _kestrel_test_definitions(kestrel_test_pch)
+  set_target_properties(kestrel_test_pch PROPERTIES KESTREL_TEST_CODE ON)  # as its users
 endfunction()
 
 # kestrel_test(name SOURCES ... [DEPS ...] LABELS unit|integration|data [TIMEOUT s])
@@ -244,7 +245,8 @@ function(kestrel_test name)
   _kestrel_test_definitions(${name})
   _kestrel_test_pch()
   _kestrel_use_pch(${name} kestrel_test_pch "${_KESTREL_TEST_PCH_DEPS}")
-  set_target_properties(${name} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/test)
+  set_target_properties(${name} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/test
+                                           KESTREL_TEST_CODE ON)  # -O1 (KestrelWarnings.cmake)
   gtest_discover_tests(${name}
     PROPERTIES LABELS "${ARG_LABELS}" TIMEOUT ${ARG_TIMEOUT}
     DISCOVERY_TIMEOUT 60)

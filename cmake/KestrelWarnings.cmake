@@ -36,8 +36,13 @@ if(KESTREL_SANITIZE)
 endif()
 
 if(CMAKE_BUILD_TYPE STREQUAL "Release")
-  # -O3 lets GCC vectorise the per-pixel loops; keep asserts out of the hot paths.
-  target_compile_options(kestrel_options INTERFACE -O3)
+  # -O3 lets GCC vectorise the per-pixel loops; keep asserts out of the hot paths. The tests'
+  # own code (targets with KESTREL_TEST_CODE: the test executables and their precompiled
+  # header) is compiled at -O1: it drives the libraries, which keep -O3, and -O3 was most of
+  # its compile time (docs/decisions/2026-12-02-process-start-and-test-code.md). On x86-64
+  # (SSE2, no FMA without -march) the level changes no floating-point result.
+  target_compile_options(kestrel_options INTERFACE
+    $<IF:$<BOOL:$<TARGET_PROPERTY:KESTREL_TEST_CODE>>,-O1,-O3>)
 endif()
 
 # LLVM's linker when the system has it (Debian's `lld`, in ../kestrel's package list): it

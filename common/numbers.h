@@ -1,5 +1,7 @@
 #pragma once
-// The few numeric constants several components need, spelled once (C++17 has no <numbers>).
+// The few numeric constants and one-line helpers several components need, spelled once (C++17
+// has no <numbers>). One home also keeps them out of the files' anonymous namespaces, where
+// two copies in one unity batch (CMakeLists.txt) would be a redefinition.
 
 #include <limits>
 
@@ -9,5 +11,8 @@ inline constexpr double kPi = 3.14159265358979323846;
 inline constexpr double kTwoPi = 2.0 * kPi;
 inline constexpr double kDegree = kPi / 180.0;  ///< one degree in radians
 inline constexpr double kInf = std::numeric_limits<double>::infinity();
+
+/// v * v: a variance from a standard deviation, without writing the expression twice.
+constexpr double sq(double v) { return v * v; }
 
 }  // namespace kestrel

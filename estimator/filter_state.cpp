@@ -101,11 +101,6 @@ void inject(FilterState& s, const Eigen::Ref<const ErrorVector>& dx) {
   symmetrize(s.P);
 }
 
-void symmetrize(Covariance& P) {
-  const Covariance Pt = P.transpose();
-  P = 0.5 * (P + Pt);
-}
-
 Eigen::Isometry3d world_change(const Eigen::Isometry3d& ours, const Eigen::Isometry3d& theirs) {
   const Eigen::Matrix3d R_delta = theirs.linear() * ours.linear().transpose();
   Eigen::Isometry3d change = Eigen::Isometry3d::Identity();

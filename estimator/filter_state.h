@@ -114,7 +114,12 @@ Eigen::Matrix<double, 6, 4> world_change_jacobian(const Eigen::Vector3d& p_world
 /// against the world's uncertainty rather than the old world's.
 void widen_for_world_change(FilterState& s, const Eigen::Matrix4d& sigma);
 
-/// Makes P exactly symmetric (rounding in the updates breaks it slowly).
-void symmetrize(Covariance& P);
+/// Makes P exactly symmetric (rounding in the updates breaks it slowly): the filter's
+/// Covariance and the visual-only estimator's fixed 6 x 6 blocks alike. Evaluated into a
+/// temporary first: P and its transpose alias.
+template <class Derived>
+void symmetrize(Eigen::MatrixBase<Derived>& P) {
+  P.derived() = 0.5 * (P + P.transpose()).eval();
+}
 
 }  // namespace kestrel::estimator

@@ -6,11 +6,10 @@
 #include <Eigen/Eigenvalues>
 
 #include "common/geometry/so3.h"
+#include "common/numbers.h"
 
 namespace kestrel::estimator {
 namespace {
-
-double sq(double v) { return v * v; }
 
 // The diagonal prior of a start; still and moving starts differ only in how well they know
 // velocity, tilt and gyro bias.

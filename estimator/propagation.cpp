@@ -1,6 +1,7 @@
 #include "estimator/propagation.h"
 
 #include "common/geometry/so3.h"
+#include "common/numbers.h"
 
 namespace kestrel::estimator {
 
@@ -90,7 +91,6 @@ NoiseJacobian noise_jacobian(const Transition& phi) {
 }
 
 Eigen::Matrix<double, 12, 1> noise_variances(const ImuNoise& noise, double dt, bool gap) {
-  const auto sq = [](double v) { return v * v; };
   double gyro = sq(noise.gyro_noise_density) / dt;
   double accel = sq(noise.accel_noise_density) / dt;
   if (gap) {

@@ -5,13 +5,13 @@
 
 #include "common/error.h"
 #include "common/geometry/so3.h"
+#include "common/numbers.h"
+#include "common/time.h"
+#include "estimator/filter_state.h"
 #include "estimator/initializer.h"
 
 namespace kestrel::estimator {
 namespace {
-
-double sq(double v) { return v * v; }
-double seconds(int64_t dt_us) { return static_cast<double>(dt_us) * 1e-6; }
 
 // Jacobian of T_world_cur = T_world_ref * Delta with respect to the reference pose's error,
 // both in [dp (world); dtheta (body)].
@@ -21,8 +21,6 @@ Matrix6d compose_jacobian(const Eigen::Matrix3d& R_world_ref, const Eigen::Isome
   A.block<3, 3>(3, 3) = Delta.linear().transpose();
   return A;
 }
-
-void symmetrize(Matrix6d& P) { P = 0.5 * (P + P.transpose()).eval(); }
 
 }  // namespace
 
@@ -101,7 +99,7 @@ VisualOnlyEstimator::Frame VisualOnlyEstimator::predict(int64_t utime) const {
   auto it = std::upper_bound(frames_.begin(), frames_.end(), utime,
                              [](int64_t t, const Frame& f) { return t < f.utime; });
   const Frame& from = it == frames_.begin() ? frames_.front() : *std::prev(it);
-  const double dt = seconds(utime - from.utime);
+  const double dt = to_seconds(utime - from.utime);
   Frame f;
   f.utime = utime;
   f.T_world_body = se3::make(from.T_world_body.linear() * so3::exp(omega_body_ * dt),
@@ -121,7 +119,7 @@ VisualOnlyEstimator::Frame VisualOnlyEstimator::predict(int64_t utime) const {
 void VisualOnlyEstimator::push(Frame frame) {
   const VisualOnlyOptions& m = options_.visual_only;
   const Frame& previous = frames_.back();
-  const double dt = seconds(frame.utime - previous.utime);
+  const double dt = to_seconds(frame.utime - previous.utime);
   rate_covariance_.topLeftCorner<3, 3>().diagonal().array() += sq(m.accel_noise_density) * dt;
   rate_covariance_.bottomRightCorner<3, 3>().diagonal().array() +=
       sq(m.angular_accel_noise_density) * dt;
@@ -133,7 +131,7 @@ void VisualOnlyEstimator::push(Frame frame) {
 }
 
 void VisualOnlyEstimator::update_rates(const Frame& previous, const Frame& current) {
-  const double dt = seconds(current.utime - previous.utime);
+  const double dt = to_seconds(current.utime - previous.utime);
   Vector6d z;
   z.head<3>() = (current.T_world_body.translation() - previous.T_world_body.translation()) / dt;
   z.tail<3>() = so3::log(previous.T_world_body.linear().transpose() * current.T_world_body.linear()) / dt;
@@ -369,7 +367,7 @@ std::optional<EstimatorOutput> VisualOnlyEstimator::output() const {
   EstimatorOutput out;
   out.utime = f.utime;
   const bool stale = last_applied_utime_ < 0 ||
-                     seconds(f.utime - last_applied_utime_) > options_.vo_timeout_s;
+                     to_seconds(f.utime - last_applied_utime_) > options_.vo_timeout_s;
   out.status = stale ? Status::kDegraded : Status::kOk;
   out.nav.p_world_body = f.T_world_body.translation();
   out.nav.R_world_body = f.T_world_body.linear();

@@ -45,13 +45,30 @@ void add_mapper_options(CLI::App& app, MapperOptions& o) {
   opt("--frame-buffer", o.frame_buffer_s, "Frames kept for SLAM keyframes to refer to, s");
 }
 
+namespace {
+
+// validate()'s "key: why" as the option's usage error, "--key: why".
+[[noreturn]] void throw_as_option_error(const std::invalid_argument& e) {
+  const std::string what = e.what();
+  const auto colon = what.find(':');
+  throw CLI::ValidationError("--" + what.substr(0, colon), what.substr(colon == std::string::npos ? 0 : colon + 2));
+}
+
+}  // namespace
+
 void check_mapper_options(const MapperOptions& o) {
   try {
     o.validate();
   } catch (const std::invalid_argument& e) {
-    const std::string what = e.what();
-    const auto colon = what.find(':');
-    throw CLI::ValidationError("--" + what.substr(0, colon), what.substr(colon == std::string::npos ? 0 : colon + 2));
+    throw_as_option_error(e);
+  }
+}
+
+void check_node_options(const NodeOptions& o) {
+  try {
+    o.validate();
+  } catch (const std::invalid_argument& e) {
+    throw_as_option_error(e);
   }
 }
 

@@ -5,6 +5,7 @@
 // names the key.
 
 #include "common/cli.h"
+#include "mapper/map_node.h"
 #include "mapper/mapper.h"
 
 namespace kestrel::mapper {
@@ -15,5 +16,7 @@ void add_mapper_options(CLI::App& app, MapperOptions& o);
 
 /// Runs o.validate(), turning its std::invalid_argument into a CLI::ValidationError (exit 2).
 void check_mapper_options(const MapperOptions& o);
+/// The same for the process's options (the map's, and the pose source, rate and journal).
+void check_node_options(const NodeOptions& o);
 
 }  // namespace kestrel::mapper

@@ -5,6 +5,8 @@
 #include <cstring>
 #include <filesystem>
 #include <optional>
+#include <stdexcept>
+#include <string_view>
 #include <utility>
 
 #include "common/atomic_file.h"
@@ -18,6 +20,8 @@ namespace kestrel::mapper {
 
 namespace {
 
+namespace fs = std::filesystem;
+
 // The journal keeps the frame exactly: raw colour, lossless depth.
 transport::RgbdEncoding lossless() {
   transport::RgbdEncoding e;
@@ -26,7 +30,82 @@ transport::RgbdEncoding lossless() {
   return e;
 }
 
+// A whole number of at most 18 digits (no sign, no spaces), or empty.
+std::optional<int64_t> whole_number(std::string_view digits) {
+  if (digits.empty() || digits.size() > 18) return std::nullopt;
+  int64_t value = 0;
+  for (const char c : digits) {
+    if (c < '0' || c > '9') return std::nullopt;
+    value = value * 10 + (c - '0');
+  }
+  return value;
+}
+
+// What follows "<path>.<tag>-" in a name keep_aside() gives, "<utime>" or "<utime>-<n>" (n >= 2,
+// a second name in one microsecond), as (utime, n) with n = 1 for the first; else empty, and
+// the file is not one the writer kept.
+std::optional<std::pair<int64_t, int64_t>> kept_order(std::string_view suffix) {
+  const size_t dash = suffix.find('-');
+  const std::optional<int64_t> utime = whole_number(suffix.substr(0, dash));
+  if (!utime) return std::nullopt;
+  if (dash == std::string_view::npos) return std::make_pair(*utime, int64_t{1});
+  const std::optional<int64_t> n = whole_number(suffix.substr(dash + 1));
+  if (!n || *n < 2) return std::nullopt;
+  return std::make_pair(*utime, *n);
+}
+
 }  // namespace
+
+std::vector<std::string> kept_journals(const std::string& path, const std::string& tag) {
+  const fs::path journal(path);
+  const fs::path folder = journal.parent_path().empty() ? fs::path(".") : journal.parent_path();
+  const std::string prefix = journal.filename().string() + "." + tag + "-";
+  std::vector<std::pair<std::pair<int64_t, int64_t>, std::string>> found;
+  std::error_code ec;
+  for (fs::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (name.compare(0, prefix.size(), prefix) != 0) continue;
+    const auto order = kept_order(std::string_view(name).substr(prefix.size()));
+    // keep_aside() makes regular files (a hard link or a copy); anything else is not ours.
+    std::error_code type_ec;
+    if (!order || it->symlink_status(type_ec).type() != fs::file_type::regular) continue;
+    found.emplace_back(*order, (journal.parent_path() / name).string());
+  }
+  if (ec) throw InputError(folder.string() + ": cannot list the journals kept aside: " + ec.message());
+  std::sort(found.begin(), found.end());
+  std::vector<std::string> names;
+  names.reserve(found.size());
+  for (auto& entry : found) names.push_back(std::move(entry.second));
+  return names;
+}
+
+PrunedJournals prune_kept_journals(const std::string& path, const std::string& tag, int keep,
+                                   const std::string& just_kept) {
+  if (keep < 1)
+    throw std::invalid_argument("pruning the kept journals: keep must be >= 1, not " + std::to_string(keep));
+  PrunedJournals pruned;
+  std::vector<std::string> kept;
+  try {
+    kept = kept_journals(path, tag);
+  } catch (const InputError& e) {
+    pruned.failures.push_back(e.what());
+    return pruned;
+  }
+  const fs::path newest = fs::path(just_kept).filename();
+  const auto is_newest = [&](const std::string& p) { return !just_kept.empty() && fs::path(p).filename() == newest; };
+  const size_t before = kept.size();
+  kept.erase(std::remove_if(kept.begin(), kept.end(), is_newest), kept.end());
+  const size_t others_kept = static_cast<size_t>(keep) - (kept.size() < before ? 1 : 0);
+  for (size_t i = 0; i + others_kept < kept.size(); ++i) {  // oldest first
+    std::error_code ec;
+    if (fs::remove(kept[i], ec)) {
+      pruned.removed.push_back(kept[i]);
+    } else if (ec) {
+      pruned.failures.push_back(kept[i] + ": cannot delete it: " + ec.message());
+    }
+  }
+  return pruned;
+}
 
 JournalContents read_journal(const std::string& path) {
   JournalContents contents;
@@ -112,7 +191,10 @@ Restored restore_journal(const JournalContents& journal, Mapper& mapper, const s
   return restored;
 }
 
-JournalWriter::JournalWriter(std::string path, const JournalContents& contents) : path_(std::move(path)) {
+JournalWriter::JournalWriter(std::string path, const JournalContents& contents, int keep)
+    : path_(std::move(path)), keep_(keep) {
+  if (keep_ < 1)
+    throw std::invalid_argument(path_ + ": journals kept aside: keep must be >= 1, not " + std::to_string(keep_));
   std::error_code ec;
   const bool exists = std::filesystem::exists(path_, ec);
   const uintmax_t size = exists ? std::filesystem::file_size(path_, ec) : 0;
@@ -128,6 +210,8 @@ JournalWriter::JournalWriter(std::string path, const JournalContents& contents) 
     // read, copied byte for byte, so the damage is neither cut off nor appended after.
     kept_aside_ = keep_aside(path_, "damaged");
     start_fresh(kept_aside_, contents.spans);
+    // Only once the fresh journal is in place: until then the damaged file is the only copy.
+    pruned_ = prune_kept_journals(path_, "damaged", keep_, kept_aside_);
   }
   open_for_append();
 }
@@ -187,12 +271,14 @@ void JournalWriter::graph(const kestrel::slam_graph_t& graph) {
 
 void JournalWriter::restart() {
   kept_aside_.clear();
+  pruned_ = {};
   if (bytes_ <= journal::kHeaderSize) return;  // no record: nothing to keep
   out_.close();
   // keep_aside throws before anything changed; start_fresh replaces the file by a rename.
   kept_aside_ = keep_aside(path_, "reset");
   start_fresh("", {});
   open_for_append();
+  pruned_ = prune_kept_journals(path_, "reset", keep_, kept_aside_);
 }
 
 }  // namespace kestrel::mapper

@@ -32,6 +32,11 @@
 //    copied byte for byte, which the writer then appends to.
 //  * A reset (lock-step replay's RESET) keeps the journal it ends as "<file>.reset-<utime>" and
 //    starts "<file>" again empty; a journal without records is simply kept.
+//  * The only deletion: so that repeated resets (or damage) cannot fill the disk, each time a
+//    journal is set aside the oldest of that kind ("reset" or "damaged") beyond the `keep` most
+//    recent are deleted, and each deletion is reported (JournalWriter::pruned()) for the
+//    process to log. `keep` is at least 1 and the journal just set aside is always kept: what a
+//    reset or the damage has just ended is never the one deleted. Other files are never touched.
 
 #include <cstdint>
 #include <fstream>
@@ -82,14 +87,38 @@ struct Restored {
 /// map from them. `what` names the journal in errors.
 Restored restore_journal(const JournalContents& journal, Mapper& mapper, const std::string& what);
 
+/// How many journals set aside of each kind a writer keeps unless told otherwise.
+constexpr int kDefaultKeptJournals = 5;
+
+/// The journals kept aside for `path` under `tag` ("reset", "damaged"): the regular files
+/// beside it named as keep_aside() names them, "<path>.<tag>-<utime>" or "...-<utime>-<n>",
+/// oldest first (by the time and number in the name, which say when each was set aside).
+/// Throws InputError naming the folder if it cannot be listed.
+std::vector<std::string> kept_journals(const std::string& path, const std::string& tag);
+
+/// What pruning the journals kept aside did.
+struct PrunedJournals {
+  std::vector<std::string> removed;   ///< deleted, oldest first
+  std::vector<std::string> failures;  ///< "<file or folder>: why" for what could not be deleted (it stays)
+};
+
+/// Deletes the oldest of kept_journals(path, tag) beyond the `keep` most recent, never
+/// `just_kept` (the one set aside just now, kept whatever its name says: the wall clock can
+/// step back). `keep` < 1 is std::invalid_argument: pruning never empties the set.
+PrunedJournals prune_kept_journals(const std::string& path, const std::string& tag, int keep,
+                                   const std::string& just_kept);
+
 class JournalWriter {
  public:
   /// Journals to `path`, whose read_journal() is `contents` (default: a missing or empty file,
   /// where a new journal starts): a whole journal is appended to; a damaged one is kept aside
   /// and replaced by a fresh journal of `contents`' records (see the top of this file). Throws
   /// InputError naming the file if it cannot be written, or if it is no longer what was read
-  /// (its size differs), so a journal is never written over unread.
-  explicit JournalWriter(std::string path, const JournalContents& contents = {});
+  /// (its size differs), so a journal is never written over unread. Of the journals set aside
+  /// `keep` of each kind are kept (see the top of this file); `keep` < 1 is
+  /// std::invalid_argument.
+  explicit JournalWriter(std::string path, const JournalContents& contents = {},
+                         int keep = kDefaultKeptJournals);
 
   void keyframe(const kestrel::slam_keyframe_t& keyframe, const RgbdFrame& frame);
   void graph(const kestrel::slam_graph_t& graph);
@@ -103,6 +132,8 @@ class JournalWriter {
   /// Where the journal set aside by the constructor (damaged) or the last restart() is kept
   /// ("" = that one kept nothing).
   const std::string& kept_aside() const { return kept_aside_; }
+  /// The older journals of the same kind that setting that one aside deleted (or could not).
+  const PrunedJournals& pruned() const { return pruned_; }
 
  private:
   // `path_` replaced atomically by the header and `spans` of the file `source`.
@@ -111,9 +142,11 @@ class JournalWriter {
   void append(char kind, const std::vector<uint8_t>& payload);
 
   std::string path_;
+  int keep_;
   std::ofstream out_;
   uint64_t bytes_ = 0;
   std::string kept_aside_;
+  PrunedJournals pruned_;
 };
 
 }  // namespace kestrel::mapper

@@ -31,10 +31,19 @@ struct Options {
   mapper::NodeOptions node;
 };
 
+// Each older journal deleted so that at most --journal-keep of its kind stay is named in the
+// log: nothing on disk goes without a trace.
+void log_pruned_journals(const mapper::MapNode& map, int keep) {
+  for (const std::string& removed : map.journal_pruned().removed)
+    spdlog::info("deleted {}: the oldest beyond the {} journals of its kind kept (--journal-keep)", removed, keep);
+  for (const std::string& failure : map.journal_pruned().failures)
+    spdlog::warn("journals kept aside: {}", failure);
+}
+
 int serve(Options& o) {
-  mapper::check_mapper_options(o.node.mapper);
   o.node.pose_source = o.pose_source == "slam" ? mapper::PoseSource::kSlamGraph : mapper::PoseSource::kGroundTruth;
   o.node.full_format = o.format == "full";
+  mapper::check_node_options(o.node);
   if (!o.save.empty()) mapper::format_of(o.save);  // a bad extension is an error now, not at exit
   mapper::MapNode map(o.node);
   if (!o.node.journal_path.empty()) {
@@ -45,6 +54,7 @@ int serve(Options& o) {
     } else if (!map.journal_damage().empty()) {
       spdlog::warn("{}: damaged ({}); the damaged file is kept as {}, journalling goes on in a fresh copy of "
                    "what was read", o.node.journal_path, map.journal_damage(), map.journal_kept_aside());
+      log_pruned_journals(map, o.node.journal_keep);
     }
     spdlog::info("journal {}: {} keyframes restored", o.node.journal_path, map.stats().keyframes_restored);
   }
@@ -52,16 +62,20 @@ int serve(Options& o) {
   std::unique_ptr<transport::Node> node;
   node = std::make_unique<transport::Node>(o.name, o.lcm_url);  // UnavailableError: exit 4
   node->advertise(channel::kMapOctomap);
-  if (!o.node.journal_path.empty() && !map.journal_error().empty())
-    node->set_health(process_status_t::STATE_DEGRADED, "journal stopped: " + map.journal_error());
+  // The map's health (DEGRADED once its journal is given up, from the start or later).
+  const auto report_health = [&] {
+    const mapper::MapNode::Health health = map.health();
+    node->set_health(health.state, health.message);
+  };
   node->on_reset([&] {
     const bool journalling = !o.node.journal_path.empty() && map.journal_error().empty();
     map.reset();
     if (!map.journal_kept_aside().empty())
       spdlog::info("reset: the journal starts again; what it held is kept as {}", map.journal_kept_aside());
+    log_pruned_journals(map, o.node.journal_keep);
     if (journalling && !map.journal_error().empty()) {
       spdlog::error("journal stopped (the map goes on without it): {}", map.journal_error());
-      node->set_health(process_status_t::STATE_DEGRADED, "journal stopped: " + map.journal_error());
+      report_health();
     }
   });
   auto publish = [&](const std::optional<octomap_t>& msg) {
@@ -77,7 +91,7 @@ int serve(Options& o) {
       publish(map.on_graph(m, channel::kSlamGraph));
       if (journalling && !map.journal_error().empty()) {
         spdlog::error("journal stopped (the map goes on without it): {}", map.journal_error());
-        node->set_health(process_status_t::STATE_DEGRADED, "journal stopped: " + map.journal_error());
+        report_health();
       }
     }, 0);
   } else {
@@ -87,7 +101,8 @@ int serve(Options& o) {
   }
   // A restored map goes out at once: the planner should not wait for the next keyframe.
   if (map.stats().keyframes_restored > 0) publish(map.map_message());
-  node->set_health(process_status_t::STATE_RUNNING, "");
+  // Not RUNNING regardless: a journal that could not be continued at start is reported too.
+  report_health();
   spdlog::info("{}: CAMERA_RGBD + {} -> MAP_OCTOMAP at {} m", o.name,
                o.pose_source == "slam" ? "SLAM_GRAPH" : "GROUND_TRUTH", o.node.mapper.map.resolution_m);
   const int status = node->spin();
@@ -128,6 +143,11 @@ int main(int argc, char** argv) {
   app.add_option("--journal", o.node.journal_path,
                  "slam: journal the keyframes to this file and, if it exists, restore the map from it "
                  "first (a mapper restarted in flight; kestrel launch gives each launch its own)");
+  app.add_option("--journal-keep", o.node.journal_keep,
+                 "Journals set aside kept of each kind (FILE.reset-*, FILE.damaged-*): the newest; each older one "
+                 "is deleted, and logged, when another is set aside")
+      ->check(CLI::Range(1, 1000000))
+      ->capture_default_str();
   mapper::add_mapper_options(app, o.node.mapper);
   return app.run(argc, argv, [&] { return serve(o); });
 }

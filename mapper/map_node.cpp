@@ -25,6 +25,8 @@ void NodeOptions::validate() const {
   if (!(std::isfinite(max_pose_gap_s) && max_pose_gap_s > 0.0))
     throw std::invalid_argument("max-pose-gap: must be > 0");
   if (max_pending_frames < 1) throw std::invalid_argument("max-pending-frames: must be >= 1");
+  // 0 would delete the journal a reset has just set aside: keeping none is not offered.
+  if (journal_keep < 1) throw std::invalid_argument("journal-keep: must be >= 1");
   if (!journal_path.empty() && pose_source != PoseSource::kSlamGraph)
     throw std::invalid_argument("journal: only with the slam pose source");
 }
@@ -41,8 +43,9 @@ MapNode::MapNode(const NodeOptions& options)
   // that fails (a full disk is the usual cause of the damage), the restored map is kept and
   // mapping goes on without a journal, as after a failed write: the file stays as it was.
   try {
-    journal_ = std::make_unique<JournalWriter>(options_.journal_path, journal);
+    journal_ = std::make_unique<JournalWriter>(options_.journal_path, journal, options_.journal_keep);
     journal_kept_aside_ = journal_->kept_aside();
+    journal_pruned_ = journal_->pruned();
   } catch (const std::exception& e) {
     journal_error_ = e.what();
   }
@@ -83,11 +86,13 @@ void MapNode::write_journal(const kestrel::slam_graph_t& msg, const GraphResult&
 void MapNode::reset() {
   mapper_.reset();
   journal_kept_aside_.clear();
+  journal_pruned_ = {};
   if (journal_) {
     // The journal starts again with the map; the one it ends is kept, never emptied in place.
     try {
       journal_->restart();
       journal_kept_aside_ = journal_->kept_aside();
+      journal_pruned_ = journal_->pruned();
     } catch (const std::exception& e) {
       journal_error_ = e.what();
       journal_.reset();
@@ -102,6 +107,11 @@ void MapNode::reset() {
   last_map_frame_utime_ = 0;
   pending_.clear();
   poses_ = Trajectory();
+}
+
+MapNode::Health MapNode::health() const {
+  if (journal_error_.empty()) return {};
+  return {kestrel::process_status_t::STATE_DEGRADED, "journal stopped: " + journal_error_};
 }
 
 kestrel::octomap_t MapNode::map_message() {

@@ -15,9 +15,12 @@
 // from them, so a mapper killed and restarted in flight carries on with its map; keyframes
 // SLAM made while it was down are missing (their frames went by). A damaged journal is read
 // past the damage, kept aside whole and continued as a fresh copy; RESET starts the journal
-// again empty and keeps the old one aside (keyframe_journal.h): no journal is ever cut.
-// A journal that cannot be written mid-flight (a full disk) is given up, not the map:
-// journal_error() says why and mapping goes on.
+// again empty and keeps the old one aside (keyframe_journal.h): no journal is ever cut. Of the
+// journals set aside, NodeOptions::journal_keep of each kind are kept; the older ones deleted
+// are in journal_pruned(), for the process to log.
+// A journal that cannot be written mid-flight (a full disk), or cannot be continued at start
+// (its folder cannot be written), is given up, not the map: journal_error() says why, health()
+// is DEGRADED with it, and mapping goes on.
 //
 // MAP_OCTOMAP is produced at most once per publish_period_s of sensor time, and at once after
 // a rebuild. In kSlamGraph mode the map changes only with SLAM's keyframes, and a hovering
@@ -36,6 +39,7 @@
 #include "common/trajectory.h"
 #include "kestrel/ground_truth_t.hpp"
 #include "kestrel/octomap_t.hpp"
+#include "kestrel/process_status_t.hpp"
 #include "kestrel/rgbd_frame_t.hpp"
 #include "kestrel/slam_graph_t.hpp"
 #include "mapper/keyframe_journal.h"
@@ -53,6 +57,8 @@ struct NodeOptions {
   double max_pose_gap_s = 0.1;      ///< kGroundTruth: largest gap to interpolate across
   int max_pending_frames = 90;      ///< kGroundTruth: frames waiting for a pose after theirs
   std::string journal_path;         ///< kSlamGraph: journal here, restore from it ("" = none)
+  /// Journals set aside kept of each kind (reset, damaged), the newest; >= 1.
+  int journal_keep = kDefaultKeptJournals;
   void validate() const;
 };
 
@@ -95,6 +101,17 @@ class MapNode {
   const std::string& journal_kept_aside() const { return journal_kept_aside_; }
   /// Why journalling stopped ("" = it did not).
   const std::string& journal_error() const { return journal_error_; }
+  /// The older journals deleted (or that could not be) when the last one was set aside, so
+  /// that at most journal_keep of its kind stay.
+  const PrunedJournals& journal_pruned() const { return journal_pruned_; }
+
+  struct Health {
+    int8_t state = kestrel::process_status_t::STATE_RUNNING;
+    std::string message;
+  };
+  /// What the process reports: RUNNING, or DEGRADED "journal stopped: <why>" once the journal
+  /// was given up (the map goes on, but a restart would no longer get it back).
+  Health health() const;
 
  private:
   std::optional<kestrel::octomap_t> maybe_publish(bool now);
@@ -117,6 +134,7 @@ class MapNode {
   std::string journal_damage_;
   std::string journal_kept_aside_;
   std::string journal_error_;
+  PrunedJournals journal_pruned_;
 };
 
 }  // namespace kestrel::mapper

@@ -15,11 +15,9 @@
 #include <string>
 #include <vector>
 
-#include <opencv2/imgcodecs.hpp>
-
-#include "common/atomic_file.h"
 #include "common/cli.h"
 #include "common/error.h"
+#include "common/image/image_io.h"
 #include "common/trajectory.h"
 #include "drivers/tum/tum_sequence.h"
 #include "mapper/cli_options.h"
@@ -47,9 +45,7 @@ struct Options {
 };
 
 void write_png(const std::string& path, const cv::Mat& image) {
-  std::vector<uchar> png;
-  if (!cv::imencode(".png", image, png)) throw InputError(path + ": cannot write the PNG");
-  write_file_atomically(path, png.data(), png.size());  // no cut image that looks whole
+  image::write_png(path, image);  // atomic: no cut image that looks whole
   std::cout << "wrote " << path << " (" << image.cols << "x" << image.rows << ")\n";
 }
 

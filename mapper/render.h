@@ -9,7 +9,7 @@
 //  * perspective view: the occupied cells as shaded cubes (painter's order) from above and to
 //    the side of the map's centre, coloured by height.
 //
-// All images are BGR (CV_8UC3), ready for cv::imwrite. An empty map gives a small grey image.
+// All images are BGR (CV_8UC3), ready for image::write_png (common/image/image_io.h). An empty map gives a small grey image.
 // World x points right and world y up in the top view and the slice.
 
 #include <opencv2/core/mat.hpp>

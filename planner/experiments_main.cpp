@@ -10,11 +10,10 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
-#include <opencv2/imgcodecs.hpp>
 
-#include "common/atomic_file.h"
 #include "common/cli.h"
 #include "common/error.h"
+#include "common/image/image_io.h"
 #include "planner/eval/plot.h"
 #include "planner/eval/tables.h"
 #include "planner/experiment_worlds.h"
@@ -156,9 +155,7 @@ int main(int argc, char** argv) {
               [&] { return planner::eval::transfer_precision(sc, pairs, o); });
       if (!png_dir.empty()) {
         const std::string path = (std::filesystem::path(png_dir) / (w.name + "_paths.png")).string();
-        std::vector<uchar> png;
-        if (!cv::imencode(".png", draw_paths(w, sc, o), png)) throw InputError(path + ": cannot write");
-        write_file_atomically(path, png.data(), png.size());  // no cut image that looks whole
+        image::write_png(path, draw_paths(w, sc, o));  // atomic: no cut image that looks whole
         spdlog::info("wrote {}", path);
       }
     }

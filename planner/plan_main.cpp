@@ -4,14 +4,13 @@
 #include <spdlog/spdlog.h>
 
 #include <iostream>
-#include <opencv2/imgcodecs.hpp>
 
-#include "common/atomic_file.h"
 #include "common/cli.h"
 #include "common/error.h"
+#include "common/image/image_io.h"
+#include "drivers/sim/world_catalog.h"
 #include "planner/eval/experiment.h"
 #include "planner/eval/plot.h"
-#include "drivers/sim/world_catalog.h"
 #include "planner/map_sources.h"
 #include "planner/world_environment.h"
 
@@ -35,7 +34,17 @@ int main(int argc, char** argv) {
   uint64_t seed = 1;
   double density = 4.0, laser_range = 5.0, z_max = 3.0, start_trace = 0.4;
   double dominance_slack = kToolsDominanceSlack;
-  app.add_option("--map", map, "A sim world ('floor', 'room', 'office' or a .world file) or a ROS map YAML");
+  // Which map is a question of the command line (exit 2); what a world or map file holds is
+  // input, checked as it is read (exit 3). The sim's stata world is extruded from a ROS map,
+  // which this tool plans on as it is.
+  app.add_option("--map", map,
+                 "A sim world (built in: room, floor, office, atrium; or a .world file) or a ROS map YAML")
+      ->check(CLI::Validator(
+          [](std::string& what) {
+            if (what == "stata") return std::string("the stata world is a ROS map: give its .yaml as --map");
+            return sim::unknown_world_error(what, /*with_stata=*/false);
+          },
+          ""));
   app.add_option("--start", start, "Start x y z yaw (m, rad)")->expected(4);
   app.add_option("--goal", goal, "Goal x y z yaw (m, rad)")->expected(4);
   app.add_option("--planner", planner,
@@ -108,10 +117,8 @@ int main(int argc, char** argv) {
                 << covariances[i].trace() << "\n";
     if (!png.empty()) {
       planner::eval::DrawnPath drawn{t.path, covariances, planner != "prm" ? cv::Scalar(200, 0, 0) : cv::Scalar(0, 0, 220)};
-      std::vector<uchar> bytes;
-      if (!cv::imencode(".png", planner::eval::draw_plans(env, t.samples, {drawn}, sc.space.z_min_m), bytes))
-        throw InputError(png + ": cannot write");
-      write_file_atomically(png, bytes.data(), bytes.size());  // no cut image that looks whole
+      // Atomic: no cut image that looks whole.
+      image::write_png(png, planner::eval::draw_plans(env, t.samples, {drawn}, sc.space.z_min_m));
     }
     return kExitOk;
   });

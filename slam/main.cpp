@@ -109,6 +109,9 @@ int run_offline(const Options& o, const SlamOptions& options, std::shared_ptr<co
   const SlamRun run = run_slam_sequence(
       sequence.size(), [&sequence](size_t i) { return sequence.frame(i); }, sensor, vo::VoOptions{}, options,
       std::move(vocabulary));
+  // Nothing is written for a run that estimated nothing, as by kestrel-vo --tum: a trajectory
+  // of the first frame's identity pose alone, or of no pose, would read as a result.
+  vo::require_usable(run.odometry, o.tum);  // InputError: exit 3
   write_tum_trajectory(o.out, run.slam);
   if (!o.vo_out.empty()) write_tum_trajectory(o.vo_out, run.vo);
   std::vector<double> ms = run.keyframe_ms;

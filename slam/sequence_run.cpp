@@ -36,7 +36,7 @@ SlamRun run_slam_sequence(size_t count, const std::function<RgbdFrame(size_t)>& 
   std::optional<OdometryPose> previous_pose;  // the chain's pose of the previous frame with one
   for (size_t i = 0; i < count; ++i) {
     const RgbdFrame frame = frame_at(i);
-    const vo::VoResult r = odometry.process(frame);
+    const vo::VoResult& r = run.odometry.emplace_back(odometry.process(frame));
     VoMotion m;
     m.utime = r.utime;
     m.reference_utime = r.reference_utime;

@@ -12,6 +12,7 @@
 
 #include "common/trajectory.h"
 #include "slam/backend/slam.h"
+#include "vo/odometry.h"
 #include "vo/options.h"
 
 namespace kestrel::slam {
@@ -25,6 +26,7 @@ struct LoopEdge {
 };
 
 struct SlamRun {
+  std::vector<vo::VoResult> odometry;  ///< the VO's result for each frame, in order (vo::require_usable)
   Trajectory vo;                   ///< T_world_camera by chained odometry alone
   Trajectory slam;                 ///< the same frames placed by the optimised keyframe graph
   int keyframes = 0;

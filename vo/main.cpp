@@ -77,7 +77,7 @@ int run_offline(const Options& o, const vo::VoOptions& options) {
   const vo::LoadedSequence sequence = vo::load_tum_sequence(o.tum);
   const vo::SequenceRun run = vo::run_sequence(sequence.frames, options);
   const vo::RunFigures f = vo::score(run, sequence.ground_truth);
-  vo::require_usable(run, f, o.tum);  // InputError: exit 3
+  vo::require_usable(run.results, o.tum);  // InputError: exit 3
   write_tum_trajectory(o.out, run.trajectory);
   const size_t unpaired = sequence.rgb_images - f.frames;
   std::cout << "frames: " << f.frames << " of " << sequence.rgb_images << " RGB images (" << unpaired

@@ -45,6 +45,17 @@ Vector6d pose_error(const Eigen::Isometry3d& T_est, const Eigen::Isometry3d& T_t
   return e;
 }
 
+// The frames by status: RunFigures' frames, ok and by_status, the rest left unmeasured.
+RunFigures count_by_status(const std::vector<VoResult>& results) {
+  RunFigures f;
+  f.frames = results.size();
+  for (const VoResult& r : results) {
+    f.ok += r.status == VoStatus::kOk;
+    ++f.by_status.at(size_t(r.status));
+  }
+  return f;
+}
+
 }  // namespace
 
 LoadedSequence load_tum_sequence(const std::string& folder) {
@@ -84,12 +95,7 @@ SequenceRun run_sequence(const std::vector<RgbdFrame>& frames, const VoOptions& 
 }
 
 RunFigures score(const SequenceRun& run, const Trajectory& gt) {
-  RunFigures f;
-  f.frames = run.results.size();
-  for (const VoResult& r : run.results) {
-    f.ok += r.status == VoStatus::kOk;
-    ++f.by_status.at(size_t(r.status));
-  }
+  RunFigures f = count_by_status(run.results);
   f.median_ms = percentile(run.process_ms, 0.5);
   f.p95_ms = percentile(run.process_ms, 0.95);
   if (gt.empty()) {
@@ -154,10 +160,11 @@ std::string status_summary(const RunFigures& f) {
   return out.empty() ? "no frames" : out;
 }
 
-void require_usable(const SequenceRun& run, const RunFigures& f, const std::string& folder) {
+void require_usable(const std::vector<VoResult>& results, const std::string& folder) {
+  const RunFigures f = count_by_status(results);
   if (f.ok > 0) return;
   std::string first;  // the first frame that failed for a reason other than being the reference
-  for (const VoResult& r : run.results) {
+  for (const VoResult& r : results) {
     if (r.status == VoStatus::kNoReference) continue;
     first = "; first failure at " + format_seconds(r.utime) + " s: " + (r.message.empty() ? to_string(r.status) : r.message);
     break;

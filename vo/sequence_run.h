@@ -85,10 +85,12 @@ RunFigures score(const SequenceRun& run, const Trajectory& ground_truth);
 /// the statuses, the ones no frame had left out.
 std::string status_summary(const RunFigures& figures);
 
-/// Throws InputError naming `folder` when the run produced nothing usable: no frame with a
-/// motion (no valid depth anywhere, no features, a single frame...). The message counts the
-/// frames by status and quotes the first failure, so the user learns what to fix.
-void require_usable(const SequenceRun& run, const RunFigures& figures, const std::string& folder);
+/// Throws InputError naming `folder` when the odometry's `results` (one per frame, in order:
+/// SequenceRun::results, or the VO within another offline run such as kestrel-slam --tum) hold
+/// nothing usable: no frame with a motion (no valid depth anywhere, no features, a single
+/// frame...). The message counts the frames by status and quotes the first failure, so the
+/// user learns what to fix.
+void require_usable(const std::vector<VoResult>& results, const std::string& folder);
 
 /// Per-frame status and counts, the figures and the options as JSON text.
 std::string stats_json(const SequenceRun& run, const RunFigures& figures, const std::string& variant);

@@ -1,12 +1,16 @@
 #include "common/transport/node.h"
 
+#include <CLI/Error.hpp>
 #include <spdlog/spdlog.h>
 #include <unistd.h>
 
 #include <atomic>
+#include <chrono>
+#include <cmath>
 #include <csignal>
 #include <iterator>
 #include <stdexcept>
+#include <string_view>
 
 #include "common/error.h"
 #include "common/text.h"
@@ -66,14 +70,44 @@ std::string printable_reason(const std::string& text) {
   return out;
 }
 
+// LCM subscribes to "^CHANNEL$" compiled as a GLib regular expression: these characters
+// would make a name a pattern.
+constexpr std::string_view kPatternCharacters = "\\^$.|?*+()[]{}";
+constexpr size_t kMaxChannelChars = LCM_MAX_CHANNEL_NAME_LENGTH;  // LCM refuses longer names
+
 }  // namespace
 
-Node::Node(std::string name, const std::string& lcm_url, double heartbeat_period_s)
+int64_t steady_microseconds() {
+  const auto since_origin = std::chrono::steady_clock::now().time_since_epoch();
+  return std::chrono::duration_cast<std::chrono::microseconds>(since_origin).count();
+}
+
+std::string channel_name_problem(const std::string& channel) {
+  if (channel.empty()) return "is empty";
+  if (channel.size() > kMaxChannelChars) {
+    return "has " + std::to_string(channel.size()) + " characters; LCM takes at most " +
+           std::to_string(kMaxChannelChars);
+  }
+  for (const char c : channel) {
+    const auto byte = static_cast<unsigned char>(c);
+    if (byte == ' ') return "contains a space; a channel name is one word";
+    if (byte < 0x20 || byte >= 0x7f)
+      return "contains the byte " + escape_bytes(std::string(1, c)) + "; a channel name is printable ASCII";
+    if (kPatternCharacters.find(c) != std::string_view::npos) {
+      return std::string("contains '") + c +
+             "', which LCM would take as part of a pattern; a channel is subscribed to by its exact name";
+    }
+  }
+  return "";
+}
+
+Node::Node(std::string name, const std::string& lcm_url, double heartbeat_period_s, Clock clock)
     : name_(std::move(name)),
       url_(resolve_lcm_url(lcm_url)),
       lcm_(url_),
-      heartbeat_period_(std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-          std::chrono::duration<double>(heartbeat_period_s))) {
+      clock_(std::move(clock)),
+      heartbeat_period_us_(static_cast<int64_t>(std::llround(heartbeat_period_s * 1e6))) {
+  if (!clock_) throw std::invalid_argument("Node '" + name_ + "': the clock is empty");
   if (!lcm_.good()) throw UnavailableError("cannot start LCM on '" + url_ + "'");
   install_signal_handlers();
   add_subscription(
@@ -93,6 +127,9 @@ Node::~Node() {
 
 void Node::add_subscription(const std::string& channel, Dispatch dispatch, int queue_capacity,
                             bool is_control) {
+  // Checked before anything changes, so a caller that handles the error keeps a working node.
+  if (const std::string problem = channel_name_problem(channel); !problem.empty())
+    throw CLI::ValidationError("channel '" + escape_bytes(channel) + "'", problem);
   subscriptions_.push_back({this, channel, std::move(dispatch), is_control});
   lcm::Subscription* sub = lcm_.subscribeFunction(channel, &Node::on_message, &subscriptions_.back());
   if (!sub) throw std::runtime_error("cannot subscribe to " + channel);
@@ -153,7 +190,7 @@ void Node::reject(const std::string& channel, const std::string& why) {
   // Printable in the log as in the heartbeat: a damaged message's bytes may be terminal codes.
   const std::string reason = printable_reason(without_channel(channel, why));
   if (should_log(nth)) spdlog::warn("rejected message #{} on {}: {}", nth, channel, reason);
-  rejecting_[channel] = Rejection{std::chrono::steady_clock::now(), reason, false};
+  rejecting_[channel] = Rejection{clock_(), counters_.messages_rejected, reason, false};
   publish_heartbeat_if_state_changed();
 }
 
@@ -164,20 +201,20 @@ void Node::accepted(const std::string& channel) {
   publish_heartbeat_if_state_changed();
 }
 
-bool Node::still_rejecting(const Rejection& r, std::chrono::steady_clock::time_point now) const {
-  return !r.accepted_since || now - r.at < heartbeat_period_;
+bool Node::still_rejecting(const Rejection& r, int64_t now_us) const {
+  return !r.accepted_since || now_us - r.at_us < heartbeat_period_us_;
 }
 
 Node::Health Node::health() const {
   const int8_t own = own_health_.state;
   if (own == kestrel::process_status_t::STATE_STOPPING || own == kestrel::process_status_t::STATE_FAILED)
     return own_health_;
-  const auto now = std::chrono::steady_clock::now();
+  const int64_t now = clock_();
   const std::pair<const std::string, Rejection>* last = nullptr;
   std::vector<std::string> others;
   for (const auto& entry : rejecting_) {
     if (!still_rejecting(entry.second, now)) continue;
-    if (last && entry.second.at <= last->second.at) {
+    if (last && entry.second.order < last->second.order) {
       others.push_back(entry.first);
       continue;
     }
@@ -198,7 +235,7 @@ Node::Health Node::health() const {
 }
 
 void Node::publish_heartbeat_if_state_changed() {
-  const auto now = std::chrono::steady_clock::now();
+  const int64_t now = clock_();
   for (auto it = rejecting_.begin(); it != rejecting_.end();)
     it = still_rejecting(it->second, now) ? std::next(it) : rejecting_.erase(it);
   if (health().state != reported_state_) publish_heartbeat();
@@ -269,9 +306,9 @@ int Node::spin() {
 void Node::maybe_heartbeat() {
   // A rejected channel recovers without an event: its period ends while the process waits.
   publish_heartbeat_if_state_changed();
-  const auto now = std::chrono::steady_clock::now();
-  if (now < next_heartbeat_) return;
-  next_heartbeat_ = now + heartbeat_period_;
+  const int64_t now = clock_();
+  if (now < next_heartbeat_us_) return;
+  next_heartbeat_us_ = now + heartbeat_period_us_;
   publish_heartbeat();
 }
 

@@ -25,13 +25,18 @@
 //    (accepted or rejected) the node publishes REPLAY_ACK listing the channels it published
 //    on meanwhile; RESET calls the reset handler. See tools/replay/README.md.
 //  * SIGINT and SIGTERM make spin() return after the current handler.
+//  * Time: the rejection windows and the heartbeat period are measured on the Node's clock,
+//    the steady clock unless the constructor is given another (tests advance one by hand);
+//    the time stamp in PROCESS_STATUS is always wall-clock time, for the operator.
+//  * A channel is subscribed to by its exact name (see subscribe()); a name LCM would take as
+//    a pattern, or cannot take at all, is a configuration error, not a crash.
 
 #include <lcm/lcm-cpp.hpp>
 
-#include <chrono>
 #include <cstdint>
 #include <deque>
 #include <functional>
+#include <limits>
 #include <map>
 #include <memory>
 #include <string>
@@ -50,18 +55,35 @@ struct NodeCounters {
   int64_t last_input_utime = 0;
 };
 
+/// Microseconds on the steady (monotonic) clock: the clock a Node measures time on by default.
+int64_t steady_microseconds();
+
+/// Why `channel` cannot be subscribed to as an exact name ("" = it can): LCM allows 63
+/// characters, and compiles the name as a regular expression, so a pattern character would
+/// either subscribe to other channels too ("IMU.*") or to none ("CAM[", which LCM's C++ API
+/// then crashes on). Bytes outside printable ASCII are refused for the same reason (the
+/// pattern must be valid UTF-8) and because a name is shown on terminals.
+std::string channel_name_problem(const std::string& channel);
+
 class Node {
  public:
+  /// A monotonic time in microseconds (any origin); only differences are used.
+  using Clock = std::function<int64_t()>;
+
   /// Connects to `lcm_url` (resolved by resolve_lcm_url); throws UnavailableError naming
-  /// the URL if LCM cannot start (cli::App::run turns it into exit code 4).
-  Node(std::string name, const std::string& lcm_url, double heartbeat_period_s = 1.0);
+  /// the URL if LCM cannot start (cli::App::run turns it into exit code 4). `clock` measures
+  /// the heartbeat period and the rejection windows; an empty one is std::invalid_argument.
+  Node(std::string name, const std::string& lcm_url, double heartbeat_period_s = 1.0,
+       Clock clock = steady_microseconds);
   ~Node();
   Node(const Node&) = delete;
   Node& operator=(const Node&) = delete;
 
   /// Calls handler(const Msg&) for each valid message on `channel` (an exact name).
   /// At most `queue_capacity` messages wait; older ones are dropped by LCM when the process
-  /// falls behind (30 suits sensors; 0 means unbounded).
+  /// falls behind (30 suits sensors; 0 means unbounded). A channel name that is not one
+  /// (channel_name_problem) throws CLI::ValidationError naming it and why, which
+  /// cli::App::run turns into exit code 2; the node is then as it was.
   template <class Msg, class Handler>
   void subscribe(const std::string& channel, Handler handler, int queue_capacity = 30) {
     add_subscription(
@@ -117,8 +139,11 @@ class Node {
   };
   // Per channel with a rejection: when the last one was, and whether a message was accepted
   // after it. Entries leave once the channel is no longer being rejected.
+  // `order` ranks rejections by arrival: two within one tick of the clock are still told
+  // apart, so the newer one is the one named.
   struct Rejection {
-    std::chrono::steady_clock::time_point at;
+    int64_t at_us = 0;
+    int64_t order = 0;
     std::string why;  // printable, without the channel's name
     bool accepted_since = false;
   };
@@ -130,7 +155,7 @@ class Node {
   void on_control(const kestrel::replay_control_t& control);
   void reject(const std::string& channel, const std::string& why);
   void accepted(const std::string& channel);
-  bool still_rejecting(const Rejection& r, std::chrono::steady_clock::time_point now) const;
+  bool still_rejecting(const Rejection& r, int64_t now_us) const;
   void publish_heartbeat_if_state_changed();
   void maybe_heartbeat();
   void publish_heartbeat();
@@ -138,8 +163,9 @@ class Node {
   std::string name_;
   std::string url_;
   lcm::LCM lcm_;
-  std::chrono::steady_clock::duration heartbeat_period_;
-  std::chrono::steady_clock::time_point next_heartbeat_{};
+  Clock clock_;
+  int64_t heartbeat_period_us_;
+  int64_t next_heartbeat_us_ = std::numeric_limits<int64_t>::min();  // due at once
   std::deque<Subscription> subscriptions_;
   std::vector<std::string> advertised_;
   std::function<void()> reset_;

@@ -58,21 +58,11 @@ struct Options {
   bool list = false;
 };
 
-// Which world is a question of the command line (exit 2); what a world or map file holds is
-// input, checked as it is read (exit 3).
-std::string check_world_name(const std::string& what) {
-  if (sim::builtin_world_text(what) || what == "stata") return {};
-  for (const std::string suffix : {".world", ".yaml", ".yml"})
-    if (what.size() >= suffix.size() && what.compare(what.size() - suffix.size(), suffix.size(), suffix) == 0)
-      return {};
-  std::string known;
-  for (const auto& n : sim::builtin_world_names()) known += n + ", ";
-  return "unknown world '" + what + "' (built in: " + known + "stata; or a .world file or an occupancy map .yaml)";
-}
-
 void add_options(cli::App& app, Options& o) {
+  // Which world is a question of the command line (exit 2); what a world or map file holds is
+  // input, checked as it is read (exit 3).
   app.add_option("--world", o.world, "room, floor, office, stata (needs --map), a .world file or a map .yaml")
-      ->check(CLI::Validator([](std::string& what) { return check_world_name(what); }, ""))
+      ->check(CLI::Validator([](std::string& what) { return sim::unknown_world_error(what); }, ""))
       ->capture_default_str();
   app.add_option("--map", o.map, "ROS occupancy map (yaml) for --world stata, e.g. ../shared/data/maps/stata_basement.yaml");
   app.add_option("--flight", o.flight,

@@ -8,10 +8,10 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "common/error.h"
+#include "common/image/image_io.h"
 
 namespace kestrel::sim {
 namespace {
@@ -37,57 +37,17 @@ std::string number_text(double v) {
   return text;
 }
 
-// What an image's header says, read without decoding the image.
-struct ImageHeader {
-  enum Kind { kUnreadable, kUnknownFormat, kKnown } kind = kUnreadable;
-  int64_t width = 0, height = 0;
-};
-
-// PNG: the signature, then the IHDR chunk with width and height (big-endian, 4 bytes each).
-// PNM: "P1".."P6", then width and height as decimal fields among whitespace and '#' comments.
-ImageHeader read_image_header(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return {};
-  std::string head(4096, '\0');  // room for a PNM's comment lines (GIMP writes one)
-  in.read(head.data(), static_cast<std::streamsize>(head.size()));
-  head.resize(static_cast<size_t>(in.gcount()));
-  ImageHeader unknown{ImageHeader::kUnknownFormat, 0, 0};
-  const auto byte = [&](size_t at) { return static_cast<unsigned char>(head[at]); };
-  const bool png =
-      head.size() >= 24 && head.compare(0, 8, "\x89PNG\r\n\x1a\n") == 0 && head.compare(12, 4, "IHDR") == 0;
-  if (png) {
-    const auto be32 = [&](size_t at) {
-      return static_cast<int64_t>(uint32_t{byte(at)} << 24 | uint32_t{byte(at + 1)} << 16 |
-                                  uint32_t{byte(at + 2)} << 8 | uint32_t{byte(at + 3)});
-    };
-    return {ImageHeader::kKnown, be32(16), be32(20)};
-  }
-  if (head.size() < 3 || head[0] != 'P' || head[1] < '1' || head[1] > '6' || !std::isspace(byte(2))) return unknown;
-  size_t at = 2;
-  int64_t dims[2] = {0, 0};
-  for (int64_t& d : dims) {
-    while (at < head.size() && (std::isspace(byte(at)) || head[at] == '#')) {
-      if (head[at] == '#')
-        while (at < head.size() && head[at] != '\n' && head[at] != '\r') ++at;
-      else
-        ++at;
-    }
-    // Twelve digits are already far beyond any bound; more would overflow.
-    int digits = 0;
-    for (; at < head.size() && std::isdigit(byte(at)); ++at)
-      if (++digits <= 12) d = d * 10 + (head[at] - '0');
-    if (digits == 0) return unknown;
-  }
-  return {ImageHeader::kKnown, dims[0], dims[1]};
-}
-
 // The image's size against the bounds (occupancy_map.h), before it is decoded.
-void check_image_size(const OccupancyMap& map, const ImageHeader& header, int image_line, int resolution_line) {
+void check_image_size(const OccupancyMap& map, int image_line, int resolution_line) {
   const std::string& path = map.yaml_path;
   const std::string image = "map image '" + map.image_path + "'";
-  if (header.kind == ImageHeader::kUnreadable)
+  image::Header header;
+  try {
+    header = image::read_header(map.image_path);
+  } catch (const InputError&) {
     throw InputError(at_line(path, image_line, "cannot read " + image));
-  if (header.kind == ImageHeader::kUnknownFormat)
+  }
+  if (header.format == image::Format::kUnknown)
     throw InputError(at_line(path, image_line, image + " is not a PNG or PNM (PGM, PPM, PBM) file"));
   const std::string size = std::to_string(header.width) + " x " + std::to_string(header.height) + " pixels";
   if (header.width <= 0 || header.height <= 0)
@@ -187,14 +147,13 @@ OccupancyMap read_occupancy_map(const std::string& yaml_path) {
   std::filesystem::path image_path(image);
   if (image_path.is_relative()) image_path = std::filesystem::path(yaml_path).parent_path() / image_path;
   map.image_path = image_path.string();
-  const ImageHeader header = read_image_header(map.image_path);
-  check_image_size(map, header, line_of(root["image"]), line_of(root["resolution"]));
-  const cv::Mat raw = cv::imread(map.image_path, cv::IMREAD_UNCHANGED);
-  if (raw.empty())
-    throw InputError(at_line(yaml_path, line_of(root["image"]), "cannot read map image '" + map.image_path + "'"));
-  if (raw.cols != header.width || raw.rows != header.height)
-    throw InputError(at_line(yaml_path, line_of(root["image"]),
-                             "map image '" + map.image_path + "' is not the size its header states"));
+  check_image_size(map, line_of(root["image"]), line_of(root["resolution"]));
+  cv::Mat raw;
+  try {
+    raw = image::read_image(map.image_path);
+  } catch (const InputError& e) {
+    throw InputError(at_line(yaml_path, line_of(root["image"]), std::string("cannot read map image: ") + e.what()));
+  }
   if (raw.depth() != CV_8U)
     throw InputError(at_line(yaml_path, line_of(root["image"]), "map image '" + map.image_path + "' is not 8-bit"));
   if (raw.channels() == 1) map.image = raw;

@@ -2,11 +2,11 @@
 
 #include <filesystem>
 #include <iomanip>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <vector>
 
 #include "common/error.h"
+#include "common/image/image_io.h"
 #include "common/time.h"
 
 namespace kestrel::sim {
@@ -15,15 +15,12 @@ namespace fs = std::filesystem;
 namespace {
 
 void write_image(const std::string& path, const cv::Mat& image) {
-  // Compression level 1: these folders are scratch data, written at simulation speed.
-  const std::vector<int> params{cv::IMWRITE_PNG_COMPRESSION, 1};
-  bool ok = false;
-  try {
-    ok = cv::imwrite(path, image, params);
-  } catch (const cv::Exception& e) {
-    throw InputError(path + ": cannot write image: " + e.what());
-  }
-  if (!ok) throw InputError(path + ": cannot write image");
+  // Compression level 1: these folders are scratch data, written at simulation speed; and
+  // written in place, not atomically: an fsync per frame would be most of the run.
+  const std::vector<uint8_t> png = image::encode_png(image, 1);
+  std::ofstream out(path, std::ios::binary);
+  out.write(reinterpret_cast<const char*>(png.data()), static_cast<std::streamsize>(png.size()));
+  if (!out.flush()) throw InputError(path + ": cannot write image");
 }
 
 void pose_line(std::ostream& out, const Eigen::Isometry3d& T) {

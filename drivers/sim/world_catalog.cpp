@@ -31,6 +31,15 @@ std::optional<std::string> builtin_world_text(const std::string& name) {
   return std::nullopt;
 }
 
+std::string unknown_world_error(const std::string& what, bool with_stata) {
+  if (builtin_world_text(what) || (with_stata && what == "stata")) return {};
+  if (ends_with(what, ".world") || ends_with(what, ".yaml") || ends_with(what, ".yml")) return {};
+  std::string known;
+  for (const auto& n : builtin_world_names()) known += (known.empty() ? "" : ", ") + n;
+  if (with_stata) known += ", stata";
+  return "unknown world '" + what + "' (built in: " + known + "; or a .world file or an occupancy map .yaml)";
+}
+
 World load_world(const std::string& what, const std::string& map_yaml, uint64_t map_seed) {
   if (const auto text = builtin_world_text(what)) return parse_world(*text, "drivers/sim/worlds/" + what + ".world");
   MapWorldOptions options;
@@ -41,10 +50,7 @@ World load_world(const std::string& what, const std::string& map_yaml, uint64_t 
   }
   if (ends_with(what, ".yaml") || ends_with(what, ".yml")) return world_from_map(read_occupancy_map(what), what, options);
   if (ends_with(what, ".world")) return load_world_file(what);
-  std::string known;
-  for (const auto& n : builtin_world_names()) known += n + ", ";
-  throw InputError("unknown world '" + what + "' (built in: " + known +
-                   "stata; or a .world file or an occupancy map .yaml)");
+  throw InputError(unknown_world_error(what));
 }
 
 }  // namespace kestrel::sim

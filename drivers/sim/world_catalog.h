@@ -16,6 +16,14 @@ std::vector<std::string> builtin_world_names();
 /// Text of an embedded world, or empty if there is none of that name.
 std::optional<std::string> builtin_world_text(const std::string& name);
 
+/// Empty when `what` has the form of a world load_world() takes: an embedded world's name,
+/// "stata" (when `with_stata`: the tool takes the map it is built from), or a path ending in
+/// .world, .yaml or .yml (whether that file is there and sound is input, for load_world() to
+/// say). Otherwise the message for a world there is not, naming `what` and the worlds there
+/// are. Which world is a question of the command line (the tools exit 2 on it), what a file
+/// holds a question of input (exit 3).
+std::string unknown_world_error(const std::string& what, bool with_stata = true);
+
 /// `what` is an embedded world's name, "stata" (built from `map_yaml`), a path to a world file
 /// (*.world) or a path to an occupancy map (*.yaml). `map_seed` sets the appearance of worlds
 /// built from maps. Throws InputError for an unknown name or bad file (naming it).

@@ -4,10 +4,10 @@
 #include <filesystem>
 #include <stdexcept>
 
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "common/error.h"
+#include "common/image/image_io.h"
 
 namespace kestrel::tum {
 namespace {
@@ -26,11 +26,11 @@ cv::Mat read_image(const std::string& path, int width, int height, const ListedA
   if (!std::filesystem::is_regular_file(path, ec)) fail(path, at, "image file does not exist");
   cv::Mat image;
   try {
-    image = cv::imread(path, cv::IMREAD_UNCHANGED);
-  } catch (const cv::Exception& e) {
-    fail(path, at, std::string("cannot be decoded: ") + e.what());
+    image = image::read_image(path);
+  } catch (const InputError& e) {
+    // "path: why" from the decoder; the list and line say where the file was named.
+    throw InputError(at_line(at.list, at.line, e.what()));
   }
-  if (image.empty()) fail(path, at, "cannot be decoded as an image (corrupt or not a PNG)");
   if (image.cols != width || image.rows != height) {
     fail(path, at, "image is " + std::to_string(image.cols) + "x" + std::to_string(image.rows) +
                        ", expected " + std::to_string(width) + "x" + std::to_string(height));

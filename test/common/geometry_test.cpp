@@ -149,10 +149,10 @@ TEST(AlignRigid, RecoversAKnownTransformExactly) {
 
 TEST(AlignRigid, NeverReturnsAReflection) {
   // A mirrored copy: the best rotation is not the mirror.
-  Eigen::Matrix3Xd src(3, 4);
-  src << 0, 1, 0, 0,  //
-      0, 0, 1, 0,     //
-      0, 0, 0, 1;
+  // The origin and the three unit points (set one by one: GCC's -O1 takes the comma
+  // initialiser's copy for a read of uninitialised memory).
+  Eigen::Matrix3Xd src = Eigen::Matrix3Xd::Zero(3, 4);
+  src(0, 1) = src(1, 2) = src(2, 3) = 1.0;
   Eigen::Matrix3Xd dst = src;
   dst.row(2) *= -1.0;
   const auto est = align_rigid(src, dst);

@@ -1,12 +1,17 @@
 // The process adapter on LCM's in-process transport (memq://): decoding and rejection,
-// heartbeats (and the health they report while input is rejected), and the lock-step
-// acknowledgements the replay depends on.
+// channel names that are not exact names, heartbeats (and the health they report while input
+// is rejected, on a clock the test moves by hand), and the lock-step acknowledgements the
+// replay depends on.
 
 #include <gtest/gtest.h>
 
-#include <chrono>
-#include <thread>
+#include <ostream>
+#include <string>
+#include <vector>
 
+#include "common/cli.h"
+#include "common/error.h"
+#include "common/text.h"
 #include "common/transport/channels.h"
 #include "common/transport/node.h"
 #include "kestrel/imu_t.hpp"
@@ -127,15 +132,83 @@ TEST(Node, LockstepAcknowledgesEveryInputWithItsOutputs) {
   EXPECT_EQ(acks.got.size(), 3u);
 }
 
+// A name LCM would take as a pattern, or cannot take at all, is a configuration error naming
+// the channel and why; the node is as it was, and exact names (up to LCM's 63 characters) work.
+TEST(Node, AChannelThatIsNotAnExactNameIsAConfigurationError) {
+  struct BadName {
+    std::string channel;
+    std::string error_starts;
+  };
+  const std::string too_long(64, 'A');
+  const std::vector<BadName> bad = {
+      {"", "channel '': is empty"},
+      {too_long, "channel '" + too_long + "': has 64 characters; LCM takes at most 63"},
+      {"CAM[", "channel 'CAM[': contains '[', which LCM would take as part of a pattern"},
+      {"IMU.*", "channel 'IMU.*': contains '.', which LCM would take as part of a pattern"},
+      {"CAMERA RGBD", "channel 'CAMERA RGBD': contains a space"},
+      {"IMU\x1b", "channel 'IMU\\x1B': contains the byte \\x1B"},
+      {"KAMERA_\xc3\x9c", "channel 'KAMERA_\xc3\x9c': contains the byte \\xC3"},
+  };
+  Node node("names", "memq://", 0.0);
+  Tap<kestrel::process_status_t> status(node.lcm(), channel::kProcessStatus);
+  for (const BadName& b : bad) {
+    SCOPED_TRACE("channel '" + escape_bytes(b.channel) + "'");
+    try {
+      node.subscribe<kestrel::imu_t>(b.channel, [](const kestrel::imu_t&) {});
+      ADD_FAILURE() << "subscribed";
+    } catch (const CLI::ValidationError& e) {
+      EXPECT_EQ(std::string(e.what()).rfind(b.error_starts, 0), 0u) << e.what();
+    }
+  }
+  const std::vector<std::string> good = {std::string(63, 'A'), "CAMERA_RGBD_Z", "robot1/IMU", "sim-imu:2"};
+  std::vector<std::string> delivered;
+  for (const std::string& channel : good) {
+    node.subscribe<kestrel::imu_t>(channel,
+                                   [&delivered, channel](const kestrel::imu_t&) { delivered.push_back(channel); });
+    node.publish(channel, imu(1));
+  }
+  drain(node);
+  EXPECT_EQ(delivered, good);
+  ASSERT_FALSE(status.got.empty());
+  EXPECT_EQ(status.got.back().subscriptions, good) << "no trace of the refused names";
+}
+
+// The error reaches a tool's main as a usage error: exit code 2, not a crash deep in LCM.
+TEST(Node, ABadChannelEndsAToolWithTheUsageExitCode) {
+  cli::App app("node-test", "subscribes to a channel that is a pattern");
+  std::string tool = "kestrel-node-test";
+  char* argv[] = {tool.data(), nullptr};
+  const int code = app.run(1, argv, [] {
+    Node node("t", "memq://");
+    node.subscribe<kestrel::imu_t>("CAM[", [](const kestrel::imu_t&) {});
+    return static_cast<int>(kExitOk);
+  });
+  EXPECT_EQ(code, kExitUsage);
+}
+
+TEST(Node, AnEmptyClockIsRefused) {
+  EXPECT_THROW(Node("t", "memq://", 1.0, Node::Clock{}), std::invalid_argument);
+}
+
 
 using Status = kestrel::process_status_t;
 
+// A clock the test moves by hand: the node's heartbeat period and rejection windows run on it,
+// so a period passes when a step says so and never while a slow machine is busy.
+struct ManualClock {
+  int64_t now_us = 5'000'000;  // any origin: the node only takes differences
+  Node::Clock function() {
+    return [this] { return now_us; };
+  }
+};
+
 // A node on IMU and CAMERA whose handlers reject a negative utime, as a library would.
 struct RejectingNode {
+  ManualClock clock;
   Node node;
   Tap<Status> status;
   explicit RejectingNode(double heartbeat_period_s)
-      : node("vo", "memq://", heartbeat_period_s), status(node.lcm(), channel::kProcessStatus) {
+      : node("vo", "memq://", heartbeat_period_s, clock.function()), status(node.lcm(), channel::kProcessStatus) {
     for (const char* channel : {"IMU", "CAMERA"}) {
       const std::string name = channel;
       node.subscribe<kestrel::imu_t>(name, [name](const kestrel::imu_t& m) {
@@ -150,95 +223,180 @@ struct RejectingNode {
   }
 };
 
-TEST(NodeHealth, RejectedInputIsDegradedWithTheReasonUntilInputIsAcceptedAgain) {
-  RejectingNode n(0.0);
-  n.node.set_health(Status::STATE_RUNNING, "tracking");
-  n.node.publish("IMU", imu(1));
-  EXPECT_EQ(n.last().state, Status::STATE_RUNNING);
+// One thing that happens to a RejectingNode.
+struct Action {
+  enum class Kind { kImu, kBytes, kSetHealth, kAdvance };
+  Kind kind = Kind::kAdvance;
+  std::string text;   // kImu, kBytes: the channel; kSetHealth: the process's own reason
+  int64_t value = 0;  // kImu: the first utime (negative: rejected); kSetHealth: the state; kAdvance: us
+  int count = 1;      // kImu: this many imu_t messages, at utimes value, value + 1, ...
+  std::string bytes;  // kBytes: published as they are (too short for imu_t: rejected)
+};
 
-  n.node.publish("IMU", imu(-3));
-  EXPECT_EQ(n.last().state, Status::STATE_DEGRADED);
-  EXPECT_EQ(n.last().message, "rejecting IMU: utime -3 is negative; tracking");
-  // The process's own health, set meanwhile, is kept and not shown over the rejection.
-  n.node.set_health(Status::STATE_RUNNING, "tracking again");
-  EXPECT_EQ(n.last().state, Status::STATE_DEGRADED);
-  EXPECT_EQ(n.last().message, "rejecting IMU: utime -3 is negative; tracking again");
-  EXPECT_EQ(n.node.health().state, Status::STATE_DEGRADED);
+Action imus_on(const std::string& channel, int64_t utime, int count = 1) {
+  return {Action::Kind::kImu, channel, utime, count, ""};
+}
+Action bytes_on(const std::string& channel, const std::string& bytes) {
+  return {Action::Kind::kBytes, channel, 0, 1, bytes};
+}
+Action set_own_health(int8_t state, const std::string& why) { return {Action::Kind::kSetHealth, why, state, 1, ""}; }
+Action advance_us(int64_t us) { return {Action::Kind::kAdvance, "", us, 1, ""}; }
 
-  n.node.lcm().publish("IMU", "xyz", 3);  // undecodable: the reason follows the last rejection
-  EXPECT_EQ(n.last().message.rfind("rejecting IMU: 3 bytes are too short", 0), 0u) << n.last().message;
-
-  n.node.publish("IMU", imu(2));
-  EXPECT_EQ(n.last().state, Status::STATE_RUNNING);
-  EXPECT_EQ(n.last().message, "tracking again");
-  EXPECT_EQ(n.node.counters().messages_rejected, 2);
-
-  // A process that set itself DEGRADED stays so, with its own reason, after the rejection.
-  n.node.set_health(Status::STATE_DEGRADED, "no map yet");
-  n.node.publish("IMU", imu(-1));
-  EXPECT_EQ(n.last().message, "rejecting IMU: utime -1 is negative; no map yet");
-  n.node.publish("IMU", imu(3));
-  EXPECT_EQ(n.last().state, Status::STATE_DEGRADED);
-  EXPECT_EQ(n.last().message, "no map yet");
+std::string describe(const Action& a) {
+  switch (a.kind) {
+    case Action::Kind::kImu:
+      return std::to_string(a.count) + " message(s) on " + a.text + " from utime " + std::to_string(a.value);
+    case Action::Kind::kBytes:
+      return std::to_string(a.bytes.size()) + " raw bytes on " + a.text;
+    case Action::Kind::kSetHealth:
+      return "set_health(" + std::to_string(a.value) + ", \"" + a.text + "\")";
+    case Action::Kind::kAdvance:
+      break;
+  }
+  return "the clock advances " + std::to_string(a.value) + " us";
 }
 
-// Good messages on a busy channel do not hide a channel whose last message was rejected.
-TEST(NodeHealth, EachRejectedChannelNeedsItsOwnGoodMessage) {
-  RejectingNode n(0.0);
-  n.node.set_health(Status::STATE_RUNNING, "");
-  n.node.publish("CAMERA", imu(-5));
-  for (int i = 0; i < 20; ++i) n.node.publish("IMU", imu(i));
-  EXPECT_EQ(n.last().state, Status::STATE_DEGRADED);
-  EXPECT_EQ(n.last().message, "rejecting CAMERA: utime -5 is negative");
+// A step of a health script: the action, then what the node must report, in its last heartbeat
+// and in health() alike. A message ending in "..." is matched as a prefix.
+struct Step {
+  Action action;
+  int8_t state;
+  std::string message;
+};
 
-  n.node.publish("IMU", imu(-7));  // the newer rejection is named, the other listed
-  EXPECT_EQ(n.last().message, "rejecting IMU: utime -7 is negative (also rejecting CAMERA)");
-  n.node.publish("IMU", imu(30));
-  EXPECT_EQ(n.last().message, "rejecting CAMERA: utime -5 is negative");
-  n.node.publish("CAMERA", imu(31));
-  EXPECT_EQ(n.last().state, Status::STATE_RUNNING);
-  EXPECT_EQ(n.last().message, "");
+struct HealthScript {
+  const char* name;
+  double heartbeat_period_s;
+  std::vector<Step> steps;
+};
+void PrintTo(const HealthScript& script, std::ostream* os) { *os << script.name; }
+
+void expect_message(const std::string& got, const std::string& expected) {
+  const std::string ellipsis = "...";
+  const bool prefix = expected.size() >= ellipsis.size() &&
+                      expected.compare(expected.size() - ellipsis.size(), ellipsis.size(), ellipsis) == 0;
+  if (prefix) {
+    const std::string start = expected.substr(0, expected.size() - ellipsis.size());
+    EXPECT_EQ(got.rfind(start, 0), 0u) << got;
+  } else {
+    EXPECT_EQ(got, expected);
+  }
 }
 
-// One bad message among good ones shows at once and for one heartbeat period, so that the
-// launcher, which sees one heartbeat a period, sees it; then the process is RUNNING again.
-TEST(NodeHealth, AnIsolatedRejectionShowsForOneHeartbeatPeriod) {
-  RejectingNode n(1.0);
-  n.node.set_health(Status::STATE_RUNNING, "");
-  EXPECT_EQ(n.last().state, Status::STATE_RUNNING);
-  const size_t before = n.status.got.size();
-  n.node.publish("CAMERA", imu(-1));
-  n.node.publish("CAMERA", imu(1));
-  n.node.publish("CAMERA", imu(2));
-  const Status& degraded = n.last();
-  EXPECT_GT(n.status.got.size(), before);  // published when the state changed, not a period later
-  EXPECT_EQ(degraded.state, Status::STATE_DEGRADED);
-  EXPECT_EQ(degraded.message, "rejecting CAMERA: utime -1 is negative");
-  std::this_thread::sleep_for(std::chrono::milliseconds(1100));
-  n.node.publish("CAMERA", imu(3));
-  EXPECT_EQ(n.last().state, Status::STATE_RUNNING);
-  // No good message needed to recover once the channel had one: only the period passing.
-  n.node.publish("CAMERA", imu(-2));
-  n.node.publish("CAMERA", imu(4));
-  EXPECT_EQ(n.last().state, Status::STATE_DEGRADED);
-  std::this_thread::sleep_for(std::chrono::milliseconds(1100));
-  EXPECT_EQ(n.last().state, Status::STATE_RUNNING);
+std::vector<HealthScript> health_scripts() {
+  const int8_t kRunning = Status::STATE_RUNNING, kDegraded = Status::STATE_DEGRADED;
+  return {
+      {"RejectedInputIsDegradedWithTheReasonUntilInputIsAcceptedAgain", 0.0,
+       {
+           {set_own_health(kRunning, "tracking"), kRunning, "tracking"},
+           {imus_on("IMU", 1), kRunning, "tracking"},
+           {imus_on("IMU", -3), kDegraded, "rejecting IMU: utime -3 is negative; tracking"},
+           // The process's own health, set meanwhile, is kept and not shown over the rejection.
+           {set_own_health(kRunning, "tracking again"), kDegraded,
+            "rejecting IMU: utime -3 is negative; tracking again"},
+           // Undecodable: the reason follows the last rejection.
+           {bytes_on("IMU", "xyz"), kDegraded, "rejecting IMU: 3 bytes are too short..."},
+           {imus_on("IMU", 2), kRunning, "tracking again"},
+           // A process that set itself DEGRADED stays so, with its own reason, after the rejection.
+           {set_own_health(kDegraded, "no map yet"), kDegraded, "no map yet"},
+           {imus_on("IMU", -1), kDegraded, "rejecting IMU: utime -1 is negative; no map yet"},
+           {imus_on("IMU", 3), kDegraded, "no map yet"},
+       }},
+      // Good messages on a busy channel do not hide a channel whose last message was rejected.
+      // The clock stands still: the newer of two rejections in one tick is still the one named.
+      {"EachRejectedChannelNeedsItsOwnGoodMessage", 0.0,
+       {
+           {set_own_health(kRunning, ""), kRunning, ""},
+           {imus_on("CAMERA", -5), kDegraded, "rejecting CAMERA: utime -5 is negative"},
+           {imus_on("IMU", 0, 20), kDegraded, "rejecting CAMERA: utime -5 is negative"},
+           {imus_on("IMU", -7), kDegraded, "rejecting IMU: utime -7 is negative (also rejecting CAMERA)"},
+           {imus_on("IMU", 30), kDegraded, "rejecting CAMERA: utime -5 is negative"},
+           {imus_on("CAMERA", 31), kRunning, ""},
+       }},
+      // One bad message among good ones shows at once (the clock stands still, so the DEGRADED
+      // heartbeat is the one sent on the change, not a periodic one) and for exactly one
+      // heartbeat period, so that the launcher, which sees one heartbeat a period, sees it.
+      {"AnIsolatedRejectionShowsForOneHeartbeatPeriod", 1.0,
+       {
+           {set_own_health(kRunning, ""), kRunning, ""},
+           {imus_on("CAMERA", -1), kDegraded, "rejecting CAMERA: utime -1 is negative"},
+           {imus_on("CAMERA", 1, 2), kDegraded, "rejecting CAMERA: utime -1 is negative"},
+           {advance_us(999'999), kDegraded, "rejecting CAMERA: utime -1 is negative"},
+           {advance_us(1), kRunning, ""},
+           {imus_on("CAMERA", 3), kRunning, ""},
+           // No good message needed to recover once the channel had one: only the period passing.
+           {imus_on("CAMERA", -2), kDegraded, "rejecting CAMERA: utime -2 is negative"},
+           {imus_on("CAMERA", 4), kDegraded, "rejecting CAMERA: utime -2 is negative"},
+           {advance_us(1'100'000), kRunning, ""},
+       }},
+      // A sender whose last message was bad and that went quiet is not forgotten with time;
+      // its next good message ends the rejection at once, the period being long over.
+      {"ARejectedChannelStaysDegradedUntilAMessageOnItIsAccepted", 1.0,
+       {
+           {set_own_health(kRunning, ""), kRunning, ""},
+           {imus_on("CAMERA", -1), kDegraded, "rejecting CAMERA: utime -1 is negative"},
+           {advance_us(10'000'000), kDegraded, "rejecting CAMERA: utime -1 is negative"},
+           {imus_on("IMU", 1), kDegraded, "rejecting CAMERA: utime -1 is negative"},
+           {imus_on("CAMERA", 1), kRunning, ""},
+       }},
+      {"StartingIsDegradedByRejectionsButStoppingAndFailedAreKept", 0.0,
+       {
+           {advance_us(0), Status::STATE_STARTING, ""},
+           {imus_on("IMU", -1), kDegraded, "rejecting IMU: utime -1 is negative"},
+           {set_own_health(Status::STATE_FAILED, "camera lost"), Status::STATE_FAILED, "camera lost"},
+           {imus_on("IMU", -2), Status::STATE_FAILED, "camera lost"},
+           {set_own_health(Status::STATE_STOPPING, ""), Status::STATE_STOPPING, ""},
+       }},
+  };
 }
 
-TEST(NodeHealth, StartingIsDegradedByRejectionsButStoppingAndFailedAreKept) {
-  RejectingNode n(0.0);
-  EXPECT_EQ(n.node.health().state, Status::STATE_STARTING);
-  n.node.publish("IMU", imu(-1));
-  drain(n.node);
-  EXPECT_EQ(n.node.health().state, Status::STATE_DEGRADED);
-  n.node.set_health(Status::STATE_FAILED, "camera lost");
-  EXPECT_EQ(n.last().state, Status::STATE_FAILED);
-  EXPECT_EQ(n.last().message, "camera lost");
-  n.node.publish("IMU", imu(-2));
-  EXPECT_EQ(n.last().state, Status::STATE_FAILED);
-  n.node.set_health(Status::STATE_STOPPING, "");
-  EXPECT_EQ(n.node.health().state, Status::STATE_STOPPING);
+class NodeHealthScript : public ::testing::TestWithParam<HealthScript> {};
+
+// Every step's action is applied, then the heartbeat and health() are compared with what the
+// step expects; the counters follow from the script (a negative utime or raw bytes: rejected).
+TEST_P(NodeHealthScript, ReportsWhatEachStepExpects) {
+  const HealthScript& script = GetParam();
+  RejectingNode n(script.heartbeat_period_s);
+  int64_t sent = 0, rejected = 0;
+  for (size_t i = 0; i < script.steps.size(); ++i) {
+    const Step& step = script.steps[i];
+    SCOPED_TRACE("step " + std::to_string(i + 1) + ": " + describe(step.action));
+    const Action& a = step.action;
+    switch (a.kind) {
+      case Action::Kind::kImu:
+        for (int k = 0; k < a.count; ++k) {
+          n.node.publish(a.text, imu(a.value + k));
+          ++sent;
+          if (a.value + k < 0) ++rejected;
+        }
+        break;
+      case Action::Kind::kBytes:
+        n.node.lcm().publish(a.text, a.bytes.data(), static_cast<unsigned int>(a.bytes.size()));
+        ++sent;
+        ++rejected;
+        break;
+      case Action::Kind::kSetHealth:
+        n.node.set_health(static_cast<int8_t>(a.value), a.text);
+        break;
+      case Action::Kind::kAdvance:
+        n.clock.now_us += a.value;
+        break;
+    }
+    const Status& heartbeat = n.last();
+    EXPECT_EQ(heartbeat.state, step.state);
+    expect_message(heartbeat.message, step.message);
+    const Node::Health health = n.node.health();
+    EXPECT_EQ(health.state, step.state);
+    expect_message(health.message, step.message);
+    EXPECT_EQ(n.node.counters().messages_in, sent);
+    EXPECT_EQ(n.node.counters().messages_rejected, rejected);
+  }
 }
+
+INSTANTIATE_TEST_SUITE_P(NodeHealth, NodeHealthScript, ::testing::ValuesIn(health_scripts()),
+                         [](const ::testing::TestParamInfo<HealthScript>& script) {
+                           return std::string(script.param.name);
+                         });
 
 // The reason reaches an operator's terminal: no raw bytes from a damaged message, bounded length.
 TEST(NodeHealth, TheReasonIsPrintableAndBounded) {

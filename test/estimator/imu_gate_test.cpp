@@ -18,13 +18,7 @@ namespace kestrel::estimator::imu_gate_test {
 namespace {
 
 using test::AnalyticMotion;
-
-test::ScenarioOptions gentle_run(double duration_s) {
-  test::ScenarioOptions o;
-  o.duration_s = duration_s;
-  o.imu.gyro_bias = {0.002, -0.001, 0.001};
-  return o;
-}
+using test::gentle_run;
 
 // Bit for bit: an input the gates refused changed nothing.
 void expect_same_outputs(const std::vector<test::ScenarioStep>& want, const std::vector<test::ScenarioStep>& got) {

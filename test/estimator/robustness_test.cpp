@@ -19,20 +19,13 @@ using test::ScenarioOptions;
 
 constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
 
-ScenarioOptions scenario_with_gyro_bias(double duration) {
-  ScenarioOptions o;
-  o.duration_s = duration;
-  o.imu.gyro_bias = {0.002, -0.001, 0.001};
-  return o;
-}
-
 // An estimator that has run 3 s of the gentle motion.
 struct Running {
   EstimatorOptions options;
   Estimator estimator{options};
   std::vector<test::ScenarioStep> steps;
   Running() {
-    steps = test::run_scenario(estimator, AnalyticMotion::gentle(), scenario_with_gyro_bias(3.0));
+    steps = test::run_scenario(estimator, AnalyticMotion::gentle(), test::gentle_run(3.0));
   }
   int64_t now() const { return estimator.output()->utime; }
   FilterState state() const { return *estimator.filter_state(); }
@@ -88,7 +81,7 @@ TEST(Robustness, ImuGapIsCountedAndWidensTheCovariance) {
   for (bool with_gap : {false, true}) {
     EstimatorOptions options;
     Estimator e(options);
-    ScenarioOptions o = scenario_with_gyro_bias(3.6);
+    ScenarioOptions o = test::gentle_run(3.6);
     o.alter_vo = [&](VoUpdate& u) {
       if (in_gap(u.utime)) u.ok = false;
     };
@@ -116,7 +109,7 @@ TEST(Robustness, ImuGapIsCountedAndWidensTheCovariance) {
 TEST(Robustness, VoFailuresKeepPredictingWithGrowingCovariance) {
   EstimatorOptions options;
   Estimator e(options);
-  ScenarioOptions o = scenario_with_gyro_bias(8.0);
+  ScenarioOptions o = test::gentle_run(8.0);
   const auto outage = [](int64_t t) { return t > 1000000 + 3000000 && t < 1000000 + 5000000; };
   o.alter_vo = [&](VoUpdate& u) {
     if (outage(u.utime)) u.ok = false;
@@ -175,7 +168,7 @@ TEST(Robustness, ConstantNoiseModelNeedsNoReportedCovariance) {
   EstimatorOptions options;
   options.vo_noise.source = VoNoiseOptions::Source::kConstant;
   Estimator e(options);
-  ScenarioOptions o = scenario_with_gyro_bias(3.0);
+  ScenarioOptions o = test::gentle_run(3.0);
   o.alter_vo = [](VoUpdate& u) { u.covariance.setZero(); };
   const auto steps = test::run_scenario(e, AnalyticMotion::gentle(), o);
   EXPECT_GT(e.counters().vo_applied, 60);
@@ -187,7 +180,7 @@ TEST(Robustness, DuplicateOutOfOrderAndStaleVoAreDropped) {
   options.history_s = 1.0;
   Estimator e(options);
   const auto steps =
-      test::run_scenario(e, AnalyticMotion::gentle(), scenario_with_gyro_bias(3.0));
+      test::run_scenario(e, AnalyticMotion::gentle(), test::gentle_run(3.0));
   const int64_t now = e.output()->utime;
   EXPECT_EQ(e.add_vo(good_vo(now - 10000, now - 50000)), Verdict::kAccepted);
   EXPECT_EQ(e.add_vo(good_vo(now - 10000, now - 50000)), Verdict::kDuplicate);
@@ -197,7 +190,7 @@ TEST(Robustness, DuplicateOutOfOrderAndStaleVoAreDropped) {
   EXPECT_EQ(c.vo_out_of_order, 1);
   // A VO stream that lags by more than the history: its update is too old to place.
   Estimator lagging(options);
-  ScenarioOptions o = scenario_with_gyro_bias(3.0);
+  ScenarioOptions o = test::gentle_run(3.0);
   o.alter_vo = [](VoUpdate& u) { u.ok = false; };
   const auto steps2 = test::run_scenario(lagging, AnalyticMotion::gentle(), o);
   EXPECT_EQ(lagging.add_vo(good_vo(1000000 + 1500000, 1000000 + 1400000)), Verdict::kTooOld);
@@ -269,7 +262,7 @@ TEST(Robustness, AfterTooManyGatedUpdatesInARowTheNextIsFused) {
     r.options.vo_max_gated_in_row = max_in_row;
     Estimator e(r.options);
     const auto steps =
-        test::run_scenario(e, AnalyticMotion::gentle(), scenario_with_gyro_bias(3.0));
+        test::run_scenario(e, AnalyticMotion::gentle(), test::gentle_run(3.0));
     const int64_t now = e.output()->utime;
     const auto gated_before = e.counters().vo_gated;
     for (int k = 0; k < 5; ++k) {

@@ -2,10 +2,18 @@
 
 #include <cmath>
 
+#include "common/numbers.h"
+
 namespace kestrel::estimator::test {
 
+ScenarioOptions gentle_run(double duration_s) {
+  ScenarioOptions o;
+  o.duration_s = duration_s;
+  o.imu.gyro_bias = {0.002, -0.001, 0.001};
+  return o;
+}
+
 Matrix15d initial_covariance(const InitOptions& init) {
-  const auto sq = [](double v) { return v * v; };
   Matrix15d P = Matrix15d::Zero();
   P.diagonal() << Eigen::Vector3d::Constant(sq(init.sigma_position)),
       Eigen::Vector3d::Constant(sq(init.sigma_velocity)), sq(init.sigma_tilt), sq(init.sigma_tilt),

@@ -38,6 +38,11 @@ std::vector<ScenarioStep> run_scenario(Estimator& estimator, const AnalyticMotio
                                        const ScenarioOptions& options,
                                        const std::function<void(size_t)>& before_imu = {});
 
+/// The default scenario for `duration_s` with a small constant gyro bias: the run the gate and
+/// robustness tests disturb, one for all of them so that a refused input is judged against the
+/// same undisturbed run (the filter holds a bias estimate while inputs are refused around it).
+ScenarioOptions gentle_run(double duration_s);
+
 /// The initial covariance initialize() gets when starting from the truth.
 Matrix15d initial_covariance(const InitOptions& init);
 

@@ -18,13 +18,7 @@ namespace kestrel::estimator::vo_gate_test {
 namespace {
 
 using test::AnalyticMotion;
-
-test::ScenarioOptions gentle_run(double duration_s) {
-  test::ScenarioOptions o;
-  o.duration_s = duration_s;
-  o.imu.gyro_bias = {0.002, -0.001, 0.001};
-  return o;
-}
+using test::gentle_run;
 
 VoUpdate motion_update(int64_t utime, int64_t reference, const Eigen::Isometry3d& T_refcam_curcam) {
   VoUpdate u;

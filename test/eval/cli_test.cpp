@@ -4,8 +4,8 @@
 
 #include <fstream>
 #include <nlohmann/json.hpp>
-#include <opencv2/imgcodecs.hpp>
 
+#include "common/image/image_io.h"
 #include "common/time.h"
 #include "common/trajectory.h"
 #include "test/eval/known_log.h"
@@ -135,7 +135,7 @@ TEST(EvalCli, LogInputExportAndPlot) {
   EXPECT_EQ(j["gross_failures"]["no_estimate"], 1);
   EXPECT_LT(j["ate_m"]["max"].get<double>(), 1e-9);
   EXPECT_EQ(read_tum_trajectory(tum).size(), 59u);
-  const cv::Mat image = cv::imread(png);
+  const cv::Mat image = image::read_image(png);
   EXPECT_EQ(image.cols, 1000);
   EXPECT_EQ(image.rows, 1390);
 

@@ -3,11 +3,16 @@
 // and after the damage; a mapper started on it keeps the damaged file whole aside (its original
 // bytes) and goes on in a fresh journal made of exactly the intact records' bytes; nothing is
 // ever cut in place, and a file that is no journal, or not as it was read, is never written.
+// Of the journals set aside only the newest of each kind stay, and only files the writer set
+// aside are ever deleted.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <random>
+#include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -126,56 +131,82 @@ void expect_kept_and_continued(const Written& w, const std::string& damaged, int
 
 std::string slice(const std::string& s, uint64_t begin, uint64_t end) { return s.substr(begin, end - begin); }
 
-TEST(KeyframeJournal, AJournalCutShortInARecordKeepsEveryRecordBeforeAndTheOriginalBytes) {
-  kestrel::test::TempDir dir;
-  const Written w = write_journal(dir.path());
-  fs::resize_file(w.path, (w.ends[4] + w.ends[5]) / 2);  // killed writing keyframe 3
-  const std::string damaged = kestrel::test::read_file(w.path);
-  const JournalContents c = read_journal(w.path);
-  EXPECT_EQ(summary(c), "K0 K1 G K2");
-  EXPECT_EQ(c.intact_bytes, w.ends[4]);
-  EXPECT_NE(c.damage.find("record 4 is cut short"), std::string::npos) << c.damage;
-  expect_kept_and_continued(w, damaged, 3, w.bytes.substr(0, w.ends[4]), "K0 K1 G K2");
+// The bytes a fresh journal of `records` (a summary, "K0 G K3") holds: the header, then each
+// of those records of w's journal, byte for byte.
+std::string fresh_journal_of(const Written& w, const std::string& records) {
+  static const std::vector<std::string> written_order = {"K0", "K1", "G", "K2", "K3"};
+  std::string bytes = slice(w.bytes, 0, w.ends[0]);
+  std::istringstream names(records);
+  for (std::string name; names >> name;) {
+    const auto at = std::find(written_order.begin(), written_order.end(), name);
+    if (at == written_order.end()) {
+      ADD_FAILURE() << "no record " << name << " in the journal written";
+      continue;
+    }
+    const size_t i = static_cast<size_t>(at - written_order.begin());
+    bytes += slice(w.bytes, w.ends[i], w.ends[i + 1]);
+  }
+  return bytes;
 }
 
-TEST(KeyframeJournal, AFlippedByteLosesOnlyTheRecordItIsIn) {
-  kestrel::test::TempDir dir;
-  const Written w = write_journal(dir.path());
-  const uint64_t at = (w.ends[1] + w.ends[2]) / 2;  // inside keyframe 1's frame
-  overwrite(w.path, at, std::string(1, static_cast<char>(w.bytes[at] ^ 0x10)));
-  const std::string damaged = kestrel::test::read_file(w.path);
-  const JournalContents c = read_journal(w.path);
-  EXPECT_EQ(summary(c), "K0 G K2 K3") << "read on after the damage";
-  EXPECT_NE(c.damage.find("record 1 fails its CRC"), std::string::npos) << c.damage;
-  EXPECT_EQ(c.damaged_stretches, 1);
-  EXPECT_EQ(c.skipped_bytes, w.ends[2] - w.ends[1]);
-  expect_kept_and_continued(w, damaged, 3, slice(w.bytes, 0, w.ends[1]) + slice(w.bytes, w.ends[2], w.ends[5]),
-                            "K0 G K2 K3");
+// A kind of damage done to write_journal()'s file, and what a reader must make of it.
+struct Damage {
+  const char* name;
+  void (*apply)(const Written& w);
+  const char* records;     // the records still intact, as summary() gives them
+  int64_t keyframes;       // of those, keyframes: what a mapper restores
+  bool header_damaged;     // then the header is not among the intact bytes
+  const char* damage_starts;  // how JournalContents::damage begins (the first damage)
+};
+
+const std::vector<Damage>& damages() {
+  static const std::vector<Damage> table = {
+      // Killed writing keyframe 3: every record before it is kept.
+      {"cut short in a record",
+       [](const Written& w) { fs::resize_file(w.path, (w.ends[4] + w.ends[5]) / 2); }, "K0 K1 G K2", 3, false,
+       "record 4 is cut short"},
+      // A flipped byte inside keyframe 1's frame loses only that record; reading goes on after it.
+      {"a flipped byte",
+       [](const Written& w) {
+         const uint64_t at = (w.ends[1] + w.ends[2]) / 2;
+         overwrite(w.path, at, std::string(1, static_cast<char>(w.bytes[at] ^ 0x10)));
+       },
+       "K0 G K2 K3", 3, false, "record 1 fails its CRC"},
+      // A zeroed block from inside keyframe 1 to inside keyframe 2: the graph between is lost too.
+      {"a zeroed stretch across records",
+       [](const Written& w) {
+         const uint64_t from = (w.ends[1] + w.ends[2]) / 2, to = (w.ends[3] + w.ends[4]) / 2;
+         overwrite(w.path, from, std::string(to - from, '\0'));
+       },
+       "K0 K3", 2, false, "record 1 fails its CRC"},
+      // Every record is kept; the fresh journal gets a whole header again.
+      {"a garbage header", [](const Written& w) { overwrite(w.path, 0, "\x7f garbage \x01\x02"); }, "K0 K1 G K2 K3", 4,
+       true, "its header is damaged"},
+  };
+  return table;
 }
 
-TEST(KeyframeJournal, AZeroedStretchAcrossRecordsLosesOnlyThoseRecords) {
-  kestrel::test::TempDir dir;
-  const Written w = write_journal(dir.path());
-  // A zeroed block from inside keyframe 1 to inside keyframe 2 (the graph between is lost).
-  const uint64_t from = (w.ends[1] + w.ends[2]) / 2, to = (w.ends[3] + w.ends[4]) / 2;
-  overwrite(w.path, from, std::string(to - from, '\0'));
-  const std::string damaged = kestrel::test::read_file(w.path);
-  const JournalContents c = read_journal(w.path);
-  EXPECT_EQ(summary(c), "K0 K3");
-  EXPECT_EQ(c.skipped_bytes, w.ends[4] - w.ends[1]);
-  expect_kept_and_continued(w, damaged, 2, slice(w.bytes, 0, w.ends[1]) + slice(w.bytes, w.ends[4], w.ends[5]),
-                            "K0 K3");
-}
-
-TEST(KeyframeJournal, AGarbageHeaderKeepsEveryRecord) {
-  kestrel::test::TempDir dir;
-  const Written w = write_journal(dir.path());
-  overwrite(w.path, 0, "\x7f garbage \x01\x02");
-  const std::string damaged = kestrel::test::read_file(w.path);
-  const JournalContents c = read_journal(w.path);
-  EXPECT_EQ(summary(c), "K0 K1 G K2 K3");
-  EXPECT_EQ(c.damage.rfind("its header is damaged", 0), 0u) << c.damage;
-  expect_kept_and_continued(w, damaged, 4, w.bytes, "K0 K1 G K2 K3");
+// Each kind of damage loses only the records it is in, and only their bytes are unreadable;
+// a mapper started on the journal keeps the damaged file whole aside (its original bytes) and
+// goes on in a fresh journal of exactly the intact records' bytes.
+TEST(KeyframeJournal, EachKindOfDamageLosesOnlyTheRecordsItIsIn) {
+  for (const Damage& d : damages()) {
+    SCOPED_TRACE(d.name);
+    kestrel::test::TempDir dir;
+    const Written w = write_journal(dir.path());
+    d.apply(w);
+    const std::string damaged = kestrel::test::read_file(w.path);
+    const JournalContents c = read_journal(w.path);
+    EXPECT_EQ(summary(c), d.records) << "read on after the damage";
+    EXPECT_EQ(c.damage.rfind(d.damage_starts, 0), 0u) << c.damage;
+    EXPECT_EQ(c.damaged_stretches, 1);
+    const std::string fresh = fresh_journal_of(w, d.records);
+    const uint64_t intact = fresh.size() - (d.header_damaged ? w.ends[0] : 0);
+    EXPECT_EQ(c.file_bytes, damaged.size());
+    EXPECT_EQ(c.intact_bytes, intact);
+    EXPECT_EQ(c.skipped_bytes, damaged.size() - intact) << "every byte is intact or skipped, once";
+    expect_kept_and_continued(w, damaged, d.keyframes, fresh, d.records);
+  }
 }
 
 // Random bytes or text, with no header and no intact record: not a journal, never written.
@@ -208,6 +239,100 @@ TEST(KeyframeJournal, AWriterNeverWritesOverAJournalItDidNotRead) {
   fs::resize_file(w.path, w.ends[3]);
   EXPECT_THROW(JournalWriter(w.path, stale), InputError);
   EXPECT_TRUE(kestrel::test::read_file(w.path) == w.bytes.substr(0, w.ends[3]));
+}
+
+// Pruning by hand-made names: kept journals are ordered by the time (then the number) in their
+// names, not as text; the one just set aside always stays, even when its name is older (a wall
+// clock stepped back); names keep_aside() does not give, other kinds and other journals, a
+// folder and a symbolic link are never touched.
+TEST(KeyframeJournal, PruningKeepsTheNewestJournalsSetAsideOfOneKindAndNothingElse) {
+  kestrel::test::TempDir dir;
+  const std::string journal = (dir / "mapper.journal").string();
+  const auto make = [&](const std::string& name) { std::ofstream(dir / name) << name; };
+  for (const char* name : {"mapper.journal", "mapper.journal.reset-900", "mapper.journal.reset-1000",
+                           "mapper.journal.reset-2000", "mapper.journal.reset-2000-2", "mapper.journal.reset-3000",
+                           "mapper.journal.damaged-100", "mapper.journal.reset-abc", "mapper.journal.reset-1500-1",
+                           "mapper.journal.reset-", "mapper.journal.reset-1-2-3", "other.journal.reset-10",
+                           "mapper.journal.reset-700.tmp"})
+    make(name);
+  fs::create_directory(dir / "mapper.journal.reset-10");
+  fs::create_symlink(dir / "mapper.journal.reset-900", dir / "mapper.journal.reset-20");
+  const auto in_dir = [&](const std::vector<std::string>& names) {
+    std::vector<std::string> paths;
+    for (const std::string& name : names) paths.push_back((dir / name).string());
+    return paths;
+  };
+  EXPECT_EQ(kept_journals(journal, "reset"),
+            in_dir({"mapper.journal.reset-900", "mapper.journal.reset-1000", "mapper.journal.reset-2000",
+                    "mapper.journal.reset-2000-2", "mapper.journal.reset-3000"}));
+
+  // Keep 3, the newest just set aside: 900 and 1000 go, oldest first.
+  PrunedJournals pruned = prune_kept_journals(journal, "reset", 3, (dir / "mapper.journal.reset-3000").string());
+  EXPECT_EQ(pruned.removed, in_dir({"mapper.journal.reset-900", "mapper.journal.reset-1000"}));
+  EXPECT_TRUE(pruned.failures.empty());
+  EXPECT_EQ(kept_journals(journal, "reset"),
+            in_dir({"mapper.journal.reset-2000", "mapper.journal.reset-2000-2", "mapper.journal.reset-3000"}));
+
+  // Keep 2, the one just set aside named older than all (the clock stepped back): it stays,
+  // with the newest other; 2000 and 2000-2 go.
+  make("mapper.journal.reset-50");
+  pruned = prune_kept_journals(journal, "reset", 2, (dir / "mapper.journal.reset-50").string());
+  EXPECT_EQ(pruned.removed, in_dir({"mapper.journal.reset-2000", "mapper.journal.reset-2000-2"}));
+  EXPECT_EQ(kept_journals(journal, "reset"), in_dir({"mapper.journal.reset-50", "mapper.journal.reset-3000"}));
+
+  // Nothing else was touched.
+  for (const char* name : {"mapper.journal", "mapper.journal.damaged-100", "mapper.journal.reset-abc",
+                           "mapper.journal.reset-1500-1", "mapper.journal.reset-", "mapper.journal.reset-1-2-3",
+                           "other.journal.reset-10", "mapper.journal.reset-700.tmp"})
+    EXPECT_EQ(kestrel::test::read_file(dir / name), name) << name;
+  EXPECT_TRUE(fs::is_directory(dir / "mapper.journal.reset-10"));
+  EXPECT_TRUE(fs::is_symlink(dir / "mapper.journal.reset-20"));
+  // Keeping none would delete what was just set aside: refused.
+  EXPECT_THROW(prune_kept_journals(journal, "reset", 0, ""), std::invalid_argument);
+}
+
+// A writer prunes as it sets journals aside: each RESET and each damaged journal continued
+// leaves at most `keep` of its kind, the journal just set aside among them, and says which it
+// deleted.
+TEST(KeyframeJournal, AWriterKeepsOnlyTheNewestJournalsSetAsideOfEachKind) {
+  kestrel::test::TempDir dir;
+  const std::string path = (dir / "mapper.journal").string();
+  const auto graph = [](int64_t revision) {
+    kestrel::slam_graph_t g{};
+    g.revision = revision;
+    return g;
+  };
+  std::vector<std::string> resets;
+  {
+    JournalWriter writer(path, {}, 2);
+    for (int64_t round = 0; round < 3; ++round) {
+      writer.graph(graph(round));
+      writer.restart();
+      resets.push_back(writer.kept_aside());
+      EXPECT_EQ(writer.pruned().removed, round < 2 ? std::vector<std::string>{} : std::vector<std::string>{resets[0]})
+          << "round " << round;
+    }
+  }
+  EXPECT_FALSE(fs::exists(resets[0]));
+  EXPECT_EQ(kept_journals(path, "reset"), (std::vector<std::string>{resets[1], resets[2]}));
+  EXPECT_EQ(read_journal(resets[2]).records.at(0).graph.revision, 2) << "the newest kept is the last one ended";
+
+  // Damaged twice with keep 1: the second continuation deletes the first damaged file only.
+  std::vector<std::string> damaged;
+  for (int64_t round = 0; round < 2; ++round) {
+    {
+      JournalWriter writer(path, read_journal(path), 1);
+      writer.graph(graph(10 + round));
+    }
+    fs::resize_file(path, fs::file_size(path) - 1);  // the record just written cut short
+    JournalWriter writer(path, read_journal(path), 1);
+    damaged.push_back(writer.kept_aside());
+    ASSERT_NE(damaged.back(), "");
+    EXPECT_EQ(writer.pruned().removed, round == 0 ? std::vector<std::string>{} : std::vector<std::string>{damaged[0]});
+  }
+  EXPECT_EQ(kept_journals(path, "damaged"), std::vector<std::string>{damaged[1]});
+  EXPECT_EQ(kept_journals(path, "reset"), (std::vector<std::string>{resets[1], resets[2]})) << "another kind";
+  EXPECT_THROW(JournalWriter(path, read_journal(path), 0), std::invalid_argument);
 }
 
 }  // namespace

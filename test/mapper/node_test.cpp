@@ -2,7 +2,9 @@
 // sources, the published stream decodes to the map the library builds, the rate limit, a
 // rebuild published at once, RESET, bad messages rejected with the channel named, and the
 // journal a restarted mapper gets its map back from (whole, after a full disk, not a journal;
-// damaged journals: journal_test.cpp), which a RESET starts again without destroying it.
+// damaged journals: journal_test.cpp), which a RESET starts again without destroying it, keeping
+// only the newest journals set aside; a journal that cannot be continued at start is given up
+// (DEGRADED, with why), never the map.
 #include <gtest/gtest.h>
 
 #include <sys/resource.h>
@@ -11,6 +13,9 @@
 #include <csignal>
 #include <filesystem>
 #include <fstream>
+#include <memory>
+#include <string>
+#include <vector>
 
 #include "common/error.h"
 #include "common/transport/convert.h"
@@ -367,6 +372,102 @@ TEST(MapNode, AJournalThatCannotBeWrittenIsGivenUpAndTheMapGoesOn) {
   const JournalContents journal = read_journal(options.journal_path);
   EXPECT_EQ(journal.records.size(), 1u);
   EXPECT_NE(journal.damage, "");
+}
+
+// Repeated RESETs do not fill the disk: the newest journal_keep journals set aside stay, and
+// each older one deleted is reported by name.
+TEST(MapNode, RepeatedResetsKeepOnlyTheNewestJournalsSetAside) {
+  const test::Scene scene = test::room_with_a_box();
+  kestrel::test::TempDir dir;
+  NodeOptions options;
+  options.journal_path = (dir / "mapper.journal").string();
+  options.journal_keep = 2;
+  MapNode node(options);
+  std::vector<std::string> kept;
+  for (int round = 0; round < 3; ++round) {
+    node.on_graph(feed_keyframes(node, scene, 0, 0, 1), "SLAM_GRAPH");
+    node.reset();
+    kept.push_back(node.journal_kept_aside());
+    ASSERT_NE(kept.back(), "") << "round " << round;
+    EXPECT_EQ(node.journal_pruned().removed, round < 2 ? std::vector<std::string>{} : std::vector<std::string>{kept[0]})
+        << "round " << round;
+  }
+  EXPECT_FALSE(std::filesystem::exists(kept[0]));
+  EXPECT_EQ(kept_journals(options.journal_path, "reset"), (std::vector<std::string>{kept[1], kept[2]}));
+  EXPECT_EQ(node.journal_error(), "");
+  EXPECT_EQ(node.health().state, kestrel::process_status_t::STATE_RUNNING);
+  // Keeping none would delete the journal a reset has just set aside: not an option.
+  options.journal_keep = 0;
+  EXPECT_THROW(MapNode{options}, std::invalid_argument);
+}
+
+// A journal that cannot be started (its folder is a regular file: ENOTDIR, which stops root
+// too) is given up at once: the process reports DEGRADED with why, and the map goes on.
+TEST(MapNode, AJournalThatCannotBeStartedIsGivenUpAndTheMapGoesOn) {
+  const test::Scene scene = test::room_with_a_box();
+  kestrel::test::TempDir dir;
+  const std::string not_a_folder = (dir / "notes.txt").string();
+  std::ofstream(not_a_folder) << "my notes\n";
+  NodeOptions options;
+  options.journal_path = not_a_folder + "/mapper.journal";
+  MapNode node(options);
+  EXPECT_NE(node.journal_error().find(options.journal_path + ": cannot write in"), std::string::npos)
+      << node.journal_error();
+  const MapNode::Health health = node.health();
+  EXPECT_EQ(health.state, kestrel::process_status_t::STATE_DEGRADED);
+  EXPECT_EQ(health.message, "journal stopped: " + node.journal_error());
+
+  node.on_graph(feed_keyframes(node, scene, 0, 2, 1), "SLAM_GRAPH");
+  EXPECT_EQ(node.mapper().keyframes().size(), 3u) << "the map goes on";
+  EXPECT_EQ(node.stats().frames_inserted, 3);
+  EXPECT_GT(node.mapper().map().num_cells(), 0u);
+  node.reset();  // nothing to set aside, and still no journal
+  EXPECT_EQ(node.journal_kept_aside(), "");
+  EXPECT_EQ(node.health().state, kestrel::process_status_t::STATE_DEGRADED);
+  EXPECT_EQ(kestrel::test::read_file(not_a_folder), "my notes\n") << "the file in the way is left alone";
+  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir.path()), std::filesystem::directory_iterator()), 1);
+}
+
+// A damaged journal whose fresh copy cannot be written (the file-size limit stands in for a
+// full disk, the usual cause of the damage): the restored map is kept and goes on, the process
+// reports DEGRADED, and the damaged journal stays as it was.
+TEST(MapNode, ADamagedJournalThatCannotBeContinuedKeepsTheRestoredMapAndTheFile) {
+  const test::Scene scene = test::room_with_a_box();
+  kestrel::test::TempDir dir;
+  NodeOptions options;
+  options.journal_path = (dir / "mapper.journal").string();
+  {
+    MapNode flight(options);
+    flight.on_graph(feed_keyframes(flight, scene, 0, 2, 1), "SLAM_GRAPH");
+  }
+  std::filesystem::resize_file(options.journal_path, std::filesystem::file_size(options.journal_path) - 1);
+  const std::string damaged = kestrel::test::read_file(options.journal_path);
+
+  rlimit old_limit{};
+  ASSERT_EQ(getrlimit(RLIMIT_FSIZE, &old_limit), 0);
+  const auto old_handler = std::signal(SIGXFSZ, SIG_IGN);
+  rlimit limit = old_limit;
+  limit.rlim_cur = 100;  // the header fits, no keyframe does
+  ASSERT_EQ(setrlimit(RLIMIT_FSIZE, &limit), 0);
+  std::unique_ptr<MapNode> node;
+  try {
+    node = std::make_unique<MapNode>(options);
+  } catch (...) {
+    ADD_FAILURE() << "a journal that cannot be continued must not stop the mapper";
+  }
+  setrlimit(RLIMIT_FSIZE, &old_limit);
+  std::signal(SIGXFSZ, old_handler);
+  ASSERT_TRUE(node);
+
+  EXPECT_EQ(node->stats().keyframes_restored, 2);
+  EXPECT_NE(node->journal_damage(), "");
+  EXPECT_NE(node->journal_error().find(options.journal_path + ": write failed"), std::string::npos)
+      << node->journal_error();
+  EXPECT_EQ(node->health().state, kestrel::process_status_t::STATE_DEGRADED);
+  EXPECT_TRUE(kestrel::test::read_file(options.journal_path) == damaged) << "the journal is as it was";
+  node->on_graph(feed_keyframes(*node, scene, 3, 3, 2), "SLAM_GRAPH");
+  EXPECT_EQ(node->mapper().keyframes().size(), 3u) << "the restored map goes on";
+  EXPECT_TRUE(kestrel::test::read_file(options.journal_path) == damaged) << "and is not journalled";
 }
 
 TEST(MapNode, AFileThatIsNotAJournalIsAnErrorNamingItAndIsLeftAlone) {

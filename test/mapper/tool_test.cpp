@@ -6,8 +6,8 @@
 
 #include <filesystem>
 #include <fstream>
-#include <opencv2/imgcodecs.hpp>
 
+#include "common/image/image_io.h"
 #include "common/trajectory.h"
 #include "common/transport/convert.h"
 #include "mapper/keyframe_journal.h"
@@ -38,8 +38,8 @@ std::vector<std::pair<RgbdFrame, Eigen::Isometry3d>> write_sequence(const fs::pa
     const std::string name = std::to_string(utime / 1000000) + "." + std::to_string(utime % 1000000);
     cv::Mat raw;
     f.depth_mm.convertTo(raw, CV_16UC1, 5.0);  // TUM's 1/5000 m units
-    cv::imwrite((dir / "depth" / (name + ".png")).string(), raw);
-    cv::imwrite((dir / "rgb" / (name + ".png")).string(), cv::Mat(480, 640, CV_8UC3, cv::Scalar(90, 120, 150)));
+    image::write_png((dir / "depth" / (name + ".png")).string(), raw);
+    image::write_png((dir / "rgb" / (name + ".png")).string(), cv::Mat(480, 640, CV_8UC3, cv::Scalar(90, 120, 150)));
     rgb_list << name << " rgb/" << name << ".png\n";
     depth_list << name << " depth/" << name << ".png\n";
     truth.push_back(utime, T);
@@ -65,7 +65,7 @@ TEST(MapTool, BuildsTheLibrarysMapAndRendersIt) {
   ASSERT_EQ(map.num_cells(), reference.map().num_cells());
   reference.map().for_each_cell([&](const Key& k, float v) { ASSERT_EQ(map.log_odds(k), v); });
   for (const char* png : {"top.png", "view.png", "slice.png"}) {
-    EXPECT_FALSE(cv::imread((tmp / png).string()).empty()) << png;
+    EXPECT_FALSE(image::read_image((tmp / png).string()).empty()) << png;
   }
   std::ifstream ply(tmp / "cloud.ply");
   std::string magic;
@@ -137,7 +137,7 @@ TEST(MapTool, BuildsTheMapOfAMappersJournal) {
   const VoxelMap map = read_map_file((tmp / "flight.ot").string());
   ASSERT_EQ(map.num_cells(), live.map().num_cells());
   live.map().for_each_cell([&](const Key& k, float v) { ASSERT_EQ(map.log_odds(k), v); });
-  EXPECT_FALSE(cv::imread((tmp / "flight.png").string()).empty());
+  EXPECT_FALSE(image::read_image((tmp / "flight.png").string()).empty());
 
   // Not a journal: exit 3 naming it. Both inputs, or --surface-only with a journal: usage.
   std::ofstream(tmp / "notes.txt") << "notes\n";

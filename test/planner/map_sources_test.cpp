@@ -4,10 +4,10 @@
 #include <octomap/OcTree.h>
 
 #include <fstream>
-#include <opencv2/imgcodecs.hpp>
 #include <sstream>
 
 #include "common/error.h"
+#include "common/image/image_io.h"
 #include "mapper/octree_io.h"
 #include "planner/map_sources.h"
 #include "test/support/test_support.h"
@@ -32,7 +32,7 @@ TEST(RosMap, GridIsTheImageFlippedWithThresholdsApplied) {
   cv::Mat img(4, 6, CV_8UC1, cv::Scalar(254));  // free
   img.at<uint8_t>(0, 0) = 0;                     // top-left: occupied
   img.at<uint8_t>(3, 5) = 205;                   // bottom-right: unknown (p = 0.2)
-  cv::imwrite((dir / "m.png").string(), img);
+  image::write_png((dir / "m.png").string(), img);
   write(dir / "m.yaml", "image: m.png\nresolution: 0.5\norigin: [1.0, 2.0, 0.0]\nnegate: 0\n"
                         "occupied_thresh: 0.65\nfree_thresh: 0.196\n");
   const OccupancyGrid g = read_ros_map((dir / "m.yaml").string());
@@ -65,7 +65,7 @@ TEST(RosMap, MalformedFilesGiveErrorsNamingTheFile) {
 TEST(RosMap, SizesAreBoundedBeforeTheGridIsMade) {
   // The planner's grid comes from the sim's reader, whose bounds it relies on (occupancy_map.h).
   kestrel::test::TempDir dir;
-  cv::imwrite((dir / "m.png").string(), cv::Mat(4, 6, CV_8UC1, cv::Scalar(254)));
+  image::write_png((dir / "m.png").string(), cv::Mat(4, 6, CV_8UC1, cv::Scalar(254)));
   const std::string coarse = (dir / "coarse.yaml").string();
   write(coarse, "image: m.png\nresolution: 1000\norigin: [0, 0, 0]\n");
   EXPECT_NE(error_of([&] { read_ros_map(coarse); }).find(coarse + ":2: 'resolution' must be in"), std::string::npos)

@@ -4,9 +4,9 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
-#include <opencv2/imgcodecs.hpp>
 #include <sstream>
 
+#include "common/image/image_io.h"
 #include "test/support/test_support.h"
 
 namespace kestrel::planner {
@@ -90,12 +90,41 @@ TEST(PlanTool, BadWorldAndMapFilesAreNamedWithExitCode3) {
   }
 }
 
+// Naming a map there is not is a usage error (exit 2) that says which there are, before any
+// planning; a map file named but absent is input that is not there (exit 3), as a bad one is.
+TEST(PlanTool, AnUnknownMapIsExitCode2NamingItAndTheMapsThereAre) {
+  const test::RunResult unknown = test::run({test::tool("plan").string(), "--map", "atlantis"}, 20.0);
+  EXPECT_EQ(unknown.exit_code, 2) << unknown.err;
+  EXPECT_EQ(unknown.err.rfind("kestrel-plan: error: --map: unknown world 'atlantis' (built in: ", 0), 0u)
+      << unknown.err;
+  for (const char* world : {"room", "floor", "office", "atrium"})
+    EXPECT_NE(unknown.err.find(world), std::string::npos) << world << ": " << unknown.err;
+  EXPECT_NE(unknown.err.find("or a .world file or an occupancy map .yaml)"), std::string::npos) << unknown.err;
+  EXPECT_EQ(unknown.err.find("stata"), std::string::npos) << "kestrel-plan takes the stata map's .yaml itself: "
+                                                          << unknown.err;
+  EXPECT_TRUE(unknown.out.empty()) << unknown.out;
+
+  const test::RunResult stata = test::run({test::tool("plan").string(), "--map", "stata"}, 20.0);
+  EXPECT_EQ(stata.exit_code, 2) << stata.err;
+  EXPECT_NE(stata.err.find("kestrel-plan: error: --map: the stata world is a ROS map: give its .yaml as --map"),
+            std::string::npos)
+      << stata.err;
+
+  test::TempDir dir;
+  for (const char* name : {"absent.world", "absent.yaml"}) {
+    const std::string file = (dir / name).string();
+    const test::RunResult absent = test::run({test::tool("plan").string(), "--map", file}, 20.0);
+    EXPECT_EQ(absent.exit_code, 3) << absent.err;
+    EXPECT_NE(absent.err.find(file), std::string::npos) << absent.err;
+  }
+}
+
 TEST(PlanTool, AMapOfAbsurdSizeIsExit3NamingTheFieldNotAGrowingPlan) {
   // resolution: 1000 once made the planner grow to gigabytes; every size is now bounded first.
   test::TempDir dir;
   cv::Mat img(40, 200, CV_8UC1, cv::Scalar(254));
   for (cv::Mat wall : {img.row(0), img.row(39), img.col(0), img.col(199)}) wall.setTo(0);
-  cv::imwrite((dir / "m.png").string(), img);
+  image::write_png((dir / "m.png").string(), img);
   const std::pair<std::string, std::string> cases[] = {
       {"resolution: 1000\norigin: [0, 0, 0]\n", ":2: 'resolution' must be in [0.001, 10] m per pixel, got 1000"},
       {"resolution: 0\norigin: [0, 0, 0]\n", ":2: 'resolution' must be in"},
@@ -125,7 +154,7 @@ TEST(PlanExperimentsTool, OneCommandWritesTheTableAndThePlot) {
   for (const char* row : {"| prm | uniform |", "| brm | su |", "| brm | su-ukf |", "| brm | gaussian |", "| brm | bridge |",
                           "| brm-dominance | su |"})
     EXPECT_NE(md.find(row), std::string::npos) << row << "\n" << md;
-  const cv::Mat png = cv::imread((dir / "figures" / "floor_paths.png").string());  // the folder was made
+  const cv::Mat png = image::read_image((dir / "figures" / "floor_paths.png").string());  // the folder was made
   ASSERT_FALSE(png.empty());
   EXPECT_GT(png.rows, 200);
 }

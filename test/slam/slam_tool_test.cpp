@@ -1,12 +1,19 @@
 // kestrel-slam as a user runs it: --help lists the options, bad options are exit code 2, a
-// missing or corrupt input file is exit code 3 with one line naming it.
+// missing or corrupt input file is exit code 3 with one line naming it, and so is a --tum run
+// that estimated nothing, which writes no trajectory (as kestrel-vo --tum).
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <filesystem>
 #include <fstream>
 
 #include "common/error.h"
 #include "test/support/test_support.h"
+#if KESTREL_SLAM_OFFLINE
+#include "common/trajectory.h"
+#include "test/vo/synthetic_tum.h"
+#endif
 
 namespace kestrel::slam {
 namespace {
@@ -48,11 +55,63 @@ TEST(SlamTool, AMissingVocabularyFileIsExitCode3) {
 }
 
 #if KESTREL_SLAM_OFFLINE
+namespace fs = std::filesystem;
+using ::kestrel::test::RunResult;
+
 TEST(SlamTool, AMissingTumFolderIsExitCode3) {
   TempDir dir;
   const auto r = run({tool("slam"), "--tum", (dir / "none").string(), "--out", (dir / "t.txt").string()});
   EXPECT_EQ(r.exit_code, kExitBadInput) << r.err;
   EXPECT_NE(r.err.find("none"), std::string::npos) << r.err;
+}
+
+// Both trajectories asked for, into `dir`: slam.txt and vo.txt.
+RunResult run_slam_on(const fs::path& folder, const TempDir& dir) {
+  return run({tool("slam"), "--tum", folder.string(), "--out", (dir / "slam.txt").string(), "--vo-out",
+              (dir / "vo.txt").string(), "-q"});
+}
+
+// A trajectory of the first frame's identity pose alone, or of none, would read as a result.
+TEST(SlamTool, ATumRunWithoutAMotionIsExitCode3NamingTheFolderAndWritesNothing) {
+  TempDir dir;
+  vo::test::TumFolderSpec spec;
+  spec.blank_depth_from = 0;  // no depth reading in any frame: the odometry gives no motion
+  const fs::path folder = vo::test::write_tum_folder(dir.path(), spec);
+  const RunResult r = run_slam_on(folder, dir);
+  EXPECT_EQ(r.exit_code, kExitBadInput) << r.out << r.err;
+  EXPECT_EQ(r.err.rfind("kestrel-slam: error: " + folder.string() +
+                            ": nothing usable: 0 of 4 frames gave a motion (too little valid depth 4)",
+                        0),
+            0u)
+      << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_EQ(r.out.find("keyframes:"), std::string::npos) << "no figures of a run that estimated nothing: " << r.out;
+  EXPECT_FALSE(fs::exists(dir / "slam.txt"));
+  EXPECT_FALSE(fs::exists(dir / "vo.txt"));
+}
+
+TEST(SlamTool, ATumFolderWhereNoFramePairsIsExitCode3AndWritesNothing) {
+  TempDir dir;
+  vo::test::TumFolderSpec spec;
+  spec.depth_shift_us = 10000000;  // 10 s later: no RGB image within TUM's 20 ms of any depth image
+  const fs::path folder = vo::test::write_tum_folder(dir.path(), spec);
+  const RunResult r = run_slam_on(folder, dir);
+  EXPECT_EQ(r.exit_code, kExitBadInput) << r.out << r.err;
+  EXPECT_EQ(r.err.rfind("kestrel-slam: error: " + folder.string() + ": no RGB image has a depth image", 0), 0u)
+      << r.err;
+  EXPECT_FALSE(fs::exists(dir / "slam.txt"));
+  EXPECT_FALSE(fs::exists(dir / "vo.txt"));
+}
+
+// The refusal above is of runs without a motion only: the same room with its depth is a run.
+TEST(SlamTool, AUsableTumFolderWritesBothTrajectoriesWithEveryFrame) {
+  TempDir dir;
+  const fs::path folder = vo::test::write_tum_folder(dir.path(), vo::test::TumFolderSpec{});
+  const RunResult r = run_slam_on(folder, dir);
+  ASSERT_EQ(r.exit_code, kExitOk) << r.out << r.err;
+  EXPECT_NE(r.out.find("frames: 4, with a pose: 4\n"), std::string::npos) << r.out;
+  EXPECT_EQ(read_tum_trajectory((dir / "slam.txt").string()).size(), 4u);
+  EXPECT_EQ(read_tum_trajectory((dir / "vo.txt").string()).size(), 4u);
 }
 #endif
 

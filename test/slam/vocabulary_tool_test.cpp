@@ -5,10 +5,10 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
-#include <opencv2/imgcodecs.hpp>
 #include <sstream>
 
 #include "common/error.h"
+#include "common/image/image_io.h"
 #include "slam/place/vocabulary.h"
 #include "test/support/test_support.h"
 #include "test/tum/tum_fixture.h"
@@ -36,7 +36,7 @@ void paint_images(const std::filesystem::path& folder, bool textured) {
       for (int r = 0; r < image.rows; r += 8)
         for (int c = 0; c < image.cols; c += 8) image(cv::Rect(c, r, 8, 8)).setTo(cv::Scalar::all(rng.uniform(0, 256)));
     }
-    ASSERT_TRUE(cv::imwrite((folder / file).string(), image)) << file;
+    ASSERT_NO_THROW(image::write_png((folder / file).string(), image)) << file;
   }
 }
 

@@ -8,9 +8,9 @@
 #include <fstream>
 #include <sstream>
 
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "common/image/image_io.h"
 #include "common/numbers.h"
 #include "common/text.h"
 #include "common/time.h"
@@ -84,11 +84,11 @@ TEST(TumData, Fr1RpyLogHoldsAllFramesImuAndGroundTruthInTimeOrder) {
       EXPECT_EQ(f.camera.fx, 517.3);
       if (frames == 0 || frames == 199) {
         // The images, read here with OpenCV directly.
-        cv::Mat bgr = cv::imread((seq / rgb[static_cast<size_t>(frames)].second).string(), cv::IMREAD_UNCHANGED);
+        cv::Mat bgr = image::read_image((seq / rgb[static_cast<size_t>(frames)].second).string());
         cv::Mat expected_rgb;
         cv::cvtColor(bgr, expected_rgb, cv::COLOR_BGR2RGB);
         EXPECT_EQ(cv::norm(f.rgb, expected_rgb, cv::NORM_INF), 0.0);
-        cv::Mat raw = cv::imread((seq / depth[static_cast<size_t>(frames)].second).string(), cv::IMREAD_UNCHANGED);
+        cv::Mat raw = image::read_image((seq / depth[static_cast<size_t>(frames)].second).string());
         cv::Mat expected_mm;
         raw.convertTo(expected_mm, CV_32F, 0.2);  // 5000 units per metre
         cv::Mat got_mm;

@@ -1,3 +1,4 @@
+#include "common/image/image_io.h"
 #include "test/tum/tum_fixture.h"
 
 #include <cmath>
@@ -6,7 +7,6 @@
 #include <stdexcept>
 #include <vector>
 
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "common/time.h"
@@ -67,9 +67,8 @@ TumFixture::TumFixture(const fs::path& parent, TumFixtureOptions options)
     const std::string depth_name = "depth/" + format_seconds(depth_utime(k)) + ".png";
     cv::Mat bgr;
     cv::cvtColor(rgb_image(k), bgr, cv::COLOR_RGB2BGR);
-    if (!cv::imwrite((folder_ / rgb_name).string(), bgr) ||
-        !cv::imwrite((folder_ / depth_name).string(), depth_raw_image(k)))
-      throw std::runtime_error("cannot write fixture images");
+    image::write_png((folder_ / rgb_name).string(), bgr);
+    image::write_png((folder_ / depth_name).string(), depth_raw_image(k));
     rgb_list << format_seconds(rgb_utime(k)) << ' ' << rgb_name << '\n';
     depth_list << format_seconds(depth_utime(k)) << ' ' << depth_name << '\n';
   }

@@ -9,10 +9,10 @@
 #include <string>
 #include <vector>
 
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "common/error.h"
+#include "common/image/image_io.h"
 #include "drivers/tum/tum_images.h"
 #include "test/support/test_support.h"
 
@@ -62,8 +62,8 @@ TEST(TumImages, DamagedPngsAreRejectedAndTheNextImageReadsExactly) {
     }
   }
   const auto good_rgb = dir / "rgb.png", good_depth = dir / "depth.png", bad = dir / "bad.png";
-  ASSERT_TRUE(cv::imwrite(good_rgb.string(), rgb));  // written B, G, R: read back as R, G, B = rgb
-  ASSERT_TRUE(cv::imwrite(good_depth.string(), depth));
+  ASSERT_NO_THROW(image::write_png(good_rgb.string(), rgb));  // written B, G, R: read back as R, G, B = rgb
+  ASSERT_NO_THROW(image::write_png(good_depth.string(), depth));
   cv::Mat expected_rgb;
   cv::cvtColor(rgb, expected_rgb, cv::COLOR_BGR2RGB);
   const ListedAt at{"rgb.txt", 4};

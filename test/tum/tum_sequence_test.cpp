@@ -6,9 +6,9 @@
 #include <fstream>
 #include <functional>
 
-#include <opencv2/imgcodecs.hpp>
 
 #include "common/error.h"
+#include "common/image/image_io.h"
 #include "common/time.h"
 #include "drivers/tum/tum_sequence.h"
 #include "test/support/test_support.h"
@@ -250,13 +250,13 @@ TEST(TumSequence, UndecodableOrWrongImagesFailInFrameNamingTheListLine) {
          test::write_text(p, bytes.substr(0, bytes.size() / 2));  // truncated PNG
        },
        1, "rgb.txt:5: "},
-      {rgb1, [](const auto& p) { cv::imwrite(p.string(), cv::Mat(240, 320, CV_8UC3, cv::Scalar(1, 2, 3))); }, 1,
+      {rgb1, [](const auto& p) { image::write_png(p.string(), cv::Mat(240, 320, CV_8UC3, cv::Scalar(1, 2, 3))); }, 1,
        "image is 320x240, expected 640x480"},
-      {rgb1, [](const auto& p) { cv::imwrite(p.string(), cv::Mat(480, 640, CV_8UC1, cv::Scalar(9))); }, 1,
+      {rgb1, [](const auto& p) { image::write_png(p.string(), cv::Mat(480, 640, CV_8UC1, cv::Scalar(9))); }, 1,
        "colour image is 8-bit, 1-channel, expected 8-bit, 3-channel"},
-      {depth0, [](const auto& p) { cv::imwrite(p.string(), cv::Mat(480, 640, CV_8UC1, cv::Scalar(9))); }, 0,
+      {depth0, [](const auto& p) { image::write_png(p.string(), cv::Mat(480, 640, CV_8UC1, cv::Scalar(9))); }, 0,
        "depth.txt:4: " },
-      {depth0, [](const auto& p) { cv::imwrite(p.string(), cv::Mat(480, 640, CV_16UC3, cv::Scalar(9, 9, 9))); }, 0,
+      {depth0, [](const auto& p) { image::write_png(p.string(), cv::Mat(480, 640, CV_16UC3, cv::Scalar(9, 9, 9))); }, 0,
        "depth image is 16-bit, 3-channel, expected 16-bit, 1-channel"},
   };
   for (const Case& c : cases) {

@@ -9,6 +9,7 @@
 
 #include "common/error.h"
 #include "test/vo/synthetic_scene.h"
+#include "test/vo/synthetic_tum.h"
 #include "vo/sequence_run.h"
 
 namespace kestrel::vo::sequence_run_test {  // named: the unity batch holds pipeline_test.cpp too
@@ -17,34 +18,19 @@ namespace {
 constexpr int64_t kT0 = 1000000;
 constexpr int64_t kPeriod = 33333;
 
-Eigen::Isometry3d truth(int k) {
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.translation() = Eigen::Vector3d(0.01 * k, -0.004 * k, 0.002 * k);
-  return T;
-}
-
-// n frames of the synthetic room; the frames in [blank_from, n) have no depth at all.
+// n frames of the synthetic room along its line; the frames in [blank_from, n) have no depth at all.
 std::vector<RgbdFrame> frames(int n, int blank_from) {
   static const test::SyntheticScene scene(17);
   std::vector<RgbdFrame> out;
   for (int k = 0; k < n; ++k) {
-    out.push_back(scene.render(truth(k), test::test_camera(), kT0 + kPeriod * k));
+    out.push_back(scene.render(test::line_pose(k), test::test_camera(), kT0 + kPeriod * k));
     if (k >= blank_from) out.back().depth_mm.setTo(cv::Scalar::all(0));
   }
   return out;
 }
 
-// World = the first camera, as the run's trajectory; 10 ms samples beyond both ends.
-Trajectory ground_truth(int n) {
-  Trajectory gt;
-  for (int64_t t = kT0 - 50000; t <= kT0 + kPeriod * (n - 1) + 50000; t += 10000) {
-    const double k = double(t - kT0) / double(kPeriod);
-    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-    T.translation() = Eigen::Vector3d(0.01 * k, -0.004 * k, 0.002 * k);
-    gt.push_back(t, T);
-  }
-  return gt;
-}
+// World = the first camera, as the run's trajectory.
+Trajectory ground_truth(int n) { return test::line_ground_truth(kT0, kPeriod, n); }
 
 size_t count(const RunFigures& f, VoStatus s) { return f.by_status[size_t(s)]; }
 
@@ -62,7 +48,7 @@ TEST(SequenceRun, NoValidDepthAnywhereMeasuresNothingAndIsRefused) {
   EXPECT_EQ(j.at("not_scored"), "no frame has a motion");
   EXPECT_EQ(j.at("by_status").at("too little valid depth"), 4);
   try {
-    require_usable(run, f, "/data/zero_depth");
+    require_usable(run.results, "/data/zero_depth");
     FAIL() << "a run without a single motion was accepted";
   } catch (const InputError& e) {
     const std::string what = e.what();
@@ -80,7 +66,7 @@ TEST(SequenceRun, ASingleFrameHasNoMotionAndIsRefused) {
   EXPECT_EQ(count(f, VoStatus::kNoReference), 1u);
   EXPECT_FALSE(f.scored);
   EXPECT_EQ(run.trajectory.size(), 1u);  // the reference's identity pose, which alone scores 0
-  EXPECT_THROW(require_usable(run, f, "one"), InputError);
+  EXPECT_THROW(require_usable(run.results, "one"), InputError);
 }
 
 TEST(SequenceRun, NoFramesAtAllIsRefused) {
@@ -88,7 +74,7 @@ TEST(SequenceRun, NoFramesAtAllIsRefused) {
   const RunFigures f = score(run, ground_truth(1));
   EXPECT_FALSE(f.scored);
   EXPECT_EQ(status_summary(f), "no frames");
-  EXPECT_THROW(require_usable(run, f, "none"), InputError);
+  EXPECT_THROW(require_usable(run.results, "none"), InputError);
 }
 
 TEST(SequenceRun, APartlyUsableRunIsScoredAndCountsTheFramesByStatus) {
@@ -99,7 +85,7 @@ TEST(SequenceRun, APartlyUsableRunIsScoredAndCountsTheFramesByStatus) {
   EXPECT_EQ(count(f, VoStatus::kNoReference), 1u);
   EXPECT_EQ(count(f, VoStatus::kInsufficientDepth), 3u);
   EXPECT_EQ(status_summary(f), "ok 4, no reference 1, too little valid depth 3");
-  EXPECT_NO_THROW(require_usable(run, f, "partial"));
+  EXPECT_NO_THROW(require_usable(run.results, "partial"));
   ASSERT_TRUE(f.scored) << f.not_scored;
   EXPECT_EQ(f.scored_frames, 5u);  // the reference and the four motions
   EXPECT_LT(f.ate_rmse_m, 0.01);
@@ -112,7 +98,7 @@ TEST(SequenceRun, WithoutGroundTruthNothingIsScoredButTheRunIsUsable) {
   EXPECT_EQ(f.ok, 2u);
   EXPECT_FALSE(f.scored);
   EXPECT_EQ(f.not_scored, "no ground truth");
-  EXPECT_NO_THROW(require_usable(run, f, "no_gt"));
+  EXPECT_NO_THROW(require_usable(run.results, "no_gt"));
 }
 
 TEST(SequenceRun, GroundTruthThatCoversNoEstimateIsNotScored) {

@@ -1,4 +1,4 @@
-// kestrel-vo --tum as a user runs it, on TUM folders written here from the synthetic room: a
+// kestrel-vo --tum as a user runs it, on TUM folders of the synthetic room (synthetic_tum.h): a
 // run that produced nothing usable (no valid depth anywhere, no frame pairing with a depth
 // image, unreadable lists or images) is exit 3 with one line naming the folder or file and
 // writes no trajectory; a partly usable folder is scored and says how many frames were used.
@@ -7,17 +7,14 @@
 
 #include <algorithm>
 #include <filesystem>
-#include <fstream>
 #include <functional>
 #include <nlohmann/json.hpp>
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
-#include <sstream>
 
 #include "common/error.h"
 #include "common/time.h"
 #include "test/support/test_support.h"
-#include "test/vo/synthetic_scene.h"
+#include "test/tum/tum_fixture.h"
+#include "test/vo/synthetic_tum.h"
 
 namespace kestrel::vo {
 namespace {
@@ -27,65 +24,10 @@ using ::kestrel::test::run;
 using ::kestrel::test::RunResult;
 using ::kestrel::test::TempDir;
 
-constexpr int64_t kT0 = 1305031229528748;
-constexpr int64_t kPeriod = 33333;
-
-Eigen::Isometry3d truth(double k) {
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.translation() = Eigen::Vector3d(0.01 * k, -0.004 * k, 0.002 * k);
-  return T;
-}
-
-void write_text(const fs::path& path, const std::string& text) {
-  std::ofstream out(path);
-  out << text;
-  ASSERT_TRUE(out.good()) << path;
-}
-
-struct SequenceSpec {
-  int frames = 4;
-  int blank_depth_from = 1 << 30;  ///< frames from here on have no depth reading at all
-  int64_t depth_shift_us = 1000;   ///< depth time - RGB time
-  bool extra_rgb = false;          ///< one more RGB image, a second after the others, no depth
-};
-
-// A TUM folder with the ROS default intrinsics (its name names no freiburg camera), so the
-// run uses the simulator's profile, which the synthetic room matches.
-fs::path write_sequence(const fs::path& parent, const SequenceSpec& spec) {
-  const fs::path folder = parent / "rgbd_dataset_synthetic";
-  fs::create_directories(folder / "rgb");
-  fs::create_directories(folder / "depth");
-  static const test::SyntheticScene scene(23);
-  const PinholeCamera camera = PinholeCamera::vga(525.0, 525.0, 319.5, 239.5);
-  std::ostringstream rgb, depth, gt;
-  rgb << "# color images\n";
-  depth << "# depth maps\n";
-  gt << "# timestamp tx ty tz qx qy qz qw\n";
-  for (int k = 0; k < spec.frames + (spec.extra_rgb ? 1 : 0); ++k) {
-    const bool extra = k == spec.frames;
-    const int64_t t = extra ? kT0 + kPeriod * (k - 1) + 1000000 : kT0 + kPeriod * k;
-    const RgbdFrame f = scene.render(truth(k), camera, t);
-    cv::Mat bgr, raw;
-    cv::cvtColor(f.rgb, bgr, cv::COLOR_RGB2BGR);
-    f.depth_mm.convertTo(raw, CV_16UC1, 5.0);  // TUM's 1/5000 m
-    if (k >= spec.blank_depth_from) raw.setTo(cv::Scalar::all(0));
-    const std::string name = std::to_string(k) + ".png";
-    cv::imwrite((folder / "rgb" / name).string(), bgr);
-    rgb << format_seconds(t) << " rgb/" << name << "\n";
-    if (!extra) {
-      cv::imwrite((folder / "depth" / name).string(), raw);
-      depth << format_seconds(t + spec.depth_shift_us) << " depth/" << name << "\n";
-    }
-  }
-  for (int64_t t = kT0 - 50000; t <= kT0 + kPeriod * spec.frames + 50000; t += 10000) {
-    const Eigen::Vector3d p = truth(double(t - kT0) / double(kPeriod)).translation();
-    gt << format_seconds(t) << " " << p.x() << " " << p.y() << " " << p.z() << " 0 0 0 1\n";
-  }
-  write_text(folder / "rgb.txt", rgb.str());
-  write_text(folder / "depth.txt", depth.str());
-  write_text(folder / "groundtruth.txt", gt.str());
-  return folder;
-}
+using test::kTumT0;
+using test::TumFolderSpec;
+using test::write_tum_folder;
+using ::kestrel::test::write_text;
 
 RunResult run_vo(const fs::path& folder, const fs::path& out, const std::vector<std::string>& extra = {}) {
   std::vector<std::string> argv = {::kestrel::test::tool("vo").string(), "--tum", folder.string(), "--out", out.string()};
@@ -95,9 +37,9 @@ RunResult run_vo(const fs::path& folder, const fs::path& out, const std::vector<
 
 TEST(VoTool, NoValidDepthAnywhereExitsThreeAndWritesNothing) {
   TempDir dir;
-  SequenceSpec spec;
+  TumFolderSpec spec;
   spec.blank_depth_from = 0;
-  const fs::path folder = write_sequence(dir.path(), spec);
+  const fs::path folder = write_tum_folder(dir.path(), spec);
   const RunResult r = run_vo(folder, dir / "t.txt", {"--stats", (dir / "s.json").string(), "-q"});
   EXPECT_EQ(r.exit_code, kExitBadInput) << r.out << r.err;
   EXPECT_EQ(r.err.rfind("kestrel-vo: error: " + folder.string() +
@@ -113,9 +55,9 @@ TEST(VoTool, NoValidDepthAnywhereExitsThreeAndWritesNothing) {
 
 TEST(VoTool, NoFramePairingWithDepthExitsThreeNamingTheFolderAndTolerance) {
   TempDir dir;
-  SequenceSpec spec;
+  TumFolderSpec spec;
   spec.depth_shift_us = 10000000;  // 10 s later: no RGB image within TUM's 20 ms of any depth image
-  const fs::path folder = write_sequence(dir.path(), spec);
+  const fs::path folder = write_tum_folder(dir.path(), spec);
   const RunResult r = run_vo(folder, dir / "t.txt", {"-q"});
   EXPECT_EQ(r.exit_code, kExitBadInput) << r.out << r.err;
   EXPECT_EQ(r.err.rfind("kestrel-vo: error: " + folder.string() + ": no RGB image has a depth image", 0), 0u)
@@ -126,11 +68,11 @@ TEST(VoTool, NoFramePairingWithDepthExitsThreeNamingTheFolderAndTolerance) {
 
 TEST(VoTool, APartlyUsableFolderIsScoredAndSaysHowManyFramesWereUsed) {
   TempDir dir;
-  SequenceSpec spec;
+  TumFolderSpec spec;
   spec.frames = 6;
   spec.blank_depth_from = 4;
   spec.extra_rgb = true;
-  const fs::path folder = write_sequence(dir.path(), spec);
+  const fs::path folder = write_tum_folder(dir.path(), spec);
   const RunResult r = run_vo(folder, dir / "t.txt", {"--stats", (dir / "s.json").string()});
   ASSERT_EQ(r.exit_code, kExitOk) << r.out << r.err;
   EXPECT_NE(r.out.find("frames: 6 of 7 RGB images (1 without a depth image within 0.020000 s)\n"), std::string::npos)
@@ -156,7 +98,7 @@ TEST(VoTool, UnreadableListsAndImagesExitThreeNamingTheFileAndLine) {
   };
   const std::vector<Case> cases = {
       {"empty rgb.txt", [](const fs::path& f) { write_text(f / "rgb.txt", ""); }, "rgb.txt: lists no images"},
-      {"truncated line", [](const fs::path& f) { write_text(f / "rgb.txt", format_seconds(kT0) + "\n"); },
+      {"truncated line", [](const fs::path& f) { write_text(f / "rgb.txt", format_seconds(kTumT0) + "\n"); },
        "rgb.txt:1: expected 'timestamp filename'"},
       {"NaN time stamp", [](const fs::path& f) { write_text(f / "depth.txt", "nan depth/0.png\n"); },
        "depth.txt:1: bad timestamp 'nan'"},
@@ -169,7 +111,7 @@ TEST(VoTool, UnreadableListsAndImagesExitThreeNamingTheFileAndLine) {
   };
   for (const Case& c : cases) {
     TempDir dir;
-    const fs::path folder = write_sequence(dir.path(), SequenceSpec{});
+    const fs::path folder = write_tum_folder(dir.path(), TumFolderSpec{});
     c.damage(folder);
     const RunResult r = run_vo(folder, dir / "t.txt", {"-q"});
     EXPECT_EQ(r.exit_code, kExitBadInput) << c.what << ": " << r.err;

@@ -10,6 +10,7 @@
 
 #include "common/cli.h"
 #include "common/error.h"
+#include "common/image/image_io.h"
 #include "common/transport/channels.h"
 #include "tools/eval/evaluate.h"
 #include "tools/eval/log_input.h"
@@ -144,7 +145,7 @@ int main(int argc, char** argv) {
       std::cout << text_report(inputs, evaluation, options);
     }
     if (!plot_path.empty()) {
-      write_png(plot_path, render_plot(evaluation, options, est.source + "  vs  " + gt.source));
+      image::write_png(plot_path, render_plot(evaluation, options, est.source + "  vs  " + gt.source));
       spdlog::info("wrote {}", plot_path);
     }
     return kExitOk;

@@ -4,11 +4,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <vector>
 
-#include "common/atomic_file.h"
 #include "common/error.h"
 #include "common/time.h"
 
@@ -227,18 +225,6 @@ cv::Mat render_plot(const Evaluation& e, const EvalOptions& options, const std::
               e.velocity.errors_mps, failures, kVelocity, "velocity error (m/s)",
               options.gross_velocity_mps);
   return img;
-}
-
-void write_png(const std::string& path, const cv::Mat& image) {
-  std::vector<uchar> png;
-  bool ok = false;
-  try {
-    ok = cv::imencode(".png", image, png);
-  } catch (const cv::Exception&) {
-    ok = false;
-  }
-  if (!ok) throw InputError(path + ": cannot write the PNG image");
-  write_file_atomically(path, png.data(), png.size());  // no cut image that looks whole
 }
 
 }  // namespace kestrel::eval

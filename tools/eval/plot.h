@@ -15,7 +15,4 @@ namespace kestrel::eval {
 /// The picture (8-bit BGR, 1000 px wide); `title` is printed above the figures.
 cv::Mat render_plot(const Evaluation& e, const EvalOptions& options, const std::string& title);
 
-/// Writes `image` as PNG; throws InputError naming `path` if it cannot be written.
-void write_png(const std::string& path, const cv::Mat& image);
-
 }  // namespace kestrel::eval
