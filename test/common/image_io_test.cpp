@@ -81,14 +81,6 @@ Bytes assemble_png(uint32_t width, uint32_t height, uint8_t bit_depth, uint8_t c
 
 Bytes text(const std::string& s) { return Bytes(s.begin(), s.end()); }
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
 
 TEST(PngDecode, SixteenBitGreyIsReadBigEndianIntoHostOrder) {
   // 2 x 2: 0x0102, 0xffff / 0x0000, 5000 (0x1388), as the file stores them: big-endian.
@@ -156,7 +148,7 @@ TEST(PngDecode, EveryByteFlipDecodesOrIsAnInputError) {
 
 TEST(PngDecode, AHeaderClaimingMorePixelsThanTheBoundIsRefusedBeforeDecoding) {
   const Bytes png = assemble_png(100000, 100000, 16, 6, {{0}});
-  const std::string e = error_of([&] { decode_png(png, "huge.png"); });
+  const std::string e = test::input_error_of([&] { decode_png(png, "huge.png"); });
   EXPECT_NE(e.find("huge.png: 100000 x 100000 pixels is more than 1024 MiB"), std::string::npos) << e;
 }
 
@@ -243,7 +235,7 @@ TEST(PnmDecode, BadFilesSayWhatIsWrong) {
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(c.bytes);
-    const std::string e = error_of([&] { decode_pnm(text(c.bytes), "m.pgm"); });
+    const std::string e = test::input_error_of([&] { decode_pnm(text(c.bytes), "m.pgm"); });
     EXPECT_NE(e.find("m.pgm: " + c.expected), std::string::npos) << e;
   }
 }
@@ -268,11 +260,11 @@ TEST(ImageFile, MissingEmptyAndUnknownFilesAreNamed) {
   std::ofstream(dir / "empty.png").close();
   std::ofstream(dir / "x.bmp") << "BM not really";
   const std::string missing = (dir / "missing.png").string();
-  EXPECT_EQ(error_of([&] { read_image(missing); }), missing + ": cannot open the image file");
-  EXPECT_EQ(error_of([&] { read_image((dir / "empty.png").string()); }), (dir / "empty.png").string() + ": empty image file");
-  EXPECT_EQ(error_of([&] { read_image((dir / "x.bmp").string()); }),
+  EXPECT_EQ(test::input_error_of([&] { read_image(missing); }), missing + ": cannot open the image file");
+  EXPECT_EQ(test::input_error_of([&] { read_image((dir / "empty.png").string()); }), (dir / "empty.png").string() + ": empty image file");
+  EXPECT_EQ(test::input_error_of([&] { read_image((dir / "x.bmp").string()); }),
             (dir / "x.bmp").string() + ": not a PNG or PNM (PBM, PGM, PPM) image");
-  EXPECT_EQ(error_of([&] { read_image(dir.path().string()); }).find(dir.path().string() + ": "), 0u);
+  EXPECT_EQ(test::input_error_of([&] { read_image(dir.path().string()); }).find(dir.path().string() + ": "), 0u);
   EXPECT_THROW(read_header(missing), InputError);
 }
 

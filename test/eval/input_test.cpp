@@ -18,14 +18,6 @@ void write_file(const std::filesystem::path& p, const std::string& text) {
   std::ofstream(p) << text;
 }
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
 
 TEST(EvalInput, FrameListReadsTheFirstColumn) {
   kestrel::test::TempDir dir;
@@ -41,13 +33,13 @@ TEST(EvalInput, BadFrameListsNameFileAndLine) {
   kestrel::test::TempDir dir;
   const std::string path = dir / "rgb.txt";
   write_file(path, "1.0 a.png\nx.5 b.png\n");
-  EXPECT_NE(error_of([&] { read_frame_list(path); }).find(path + ":2: bad timestamp 'x.5'"),
+  EXPECT_NE(kestrel::test::input_error_of([&] { read_frame_list(path); }).find(path + ":2: bad timestamp 'x.5'"),
             std::string::npos);
   write_file(path, "2.0 a.png\n1.0 b.png\n");
-  EXPECT_NE(error_of([&] { read_frame_list(path); }).find(path + ":2: timestamp 1.0 is not after"),
+  EXPECT_NE(kestrel::test::input_error_of([&] { read_frame_list(path); }).find(path + ":2: timestamp 1.0 is not after"),
             std::string::npos);
   const std::string missing = dir / "missing.txt";
-  EXPECT_NE(error_of([&] { read_frame_list(missing); }).find(missing + ": cannot open"),
+  EXPECT_NE(kestrel::test::input_error_of([&] { read_frame_list(missing); }).find(missing + ": cannot open"),
             std::string::npos);
 }
 
@@ -59,7 +51,7 @@ TEST(EvalInput, TumInputListsEveryPoseAsAFrame) {
   EXPECT_EQ(in.frame, PoseFrame::kUnspecified);
   EXPECT_TRUE(in.diagnostics.problems().empty());
   write_file(dir / "nan.txt", "1.0 0 nan 0 0 0 0 1\n");
-  EXPECT_NE(error_of([&] { read_tum_input(dir / "nan.txt"); }).find(":1: non-finite value"),
+  EXPECT_NE(kestrel::test::input_error_of([&] { read_tum_input(dir / "nan.txt"); }).find(":1: non-finite value"),
             std::string::npos);
 }
 
@@ -100,7 +92,7 @@ TEST(EvalInput, FramesThatCannotBeReconciledAreAnError) {
   gt.source = "gt.lcmlog:GROUND_TRUTH";
   gt.frame = PoseFrame::kCamera;
   est.frame = PoseFrame::kBody;
-  EXPECT_NE(error_of([&] {
+  EXPECT_NE(kestrel::test::input_error_of([&] {
               reconcile_frames(gt, est);
             }).find("gt.lcmlog:GROUND_TRUTH: ground truth of the camera"),
             std::string::npos);

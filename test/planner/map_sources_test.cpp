@@ -17,15 +17,6 @@ namespace {
 
 void write(const std::filesystem::path& p, const std::string& text) { std::ofstream(p) << text; }
 
-template <class F>
-std::string error_of(F f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
-}
 
 TEST(RosMap, GridIsTheImageFlippedWithThresholdsApplied) {
   kestrel::test::TempDir dir;
@@ -50,16 +41,16 @@ TEST(RosMap, GridIsTheImageFlippedWithThresholdsApplied) {
 TEST(RosMap, MalformedFilesGiveErrorsNamingTheFile) {
   kestrel::test::TempDir dir;
   const std::string missing = (dir / "missing.yaml").string();
-  EXPECT_NE(error_of([&] { read_ros_map(missing); }).find(missing), std::string::npos);
+  EXPECT_NE(kestrel::test::input_error_of([&] { read_ros_map(missing); }).find(missing), std::string::npos);
   const std::string bad = (dir / "bad.yaml").string();
   write(bad, "image: m.png\nresolution: [oops\n");
-  EXPECT_NE(error_of([&] { read_ros_map(bad); }).find(bad), std::string::npos);
+  EXPECT_NE(kestrel::test::input_error_of([&] { read_ros_map(bad); }).find(bad), std::string::npos);
   const std::string no_image = (dir / "noimage.yaml").string();
   write(no_image, "image: none.png\nresolution: 0.1\norigin: [0, 0, 0]\n");
-  EXPECT_NE(error_of([&] { read_ros_map(no_image); }).find("noimage.yaml"), std::string::npos);
+  EXPECT_NE(kestrel::test::input_error_of([&] { read_ros_map(no_image); }).find("noimage.yaml"), std::string::npos);
   const std::string nan = (dir / "nan.yaml").string();
   write(nan, "image: m.png\nresolution: -1\norigin: [0, 0, 0]\n");
-  EXPECT_NE(error_of([&] { read_ros_map(nan); }).find(nan), std::string::npos);
+  EXPECT_NE(kestrel::test::input_error_of([&] { read_ros_map(nan); }).find(nan), std::string::npos);
 }
 
 TEST(RosMap, SizesAreBoundedBeforeTheGridIsMade) {
@@ -68,11 +59,11 @@ TEST(RosMap, SizesAreBoundedBeforeTheGridIsMade) {
   image::write_png((dir / "m.png").string(), cv::Mat(4, 6, CV_8UC1, cv::Scalar(254)));
   const std::string coarse = (dir / "coarse.yaml").string();
   write(coarse, "image: m.png\nresolution: 1000\norigin: [0, 0, 0]\n");
-  EXPECT_NE(error_of([&] { read_ros_map(coarse); }).find(coarse + ":2: 'resolution' must be in"), std::string::npos)
-      << error_of([&] { read_ros_map(coarse); });
+  EXPECT_NE(kestrel::test::input_error_of([&] { read_ros_map(coarse); }).find(coarse + ":2: 'resolution' must be in"), std::string::npos)
+      << kestrel::test::input_error_of([&] { read_ros_map(coarse); });
   const std::string far = (dir / "far.yaml").string();
   write(far, "image: m.png\nresolution: 0.05\norigin: [0, 1e15, 0]\n");
-  EXPECT_NE(error_of([&] { read_ros_map(far); }).find(far + ":3: 'origin'"), std::string::npos);
+  EXPECT_NE(kestrel::test::input_error_of([&] { read_ros_map(far); }).find(far + ":3: 'origin'"), std::string::npos);
   const std::string fine = (dir / "fine.yaml").string();
   write(fine, "image: m.png\nresolution: 10\norigin: [0, 0, 0]\n");
   EXPECT_EQ(read_ros_map(fine).width, 6);
@@ -105,16 +96,16 @@ TEST(OctoMap, CorruptStreamsAndEmptyTreesAreErrorsNamingTheSource) {
   using mapper::OctreeFormat;
   const std::vector<uint8_t> junk{1, 2, 3, 4, 5};
   for (const OctreeFormat format : {OctreeFormat::kBinary, OctreeFormat::kFull})
-    EXPECT_NE(error_of([&] { mapper::read_octree(junk.data(), junk.size(), format, "MAP_OCTOMAP"); }).find("MAP_OCTOMAP"),
+    EXPECT_NE(kestrel::test::input_error_of([&] { mapper::read_octree(junk.data(), junk.size(), format, "MAP_OCTOMAP"); }).find("MAP_OCTOMAP"),
               std::string::npos);
   std::string deep = "# Octomap OcTree binary file\nid OcTree\nsize 40\nres 0.1\ndata\n";
   for (int i = 0; i < 200000; ++i) deep += std::string("\x03\x00", 2);  // child 0 an inner node, again and again
   const auto* bytes = reinterpret_cast<const uint8_t*>(deep.data());
-  EXPECT_NE(error_of([&] { mapper::read_octree(bytes, deep.size(), OctreeFormat::kBinary, "MAP_OCTOMAP"); })
+  EXPECT_NE(kestrel::test::input_error_of([&] { mapper::read_octree(bytes, deep.size(), OctreeFormat::kBinary, "MAP_OCTOMAP"); })
                 .find("MAP_OCTOMAP"),
             std::string::npos);
   octomap::OcTree empty(0.1);
-  EXPECT_NE(error_of([&] { project_octomap(empty, 0.0, 1.0, "MAP_OCTOMAP"); }).find("MAP_OCTOMAP"), std::string::npos);
+  EXPECT_NE(kestrel::test::input_error_of([&] { project_octomap(empty, 0.0, 1.0, "MAP_OCTOMAP"); }).find("MAP_OCTOMAP"), std::string::npos);
   // A real stream round-trips.
   octomap::OcTree tree(0.1);
   tree.updateNode(octomap::point3d(1.0f, 1.0f, 1.0f), true);

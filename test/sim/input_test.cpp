@@ -16,14 +16,6 @@
 namespace kestrel::sim {
 namespace {
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "(no InputError)";
-}
 
 const char* kHeader = "kestrel-world 1\nmaterial p plaster\n";
 
@@ -43,15 +35,15 @@ TEST(WorldFileTest, MalformedStatementsNameFileAndLine) {
       {"\n", "bad.world:3: the world has no surfaces"},
   };
   for (const Case& c : cases) {
-    const std::string message = error_of([&] { parse_world(kHeader + c.body, "bad.world"); });
+    const std::string message = kestrel::test::input_error_of([&] { parse_world(kHeader + c.body, "bad.world"); });
     EXPECT_NE(message.find(c.expected), std::string::npos) << "got: " << message;
   }
-  EXPECT_NE(error_of([] { parse_world("kestrel-world 2\n", "v.world"); }).find("v.world:1: expected the header"),
+  EXPECT_NE(kestrel::test::input_error_of([] { parse_world("kestrel-world 2\n", "v.world"); }).find("v.world:1: expected the header"),
             std::string::npos);
-  EXPECT_NE(error_of([] { load_world("/nonexistent/x.world"); }).find("/nonexistent/x.world: cannot open"),
+  EXPECT_NE(kestrel::test::input_error_of([] { load_world("/nonexistent/x.world"); }).find("/nonexistent/x.world: cannot open"),
             std::string::npos);
-  EXPECT_NE(error_of([] { load_world("atlantis"); }).find("unknown world 'atlantis'"), std::string::npos);
-  EXPECT_NE(error_of([] { load_world("stata"); }).find("--map"), std::string::npos);
+  EXPECT_NE(kestrel::test::input_error_of([] { load_world("atlantis"); }).find("unknown world 'atlantis'"), std::string::npos);
+  EXPECT_NE(kestrel::test::input_error_of([] { load_world("stata"); }).find("--map"), std::string::npos);
 }
 
 TEST(OccupancyMapTest, MalformedYamlNamesFileAndLine) {
@@ -61,15 +53,15 @@ TEST(OccupancyMapTest, MalformedYamlNamesFileAndLine) {
     return (dir / name).string();
   };
   const std::string bad_number = write("a.yaml", "image: m.png\nresolution: fast\norigin: [0, 0, 0]\n");
-  EXPECT_NE(error_of([&] { read_occupancy_map(bad_number); }).find(bad_number + ":2: 'resolution' must be a number"),
+  EXPECT_NE(kestrel::test::input_error_of([&] { read_occupancy_map(bad_number); }).find(bad_number + ":2: 'resolution' must be a number"),
             std::string::npos);
   const std::string bad_origin = write("b.yaml", "image: m.png\nresolution: 0.05\norigin: [0, 0]\n");
-  EXPECT_NE(error_of([&] { read_occupancy_map(bad_origin); }).find(bad_origin + ":3: 'origin'"), std::string::npos);
+  EXPECT_NE(kestrel::test::input_error_of([&] { read_occupancy_map(bad_origin); }).find(bad_origin + ":3: 'origin'"), std::string::npos);
   const std::string no_image = write("c.yaml", "image: missing.png\nresolution: 0.05\norigin: [0, 0, 0]\n");
-  EXPECT_NE(error_of([&] { read_occupancy_map(no_image); }).find(no_image + ":1: cannot read map image"),
+  EXPECT_NE(kestrel::test::input_error_of([&] { read_occupancy_map(no_image); }).find(no_image + ":1: cannot read map image"),
             std::string::npos);
   const std::string broken = write("d.yaml", "image: m.png\nresolution: [0.05\n");
-  EXPECT_NE(error_of([&] { read_occupancy_map(broken); }).find(broken + ":"), std::string::npos);
+  EXPECT_NE(kestrel::test::input_error_of([&] { read_occupancy_map(broken); }).find(broken + ":"), std::string::npos);
 }
 
 TEST(CatalogueTest, BuiltInWorldsLoadWithTheirNames) {

@@ -18,14 +18,6 @@
 namespace kestrel::sim {
 namespace {
 
-std::string refusal_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "(no InputError)";
-}
 
 void write_text(const std::filesystem::path& path, const std::string& bytes) {
   std::ofstream(path, std::ios::binary) << bytes;
@@ -65,13 +57,13 @@ TEST_F(MapBounds, ResolutionMustBeBetweenAMillimetreAndTenMetres) {
   write_text(dir / "m.pgm", pgm(6, 4, 254));
   for (const std::string bad : {"1000", "0", "-0.05", "1e-9", "1e300"}) {
     const std::string yaml = map("m.pgm", bad);
-    EXPECT_NE(refusal_of([&] { read_occupancy_map(yaml); })
+    EXPECT_NE(kestrel::test::input_error_of([&] { read_occupancy_map(yaml); })
                   .find(yaml + ":2: 'resolution' must be in [0.001, 10] m per pixel, got "),
               std::string::npos)
-        << bad << ": " << refusal_of([&] { read_occupancy_map(yaml); });
+        << bad << ": " << kestrel::test::input_error_of([&] { read_occupancy_map(yaml); });
   }
   const std::string nan = map("m.pgm", ".nan");
-  EXPECT_NE(refusal_of([&] { read_occupancy_map(nan); }).find(nan + ":2: 'resolution' must be a number"),
+  EXPECT_NE(kestrel::test::input_error_of([&] { read_occupancy_map(nan); }).find(nan + ":2: 'resolution' must be a number"),
             std::string::npos);
   const std::string coarsest = map("m.pgm", "10");
   EXPECT_EQ(read_occupancy_map(coarsest).image.cols, 6);  // the bound itself is a map
@@ -80,12 +72,12 @@ TEST_F(MapBounds, ResolutionMustBeBetweenAMillimetreAndTenMetres) {
 TEST_F(MapBounds, OriginMustBeWithinTenKilometres) {
   write_text(dir / "m.pgm", pgm(6, 4, 254));
   const std::string far = map("m.pgm", "0.05", "[1e12, 0, 0]");
-  EXPECT_NE(refusal_of([&] { read_occupancy_map(far); })
+  EXPECT_NE(kestrel::test::input_error_of([&] { read_occupancy_map(far); })
                 .find(far + ":3: 'origin' x and y must be within +-10000 m, got [1e+12, 0]"),
             std::string::npos)
-      << refusal_of([&] { read_occupancy_map(far); });
+      << kestrel::test::input_error_of([&] { read_occupancy_map(far); });
   const std::string south = map("m.pgm", "0.05", "[0, -2e4, 0]");
-  EXPECT_NE(refusal_of([&] { read_occupancy_map(south); }).find(south + ":3: 'origin'"), std::string::npos);
+  EXPECT_NE(kestrel::test::input_error_of([&] { read_occupancy_map(south); }).find(south + ":3: 'origin'"), std::string::npos);
   const std::string edge = map("m.pgm", "0.05", "[10000, -10000, 3.14]");
   EXPECT_NEAR(read_occupancy_map(edge).origin.x(), 1e4, 1e-9);
 }
@@ -93,11 +85,11 @@ TEST_F(MapBounds, OriginMustBeWithinTenKilometres) {
 TEST_F(MapBounds, AMapWiderThanOneKilometreNamesResolutionAndImage) {
   write_text(dir / "wide.pgm", pgm(2000, 10, 254));
   const std::string wide = map("wide.pgm", "0.6");  // 1200 m
-  EXPECT_NE(refusal_of([&] { read_occupancy_map(wide); })
+  EXPECT_NE(kestrel::test::input_error_of([&] { read_occupancy_map(wide); })
                 .find(wide + ":2: 'resolution' 0.6 m per pixel makes the 2000 x 10 pixels of map image '" +
                       image_path("wide.pgm") + "' 1200 x 6 m; a map spans at most 1000 m"),
             std::string::npos)
-      << refusal_of([&] { read_occupancy_map(wide); });
+      << kestrel::test::input_error_of([&] { read_occupancy_map(wide); });
   const std::string fits = map("wide.pgm", "0.5");  // 1000 m: the bound itself
   EXPECT_EQ(read_occupancy_map(fits).image.cols, 2000);
 }
@@ -109,27 +101,27 @@ TEST_F(MapBounds, ImageHeadersClaimingTooManyPixelsAreRefusedBeforeDecoding) {
   for (const auto& [name, size] : std::vector<std::pair<std::string, std::string>>{
            {"bomb.png", "100000 x 100000"}, {"bomb.pgm", "60000 x 60000"}}) {
     const std::string yaml = map(name, "0.001");  // 100 m and 60 m: only the pixel count is wrong
-    EXPECT_NE(refusal_of([&] { read_occupancy_map(yaml); })
+    EXPECT_NE(kestrel::test::input_error_of([&] { read_occupancy_map(yaml); })
                   .find(yaml + ":1: map image '" + image_path(name) + "' is " + size +
                         " pixels, more than the 25000000 a map may have"),
               std::string::npos)
-        << refusal_of([&] { read_occupancy_map(yaml); });
+        << kestrel::test::input_error_of([&] { read_occupancy_map(yaml); });
   }
   write_text(dir / "empty.pgm", "P5\n0 10\n255\n");
   const std::string empty = map("empty.pgm", "0.05");
-  EXPECT_NE(refusal_of([&] { read_occupancy_map(empty); }).find(empty + ":1: map image '" + image_path("empty.pgm") +
+  EXPECT_NE(kestrel::test::input_error_of([&] { read_occupancy_map(empty); }).find(empty + ":1: map image '" + image_path("empty.pgm") +
                                                                "' has no pixels (0 x 10 pixels)"),
             std::string::npos)
-      << refusal_of([&] { read_occupancy_map(empty); });
+      << kestrel::test::input_error_of([&] { read_occupancy_map(empty); });
 }
 
 TEST_F(MapBounds, OnlyFormatsWhoseHeaderIsCheckedAreRead) {
   write_text(dir / "m.bmp", "BM" + std::string(60, '\0'));
   const std::string bmp = map("m.bmp", "0.05");
-  EXPECT_NE(refusal_of([&] { read_occupancy_map(bmp); })
+  EXPECT_NE(kestrel::test::input_error_of([&] { read_occupancy_map(bmp); })
                 .find(bmp + ":1: map image '" + image_path("m.bmp") + "' is not a PNG or PNM (PGM, PPM, PBM) file"),
             std::string::npos)
-      << refusal_of([&] { read_occupancy_map(bmp); });
+      << kestrel::test::input_error_of([&] { read_occupancy_map(bmp); });
   // A PNM's size may come after comment lines, as GIMP writes them.
   write_text(dir / "commented.pgm", "P5\n# one\n# two\n3\n# between\n2\n255\n" + std::string(6, '\xfe'));
   const OccupancyMap m = read_occupancy_map(map("commented.pgm", "0.05"));
@@ -156,7 +148,7 @@ TEST(WorldFileBounds, CoordinatesBeyondFiveHundredMetresNameTheField) {
       {"floor p 0 0 1 1 0\nstart 0 -600 1 0\n", "bad.world:4: start: y '-600' is beyond +-500 m"},
   };
   for (const Case& c : cases) {
-    const std::string message = refusal_of([&] { parse_world(header + c.body, "bad.world"); });
+    const std::string message = kestrel::test::input_error_of([&] { parse_world(header + c.body, "bad.world"); });
     EXPECT_NE(message.find(c.expected), std::string::npos) << "got: " << message;
   }
   // A world of the full size is a world; a yaw is an angle, not bounded.

@@ -1,5 +1,7 @@
 #include "test/support/test_support.h"
 
+#include "common/error.h"
+
 #include <fcntl.h>
 #include <poll.h>
 #include <sched.h>
@@ -19,6 +21,15 @@
 #include "common/transport/lcm_url.h"
 
 namespace kestrel::test {
+
+std::string input_error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "(no InputError)";
+}
 
 std::filesystem::path shared_data() {
   std::filesystem::path p = KESTREL_SHARED_DATA;

@@ -6,6 +6,7 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -64,6 +65,10 @@ std::string quoted(const std::string& s);
 /// Whether a test that cannot run here (no network namespace, no ../shared/data, a tool or a
 /// system program missing) fails instead of skipping. Under CI=true every environment the
 /// suite needs is provided, so a skip there is a set-up step that went missing, not a pass.
+/// The message of the InputError that `f` throws, or "(no InputError)" when it throws none
+/// (any other exception propagates, failing the test).
+std::string input_error_of(const std::function<void()>& f);
+
 inline bool environmental_skips_fail() {
   const char* ci = std::getenv("CI");
   return ci != nullptr && std::string(ci) == "true";
