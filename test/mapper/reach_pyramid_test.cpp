@@ -146,6 +146,9 @@ TEST(Ray, IndexOnlyWalksVisitOctomapsRayCells) {
   size_t walked = 0;
   std::vector<IndexWalk> walks;
   std::vector<std::vector<int>> wanted;
+  // One KeyRay for every trial: each allocates and clears room for 100,000 keys, which was
+  // most of this test's time (and, under ASan, an mmap per trial). computeRayKeys resets it.
+  octomap::KeyRay expected;
   for (int trial = 0; trial < 20000; ++trial) {
     const int k = kind(rng);
     octomap::point3d origin(static_cast<float>(any(rng)), static_cast<float>(any(rng)), static_cast<float>(any(rng)));
@@ -159,7 +162,6 @@ TEST(Ray, IndexOnlyWalksVisitOctomapsRayCells) {
     ASSERT_TRUE(keys.key(origin, key_origin));
     const Ray ray = make_ray(keys, origin, key_origin, end, 10.0);
     if (!ray.clears) continue;
-    octomap::KeyRay expected;
     ASSERT_TRUE(tree.computeRayKeys(origin, ray.end, expected));
     auto grid_index = [&](const Key& key) {
       int idx = 0;
