@@ -133,8 +133,8 @@ int run(const Options& o) {
     std::cout << "flight vehicle (closed loop)\n";
     return kExitOk;
   }
-  if (o.world == "stata" && o.map.empty())
-    throw CLI::ValidationError("--world", "world 'stata' needs an occupancy map (--map FILE.yaml)");
+  if (const std::string problem = sim::world_choice_error(o.world, o.map); !problem.empty())
+    throw CLI::ValidationError("--world", problem);
   const auto t0 = Clock::now();
   const sim::World world = sim::load_world(o.world, o.map);
   std::unique_ptr<sim::Flight> flight;

@@ -4,8 +4,10 @@
 
 #include <cmath>
 #include <cstdio>
-#include <limits>
 #include <iostream>
+#include <limits>
+#include <memory>
+#include <stdexcept>
 
 #include "common/cli.h"
 #include "common/error.h"
@@ -29,12 +31,21 @@ struct Options {
 };
 
 int run(const Options& o) {
+  // What the command line chose is checked before any input is read: a world or flight there
+  // is not is a usage error (exit 2), as in `kestrel sim`; a bad folder or file is input (3).
+  if (const std::string problem = sim::world_choice_error(o.world, o.map); !problem.empty())
+    throw CLI::ValidationError("--world", problem);
+  const sim::World world = sim::load_world(o.world, o.map);
+  std::unique_ptr<sim::Flight> flight;
+  try {
+    flight = sim::make_flight(o.flight, world);
+  } catch (const std::invalid_argument& e) {
+    throw CLI::ValidationError("--flight", e.what());
+  }
   std::vector<sim::FrameStats> real, simulated;
   const tum::TumSequence sequence(o.tum, tum::SequenceOptions{});
   for (size_t i = 0; i < sequence.size() && static_cast<int>(i) < o.frames; ++i)
     real.push_back(sim::frame_stats(sequence.frame(i)));
-  const sim::World world = sim::load_world(o.world, o.map);
-  const auto flight = sim::make_flight(o.flight, world);
   sim::SimulationOptions so;
   so.seed = o.seed;
   sim::Simulation simulation(world, *flight, so);

@@ -40,6 +40,11 @@ std::string unknown_world_error(const std::string& what, bool with_stata) {
   return "unknown world '" + what + "' (built in: " + known + "; or a .world file or an occupancy map .yaml)";
 }
 
+std::string world_choice_error(const std::string& world, const std::string& map_yaml) {
+  if (world == "stata" && map_yaml.empty()) return "world 'stata' needs an occupancy map (--map FILE.yaml)";
+  return unknown_world_error(world);
+}
+
 World load_world(const std::string& what, const std::string& map_yaml, uint64_t map_seed) {
   if (const auto text = builtin_world_text(what)) return parse_world(*text, "drivers/sim/worlds/" + what + ".world");
   MapWorldOptions options;

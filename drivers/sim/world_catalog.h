@@ -24,6 +24,11 @@ std::optional<std::string> builtin_world_text(const std::string& name);
 /// holds a question of input (exit 3).
 std::string unknown_world_error(const std::string& what, bool with_stata = true);
 
+/// Empty when (`world`, `map_yaml`) names a world load_world() can try: unknown_world_error()
+/// and "stata" without its map. The check a tool with --world and --map makes of its command
+/// line before it reads any input.
+std::string world_choice_error(const std::string& world, const std::string& map_yaml);
+
 /// `what` is an embedded world's name, "stata" (built from `map_yaml`), a path to a world file
 /// (*.world) or a path to an occupancy map (*.yaml). `map_seed` sets the appearance of worlds
 /// built from maps. Throws InputError for an unknown name or bad file (naming it).

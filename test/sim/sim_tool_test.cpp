@@ -212,6 +212,26 @@ TEST(SimToolTest, BadInputIsOneLineNamingTheFileWithExitCode3) {
   const auto help = run({tool("sim").string(), "--help"});
   EXPECT_EQ(help.exit_code, 0);
   EXPECT_NE(help.out.find("--flight"), std::string::npos);
+
+  // sim-realism takes the same worlds and flights, with the same exit codes, and says so
+  // before it reads its TUM folder (absent here: that would be exit 3).
+  const std::string no_tum = (dir / "no-tum").string();
+  struct Case {
+    std::vector<std::string> args;
+    std::string says;
+  };
+  for (const Case& c : std::vector<Case>{{{"--world", "atlantis"}, "--world: unknown world 'atlantis'"},
+                                         {{"--world", "stata"}, "--world: world 'stata' needs an occupancy map"},
+                                         {{"--flight", "barrel-roll"}, "unknown flight 'barrel-roll'"}}) {
+    std::vector<std::string> argv{tool("sim-realism").string(), "--tum", no_tum};
+    argv.insert(argv.end(), c.args.begin(), c.args.end());
+    const auto r = run(argv);
+    EXPECT_EQ(r.exit_code, 2) << c.args[1] << ": " << r.err;
+    EXPECT_NE(r.err.find("kestrel-sim-realism: error: "), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(c.says), std::string::npos) << r.err;
+  }
+  const auto absent_tum = run({tool("sim-realism").string(), "--tum", no_tum});
+  EXPECT_EQ(absent_tum.exit_code, 3) << absent_tum.err;
 }
 
 }  // namespace
