@@ -141,6 +141,7 @@ TEST(PlannerProcess, AnswersEveryRequestOverLcmAndRepeatsAfterReset) {
   EXPECT_EQ(a[0].status, kestrel::plan_t::STATUS_NO_MAP);
   EXPECT_EQ(a[3].status, kestrel::plan_t::STATUS_GOAL_IN_COLLISION);
   EXPECT_EQ(a[4].status, kestrel::plan_t::STATUS_BAD_REQUEST);
+  EXPECT_EQ(a[4].message, "PLAN_REQUEST: unknown planner 7");  // answered, naming the field
   for (int k : {1, 2, 5}) {
     const kestrel::plan_t& p = a[k];
     ASSERT_EQ(p.status, kestrel::plan_t::STATUS_OK) << p.message;
