@@ -3,6 +3,8 @@
 # Debian's LCM 1.3.1 ships no CMake helpers, so this runs lcm-gen itself. It generates the C++
 # headers into <build>/lcmtypes/<package>/<type>.hpp at build time and exposes them through an
 # INTERFACE library, so that `#include "kestrel/rgbd_frame_t.hpp"` works for anyone linking it.
+# The generated decoders are then made to refuse array counts the message cannot hold
+# (lcm_guard_counts.cmake): lcm-gen's size arrays from the count before checking it.
 
 find_program(LCM_GEN_EXECUTABLE lcm-gen REQUIRED)
 
@@ -19,7 +21,8 @@ function(kestrel_lcmtypes)
     OUTPUT ${outputs}
     COMMAND ${CMAKE_COMMAND} -E make_directory ${out_root}
     COMMAND ${LCM_GEN_EXECUTABLE} --cpp --cpp-std c++11 --cpp-hpath ${out_root} ${abs_files}
-    DEPENDS ${abs_files}
+    COMMAND ${CMAKE_COMMAND} "-DFILES=${outputs}" -P ${PROJECT_SOURCE_DIR}/cmake/lcm_guard_counts.cmake
+    DEPENDS ${abs_files} ${PROJECT_SOURCE_DIR}/cmake/lcm_guard_counts.cmake
     COMMENT "lcm-gen: ${ARG_PACKAGE} message types"
     VERBATIM)
   add_custom_target(${ARG_TARGET}_gen DEPENDS ${outputs})

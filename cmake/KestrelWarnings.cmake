@@ -39,6 +39,17 @@ if(KESTREL_SANITIZE)
   target_link_options(kestrel_options INTERFACE -fsanitize=address,undefined -fno-sanitize=object-size)
 endif()
 
+# The fuzz build (`./kestrel fuzz`, fuzz/README.md): every library is compiled with libFuzzer's
+# coverage instrumentation, on top of the sanitizers, so that the fuzzer sees which branches of
+# the decoders an input reached; kestrel-fuzz links libFuzzer's driver (fuzz/CMakeLists.txt).
+if(KESTREL_FUZZ)
+  if(NOT CMAKE_CXX_COMPILER_ID MATCHES "Clang" OR NOT KESTREL_SANITIZE)
+    message(FATAL_ERROR "KESTREL_FUZZ needs clang and KESTREL_SANITIZE=ON (the fuzz preset)")
+  endif()
+  target_compile_options(kestrel_options INTERFACE -fsanitize=fuzzer-no-link)
+  target_link_options(kestrel_options INTERFACE -fsanitize=fuzzer-no-link)
+endif()
+
 if(CMAKE_BUILD_TYPE STREQUAL "Release")
   # -O3 lets GCC vectorise the per-pixel loops; keep asserts out of the hot paths. The tests'
   # own code (targets with KESTREL_TEST_CODE: the test executables and their precompiled

@@ -65,6 +65,8 @@ cv::Mat decode_pnm(const std::vector<uint8_t>& bytes, const std::string& what) {
   if (bytes.size() < 2 || bytes[0] != 'P') return fail("not a PNM file");
   const char kind = static_cast<char>(bytes[1]);
   if (kind < '1' || kind > '6') return fail("not a PBM, PGM or PPM file");
+  // Netpbm: whitespace follows the magic number ("P13" is no PBM); parse_header agrees.
+  if (bytes.size() < 3 || !std::isspace(bytes[2])) return fail("no whitespace after the magic number P" + std::string(1, kind));
   const int channels = (kind == '3' || kind == '6') ? 3 : 1;
   const bool plain = kind <= '3';
   const bool bitmap = kind == '1' || kind == '4';

@@ -33,8 +33,16 @@ struct FreeMask {
   bool contains(const Eigen::Vector3d& p) const;
 };
 
+/// What of a world to build: everything, or its geometry alone (surfaces, boxes, bounds,
+/// start, lights, collision queries) for what never renders it (a file's check, fuzzing):
+/// textures and light maps are most of the time a world takes to build.
+enum class WorldParts { kAll, kGeometry };
+
 class World {
  public:
+  /// False for a world built with WorldParts::kGeometry: look(), wear_texture() and
+  /// feature_density() must not be called on it.
+  bool has_appearance() const { return wear_ != nullptr; }
   const std::string& name() const { return name_; }
   /// The file or map the world was read from ("" if built in code).
   const std::string& source() const { return source_; }

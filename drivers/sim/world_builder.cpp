@@ -106,7 +106,7 @@ int WorldBuilder::add_slab(int material, const Eigen::Vector2d& a, const Eigen::
   return add_box(material, T, {0.5 * d.norm(), 0.5 * thickness, 0.5 * (z1 - z0)}, texture);
 }
 
-World WorldBuilder::build() {
+World WorldBuilder::build(WorldParts parts) {
   World w;
   w.name_ = name_;
   w.source_ = source_;
@@ -120,6 +120,20 @@ World WorldBuilder::build() {
   const Eigen::Vector3d centre = w.bounds_.center();
   w.start_ = start_ ? *start_ : Eigen::Vector4d(centre.x(), centre.y(), w.bounds_.min().z() + 1.2, 0.0);
   w.index_ = CollisionIndex(surfaces_, boxes_);
+  if (parts == WorldParts::kAll) add_appearance(w);
+  w.materials_ = std::move(materials_);
+  w.surfaces_ = std::move(surfaces_);
+  w.boxes_ = std::move(boxes_);
+  w.lights_ = std::move(lights_);
+  w.free_mask_ = std::move(free_mask_);
+  materials_.clear();
+  surfaces_.clear();
+  boxes_.clear();
+  lights_.clear();
+  return w;
+}
+
+void WorldBuilder::add_appearance(World& w) const {
   w.looks_ = make_looks(surfaces_, materials_, seed_);
   compute_shade_maps(w.looks_, surfaces_, lights_, w.index_, lighting_, seed_);
   // Tiled surfaces of one material and density share a texture: measure each pair once.
@@ -131,16 +145,6 @@ World WorldBuilder::build() {
     look.features_per_m2 = it->second;
   }
   w.wear_ = make_wear_texture(seed_);
-  w.materials_ = std::move(materials_);
-  w.surfaces_ = std::move(surfaces_);
-  w.boxes_ = std::move(boxes_);
-  w.lights_ = std::move(lights_);
-  w.free_mask_ = std::move(free_mask_);
-  materials_.clear();
-  surfaces_.clear();
-  boxes_.clear();
-  lights_.clear();
-  return w;
 }
 
 }  // namespace kestrel::sim

@@ -52,10 +52,13 @@ class WorldBuilder {
   size_t surface_count() const { return surfaces_.size(); }
   const std::vector<Surface>& surfaces() const { return surfaces_; }
 
-  /// Generates everything and returns the finished world; the builder is left empty.
-  World build();
+  /// Generates the world's `parts` (by default everything) and returns it; the builder is
+  /// left empty.
+  World build(WorldParts parts = WorldParts::kAll);
 
  private:
+  // Textures, light maps and feature densities: most of a build's time.
+  void add_appearance(World& w) const;
   int add_surface(Surface s, SurfaceKind kind, int material, double texture);
   void check_material(int material) const;
 

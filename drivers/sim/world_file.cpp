@@ -138,10 +138,10 @@ class Parser {
     st.fail("unknown statement '" + k + "'");
   }
 
-  World finish(int last_line) {
+  World finish(int last_line, WorldParts parts) {
     if (!header_seen_) throw InputError(at_line(source_, std::max(1, last_line), "empty world (no 'kestrel-world 1' header)"));
     if (builder_.surface_count() == 0) throw InputError(at_line(source_, last_line, "the world has no surfaces"));
-    return builder_.build();
+    return builder_.build(parts);
   }
 
  private:
@@ -273,7 +273,7 @@ class Parser {
 
 }  // namespace
 
-World parse_world(const std::string& text, const std::string& source) {
+World parse_world(const std::string& text, const std::string& source, WorldParts parts) {
   Parser parser(source);
   std::istringstream in(text);
   std::string line;
@@ -285,7 +285,7 @@ World parse_world(const std::string& text, const std::string& source) {
     if (is_comment_or_blank(view)) continue;
     parser.statement(Statement(split_fields(view), source, line_no));
   }
-  return parser.finish(line_no);
+  return parser.finish(line_no, parts);
 }
 
 World load_world_file(const std::string& path) {

@@ -16,8 +16,9 @@ namespace kestrel::sim {
 /// A world spans at most 1 km along each axis (a collision index of a million cells).
 inline constexpr double kMaxWorldCoordinate_m = 500.0;
 
-/// Parses world text; `source` names it in errors and becomes World::source().
-World parse_world(const std::string& text, const std::string& source);
+/// Parses world text; `source` names it in errors and becomes World::source(). `parts`:
+/// what to build of it (world.h).
+World parse_world(const std::string& text, const std::string& source, WorldParts parts = WorldParts::kAll);
 
 /// Reads and parses a world file; a missing file is an InputError naming it.
 World load_world_file(const std::string& path);

@@ -232,6 +232,9 @@ TEST(PnmDecode, BadFilesSayWhatIsWrong) {
       {"P2 2 1 9\n3 10", "sample 10 is above maxval 9"},
       {"P5 100000 100000 65535\n", "100000 x 100000 pixels is more than 1024 MiB"},
       {"P4 9 2\n\x01", "truncated: 1 bytes of bits, 4 needed"},
+      // Found by fuzzing: decode_pnm took "P13" as P1 of width 3, parse_header as no PNM.
+      {"P13 2 1\n1 0 1\n", "no whitespace after the magic number P1"},
+      {"P5", "no whitespace after the magic number P5"},
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(c.bytes);

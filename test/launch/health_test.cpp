@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 namespace kestrel::launch {
 namespace {
 
@@ -52,6 +54,26 @@ TEST(HealthBoard, FollowsEachProcessThroughItsLife) {
   rows = board.rows(t0 + milliseconds(5200));
   EXPECT_EQ(rows[0].state, "starting");
   EXPECT_EQ(rows.back().name, "vo (not launched here)");  // the stale pid, shown apart
+}
+
+// A heartbeat's name and message reach the terminal escaped, whatever bytes they hold (found
+// by fuzzing: a backspace and invalid UTF-8 in a message went to the table raw).
+TEST(HealthBoard, TheTableEscapesBytesThatDoNotPrint) {
+  HealthBoard board(3.0);
+  const auto t0 = Clock::now();
+  board.started("vo", 100, t0);
+  process_status_t s = beat("v\x1b[2Jo", 100, process_status_t::STATE_DEGRADED);
+  s.message = std::string("rejecting IMU: be\x08yond s\xea\xa5 range\nnext");
+  board.heartbeat(s, t0);
+  process_status_t stranger = beat("x\ty", 7, process_status_t::STATE_RUNNING);
+  board.heartbeat(stranger, t0);
+  const std::string table = board.table(t0);
+  for (const char c : table) {
+    const auto u = static_cast<unsigned char>(c);
+    EXPECT_FALSE((u < 0x20 && c != '\n') || u >= 0x7f) << "byte " << int(u) << " in:\n" << table;
+  }
+  EXPECT_EQ(std::count(table.begin(), table.end(), '\n'), 3) << table;  // header and two rows
+  EXPECT_NE(table.find("be\\x08yond s\\xEA\\xA5 range\\nnext"), std::string::npos) << table;
 }
 
 TEST(HealthBoard, ASourceWithoutHeartbeatsIsRunningUntilItEnds) {

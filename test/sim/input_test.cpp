@@ -46,6 +46,27 @@ TEST(WorldFileTest, MalformedStatementsNameFileAndLine) {
   EXPECT_NE(kestrel::test::input_error_of([] { load_world("stata"); }).find("--map"), std::string::npos);
 }
 
+// A world built for its geometry alone has every shape and collision query of the whole one,
+// and says that it has no appearance.
+TEST(WorldFileTest, AGeometryOnlyWorldAnswersCollisionQueriesAsTheWholeOne) {
+  const std::string text = std::string(kHeader) +
+                           "bounds 0 0 0 4 3 2.5\nfloor p 0 0 4 3 0\nwall p 0 0 4 0 z 0 2.5\n"
+                           "wall p 4 3 0 3 z 0 2.5\nbox p 1.7 1.2 0 2.3 1.8 1.0\nlight 2 1.5 2.4 1\n";
+  const World whole = parse_world(text, "room.world");
+  const World geometry = parse_world(text, "room.world", WorldParts::kGeometry);
+  EXPECT_TRUE(whole.has_appearance());
+  EXPECT_FALSE(geometry.has_appearance());
+  EXPECT_EQ(geometry.surfaces().size(), whole.surfaces().size());
+  EXPECT_EQ(geometry.boxes().size(), whole.boxes().size());
+  EXPECT_EQ(geometry.lights().size(), whole.lights().size());
+  EXPECT_TRUE(geometry.bounds().isApprox(whole.bounds()));
+  EXPECT_EQ(geometry.start(), whole.start());
+  for (const Eigen::Vector3d p : {Eigen::Vector3d(1.0, 1.0, 1.0), Eigen::Vector3d(2.0, 1.5, 0.5), Eigen::Vector3d(3.5, 0.2, 2.0)}) {
+    EXPECT_EQ(geometry.clearance(p), whole.clearance(p));
+    EXPECT_EQ(geometry.is_free(p, 0.2), whole.is_free(p, 0.2));
+  }
+}
+
 TEST(OccupancyMapTest, MalformedYamlNamesFileAndLine) {
   kestrel::test::TempDir dir;
   const auto write = [&](const std::string& name, const std::string& text) {

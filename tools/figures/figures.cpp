@@ -45,6 +45,7 @@ const std::vector<std::pair<std::string, std::string>> kReadmes = {
     {"eval", "tools/eval/README.md"},
     {"replay", "tools/replay/README.md"},
     {"launch", "tools/launch/README.md"},
+    {"fuzz", "fuzz/README.md"},
 };
 
 const std::set<std::string> kKeys = {"id",   "component", "table", "figure", "data",  "value",   "unit",

@@ -4,6 +4,8 @@
 
 #include <algorithm>
 
+#include "common/cli.h"
+
 namespace kestrel::launch {
 
 std::string state_name(int8_t state) {
@@ -80,9 +82,12 @@ std::string HealthBoard::table(Clock::time_point now) const {
                               "out", "rejected", "state", "message");
   for (const Row& r : rows(now)) {
     const auto& l = r.last;
-    s += fmt::format("{:<16} {:>7} {:>9} {:>9} {:>8}  {:<16} {}\n", r.name, r.pid,
+    // A heartbeat's strings are any bytes a process (or a corrupt message) put there: the
+    // terminal gets them escaped (found by fuzzing, fuzz/corpus/lcm-process_status_t/).
+    s += fmt::format("{:<16} {:>7} {:>9} {:>9} {:>8}  {:<16} {}\n", cli::printable(r.name), r.pid,
                      l ? std::to_string(l->messages_in) : "-", l ? std::to_string(l->messages_out) : "-",
-                     l ? std::to_string(l->messages_rejected) : "-", r.state, l ? l->message : "");
+                     l ? std::to_string(l->messages_rejected) : "-", r.state,
+                     l ? cli::printable(l->message) : "");
   }
   return s;
 }
