@@ -59,6 +59,12 @@ size_t utf8_length(std::string_view s, size_t i) {
 
 }  // namespace
 
+std::string number_text(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", v);
+  return text;
+}
+
 std::string escape_bytes(std::string_view text, std::string_view also) {
   std::string out;
   for (size_t i = 0; i < text.size(); ++i) {

@@ -21,6 +21,10 @@ std::optional<double> parse_double(std::string_view token);
 /// The whole token as a base-10 integer, or empty.
 std::optional<long long> parse_int(std::string_view token);
 
+/// `v` as printf's %g (six significant digits): the one way a number is written into an error
+/// message ("must be in [0.01, 1] m per pixel, got 1e+06").
+std::string number_text(double v);
+
 /// `text` with every byte that does not print escaped: \n, \t, \r, other control bytes and
 /// bytes that are not valid UTF-8 as \xHH; each character of `also` gets a backslash before it.
 /// The one escaping for text that reaches a terminal or a file from outside input (error

@@ -1,10 +1,9 @@
 // The mapper's journal (mapper/keyframe_journal.h), as a mapper started on it reads it and
 // rebuilds its map: every intact record kept, damage skipped, never a crash.
 
-#include <Eigen/Geometry>
 #include <filesystem>
 
-#include "common/transport/convert.h"
+#include "fuzz/examples.h"
 #include "fuzz/groups.h"
 #include "mapper/keyframe_journal.h"
 #include "mapper/mapper.h"
@@ -29,20 +28,7 @@ bool run_journal(const uint8_t* data, size_t size) {
 // A journal as a mapper writes it: two keyframes (a wall 1.5 m ahead, seen from two places),
 // a graph that moves the first, a third keyframe.
 std::vector<Bytes> journal_seeds() {
-  PinholeCamera camera;
-  camera.width = 32;
-  camera.height = 24;
-  camera.fx = camera.fy = 26.0;
-  camera.cx = 15.5;
-  camera.cy = 11.5;
-  const auto keyframe = [](int64_t id, double x) {
-    kestrel::slam_keyframe_t k{};
-    k.id = id;
-    k.utime = id;
-    k.T_world_camera = transport::to_message(Eigen::Isometry3d(Eigen::Translation3d(x, 0.0, 1.0)));
-    k.T_camera_depth = transport::to_message(Eigen::Isometry3d::Identity());
-    return k;
-  };
+  const PinholeCamera camera = small_camera(32, 24);
   const auto frame = [&](int64_t utime) {
     RgbdFrame f;
     f.utime = f.depth_utime = utime;

@@ -12,6 +12,7 @@
 #include "control/follower_node.h"
 #include "drivers/sim/messages.h"
 #include "estimator/messages.h"
+#include "fuzz/examples.h"
 #include "fuzz/groups.h"
 #include "kestrel/camera_info_t.hpp"
 #include "kestrel/ground_truth_t.hpp"
@@ -75,16 +76,6 @@ kestrel::pose3_t pose(double x, double y, double z, double yaw = 0.3) {
   return transport::to_message(Eigen::Translation3d(x, y, z) * Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()));
 }
 
-PinholeCamera small_camera() {
-  PinholeCamera c;
-  c.width = 64;
-  c.height = 48;
-  c.fx = c.fy = 52.5;
-  c.cx = 31.5;
-  c.cy = 23.5;
-  return c;
-}
-
 void set_identity_covariance(double (&c)[36], double variance) {
   for (int i = 0; i < 36; ++i) c[i] = i % 7 == 0 ? variance : 0.0;
 }
@@ -96,7 +87,7 @@ void convert_camera(const kestrel::camera_info_t& m) {
   transport::from_message(m.T_body_camera, "CAMERA_INFO");
 }
 std::vector<kestrel::camera_info_t> camera_examples() {
-  return {transport::to_message(small_camera(), Eigen::Isometry3d::Identity()),
+  return {transport::to_message(small_camera(64, 48), Eigen::Isometry3d::Identity()),
           transport::to_message(PinholeCamera::vga(525, 525, 319.5, 239.5), Eigen::Isometry3d(Eigen::Translation3d(0.1, 0, 0)))};
 }
 
@@ -267,7 +258,7 @@ std::vector<kestrel::rgbd_frame_t> frame_examples() {
   RgbdFrame f;
   f.utime = f.depth_utime = 1000000;
   f.seq = 3;
-  f.camera = small_camera();
+  f.camera = small_camera(64, 48);
   f.sensor = sensor_model::kSimulator;
   f.rgb = cv::Mat(48, 64, CV_8UC3);
   f.depth_mm = cv::Mat(48, 64, CV_16UC1);
@@ -313,15 +304,6 @@ std::vector<kestrel::slam_edge_t> edge_examples() {
   e.kind = kestrel::slam_edge_t::KIND_LOOP_CLOSURE;
   e.T_from_to = pose(0.2, 0, 0, 0.05);
   return {e};
-}
-
-kestrel::slam_keyframe_t keyframe(int64_t id, double x) {
-  kestrel::slam_keyframe_t k{};
-  k.id = id;
-  k.utime = id;
-  k.T_world_camera = pose(x, 0, 1);
-  k.T_camera_depth = transport::to_message(Eigen::Isometry3d::Identity());
-  return k;
 }
 
 // The mapper's: each keyframe's poses as it takes them.

@@ -74,8 +74,10 @@ bool run_world(const uint8_t* data, size_t size) {
     const sim::World w = sim::parse_world(std::string(reinterpret_cast<const char*>(data), size), "fuzz.world",
                                           sim::WorldParts::kGeometry);
     const Eigen::Vector3d start = w.start().head<3>();
-    if (!w.bounds().contains(start) && w.inside(start)) defect("world", "a start outside the bounds is inside");
-    w.clearance(start);
+    // The first questions the sim and the planner ask of a world they load; parse_world has
+    // already checked what a world must satisfy, so these must only not crash.
+    static_cast<void>(w.inside(start));
+    static_cast<void>(w.clearance(start));
   });
 }
 std::vector<Bytes> world_seeds() {

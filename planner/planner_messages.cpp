@@ -4,10 +4,10 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
-#include <cstdio>
 #include <string>
 
 #include "common/error.h"
+#include "common/text.h"
 #include "mapper/octree_io.h"
 #include "planner/map_sources.h"
 
@@ -16,12 +16,6 @@ namespace {
 
 constexpr const char* kRequest = "PLAN_REQUEST";
 
-std::string format_number(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
-}
-
 void check_position(const double (&q)[4], const char* field) {
   for (int i = 0; i < 4; ++i) {
     if (!std::isfinite(q[i])) throw InputError(std::string(kRequest) + ": " + field + " is not finite");
@@ -29,7 +23,7 @@ void check_position(const double (&q)[4], const char* field) {
   for (int i = 0; i < 3; ++i) {
     if (std::abs(q[i]) > kMaxPlanCoordinate_m) {
       throw InputError(std::string(kRequest) + ": " + field + " is farther than " +
-                       format_number(kMaxPlanCoordinate_m) + " m from the origin");
+                       number_text(kMaxPlanCoordinate_m) + " m from the origin");
     }
   }
 }
@@ -37,7 +31,7 @@ void check_position(const double (&q)[4], const char* field) {
 void check_trace(double trace, const char* field, bool zero_allowed) {
   if (!std::isfinite(trace) || trace < 0.0 || (!zero_allowed && trace == 0.0)) {
     throw InputError(std::string(kRequest) + ": " + field + " must be a finite number " +
-                     (zero_allowed ? ">= 0" : "> 0") + ", got " + format_number(trace));
+                     (zero_allowed ? ">= 0" : "> 0") + ", got " + number_text(trace));
   }
 }
 

@@ -5,12 +5,12 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <opencv2/imgproc.hpp>
 
 #include "common/error.h"
+#include "common/text.h"
 #include "common/image/image_io.h"
 
 namespace kestrel::sim {
@@ -28,13 +28,6 @@ double number(const YAML::Node& root, const std::string& path, const char* key) 
   } catch (const YAML::Exception&) {
     throw InputError(at_line(path, line_of(n), std::string("'") + key + "' must be a number"));
   }
-}
-
-// A number as %g, for messages.
-std::string number_text(double v) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%g", v);
-  return text;
 }
 
 // The image's size against the bounds (occupancy_map.h), before it is decoded.
