@@ -53,11 +53,16 @@ cv::Mat decode_pnm(const std::vector<uint8_t>& bytes, const std::string& what = 
 /// Reads and decodes the PNG or PNM file at `path` (the format from its first bytes).
 cv::Mat read_image(const std::string& path);
 
+/// How each row is predicted from the ones before it before zlib compresses it (PNG's filter
+/// types). kAdaptive tries all five on every row and keeps the one that looks smallest; it
+/// costs as much as zlib at level 1. Any choice decodes to the same pixels.
+enum class PngFilter { kAdaptive, kNone, kSub, kUp, kAverage, kPaeth };
+
 /// PNG bytes of an 8- or 16-bit image of 1 to 4 channels (layout as above). `level` is zlib's
 /// compression level, 0 (none) to 9 (smallest); 1 is fast and still halves depth images.
 /// Throws std::invalid_argument for an image it cannot represent (float, 5 channels, empty).
-std::vector<uint8_t> encode_png(const cv::Mat& image, int level = 6);
+std::vector<uint8_t> encode_png(const cv::Mat& image, int level = 6, PngFilter filter = PngFilter::kAdaptive);
 /// encode_png written to `path` atomically.
-void write_png(const std::string& path, const cv::Mat& image, int level = 6);
+void write_png(const std::string& path, const cv::Mat& image, int level = 6, PngFilter filter = PngFilter::kAdaptive);
 
 }  // namespace kestrel::image

@@ -96,7 +96,7 @@ cv::Mat decode_png(const std::vector<uint8_t>& bytes, const std::string& what) {
   return image;
 }
 
-std::vector<uint8_t> encode_png(const cv::Mat& image, int level) {
+std::vector<uint8_t> encode_png(const cv::Mat& image, int level, PngFilter filter) {
   if (image.empty()) throw std::invalid_argument("encode_png: empty image");
   if (image.depth() != CV_8U && image.depth() != CV_16U)
     throw std::invalid_argument("encode_png: only 8- and 16-bit images");
@@ -116,6 +116,9 @@ std::vector<uint8_t> encode_png(const cv::Mat& image, int level) {
   };
   ok(spng_set_option(ctx.get(), SPNG_ENCODE_TO_BUFFER, 1), "buffer");
   ok(spng_set_option(ctx.get(), SPNG_IMG_COMPRESSION_LEVEL, level), "level");
+  static constexpr int kFilterChoice[] = {SPNG_FILTER_CHOICE_ALL, SPNG_FILTER_CHOICE_NONE, SPNG_FILTER_CHOICE_SUB,
+                                          SPNG_FILTER_CHOICE_UP, SPNG_FILTER_CHOICE_AVG, SPNG_FILTER_CHOICE_PAETH};
+  ok(spng_set_option(ctx.get(), SPNG_FILTER_CHOICE, kFilterChoice[static_cast<int>(filter)]), "filter");
   spng_ihdr ihdr{};
   ihdr.width = static_cast<uint32_t>(rows.cols);
   ihdr.height = static_cast<uint32_t>(rows.rows);
@@ -132,8 +135,8 @@ std::vector<uint8_t> encode_png(const cv::Mat& image, int level) {
   return {first, first + length};
 }
 
-void write_png(const std::string& path, const cv::Mat& image, int level) {
-  const std::vector<uint8_t> bytes = encode_png(image, level);
+void write_png(const std::string& path, const cv::Mat& image, int level, PngFilter filter) {
+  const std::vector<uint8_t> bytes = encode_png(image, level, filter);
   write_file_atomically(path, bytes.data(), bytes.size());
 }
 

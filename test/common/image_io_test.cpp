@@ -165,6 +165,33 @@ TEST(PngEncode, EveryLayoutRoundTripsExactlyAtEveryLevel) {
   }
 }
 
+// With a fixed filter every row carries that filter's type byte (PNG 1.2, section 6: None 0,
+// Sub 1, Up 2, Average 3, Paeth 4); at level 0 zlib stores the rows as they are (a two-byte
+// zlib header, then one stored block: a byte of flags and four of lengths), so the bytes can be
+// read in the file. Each filter decodes to the same pixels.
+TEST(PngEncode, AFixedFilterIsWrittenOnEveryRowAndEveryFilterRoundTrips) {
+  cv::RNG rng(11);
+  cv::Mat image(6, 5, CV_16UC3);
+  rng.fill(image, cv::RNG::UNIFORM, 0, 65536);
+  const std::pair<PngFilter, int> fixed[] = {{PngFilter::kNone, 0}, {PngFilter::kSub, 1}, {PngFilter::kUp, 2},
+                                             {PngFilter::kAverage, 3}, {PngFilter::kPaeth, 4}};
+  const size_t row_bytes = 1 + 5 * 3 * 2;
+  for (const auto& [filter, type_byte] : fixed) {
+    const Bytes png = encode_png(image, 0, filter);
+    const std::string text(png.begin(), png.end());
+    const size_t idat = text.find("IDAT");
+    ASSERT_NE(idat, std::string::npos);
+    const size_t rows = idat + 4 + 2 + 5;
+    ASSERT_LE(rows + 6 * row_bytes, png.size());
+    for (int r = 0; r < 6; ++r) EXPECT_EQ(png[rows + r * row_bytes], type_byte) << "row " << r << " filter " << type_byte;
+    EXPECT_EQ(cv::norm(decode_png(png), image, cv::NORM_INF), 0.0) << "filter " << type_byte;
+  }
+  for (const int level : {1, 9}) {
+    const cv::Mat back = decode_png(encode_png(image, level, PngFilter::kAdaptive));
+    EXPECT_EQ(cv::norm(back, image, cv::NORM_INF), 0.0) << "adaptive, level " << level;
+  }
+}
+
 TEST(PngEncode, ARegionOfALargerImageIsWrittenAsItsOwnPixels) {
   cv::Mat big(10, 10, CV_16UC1);
   for (int r = 0; r < 10; ++r)
