@@ -10,6 +10,7 @@
 #include "common/geometry/se3.h"
 #include "common/geometry/so3.h"
 #include "common/numbers.h"
+#include "test/support/numerical.h"
 
 namespace kestrel {
 namespace {
@@ -52,13 +53,8 @@ TEST(So3, RightJacobianMatchesFiniteDifferences) {
   const double h = 1e-6;
   for (const auto& phi : rotation_samples()) {
     if (phi.norm() > 3.0) continue;  // log is not smooth at pi
-    Eigen::Matrix3d numeric;
-    for (int k = 0; k < 3; ++k) {
-      const Eigen::Vector3d d = Eigen::Vector3d::Unit(k) * h;
-      const Eigen::Matrix3d Rp = so3::exp(phi).transpose() * so3::exp(phi + d);
-      const Eigen::Matrix3d Rm = so3::exp(phi).transpose() * so3::exp(phi - d);
-      numeric.col(k) = (so3::log(Rp) - so3::log(Rm)) / (2 * h);
-    }
+    const Eigen::Matrix3d numeric = test::numerical_jacobian<3>(
+        [&](const Eigen::Vector3d& d) -> Eigen::Vector3d { return so3::log(so3::exp(phi).transpose() * so3::exp(phi + d)); }, h);
     EXPECT_LT((so3::right_jacobian(phi) - numeric).norm(), 1e-6) << phi.transpose();
     EXPECT_LT((so3::right_jacobian(phi) * so3::right_jacobian_inverse(phi) -
                Eigen::Matrix3d::Identity()).norm(), 1e-9);

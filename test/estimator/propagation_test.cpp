@@ -10,6 +10,7 @@
 #include "estimator/filter.h"
 #include "common/gaussian/information.h"
 #include "estimator/propagation.h"
+#include "test/support/numerical.h"
 
 namespace kestrel::estimator {
 namespace {
@@ -46,14 +47,9 @@ TEST(Propagation, JacobianMatchesFiniteDifferences) {
       const ImuInterval u = random_interval(rng, dt);
       const ImuStep step = propagate(x, u, kStandardGravity);
       const Matrix15d F = step.phi.dense();
-      Matrix15d numeric;
-      const double h = 1e-6;
-      for (int k = 0; k < 15; ++k) {
-        const Vector15d d = Vector15d::Unit(k) * h;
-        const NavState plus = propagate_mean(boxplus(x, d), u, kStandardGravity);
-        const NavState minus = propagate_mean(boxplus(x, -d), u, kStandardGravity);
-        numeric.col(k) = (boxminus(plus, step.next) - boxminus(minus, step.next)) / (2 * h);
-      }
+      const Matrix15d numeric = test::numerical_jacobian<15>([&](const Vector15d& d) -> Vector15d {
+        return boxminus(propagate_mean(boxplus(x, d), u, kStandardGravity), step.next);
+      });
       EXPECT_LT((F - numeric).cwiseAbs().maxCoeff(), 1e-6) << "dt " << dt << "\n" << F - numeric;
     }
   }

@@ -5,6 +5,7 @@
 #include "common/gaussian/information.h"
 #include "planner/grid_environment.h"
 #include "planner/sensor_model.h"
+#include "test/support/numerical.h"
 #include "test_environments.h"
 
 namespace kestrel::planner {
@@ -61,14 +62,8 @@ TEST(FeatureSensor, JacobianMatchesNumericalDifferentiation) {
   for (int i = 0; i < 20; ++i) {
     const Config q(0.1 * u(rng), 0.1 * u(rng), 1.0, u(rng));
     const FeatureMeasurement m = sensor.measure(q, i);
-    Eigen::Matrix<double, 3, 4> numeric;
-    for (int k = 0; k < 4; ++k) {
-      const double h = 1e-6;
-      Config a = q, b = q;
-      a[k] += h;
-      b[k] -= h;
-      numeric.col(k) = (sensor.predict(a, i, m.z[1]) - sensor.predict(b, i, m.z[1])) / (2 * h);
-    }
+    const Eigen::Matrix<double, 3, 4> numeric = test::numerical_jacobian<4>(
+        [&](const Eigen::Vector4d& d) -> Eigen::Vector3d { return sensor.predict(q + d, i, m.z[1]); });
     EXPECT_LT((numeric - m.H).norm(), 1e-6) << i;
     EXPECT_NEAR(sensor.predict(q, i, m.z[1])[1], m.z[1], 1e-12);
   }
