@@ -17,6 +17,7 @@
 #include "kestrel/state_t.hpp"
 #include "planner/online_planner.h"
 #include "planner/planner_messages.h"
+#include "planner/samplers.h"
 
 using namespace kestrel;
 using namespace kestrel::planner;
@@ -38,8 +39,8 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_option("--connect-radius", o.roadmap.connect_radius_m, "Longest edge (m)")->check(cli::Positive);
-  app.add_option("--sampler", o.sampler, "uniform, su, gaussian, bridge")
-      ->check(CLI::IsMember({"uniform", "su", "gaussian", "bridge"}));
+  app.add_option("--sampler", o.sampler, "uniform, su, gaussian, bridge, su-ukf (planner/README.md)")
+      ->check(CLI::IsMember(planner::sampler_names()));
   app.add_option("--sensor", sensor, "kinect or camera (the paper's)")->check(CLI::IsMember({"kinect", "camera"}));
   app.add_option("--feature-density", o.feature_density_per_m2, "Features assumed per m^2 of wall")->check(cli::Positive);
   double dominance_slack = kToolsDominanceSlack;

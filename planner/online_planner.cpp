@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "planner/grid_environment.h"
+#include "planner/samplers.h"
 
 namespace kestrel::planner {
 
@@ -98,12 +99,8 @@ PlanAnswer OnlinePlanner::plan(const PlanQuery& query) const {
   }
   const FeatureSensor sensor(env, options_.sensor);
   const BeliefModel model(options_.motion, [&](const Config& q) { return sensor.information(q); });
-  std::unique_ptr<Sampler> sampler;
-  const double range = options_.sensor.max_range_m;
-  if (options_.sampler == "uniform") sampler = make_uniform_sampler(space);
-  else if (options_.sampler == "gaussian") sampler = make_gaussian_sampler(space, range);
-  else if (options_.sampler == "bridge") sampler = make_bridge_sampler(space, 2.0 * range);
-  else sampler = make_sensor_sampler(space, [&](const Config& q) { return sensor.information(q).trace(); });
+  // su-ukf measures the information gain against the start's covariance.
+  const std::unique_ptr<Sampler> sampler = make_sampler(options_.sampler, space, sensor, sigma0);
   Rng rng(static_cast<uint64_t>(query.request_id) * 0x9E3779B97F4A7C15ull + 1);
   const Roadmap map = build_roadmap(space, *sampler, start, query.goal, options_.roadmap, query.brm ? &model : nullptr, rng);
   PlanResult r;

@@ -12,6 +12,7 @@
 #include "planner/eval/experiment.h"
 #include "planner/eval/plot.h"
 #include "planner/map_sources.h"
+#include "planner/samplers.h"
 #include "planner/world_environment.h"
 
 namespace {
@@ -55,8 +56,8 @@ int main(int argc, char** argv) {
                  "brm-dominance: drop a label within this fraction of a kept one (0: exact, can take minutes)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
-  app.add_option("--sampler", sampler, "uniform, su, su-ukf, gaussian, bridge")
-      ->check(CLI::IsMember({"uniform", "su", "su-ukf", "gaussian", "bridge"}));
+  app.add_option("--sampler", sampler, "uniform, su, gaussian, bridge, su-ukf")
+      ->check(CLI::IsMember(planner::sampler_names()));
   app.add_option("--sensor", sensor, "camera (the paper's), kinect, laser")->check(CLI::IsMember({"camera", "kinect", "laser"}));
   app.add_option("--laser-range", laser_range, "Laser range (m)")->check(cli::Positive);
   app.add_option("--samples", samples, "Roadmap samples (drawn again while start and goal are not connected)")

@@ -4,29 +4,14 @@
 #include <chrono>
 #include <stdexcept>
 
+#include "planner/samplers.h"
+
 namespace kestrel::planner::eval {
 namespace {
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 }  // namespace
-
-std::unique_ptr<Sampler> make_sampler(const std::string& name, const ConfigurationSpace& space,
-                                      const FeatureSensor& sensor, const Mat4& ukf_prior) {
-  const double range = sensor.options().max_range_m;
-  if (name == "uniform") return make_uniform_sampler(space);
-  if (name == "gaussian") return make_gaussian_sampler(space, range);
-  if (name == "bridge") return make_bridge_sampler(space, 2.0 * range);
-  // Each as the paper states it: the EKF sampler keeps what passes the threshold (§3.2.1),
-  // Algorithm 2 (the UKF sampler) then adds it with probability = its normalised weight.
-  if (name == "su")
-    return make_sensor_sampler(space, [&sensor](const Config& q) { return sensor.information(q).trace(); }, "su");
-  if (name == "su-ukf")
-    return make_sensor_sampler(
-        space, [&sensor, ukf_prior](const Config& q) { return sensor.ukf_information_gain(q, ukf_prior); }, "su-ukf",
-        100000, SuAcceptance::kThresholdThenWeight);
-  throw std::invalid_argument("unknown sampler '" + name + "' (uniform, su, su-ukf, gaussian, bridge)");
-}
 
 double path_length(const std::vector<Config>& path) {
   double len = 0.0;

@@ -46,9 +46,6 @@ struct Trial {
   std::vector<Config> samples;
 };
 
-std::unique_ptr<Sampler> make_sampler(const std::string& name, const ConfigurationSpace& space,
-                                      const FeatureSensor& sensor, const Mat4& ukf_prior);
-
 Trial run_trial(const Scenario& scenario, const Setting& setting, const Config& start, const Config& goal,
                 uint64_t seed);
 

@@ -7,6 +7,7 @@
 #include <benchmark/benchmark.h>
 
 #include "planner/eval/experiment.h"
+#include "planner/samplers.h"
 #include "planner/experiment_worlds.h"
 
 namespace {
@@ -27,7 +28,7 @@ void BM_BuildBrm(benchmark::State& state, const char* sampler_name, bool kinect)
   uint64_t seed = 1;
   for (auto _ : state) {
     Rng rng(seed++);
-    auto sampler = eval::make_sampler(sampler_name, space, sensor, 0.1 * Mat4::Identity());
+    auto sampler = make_sampler(sampler_name, space, sensor, 0.1 * Mat4::Identity());
     benchmark::DoNotOptimize(build_roadmap(space, *sampler, pair.first, pair.second, RoadmapOptions::all_pairs(), &model, rng));
   }
 }
@@ -43,7 +44,7 @@ void BM_SearchBrm(benchmark::State& state, BrmPruning pruning, double slack) {
   const BeliefModel model(MotionOptions{}, [&](const Config& q) { return sensor.information(q); });
   const auto pair = floor().pairs[0];
   Rng rng(1);
-  auto sampler = eval::make_sampler("su", space, sensor, 0.1 * Mat4::Identity());
+  auto sampler = make_sampler("su", space, sensor, 0.1 * Mat4::Identity());
   const Roadmap map = build_roadmap(space, *sampler, pair.first, pair.second, RoadmapOptions::all_pairs(), &model, rng);
   BrmQuery q;
   q.start_covariance = 0.1 * Mat4::Identity();
