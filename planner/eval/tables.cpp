@@ -2,15 +2,18 @@
 #include "planner/eval/tables.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <iomanip>
 #include <limits>
+#include <map>
 #include <numeric>
 #include <sstream>
 
 #include "common/gaussian/information.h"
 #include "planner/grid_environment.h"
+#include "planner/samplers.h"
 
 namespace kestrel::planner::eval {
 namespace {
@@ -117,29 +120,32 @@ std::string table3_weight_cost(uint64_t seed) {
 }
 
 std::string table4_samplers(const Scenario& sc, const Pairs& pairs, const ExperimentOptions& o) {
-  static const char* paper[4][5] = {{"100 · 17.87", "96.6 · 22.60", "100 · 2.22", "100 · 19.11", "100 · 1.48"},
-                                    {"100 · 12.38", "96.6 · 11.36", "100 · 1.99", "100 · 12.39", "100 · 1.39"},
-                                    {"96.6 · 23.89", "96.6 · 17.89", "100 · 17.2", "93.1 · 22.16", "89.7 · 1.41"},
-                                    {"100 · 21.58", "3.5 · 13.48", "17.2 · 2.33", "100 · 21.32", "13.8 · 1.36"}};
+  // The paper's rows (success % · goal tr(Sigma), paths 1-5), by sampler; it has no UKF row.
+  static const std::map<std::string, std::array<const char*, 5>> paper = {
+      {"uniform", {"100 · 17.87", "96.6 · 22.60", "100 · 2.22", "100 · 19.11", "100 · 1.48"}},
+      {"su", {"100 · 12.38", "96.6 · 11.36", "100 · 1.99", "100 · 12.39", "100 · 1.39"}},
+      {"gaussian", {"96.6 · 23.89", "96.6 · 17.89", "100 · 17.2", "93.1 · 22.16", "89.7 · 1.41"}},
+      {"bridge", {"100 · 21.58", "3.5 · 13.48", "17.2 · 2.33", "100 · 21.32", "13.8 · 1.36"}}};
+  const std::vector<std::string>& names = sampler_names();
   std::ostringstream out;
   out << "| sampler |";
   for (size_t p = 0; p < pairs.size(); ++p) out << " path " << p + 1 << " |";
   out << " paper (paths 1-5) |\n|---|";
   for (size_t p = 0; p <= pairs.size(); ++p) out << "---|";
   out << "\n";
-  const char* names[] = {"uniform", "su", "gaussian", "bridge", "su-ukf"};
-  std::vector<std::vector<Summary>> all(5);
-  for (int k = 0; k < 5; ++k) {
-    out << "| " << names[k] << " |";
+  std::map<std::string, std::vector<Summary>> all;
+  for (const std::string& name : names) {
+    out << "| " << name << " |";
     for (size_t p = 0; p < pairs.size(); ++p) {
-      all[k].push_back(run_many(sc, Setting{"brm", names[k], o.samples}, Pairs{pairs[p]}, o, p));
-      const Summary& s = all[k].back();
+      all[name].push_back(run_many(sc, Setting{"brm", name, o.samples}, Pairs{pairs[p]}, o, p));
+      const Summary& s = all[name].back();
       out << " " << fmt("%.1f", s.success_pct()) << " · " << fmt("%.2f", s.mean_trace()) << " ± "
           << fmt("%.2f", s.sem_trace()) << " |";
     }
     out << " ";
-    if (k < 4)
-      for (int p = 0; p < 5; ++p) out << paper[k][p] << (p < 4 ? "; " : "");
+    const auto row = paper.find(name);
+    if (row != paper.end())
+      for (size_t p = 0; p < row->second.size(); ++p) out << row->second[p] << (p + 1 < row->second.size() ? "; " : "");
     else
       out << "—";
     out << " |\n";
@@ -149,17 +155,17 @@ std::string table4_samplers(const Scenario& sc, const Pairs& pairs, const Experi
   // higher, by more than two standard errors of the difference (binomial for the rates).
   out << "\nSU (EKF) against the other samplers, per path:";
   for (size_t p = 0; p < pairs.size(); ++p) {
-    const Summary& su = all[1][p];
+    const Summary& su = all.at("su")[p];
     std::string worse;
-    for (int k : {0, 2, 3}) {
-      const Summary& other = all[k][p];
+    for (const char* other_name : {"uniform", "gaussian", "bridge"}) {
+      const Summary& other = all.at(other_name)[p];
       const double se = std::hypot(su.sem_trace(), other.sem_trace());
       const double p1 = su.success_pct() / 100.0, p2 = other.success_pct() / 100.0;
       const double se_rate = std::sqrt(p1 * (1 - p1) / su.trials + p2 * (1 - p2) / other.trials);
       // Traces are compared only when both have successes (a mean over none is no value).
       const bool traces = su.successes > 0 && other.successes > 0;
       if (p1 < p2 - 2.0 * se_rate - 1e-12 || (traces && su.mean_trace() > other.mean_trace() + 2.0 * se))
-        worse += std::string(worse.empty() ? "" : ", ") + names[k];
+        worse += std::string(worse.empty() ? "" : ", ") + other_name;
     }
     out << " path " << p + 1 << ": " << (worse.empty() ? "no worse" : "worse than " + worse) << ";";
   }

@@ -21,13 +21,6 @@ Eigen::Matrix3d random_rotation(std::mt19937& rng) {
   return so3::exp(axis.normalized() * std::uniform_real_distribution<double>(0.0, kPi)(rng));
 }
 
-Eigen::VectorXd flat(const Eigen::Matrix3d& R) { return Eigen::Map<const Eigen::VectorXd>(R.data(), 9); }
-
-bool is_rotation(const Eigen::Matrix3d& R) {
-  return R.allFinite() && (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() < 1e-9 &&
-         std::abs(R.determinant() - 1.0) < 1e-9;
-}
-
 // SO(3) with the right perturbation the filters use: R ⊞ d = R Exp(d).
 struct So3Model {
   using Point = Eigen::Matrix3d;
@@ -36,8 +29,8 @@ struct So3Model {
   static Point sample(std::mt19937& rng) { return random_rotation(rng); }
   static Point plus(const Point& R, const Eigen::Vector3d& d) { return R * so3::exp(d); }
   static Eigen::Vector3d minus(const Point& S, const Point& R) { return so3::log(R.transpose() * S); }
-  static Eigen::VectorXd embed(const Point& R) { return flat(R); }
-  static bool valid(const Point& R) { return is_rotation(R); }
+  static Eigen::VectorXd embed(const Point& R) { return test::embed_rotation(R); }
+  static bool valid(const Point& R) { return test::is_rotation(R); }
   static Point identity() { return Point::Identity(); }
   static Point compose(const Point& a, const Point& b) { return a * b; }
   static Point inverse(const Point& a) { return a.transpose(); }
@@ -54,11 +47,7 @@ struct Se3Model {
   }
   static Point plus(const Point& T, const Vector6d& d) { return se3::boxplus(T, d); }
   static Vector6d minus(const Point& U, const Point& T) { return se3::boxminus(U, T); }
-  static Eigen::VectorXd embed(const Point& T) {
-    Eigen::VectorXd v(12);
-    v << flat(T.linear()), T.translation();
-    return v;
-  }
+  static Eigen::VectorXd embed(const Point& T) { return test::embed_pose(T.linear(), T.translation()); }
   static bool valid(const Point& T) { return se3::is_valid(T, 1e-9); }
   static Point identity() { return Point::Identity(); }
   static Point compose(const Point& a, const Point& b) { return a * b; }

@@ -19,19 +19,11 @@ Eigen::Vector3d gaussian3(std::mt19937& rng, double sigma) {
   return {n(rng), n(rng), n(rng)};
 }
 
-void append_rotation(Eigen::VectorXd& v, Eigen::Index& at, const Eigen::Matrix3d& R) {
-  v.segment<9>(at) = Eigen::Map<const Eigen::Matrix<double, 9, 1>>(R.data());
-  at += 9;
-}
-
-void append(Eigen::VectorXd& v, Eigen::Index& at, const Eigen::Vector3d& x) {
-  v.segment<3>(at) = x;
-  at += 3;
-}
-
-bool is_rotation(const Eigen::Matrix3d& R) {
-  return R.allFinite() && (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() < 1e-9 &&
-         R.determinant() > 0.0;
+// Appends a block's coordinates to an embedding filled from `at`.
+template <int kRows>
+void append(Eigen::VectorXd& v, Eigen::Index& at, const Eigen::Matrix<double, kRows, 1>& x) {
+  v.segment<kRows>(at) = x;
+  at += kRows;
 }
 
 NavState sample_nav(std::mt19937& rng) {
@@ -56,12 +48,12 @@ struct NavStateModel {
     Eigen::Index at = 0;
     append(v, at, x.p_world_body);
     append(v, at, x.v_world_body);
-    append_rotation(v, at, x.R_world_body);
+    append(v, at, test::embed_rotation(x.R_world_body));
     append(v, at, x.gyro_bias);
     append(v, at, x.accel_bias);
     return v;
   }
-  static bool valid(const Point& x) { return x.all_finite() && is_rotation(x.R_world_body); }
+  static bool valid(const Point& x) { return x.all_finite() && test::is_rotation(x.R_world_body); }
 };
 
 struct FilterMeanModel {
@@ -88,8 +80,9 @@ struct FilterMeanModel {
     v.head<21>() = NavStateModel::embed(x.nav);
     Eigen::Index at = 21;
     for (int i = 0; i < x.num_clones; ++i) {
-      append(v, at, x.clones[static_cast<size_t>(i)].p_world_body);
-      append_rotation(v, at, x.clones[static_cast<size_t>(i)].R_world_body);
+      const Clone& c = x.clones[static_cast<size_t>(i)];
+      append(v, at, c.p_world_body);
+      append(v, at, test::embed_rotation(c.R_world_body));
     }
     return v;
   }
@@ -97,7 +90,7 @@ struct FilterMeanModel {
     if (!NavStateModel::valid(x.nav)) return false;
     for (int i = 0; i < x.num_clones; ++i) {
       const Clone& c = x.clones[static_cast<size_t>(i)];
-      if (!c.p_world_body.allFinite() || !is_rotation(c.R_world_body)) return false;
+      if (!c.p_world_body.allFinite() || !test::is_rotation(c.R_world_body)) return false;
     }
     return true;
   }

@@ -39,44 +39,35 @@ struct Samples<Se3> {
 
 // The spaces as manifolds: their own retract and group operations; ⊟ written here as the
 // inverse the solver's retract must have (g2o's: translation in the pose's frame for SE(3),
-// plain differences with the angle wrapped for SE(2)).
-struct Se2Model {
-  using Point = Se2::Pose;
-  static constexpr int kDim = 3;
+// plain differences with the angle wrapped for SE(2)), with each space's embedding and validity.
+template <class Space>
+struct SpaceModel {
+  using Point = typename Space::Pose;
+  static constexpr int kDim = Space::kDim;
   static constexpr double kChartRadius = 3.1;
-  static Point sample(std::mt19937& rng) { return Samples<Se2>::pose(rng); }
-  static Point plus(const Point& X, const Se2::Vector& d) { return Se2::retract(X, d); }
+  static Point sample(std::mt19937& rng) { return Samples<Space>::pose(rng); }
+  static Point plus(const Point& X, const typename Space::Vector& d) { return Space::retract(X, d); }
+  static Point identity() { return Space::identity(); }
+  static Point compose(const Point& a, const Point& b) { return Space::compose(a, b); }
+  static Point inverse(const Point& a) { return Space::inverse(a); }
+};
+
+struct Se2Model : SpaceModel<Se2> {
   static Se2::Vector minus(const Point& Y, const Point& X) {
     return {Y.x() - X.x(), Y.y() - X.y(), wrap_angle(Y.z() - X.z())};
   }
   static Eigen::VectorXd embed(const Point& X) { return Eigen::Vector4d(X.x(), X.y(), std::cos(X.z()), std::sin(X.z())); }
   static bool valid(const Point& X) { return X.allFinite() && std::abs(X.z()) <= kPi; }
-  static Point identity() { return Se2::identity(); }
-  static Point compose(const Point& a, const Point& b) { return Se2::compose(a, b); }
-  static Point inverse(const Point& a) { return Se2::inverse(a); }
 };
 
-struct Se3Model {
-  using Point = Se3::Pose;
-  static constexpr int kDim = 6;
-  static constexpr double kChartRadius = 3.1;
-  static Point sample(std::mt19937& rng) { return Samples<Se3>::pose(rng); }
-  static Point plus(const Point& X, const Se3::Vector& d) { return Se3::retract(X, d); }
+struct Se3Model : SpaceModel<Se3> {
   static Se3::Vector minus(const Point& Y, const Point& X) {
     Se3::Vector d;
     d << X.linear().transpose() * (Y.translation() - X.translation()), so3::log(X.linear().transpose() * Y.linear());
     return d;
   }
-  static Eigen::VectorXd embed(const Point& X) {
-    const Eigen::Matrix3d R = X.linear();
-    Eigen::VectorXd v(12);
-    v << Eigen::Map<const Eigen::VectorXd>(R.data(), 9), X.translation();
-    return v;
-  }
+  static Eigen::VectorXd embed(const Point& X) { return test::embed_pose(X.linear(), X.translation()); }
   static bool valid(const Point& X) { return se3::is_valid(X, 1e-9); }
-  static Point identity() { return Se3::identity(); }
-  static Point compose(const Point& a, const Point& b) { return Se3::compose(a, b); }
-  static Point inverse(const Point& a) { return Se3::inverse(a); }
 };
 
 using namespace ::kestrel::test;  // the suites' names, as INSTANTIATE_TYPED_TEST_SUITE_P needs them

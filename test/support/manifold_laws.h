@@ -18,17 +18,16 @@
 //   INSTANTIATE_TYPED_TEST_SUITE_P(Common, ManifoldLaws, ::testing::Types<So3Model, ...>);
 //
 // `embed` compares points without ⊟, so that a ⊟ that is wrong in the same way as ⊞ is still
-// caught. Groups add `identity()`, `compose(a, b)` and `inverse(a)` and instantiate GroupLaws
+// caught; `embed_rotation` / `embed_pose` and `is_rotation` below are the pieces models share. Groups add `identity()`, `compose(a, b)` and `inverse(a)` and instantiate GroupLaws
 // too. Each law is also a function returning an AssertionResult (namespace laws), so that
 // test/common/manifold_laws_test.cpp can show that a broken model breaks it.
 
 #include <gtest/gtest.h>
 
 #include <Eigen/Core>
-#include <Eigen/LU>
 #include <algorithm>
 #include <random>
-#include <sstream>
+#include <string>
 
 #include "test/support/numerical.h"
 
@@ -50,18 +49,24 @@ TangentOf<M> sample_tangent(std::mt19937& rng, double radius) {
   return d.normalized() * radius * u(rng);
 }
 
+/// R^T R = I and det R = +1, to `tolerance`, with every entry finite.
+bool is_rotation(const Eigen::Matrix3d& R, double tolerance = 1e-9);
+
+/// A rotation's 9 entries (column-major): the embedding of SO(3) the models compare in.
+Eigen::Matrix<double, 9, 1> embed_rotation(const Eigen::Matrix3d& R);
+
+/// A pose (R, t) as R's 9 entries followed by t: the embedding of SE(3).
+Eigen::VectorXd embed_pose(const Eigen::Matrix3d& R, const Eigen::Vector3d& t);
+
 namespace laws {
+
+// Out of line (manifold_laws.cpp): the same for every model, so compiled once.
+std::string text(const Eigen::VectorXd& v);
+Eigen::Index rank(const Eigen::MatrixXd& J, double threshold);
 
 template <class M>
 double embedded_distance(const typename M::Point& a, const typename M::Point& b) {
   return (M::embed(a) - M::embed(b)).cwiseAbs().maxCoeff();
-}
-
-template <class V>
-std::string text(const V& v) {
-  std::ostringstream s;
-  s << v.transpose();
-  return s.str();
 }
 
 /// x ⊞ 0 = x.
@@ -110,9 +115,9 @@ template <class M>
 ::testing::AssertionResult plus_has_full_rank(const typename M::Point& x) {
   const auto J = numerical_jacobian<M::kDim>(
       [&](const TangentOf<M>& d) -> Eigen::VectorXd { return M::embed(M::plus(x, d)); });
-  const Eigen::Index rank = Eigen::FullPivLU<Eigen::MatrixXd>(J).setThreshold(1e-6).rank();
-  if (rank == M::kDim) return ::testing::AssertionSuccess();
-  return ::testing::AssertionFailure() << "d ↦ x ⊞ d has rank " << rank << " of " << M::kDim << " at x";
+  const Eigen::Index r = rank(J, 1e-6);
+  if (r == M::kDim) return ::testing::AssertionSuccess();
+  return ::testing::AssertionFailure() << "d ↦ x ⊞ d has rank " << r << " of " << M::kDim << " at x";
 }
 
 /// e a = a = a e, a a⁻¹ = e, (a b) c = a (b c).

@@ -25,14 +25,15 @@ auto numerical_jacobian(const G& g, double h = 1e-6, Eigen::Index n = kIn) {
   using In = Eigen::Matrix<double, kIn, 1>;
   In d = In::Zero(n);
   using Out = typename std::decay_t<decltype(g(d).eval())>::PlainObject;
-  const Out at_zero = g(d);
-  Eigen::Matrix<double, Out::RowsAtCompileTime, kIn> J(at_zero.size(), n);
+  // Sized from the first column: g is evaluated at ±h only, never at 0.
+  Eigen::Matrix<double, Out::RowsAtCompileTime, kIn> J(Out::RowsAtCompileTime == Eigen::Dynamic ? 0 : Out::RowsAtCompileTime, n);
   for (Eigen::Index k = 0; k < n; ++k) {
     d.setZero();
     d(k) = h;
     const Out plus = g(d);
     d(k) = -h;
     const Out minus = g(d);
+    if (k == 0) J.resize(plus.size(), n);
     J.col(k) = (plus - minus) / (2.0 * h);
   }
   return J;
