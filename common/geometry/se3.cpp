@@ -73,10 +73,7 @@ double rotation_distance(const Eigen::Isometry3d& T_a, const Eigen::Isometry3d& 
 }
 
 bool is_valid(const Eigen::Isometry3d& T, double tolerance) {
-  if (!T.matrix().allFinite()) return false;
-  const Eigen::Matrix3d R = T.linear();
-  return (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() < tolerance &&
-         std::abs(R.determinant() - 1.0) < tolerance;
+  return T.matrix().allFinite() && so3::is_valid(T.linear(), tolerance);
 }
 
 }  // namespace kestrel::se3

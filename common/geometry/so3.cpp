@@ -86,4 +86,10 @@ Eigen::Matrix3d orthonormalize(const Eigen::Matrix3d& M) {
   return R;
 }
 
+bool is_valid(const Eigen::Matrix3d& R, double tolerance) {
+  return R.allFinite() &&
+         (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() <= tolerance &&
+         std::abs(R.determinant() - 1.0) <= tolerance;
+}
+
 }  // namespace kestrel::so3

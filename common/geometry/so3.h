@@ -30,4 +30,7 @@ double angle(const Eigen::Matrix3d& R);
 /// Nearest rotation matrix (SVD projection); removes drift from repeated products.
 Eigen::Matrix3d orthonormalize(const Eigen::Matrix3d& M);
 
+/// Whether R is a rotation: every entry finite, |R^T R - I| and |det R - 1| below `tolerance`.
+bool is_valid(const Eigen::Matrix3d& R, double tolerance = 1e-6);
+
 }  // namespace kestrel::so3

@@ -121,6 +121,16 @@ TEST(Se3, InterpolateHitsEndsAndMidpoint) {
   EXPECT_NEAR(so3::log(M.linear()).z(), 0.5, 1e-12);
 }
 
+TEST(So3, ValidityRejectsReflectionsScalingAndNan) {
+  EXPECT_TRUE(so3::is_valid(so3::exp(Eigen::Vector3d(0.3, -1.2, 2.0)), 1e-12));
+  EXPECT_FALSE(so3::is_valid(Eigen::Vector3d(1, 1, -1).asDiagonal().toDenseMatrix()));  // det -1
+  EXPECT_FALSE(so3::is_valid(1.001 * Eigen::Matrix3d::Identity(), 1e-6));
+  EXPECT_TRUE(so3::is_valid(1.001 * Eigen::Matrix3d::Identity(), 1e-2));
+  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
+  R(2, 1) = std::nan("");
+  EXPECT_FALSE(so3::is_valid(R, 1e9));
+}
+
 TEST(Se3, ValidityRejectsNanAndNonRotations) {
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
   EXPECT_TRUE(se3::is_valid(T));

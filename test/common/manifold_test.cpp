@@ -30,7 +30,7 @@ struct So3Model {
   static Point plus(const Point& R, const Eigen::Vector3d& d) { return R * so3::exp(d); }
   static Eigen::Vector3d minus(const Point& S, const Point& R) { return so3::log(R.transpose() * S); }
   static Eigen::VectorXd embed(const Point& R) { return test::embed_rotation(R); }
-  static bool valid(const Point& R) { return test::is_rotation(R); }
+  static bool valid(const Point& R) { return so3::is_valid(R, test::kLawTolerance); }
   static Point identity() { return Point::Identity(); }
   static Point compose(const Point& a, const Point& b) { return a * b; }
   static Point inverse(const Point& a) { return a.transpose(); }
@@ -48,7 +48,7 @@ struct Se3Model {
   static Point plus(const Point& T, const Vector6d& d) { return se3::boxplus(T, d); }
   static Vector6d minus(const Point& U, const Point& T) { return se3::boxminus(U, T); }
   static Eigen::VectorXd embed(const Point& T) { return test::embed_pose(T.linear(), T.translation()); }
-  static bool valid(const Point& T) { return se3::is_valid(T, 1e-9); }
+  static bool valid(const Point& T) { return se3::is_valid(T, test::kLawTolerance); }
   static Point identity() { return Point::Identity(); }
   static Point compose(const Point& a, const Point& b) { return a * b; }
   static Point inverse(const Point& a) { return a.inverse(Eigen::Isometry); }

@@ -53,7 +53,7 @@ struct NavStateModel {
     append(v, at, x.accel_bias);
     return v;
   }
-  static bool valid(const Point& x) { return x.all_finite() && test::is_rotation(x.R_world_body); }
+  static bool valid(const Point& x) { return x.all_finite() && so3::is_valid(x.R_world_body, test::kLawTolerance); }
 };
 
 struct FilterMeanModel {
@@ -90,7 +90,7 @@ struct FilterMeanModel {
     if (!NavStateModel::valid(x.nav)) return false;
     for (int i = 0; i < x.num_clones; ++i) {
       const Clone& c = x.clones[static_cast<size_t>(i)];
-      if (!c.p_world_body.allFinite() || !test::is_rotation(c.R_world_body)) return false;
+      if (!c.p_world_body.allFinite() || !so3::is_valid(c.R_world_body, test::kLawTolerance)) return false;
     }
     return true;
   }

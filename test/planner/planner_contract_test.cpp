@@ -150,25 +150,31 @@ TEST_P(PlannerContract, ImpossibleRequestsAreAnsweredNotPlanned) {
   EXPECT_EQ(blocked.plan(query(s)).status, PlanAnswer::kNoPath);
 }
 
-std::vector<std::tuple<Search, std::string>> every_pair(bool with_prm) {
-  std::vector<std::tuple<Search, std::string>> out;
+using Case = std::tuple<Search, std::string>;
+
+// Each search paired with each sampler; `belief_only` keeps the BRM searches.
+std::vector<Case> cases(bool belief_only) {
+  std::vector<Case> out;
   for (const Search& s : searches()) {
-    if (!s.brm && !with_prm) continue;
+    if (belief_only && !s.brm) continue;
     for (const std::string& sampler : sampler_names()) out.emplace_back(s, sampler);
   }
   return out;
 }
+std::vector<Case> every_search_and_sampler() { return cases(false); }
+std::vector<Case> every_belief_search_and_sampler() { return cases(true); }
 
-std::string case_name(const ::testing::TestParamInfo<std::tuple<Search, std::string>>& info) {
+std::string case_name(const ::testing::TestParamInfo<Case>& info) {
   std::string sampler = std::get<1>(info.param);
   for (char& c : sampler)
     if (c == '-') c = '_';
   return std::get<0>(info.param).name + "_" + sampler;
 }
 
-INSTANTIATE_TEST_SUITE_P(EveryPlannerAndSampler, PlannerContract, ::testing::ValuesIn(every_pair(true)), case_name);
-INSTANTIATE_TEST_SUITE_P(EveryBeliefPlannerAndSampler, PlannerContractAgainstPrm, ::testing::ValuesIn(every_pair(false)),
-                         case_name);
+INSTANTIATE_TEST_SUITE_P(EveryPlannerAndSampler, PlannerContract,
+                         ::testing::ValuesIn(every_search_and_sampler()), case_name);
+INSTANTIATE_TEST_SUITE_P(EveryBeliefPlannerAndSampler, PlannerContractAgainstPrm,
+                         ::testing::ValuesIn(every_belief_search_and_sampler()), case_name);
 
 }  // namespace
 }  // namespace kestrel::planner

@@ -67,7 +67,7 @@ struct Se3Model : SpaceModel<Se3> {
     return d;
   }
   static Eigen::VectorXd embed(const Point& X) { return test::embed_pose(X.linear(), X.translation()); }
-  static bool valid(const Point& X) { return se3::is_valid(X, 1e-9); }
+  static bool valid(const Point& X) { return se3::is_valid(X, test::kLawTolerance); }
 };
 
 using namespace ::kestrel::test;  // the suites' names, as INSTANTIATE_TYPED_TEST_SUITE_P needs them

@@ -8,11 +8,6 @@
 
 namespace kestrel::test {
 
-bool is_rotation(const Eigen::Matrix3d& R, double tolerance) {
-  return R.allFinite() && (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() <= tolerance &&
-         std::abs(R.determinant() - 1.0) <= tolerance;
-}
-
 Eigen::Matrix<double, 9, 1> embed_rotation(const Eigen::Matrix3d& R) {
   return Eigen::Map<const Eigen::Matrix<double, 9, 1>>(R.data());
 }

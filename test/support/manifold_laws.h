@@ -18,9 +18,11 @@
 //   INSTANTIATE_TYPED_TEST_SUITE_P(Common, ManifoldLaws, ::testing::Types<So3Model, ...>);
 //
 // `embed` compares points without ⊟, so that a ⊟ that is wrong in the same way as ⊞ is still
-// caught; `embed_rotation` / `embed_pose` and `is_rotation` below are the pieces models share. Groups add `identity()`, `compose(a, b)` and `inverse(a)` and instantiate GroupLaws
-// too. Each law is also a function returning an AssertionResult (namespace laws), so that
-// test/common/manifold_laws_test.cpp can show that a broken model breaks it.
+// caught; `embed_rotation` and `embed_pose` below are the pieces models share (validity is
+// so3::is_valid / se3::is_valid at kLawTolerance). Groups add `identity()`, `compose(a, b)` and
+// `inverse(a)` and instantiate GroupLaws too. Each law is also a function returning an
+// AssertionResult (namespace laws), so that test/common/manifold_test.cpp can show that a
+// broken model breaks it.
 
 #include <gtest/gtest.h>
 
@@ -48,9 +50,6 @@ TangentOf<M> sample_tangent(std::mt19937& rng, double radius) {
   for (int k = 0; k < M::kDim; ++k) d(k) = n(rng);
   return d.normalized() * radius * u(rng);
 }
-
-/// R^T R = I and det R = +1, to `tolerance`, with every entry finite.
-bool is_rotation(const Eigen::Matrix3d& R, double tolerance = 1e-9);
 
 /// A rotation's 9 entries (column-major): the embedding of SO(3) the models compare in.
 Eigen::Matrix<double, 9, 1> embed_rotation(const Eigen::Matrix3d& R);
