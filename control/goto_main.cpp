@@ -4,8 +4,9 @@
 // A "no path" answer (no map yet, start or goal not in known free space, no way) is asked
 // again every second for --retry-for seconds from the first answer: at start-up the map
 // changes fast. A request without an answer is sent again every --resend-after seconds (a
-// planner restarted since never saw it; a UDP datagram can be lost). Exit 0: planned (and
-// arrived); 1: no path, or no answer / no arrival within --timeout.
+// planner restarted since never saw it; a UDP datagram can be lost). Those seconds are the
+// sensor time of STATE. Exit 0: planned (and arrived); 1: no path, or no answer / no arrival
+// within --timeout (wall seconds).
 #include <spdlog/spdlog.h>
 
 #include <chrono>
@@ -44,57 +45,63 @@ int run(const Options& o) {
   const auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
   const int64_t request_id = std::chrono::duration_cast<std::chrono::microseconds>(
                                  std::chrono::system_clock::now().time_since_epoch()).count();
+  // Asking again is timed on the sensor time of STATE, and the request goes out from the STATE
+  // handler: under lock-step (sim --lockstep) it is then an output like any other, and the
+  // same flight asks at the same instants on any machine. Only giving up (--timeout) is wall time.
   std::optional<kestrel::state_t> state;
   std::optional<kestrel::plan_t> plan;
   bool sent = false;
-  double sent_at = 0.0;
-  std::optional<double> first_answer_at;  // --retry-for counts from the planner's first answer
-  node.subscribe<kestrel::state_t>(channel::kState, [&](const kestrel::state_t& m) {
-    if (m.status == kestrel::state_t::STATUS_OK || m.status == kestrel::state_t::STATUS_DEGRADED) state = m;
-  });
-  node.subscribe<kestrel::plan_t>(channel::kPlan, [&](const kestrel::plan_t& m) {
-    if (m.request_id != request_id) return;
-    plan = m;
-    if (!first_answer_at) first_answer_at = elapsed();
-  });
-  const auto no_path_yet = [&] {
-    return plan && plan->status != kestrel::plan_t::STATUS_OK && plan->status != kestrel::plan_t::STATUS_BAD_REQUEST &&
-           elapsed() - *first_answer_at < o.retry_s;
+  int64_t sent_utime = 0;
+  std::optional<int64_t> first_answer_utime;  // --retry-for counts from the planner's first answer
+  const auto seconds_since = [](int64_t utime, int64_t since) { return 1e-6 * static_cast<double>(utime - since); };
+  const auto send_request = [&] {
+    kestrel::plan_request_t r{};
+    r.utime = state->utime;
+    r.request_id = request_id;
+    r.start_mode = kestrel::plan_request_t::START_FROM_STATE;
+    for (int i = 0; i < 4; ++i) r.goal[i] = o.goal[static_cast<size_t>(i)];
+    r.planner = o.planner == "prm"             ? kestrel::plan_request_t::PLANNER_PRM
+                : o.planner == "brm-dominance" ? kestrel::plan_request_t::PLANNER_BRM_DOMINANCE
+                                               : kestrel::plan_request_t::PLANNER_BRM;
+    r.objective = o.max_trace > 0.0 ? kestrel::plan_request_t::OBJECTIVE_SHORTEST_BOUNDED
+                                    : kestrel::plan_request_t::OBJECTIVE_MIN_GOAL_UNCERTAINTY;
+    r.max_covariance_trace = o.max_trace;
+    node.publish(channel::kPlanRequest, r);
+    sent = true;
+    sent_utime = state->utime;
+    spdlog::info("asked for a path from ({:.2f}, {:.2f}, {:.2f}) to ({:.2f}, {:.2f}, {:.2f})",
+                 state->T_world_body.position[0], state->T_world_body.position[1],
+                 state->T_world_body.position[2], o.goal[0], o.goal[1], o.goal[2]);
   };
-  while (elapsed() < o.timeout_s && node.spin_once(100)) {
+  const auto no_path_yet = [&](int64_t now_utime) {
+    return plan && plan->status != kestrel::plan_t::STATUS_OK && plan->status != kestrel::plan_t::STATUS_BAD_REQUEST &&
+           seconds_since(now_utime, *first_answer_utime) < o.retry_s;
+  };
+  node.subscribe<kestrel::state_t>(channel::kState, [&](const kestrel::state_t& m) {
+    if (m.status != kestrel::state_t::STATUS_OK && m.status != kestrel::state_t::STATUS_DEGRADED) return;
+    state = m;
     // No map yet, or no way on it yet: at start-up the map changes fast (the first keyframes,
     // SLAM moving it into the estimator's world), so ask again each second for --retry-for.
-    if (no_path_yet() && elapsed() - sent_at >= 1.0) {
+    if (no_path_yet(m.utime) && seconds_since(m.utime, sent_utime) >= 1.0) {
       spdlog::info("no path yet ({}); asking again", plan->message);
       plan.reset();
       sent = false;
     }
-    if (sent && !plan && elapsed() - sent_at >= o.resend_s) {
-      spdlog::info("no answer after {:.1f} s (is the planner running?); asking again", elapsed() - sent_at);
+    if (sent && !plan && seconds_since(m.utime, sent_utime) >= o.resend_s) {
+      spdlog::info("no answer after {:.1f} s (is the planner running?); asking again", seconds_since(m.utime, sent_utime));
       sent = false;
     }
-    if (!sent && state) {
-      kestrel::plan_request_t r{};
-      r.utime = state->utime;
-      r.request_id = request_id;
-      r.start_mode = kestrel::plan_request_t::START_FROM_STATE;
-      for (int i = 0; i < 4; ++i) r.goal[i] = o.goal[static_cast<size_t>(i)];
-      r.planner = o.planner == "prm"             ? kestrel::plan_request_t::PLANNER_PRM
-                  : o.planner == "brm-dominance" ? kestrel::plan_request_t::PLANNER_BRM_DOMINANCE
-                                                 : kestrel::plan_request_t::PLANNER_BRM;
-      r.objective = o.max_trace > 0.0 ? kestrel::plan_request_t::OBJECTIVE_SHORTEST_BOUNDED
-                                      : kestrel::plan_request_t::OBJECTIVE_MIN_GOAL_UNCERTAINTY;
-      r.max_covariance_trace = o.max_trace;
-      node.publish(channel::kPlanRequest, r);
-      sent = true;
-      sent_at = elapsed();
-      spdlog::info("asked for a path from ({:.2f}, {:.2f}, {:.2f}) to ({:.2f}, {:.2f}, {:.2f})",
-                   state->T_world_body.position[0], state->T_world_body.position[1],
-                   state->T_world_body.position[2], o.goal[0], o.goal[1], o.goal[2]);
-    }
-    if (no_path_yet()) continue;
-    if (plan && (plan->status != kestrel::plan_t::STATUS_OK || !o.wait)) break;
-    if (plan && state) {
+    if (!sent) send_request();
+  });
+  node.subscribe<kestrel::plan_t>(channel::kPlan, [&](const kestrel::plan_t& m) {
+    if (m.request_id != request_id) return;
+    plan = m;
+    if (!first_answer_utime) first_answer_utime = state ? state->utime : m.utime;
+  });
+  while (elapsed() < o.timeout_s && node.spin_once(100)) {
+    if (!plan || (state && no_path_yet(state->utime))) continue;
+    if (plan->status != kestrel::plan_t::STATUS_OK || !o.wait) break;
+    if (state) {
       const auto& p = state->T_world_body.position;
       const double d = std::hypot(p[0] - o.goal[0], p[1] - o.goal[1], p[2] - o.goal[2]);
       if (d <= o.arrive_radius_m) {
@@ -142,9 +149,9 @@ int main(int argc, char** argv) {
   app.add_flag("--wait", o.wait, "Wait until the vehicle is at the goal");
   app.add_option("--arrive-radius", o.arrive_radius_m, "Arrived within this of the goal (m)")->check(cli::Positive)->capture_default_str();
   app.add_option("--timeout", o.timeout_s, "Give up after this many wall seconds")->check(cli::Positive)->capture_default_str();
-  app.add_option("--resend-after", o.resend_s, "Send the request again after this many wall seconds without an answer")
+  app.add_option("--resend-after", o.resend_s, "Send the request again after this many seconds of STATE without an answer")
       ->check(cli::Positive)->capture_default_str();
-  app.add_option("--retry-for", o.retry_s, "Ask again each second while the answer is no path, for this many wall seconds from the first answer")
+  app.add_option("--retry-for", o.retry_s, "Ask again each second of STATE while the answer is no path, for this many seconds from the first answer")
       ->check(CLI::NonNegativeNumber)->capture_default_str();
   return app.run(argc, argv, [&] {
     for (double v : o.goal)

@@ -247,6 +247,17 @@ void Node::on_control(const kestrel::replay_control_t& control) {
       if (lockstep_session_ != control.session) spdlog::info("lock-step replay session {} begins", control.session);
       lockstep_session_ = control.session;
       publish_heartbeat();  // the replay learns our subscriptions from this
+      {
+        // "I have joined": a driver whose set may change takes a process in from this answer
+        // on (tools/replay/lockstep_driver.h); the channel is the control channel itself.
+        kestrel::replay_ack_t joined;
+        joined.session = lockstep_session_;
+        joined.process = name_;
+        joined.channel = channel::kReplayControl;
+        joined.input_utime = 0;
+        joined.num_outputs = 0;
+        lcm_.publish(channel::kReplayAck, &joined);
+      }
       break;
     case kestrel::replay_control_t::COMMAND_RESET:
       spdlog::info("reset requested by replay session {}", control.session);

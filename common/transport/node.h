@@ -23,7 +23,8 @@
 //    before its sender went quiet.
 //  * Lock-step: between REPLAY_CONTROL BEGIN and END of a session, after every input handled
 //    (accepted or rejected) the node publishes REPLAY_ACK listing the channels it published
-//    on meanwhile; RESET calls the reset handler. See tools/replay/README.md.
+//    on meanwhile; RESET calls the reset handler. Each BEGIN is answered by a heartbeat and by
+//    a REPLAY_ACK whose channel is REPLAY_CONTROL ("joined"). See tools/replay/README.md.
 //  * SIGINT and SIGTERM make spin() return after the current handler.
 //  * Time: the rejection windows and the heartbeat period are measured on the Node's clock,
 //    the steady clock unless the constructor is given another (tests advance one by hand);

@@ -3,6 +3,7 @@
 // at --rate or as fast as possible; or into an LCM log (--log) and/or a TUM RGB-D folder
 // (--tum), without touching the network. See README.md.
 
+#include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
 #include <atomic>
@@ -11,6 +12,7 @@
 #include <csignal>
 #include <iostream>
 #include <optional>
+#include <regex>
 #include <thread>
 
 #include "common/interrupt.h"
@@ -27,7 +29,8 @@
 #include "drivers/sim/tum_writer.h"
 #include "drivers/sim/vehicle.h"
 #include "drivers/sim/world_catalog.h"
-#include "kestrel/vo_update_t.hpp"
+#include "tools/replay/event_filter.h"
+#include "tools/replay/lockstep_driver.h"
 
 namespace {
 
@@ -53,7 +56,11 @@ struct Options {
   double tilt_deg = 10.0;
   double camera_rate_hz = 30.0;
   std::string feedback = "state";
+  std::vector<double> start;  // x, y, z, yaw of the vehicle; empty: the world's take-off pose
   double lockstep_s = 0.0;
+  std::vector<std::string> expect;
+  std::string record;
+  std::string record_channels = ".*";
   double body_radius_m = 0.25;
   bool list = false;
 };
@@ -73,11 +80,23 @@ void add_options(cli::App& app, Options& o) {
                  "usable STATE) or the truth")
       ->check(CLI::IsMember({"state", "truth"}))
       ->capture_default_str();
+  app.add_option("--start", o.start, "vehicle: where it starts, x,y,z,yaw (m, rad; default: the world's take-off pose)")
+      ->expected(4)
+      ->delimiter(',');
   app.add_option("--lockstep", o.lockstep_s,
-                 "vehicle, live: after each camera frame wait for its VO_UPDATE, after each IMU sample for "
-                 "its STATE (once STATE flows), at most this many wall seconds each, so the closed loop "
-                 "runs at the pace of the VO and the estimator on a loaded machine (with --rate 0); 0 = off")
-      ->check(CLI::Range(0.0, 60.0))
+                 "vehicle, live: drive the processes in lock-step (tools/replay/README.md): each IMU sample and "
+                 "frame waits until every process it reaches, and all they publish in turn (the follower's "
+                 "VEHICLE_COMMAND to this vehicle too), is handled, so a flight is the same on any machine; "
+                 "the value is the longest wait without progress, in wall seconds (--rate is then ignored; 0 = off)")
+      ->check(CLI::Range(0.0, 600.0))
+      ->capture_default_str();
+  app.add_option("--expect", o.expect, "--lockstep: processes that must take part (a,b,c)")->delimiter(',');
+  app.add_option("--record", o.record,
+                 "--lockstep: write GROUND_TRUTH and every message the processes publish to this LCM log, "
+                 "stamped with the sensor time of the event that caused it");
+  app.add_option("--record-channels", o.record_channels,
+                 "--record: only the processes' channels matching this regex (whole name); GROUND_TRUTH always")
+      ->check(CLI::Validator(replay::check_channel_regex, "REGEX"))
       ->capture_default_str();
   app.add_option("--duration", o.duration_s, "Seconds of flight to simulate")->check(cli::Positive)->capture_default_str();
   app.add_option("--seed", o.seed, "Sensor noise seed (same seed, same bytes)")->capture_default_str();
@@ -141,7 +160,10 @@ int run(const Options& o) {
   sim::VehicleFlight* vehicle = nullptr;
   try {
     if (o.flight == "vehicle") {
-      auto v = std::make_unique<sim::VehicleFlight>(world.start(), sim::VehicleOptions{}, o.seed);
+      Eigen::Vector4d start = world.start();
+      if (!o.start.empty()) start = Eigen::Vector4d(o.start[0], o.start[1], o.start[2], o.start[3]);
+      if (!start.allFinite()) throw CLI::ValidationError("--start", "x, y, z and yaw must be finite");
+      auto v = std::make_unique<sim::VehicleFlight>(start, sim::VehicleOptions{}, o.seed);
       vehicle = v.get();
       flight = std::move(v);
     } else {
@@ -182,13 +204,12 @@ int run(const Options& o) {
                world.surfaces().size(), flight->name(), o.duration_s, o.seed,
                std::chrono::duration<double>(Clock::now() - t0).count());
 
-  // Lock-step with the loop's consumers (--lockstep): the newest STATE and VO_UPDATE seen.
-  int64_t last_state_utime = -1, last_vo_utime = -1;
-  int64_t lockstep_timeouts = 0;
-  bool wait_vo = vehicle && o.lockstep_s > 0, wait_state = wait_vo && o.feedback == "state";
-
   Sinks sinks;
   const bool offline = !o.log.empty() || !o.tum.empty();
+  if (o.lockstep_s > 0 && offline) throw CLI::ValidationError("--lockstep", "drives live processes: not with --log or --tum");
+  if (o.lockstep_s <= 0 && !(o.record.empty() && o.expect.empty()))
+    throw CLI::ValidationError(o.record.empty() ? "--expect" : "--record", "only with --lockstep");
+  if (!vehicle && !o.start.empty()) throw CLI::ValidationError("--start", "only with --flight vehicle");
   if (!o.log.empty()) sinks.log.emplace(o.log);
   if (!o.tum.empty()) sinks.tum.emplace(o.tum, so.camera.camera, so.camera.T_body_camera);
   bool restart = false;
@@ -202,30 +223,37 @@ int run(const Options& o) {
           channel::kVehicleCommand, [&](const kestrel::vehicle_command_t& m) { loop->set_command(sim::vehicle_command(m)); });
       if (o.feedback == "state")
         sinks.node->subscribe<kestrel::state_t>(channel::kState, [&](const kestrel::state_t& m) {
-          last_state_utime = std::max(last_state_utime, m.utime);
           sim::VehicleEstimate e;
           if (sim::vehicle_estimate(m, e)) estimate = e;
-        });
-      if (o.lockstep_s > 0)
-        sinks.node->subscribe<kestrel::vo_update_t>(channel::kVoUpdate, [&](const kestrel::vo_update_t& m) {
-          last_vo_utime = std::max(last_vo_utime, m.utime);
         });
     }
     sinks.node->on_reset([&] { restart = true; });
     sinks.node->set_health(kestrel::process_status_t::STATE_RUNNING, "");
   }
   auto stopping = [&] { return interrupted() || (sinks.node && sinks.node->stopping()); };
-  // Waits until `seen` reaches `utime`; a consumer that misses the timeout is not waited for
-  // again (it may not run at all), so the simulation never hangs on it.
-  auto wait_for = [&](const int64_t& seen, int64_t utime, bool& waiting, const char* what) {
-    const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                                             std::chrono::duration<double>(o.lockstep_s));
-    while (seen < utime && !stopping() && Clock::now() < deadline) sinks.node->spin_once(5);
-    if (seen < utime && !stopping()) {
-      ++lockstep_timeouts;
-      waiting = false;
-      spdlog::warn("--lockstep: no {} for utime {} within {} s; no longer waiting for it", what, utime, o.lockstep_s);
-    }
+  // Lock-step (--lockstep): this process drives the set, and is one of it: its Node, on the
+  // same connection, acknowledges the VEHICLE_COMMAND and STATE it consumes, so an event has
+  // settled only once the vehicle has its answer.
+  std::optional<replay::LockstepDriver> driver;
+  if (o.lockstep_s > 0) {
+    replay::DriverOptions d;
+    d.expect = o.expect;
+    d.ack_timeout_s = o.lockstep_s;
+    d.record_path = o.record;  // InputError: exit 3
+    d.record_inputs = {channel::kGroundTruth};
+    const std::regex recorded(o.record_channels);
+    d.record_filter = [recorded](const std::string& c) { return std::regex_match(c, recorded); };
+    d.dynamic_membership = true;  // a process killed in flight and restarted by kestrel launch
+    transport::Node& node = *sinks.node;
+    driver.emplace(node.lcm(), [&node](int ms) { node.spin_once(ms); }, d, stopping);
+    if (!driver->begin()) return kExitInterrupted;  // PeerError: exit 1
+  }
+  auto emit = [&](const char* channel, int64_t utime, const std::vector<uint8_t>& bytes) {
+    if (driver)
+      driver->publish(channel, bytes.data(), bytes.size(), utime,
+                      fmt::format("{} at t = {:.3f} s", channel, simulation.seconds(utime)));
+    else
+      sinks.publish(channel, utime, bytes);
   };
 
   // The simulated vehicle passes through walls: every contact is reported instead.
@@ -242,7 +270,6 @@ int run(const Options& o) {
         vehicle->reset();
         loop->set_command(sim::VehicleCommand{});  // hold where it starts
         estimate.reset();
-        last_state_utime = last_vo_utime = -1;
       }
       wall_start = Clock::now();
       restart = false;
@@ -262,7 +289,7 @@ int run(const Options& o) {
     }
     sim::SimEvent e = simulation.next();
     if (e.utime > end_utime) break;
-    if (sinks.node && o.rate > 0) {  // pace: wait for the event's wall time, serving LCM
+    if (sinks.node && !driver && o.rate > 0) {  // pace: wait for the event's wall time, serving LCM
       const auto due = wall_start + std::chrono::duration_cast<Clock::duration>(
                                         std::chrono::duration<double>(simulation.seconds(e.utime) / o.rate));
       while (!stopping() && Clock::now() < due) {
@@ -282,21 +309,20 @@ int run(const Options& o) {
       if (contact.observe(simulation.seconds(e.utime), p))
         spdlog::warn("the vehicle touches the world at t = {:.3f} s, ({:.2f}, {:.2f}, {:.2f}) (body radius {} m)",
                      simulation.seconds(e.utime), p.x(), p.y(), p.z(), o.body_radius_m);
-      sinks.publish(channel::kImu, e.utime, transport::encode_message(sim::imu_message(e.utime, e.imu)));
-      sinks.publish(channel::kGroundTruth, e.utime,
-                    transport::encode_message(sim::ground_truth_message(e.utime, e.truth, &e.imu)));
+      // The truth of the instant first: under lock-step everything the IMU sample causes
+      // (STATE, a command) then comes after it in any recording, as it did in time.
+      emit(channel::kGroundTruth, e.utime, transport::encode_message(sim::ground_truth_message(e.utime, e.truth, &e.imu)));
+      emit(channel::kImu, e.utime, transport::encode_message(sim::imu_message(e.utime, e.imu)));
       if (sinks.tum) sinks.tum->add_imu(e.utime, e.imu, e.T_world_camera);
       ++imu_samples;
-      // The estimator publishes STATE only once initialised: until then there is nothing to wait for.
-      if (wait_state && last_state_utime >= 0) wait_for(last_state_utime, e.utime, wait_state, "STATE");
     } else {
       if (sinks.log || sinks.node)
-        sinks.publish(channel::kCameraRgbd, e.utime, transport::encode_message(transport::encode_rgbd(e.frame, encoding)));
+        emit(channel::kCameraRgbd, e.utime, transport::encode_message(transport::encode_rgbd(e.frame, encoding)));
       if (sinks.tum) sinks.tum->add_frame(e.frame, e.T_world_camera);
       ++frames;
-      if (wait_vo) wait_for(last_vo_utime, e.utime, wait_vo, "VO_UPDATE");
     }
   }
+  if (driver) driver->close();
   if (sinks.log) sinks.log->close();
   if (sinks.tum) sinks.tum->close();
   const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
@@ -305,7 +331,12 @@ int run(const Options& o) {
             << "simulated seconds: " << o.duration_s << "\n"
             << "wall seconds: " << seconds << "\n"
             << "times real time: " << (seconds > 0 ? o.duration_s / seconds : 0.0) << "\n";
-  if (o.lockstep_s > 0) std::cout << "lockstep timeouts: " << lockstep_timeouts << "\n";
+  if (driver) {
+    std::cout << "lockstep processes: " << driver->processes().size() << "\n"
+              << "lockstep dropped: " << driver->dropped() << "\n"
+              << "lockstep joined: " << driver->joined() << "\n";
+    for (const auto& [channel, n] : driver->recorded()) std::cout << "recorded " << channel << ": " << n << "\n";
+  }
   std::cout << "contacts: " << contact.contacts() << "\n"
             << "min clearance: " << contact.min_clearance_m() << " m\n";
   return stopping() ? kExitInterrupted : kExitOk;

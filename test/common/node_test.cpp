@@ -114,22 +114,28 @@ TEST(Node, LockstepAcknowledgesEveryInputWithItsOutputs) {
   node.lcm().publish("IMU", "x", 1);  // rejected inputs are acknowledged too
   drain(node);
 
-  ASSERT_EQ(acks.got.size(), 3u);
+  // BEGIN is answered with "joined" (an acknowledgement of the control channel), then one
+  // acknowledgement per input.
+  ASSERT_EQ(acks.got.size(), 4u);
   EXPECT_EQ(resets, 1);
   EXPECT_EQ(acks.got[0].session, 77);
   EXPECT_EQ(acks.got[0].process, "chain");
-  EXPECT_EQ(acks.got[0].channel, "IMU");
-  EXPECT_EQ(acks.got[0].input_utime, 2);
-  EXPECT_EQ(acks.got[0].output_channels, (std::vector<std::string>{"A", "B"}));
-  EXPECT_TRUE(acks.got[1].output_channels.empty());
-  EXPECT_EQ(acks.got[2].input_utime, 0);
+  EXPECT_EQ(acks.got[0].channel, channel::kReplayControl);
+  EXPECT_TRUE(acks.got[0].output_channels.empty());
+  EXPECT_EQ(acks.got[1].session, 77);
+  EXPECT_EQ(acks.got[1].process, "chain");
+  EXPECT_EQ(acks.got[1].channel, "IMU");
+  EXPECT_EQ(acks.got[1].input_utime, 2);
+  EXPECT_EQ(acks.got[1].output_channels, (std::vector<std::string>{"A", "B"}));
+  EXPECT_TRUE(acks.got[2].output_channels.empty());
+  EXPECT_EQ(acks.got[3].input_utime, 0);
 
   kestrel::replay_control_t end = begin;
   end.command = kestrel::replay_control_t::COMMAND_END;
   node.publish(channel::kReplayControl, end);
   node.publish("IMU", imu(4));
   drain(node);
-  EXPECT_EQ(acks.got.size(), 3u);
+  EXPECT_EQ(acks.got.size(), 4u);
 }
 
 // A name LCM would take as a pattern, or cannot take at all, is a configuration error naming

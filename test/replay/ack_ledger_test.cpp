@@ -55,6 +55,37 @@ TEST(AckLedger, ToleratesAnAcknowledgementOvertakingItsCause) {
   EXPECT_TRUE(ledger.settled());
 }
 
+// A process that joined during the event (sim --lockstep, a restart) owed nothing, but what it
+// published is an input of the others, whose acknowledgements are then awaited.
+TEST(AckLedger, AnAnnouncementWithoutAnInputExpectsTheConsumersOfItsOutputs) {
+  AckLedger ledger({{"IMU", {"est"}}, {"STATE", {"follow"}}}, record_none);
+  ledger.publish("IMU");
+  ledger.announce({"STATE"});  // a newcomer's STATE
+  ledger.acknowledge("est", "IMU", {"STATE"});
+  EXPECT_FALSE(ledger.settled());
+  EXPECT_EQ(ledger.awaited_acks(), 2);
+  ledger.acknowledge("follow", "STATE", {});
+  EXPECT_FALSE(ledger.settled());
+  ledger.acknowledge("follow", "STATE", {});
+  EXPECT_TRUE(ledger.settled());
+}
+
+// A process that left (killed in flight) owes nothing more, now or in later events.
+TEST(AckLedger, AForgottenProcessIsOwedNothingAndNoLongerAConsumer) {
+  AckLedger ledger({{"IMU", {"est", "slam"}}}, record_none);
+  ledger.publish("IMU");
+  ledger.acknowledge("slam", "IMU", {});
+  EXPECT_TRUE(ledger.owes("est"));
+  ledger.forget("est");
+  EXPECT_FALSE(ledger.owes("est"));
+  EXPECT_TRUE(ledger.settled());
+  ledger.finish_event();
+  ledger.publish("IMU");
+  EXPECT_FALSE(ledger.owes("est"));
+  ledger.acknowledge("slam", "IMU", {});
+  EXPECT_TRUE(ledger.settled());
+}
+
 TEST(AckLedger, AnUnexpectedAcknowledgementKeepsTheEventOpenAndIsExplained) {
   AckLedger ledger(chain(), record_none);
   ledger.publish("CAMERA_RGBD");

@@ -43,6 +43,18 @@ TEST(ProcessTable, KnowsConsumersAndPublishersWithoutProtocolChannels) {
   EXPECT_EQ(describe(table)[2], "vo (pid 1): CAMERA_RGBD -> VO_UPDATE");
 }
 
+TEST(ProcessTable, AProcessRemovedIsNoLongerAConsumerNorMissingFromOthers) {
+  ProcessTable table;
+  table.update(heartbeat("est", 3, {"IMU"}, {"STATE"}), 0.0);
+  table.update(heartbeat("follow", 4, {"STATE"}, {"VEHICLE_COMMAND"}), 0.0);
+  table.remove("est");
+  EXPECT_FALSE(table.contains("est"));
+  EXPECT_EQ(table.consumers().count("IMU"), 0u);
+  EXPECT_EQ(table.consumers().at("STATE"), std::vector<std::string>{"follow"});
+  table.remove("nobody");  // harmless
+  EXPECT_EQ(table.processes().size(), 1u);
+}
+
 TEST(ProcessTable, NamesTheMissingExpectedProcesses) {
   ProcessTable table;
   table.update(heartbeat("a", 1, {}, {}), 0.0);

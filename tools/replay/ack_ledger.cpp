@@ -1,5 +1,8 @@
 #include "tools/replay/ack_ledger.h"
 
+#include <algorithm>
+#include <iterator>
+
 namespace kestrel::replay {
 
 AckLedger::AckLedger(ConsumerMap consumers, std::function<bool(const std::string&)> is_recorded)
@@ -16,10 +19,19 @@ void AckLedger::publish(const std::string& channel) { expect_consumers(channel);
 void AckLedger::acknowledge(const std::string& process, const std::string& channel,
                             const std::vector<std::string>& outputs) {
   --acks_[{process, channel}];
+  announce(outputs);
+}
+
+void AckLedger::announce(const std::vector<std::string>& outputs) {
   for (const auto& out : outputs) {
     expect_consumers(out);
     if (is_recorded_(out)) ++messages_[out];
   }
+}
+
+void AckLedger::forget(const std::string& process) {
+  for (auto it = acks_.begin(); it != acks_.end();) it = it->first.first == process ? acks_.erase(it) : std::next(it);
+  for (auto& [channel, names] : consumers_) names.erase(std::remove(names.begin(), names.end(), process), names.end());
 }
 
 void AckLedger::receive(const std::string& channel) { --messages_[channel]; }

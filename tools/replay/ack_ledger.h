@@ -34,6 +34,12 @@ class AckLedger {
   /// `process` finished one input on `channel` and published on each of `outputs`.
   void acknowledge(const std::string& process, const std::string& channel,
                    const std::vector<std::string>& outputs);
+  /// A process outside the consumer map (one that joined during the event) finished an
+  /// input and published on each of `outputs`: nothing was owed by it, but its outputs are
+  /// inputs of the others, whose acknowledgements are awaited.
+  void announce(const std::vector<std::string>& outputs);
+  /// `process` left: whatever it still owes is written off.
+  void forget(const std::string& process);
   /// A message arrived on a recorded channel.
   void receive(const std::string& channel);
 

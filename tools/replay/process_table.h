@@ -41,6 +41,9 @@ class ProcessTable {
   /// channels of one (the discovery is not stable yet).
   bool update(const kestrel::process_status_t& status, double now_s);
 
+  /// Forgets `name` (a process that left a session whose membership may change).
+  void remove(const std::string& name) { processes_.erase(name); }
+
   const std::map<std::string, ProcessInfo>& processes() const { return processes_; }
   bool contains(const std::string& name) const { return processes_.count(name) > 0; }
   /// Names in `expected` not heard from.

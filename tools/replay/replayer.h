@@ -18,15 +18,11 @@
 
 #include "common/transport/log_file.h"
 #include "tools/replay/event_filter.h"
+#include "tools/replay/lockstep_driver.h"
 #include "tools/replay/report.h"
 
 namespace kestrel::replay {
 
-/// A process did not answer, stopped, or broke the protocol; what() names it.
-class PeerError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
 /// LCM could not be started on the URL.
 class NetworkUnavailable : public std::runtime_error {
  public:
