@@ -7,10 +7,9 @@
 #include "drivers/sim/world_catalog.h"
 
 namespace kestrel::planner {
-namespace {
 
-ExperimentWorld make(const std::string& name, sim::World world, const WorldFeatureOptions& features,
-                     std::vector<std::pair<Config, Config>> pairs, double radius_m) {
+ExperimentWorld make_experiment_world(const std::string& name, sim::World world, const WorldFeatureOptions& features,
+                                      std::vector<std::pair<Config, Config>> pairs, double radius_m) {
   ExperimentWorld w;
   w.name = name;
   w.world = std::make_unique<sim::World>(std::move(world));
@@ -24,8 +23,6 @@ ExperimentWorld make(const std::string& name, sim::World world, const WorldFeatu
   return w;
 }
 
-}  // namespace
-
 ExperimentWorld floor_experiment_world(const WorldFeatureOptions& features, double radius_m) {
   // Room to room across the corridors, and the corridor's length (drivers/sim/worlds/floor.world):
   // 17.0, 18.3, 20.0, 10.8 and 11.5 m apart (mean 15.5 m; the paper's: >= 8.53, mean 13.66).
@@ -35,7 +32,7 @@ ExperimentWorld floor_experiment_world(const WorldFeatureOptions& features, doub
       {Config(6.5, 1.5, 1.0, 0.0), Config(6.5, 21.5, 1.0, 0.0)},    // the main corridor
       {Config(11.5, 8.5, 1.0, 0.0), Config(2.5, 14.5, 1.0, 0.0)},   // SE room -> NW room
       {Config(1.0, 11.5, 1.0, 0.0), Config(10.5, 5.0, 1.0, 0.0)}};  // cross corridor -> SE room
-  return make("floor", sim::load_world("floor"), features, std::move(pairs), radius_m);
+  return make_experiment_world("floor", sim::load_world("floor"), features, std::move(pairs), radius_m);
 }
 
 ExperimentWorld atrium_experiment_world(const WorldFeatureOptions& features, double radius_m) {
@@ -48,7 +45,7 @@ ExperimentWorld atrium_experiment_world(const WorldFeatureOptions& features, dou
       {Config(6.5, 1.5, 1.0, 0.0), Config(6.5, 21.5, 1.0, 0.0)},    // south to north past the core
       {Config(1.5, 11.5, 1.0, 0.0), Config(11.5, 11.5, 1.0, 0.0)},  // west to east past the core
       {Config(11.0, 20.0, 1.0, 0.0), Config(3.0, 8.0, 1.0, 0.0)}};  // north-east -> south-west
-  return make("atrium", sim::load_world("atrium"), features, std::move(pairs), radius_m);
+  return make_experiment_world("atrium", sim::load_world("atrium"), features, std::move(pairs), radius_m);
 }
 
 std::optional<ExperimentWorld> stata_experiment_world(const std::string& map_yaml,
@@ -65,7 +62,7 @@ std::optional<ExperimentWorld> stata_experiment_world(const std::string& map_yam
       {Config(-54.67, 31.31, 1.0, 0.0), Config(-36.08, 34.03, 1.0, 0.0)},
       {Config(-4.44, 25.03, 1.0, 0.0), Config(-20.40, 29.87, 1.0, 0.0)},
       {Config(-54.70, 10.66, 1.0, 0.0), Config(-54.67, 27.86, 1.0, 0.0)}};
-  return make("stata", sim::load_world("stata", map_yaml), features, std::move(pairs), radius_m);
+  return make_experiment_world("stata", sim::load_world("stata", map_yaml), features, std::move(pairs), radius_m);
 }
 
 }  // namespace kestrel::planner

@@ -25,6 +25,11 @@ struct ExperimentWorld {
   std::vector<std::pair<Config, Config>> pairs;
 };
 
+/// Any sim world with its features placed and these start/goal pairs. Throws
+/// std::runtime_error if a pair is not free for `radius_m`.
+ExperimentWorld make_experiment_world(const std::string& name, sim::World world, const WorldFeatureOptions& features,
+                                      std::vector<std::pair<Config, Config>> pairs, double radius_m);
+
 /// The shipped `floor` world. Throws std::runtime_error if a pair is not free for `radius_m`.
 ExperimentWorld floor_experiment_world(const WorldFeatureOptions& features, double radius_m);
 

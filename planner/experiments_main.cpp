@@ -39,10 +39,8 @@ cv::Mat draw_paths(const ExperimentWorld& w, const planner::eval::Scenario& sc, 
       const bool brm = planner[0] == 'b';
       const planner::eval::Trial t = planner::eval::run_trial(sc, planner::eval::Setting{planner, brm ? "su" : "uniform", o.samples},
                                             w.pairs[p].first, w.pairs[p].second, o.seed * 1000003ull + p * 1009ull);
-      std::vector<Mat4> cov{sc.start_covariance};
-      for (size_t i = 1; i < t.path.size(); ++i)
-        cov.push_back(propagate_ekf(cov.back(), model.steps(t.path[i - 1], t.path[i])));
-      drawn.push_back({t.path, cov, brm ? cv::Scalar(200, 0, 0) : cv::Scalar(0, 0, 220)});
+      drawn.push_back({t.path, planner::eval::node_covariances(t.path, model, sc.start_covariance),
+                       brm ? cv::Scalar(200, 0, 0) : cv::Scalar(0, 0, 220)});
       if (brm && p == 0) samples = t.samples;
     }
   const Eigen::AlignedBox3d b = w.env->bounds();

@@ -30,6 +30,15 @@ std::vector<double> fly(const std::vector<Config>& path, const BeliefModel& mode
   return traces;
 }
 
+std::vector<Mat4> node_covariances(const std::vector<Config>& path, const BeliefModel& model,
+                                   const Mat4& start_covariance) {
+  std::vector<Mat4> out;
+  if (path.empty()) return out;
+  out.push_back(start_covariance);
+  for (size_t i = 1; i < path.size(); ++i) out.push_back(propagate_ekf(out.back(), model.steps(path[i - 1], path[i])));
+  return out;
+}
+
 Trial run_trial(const Scenario& sc, const Setting& setting, const Config& start, const Config& goal, uint64_t seed) {
   if (setting.planner != "brm" && setting.planner != "brm-dominance" && setting.planner != "prm")
     throw std::invalid_argument("unknown planner '" + setting.planner + "' (brm, brm-dominance, prm)");

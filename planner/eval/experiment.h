@@ -53,6 +53,10 @@ Trial run_trial(const Scenario& scenario, const Setting& setting, const Config& 
 /// each step's end (the first entry is the start).
 std::vector<double> fly(const std::vector<Config>& path, const BeliefModel& model, const Mat4& start_covariance);
 
+/// The same flight's covariance at each node of `path` (the first is `start_covariance`).
+std::vector<Mat4> node_covariances(const std::vector<Config>& path, const BeliefModel& model,
+                                   const Mat4& start_covariance);
+
 double path_length(const std::vector<Config>& path);
 
 }  // namespace kestrel::planner::eval

@@ -4,12 +4,19 @@
 #include "common/numbers.h"
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <opencv2/imgproc.hpp>
 
 namespace kestrel::planner::eval {
 
+cv::Scalar track_colour(double value, double full_scale) {
+  const double s = std::clamp(value / full_scale, 0.0, 1.0);
+  // green (0, 170, 0) -> yellow (0, 200, 230) -> red (0, 0, 220), BGR
+  return s < 0.5 ? cv::Scalar(0, 170 + 60 * s, 460 * s) : cv::Scalar(0, 200 - 400 * (s - 0.5), 230 - 20 * (s - 0.5));
+}
+
 cv::Mat draw_plans(const Environment& env, const std::vector<Config>& samples, const std::vector<DrawnPath>& paths,
-                   double z_m, double ppm) {
+                   double z_m, double ppm, const std::vector<DrawnTrack>& tracks) {
   const Eigen::AlignedBox3d b = env.bounds();
   const int w = static_cast<int>(std::ceil((b.max().x() - b.min().x()) * ppm));
   const int h = static_cast<int>(std::ceil((b.max().y() - b.min().y()) * ppm));
@@ -24,6 +31,10 @@ cv::Mat draw_plans(const Environment& env, const std::vector<Config>& samples, c
     }
   for (const Feature& f : env.features()) cv::circle(img, px(f.position), 1, cv::Scalar(0, 160, 0), cv::FILLED);
   for (const Config& q : samples) cv::circle(img, px(position(q)), 3, cv::Scalar(200, 120, 0), cv::FILLED);
+  for (const DrawnTrack& t : tracks)
+    for (size_t i = 1; i < t.points.size() && i < t.values.size(); ++i)
+      cv::line(img, px(t.points[i - 1]), px(t.points[i]), track_colour(t.values[i], t.full_scale), t.thickness,
+               cv::LINE_AA);
   for (const DrawnPath& path : paths) {
     for (size_t i = 1; i < path.nodes.size(); ++i)
       cv::line(img, px(position(path.nodes[i - 1])), px(position(path.nodes[i])), path.colour, 2, cv::LINE_AA);

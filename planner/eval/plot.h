@@ -16,9 +16,21 @@ struct DrawnPath {
   cv::Scalar colour{0, 0, 255};
 };
 
+/// A flown track, each segment coloured by a value: green at 0, through yellow, red at
+/// `full_scale` and above (a flight's true position error, say).
+struct DrawnTrack {
+  std::vector<Eigen::Vector3d> points;
+  std::vector<double> values;  ///< one per point
+  double full_scale = 1.0;
+  int thickness = 2;
+};
+
 /// `pixels_per_m` sets the scale; the image is the environment's x-y bounds, y up; free space
-/// is drawn as seen at height `z_m`.
+/// is drawn as seen at height `z_m`. Tracks are drawn under the paths.
 cv::Mat draw_plans(const Environment& env, const std::vector<Config>& samples, const std::vector<DrawnPath>& paths,
-                   double z_m, double pixels_per_m = 30.0);
+                   double z_m, double pixels_per_m = 30.0, const std::vector<DrawnTrack>& tracks = {});
+
+/// The colour draw_plans gives `value` on a track of `full_scale` (BGR).
+cv::Scalar track_colour(double value, double full_scale);
 
 }  // namespace kestrel::planner::eval

@@ -49,17 +49,6 @@ struct Options {
   bool list = false;
 };
 
-// The last lines of a dead process's log: usually the reason it died.
-std::string tail(const fs::path& log, size_t lines) {
-  std::ifstream in(log);
-  std::vector<std::string> all;
-  for (std::string l; std::getline(in, l);) all.push_back(l);
-  std::string out;
-  for (size_t i = all.size() > lines ? all.size() - lines : 0; i < all.size(); ++i)
-    out += (out.empty() ? "    | " : "\n    | ") + all[i];
-  return out;
-}
-
 // LCM 1.3 takes member functions, not lambdas.
 struct HeartbeatListener {
   HealthBoard* board;
@@ -152,7 +141,7 @@ int launch(const Options& o) {
           } else if (!stopping) {
             unexpected_end |= !so.restart;  // a restarted process fails the launch only once it is given up
             spdlog::error("{} (pid {}) {}; last lines of {}:\n{}", e.name, e.pid,
-                          e.ending.description, child->log.string(), tail(child->log, 5));
+                          e.ending.description, child->log.string(), log_tail(child->log, 5));
           }
           break;
         case ChildEvent::kRestarting:

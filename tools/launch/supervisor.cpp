@@ -9,12 +9,23 @@
 
 #include <cerrno>
 #include <cstdlib>
+#include <fstream>
 #include <stdexcept>
 #include <thread>
 
 #include "common/error.h"
 
 namespace kestrel::launch {
+
+std::string log_tail(const std::filesystem::path& log, size_t lines) {
+  std::ifstream in(log);
+  std::vector<std::string> all;
+  for (std::string l; std::getline(in, l);) all.push_back(l);
+  std::string out;
+  for (size_t i = all.size() > lines ? all.size() - lines : 0; i < all.size(); ++i)
+    out += (out.empty() ? "    | " : "\n    | ") + all[i];
+  return out;
+}
 
 Ending describe_wait_status(int wait_status) {
   if (WIFEXITED(wait_status)) {

@@ -39,6 +39,10 @@ struct Ending {
 };
 Ending describe_wait_status(int wait_status);
 
+/// The last `lines` lines of a child's log, each indented as "    | ": usually the reason it
+/// died. Empty if the log cannot be read.
+std::string log_tail(const std::filesystem::path& log, size_t lines);
+
 /// Something that happened to a child, for the launcher to report.
 struct ChildEvent {
   enum Kind { kStarted, kEnded, kRestarting, kGaveUp } kind;
