@@ -62,6 +62,10 @@ Trial run_trial(const Scenario& sc, const Setting& setting, const Config& start,
   if (brm) {
     BrmQuery q;
     q.start_covariance = sc.start_covariance;
+    if (setting.max_trace > 0.0) {
+      q.objective = BrmObjective::kShortestBounded;
+      q.max_trace = setting.max_trace;
+    }
     if (setting.planner == "brm-dominance") {
       q.pruning = BrmPruning::kCovarianceDominance;
       q.dominance_slack = setting.dominance_slack;

@@ -32,6 +32,10 @@ struct Setting {
   /// brm-dominance's BrmQuery::dominance_slack: 0 is exact up to the no-revisit rule but can
   /// take minutes on a grown 3000-sample roadmap; 1 % costs ~1 % and ~45x less time.
   double dominance_slack = kToolsDominanceSlack;
+  /// > 0: BRM's other objective, the shortest path whose tr(Sigma) stays below this at every
+  /// node (the paper's first one, §4; what a vehicle that must stay localised flies); 0: the
+  /// least uncertain goal (Algorithm 1 as the tables run it).
+  double max_trace = 0.0;
 };
 
 struct Trial {

@@ -50,10 +50,12 @@ struct Options {
   int seeds = 3;
   uint64_t first_seed = 1;
   std::string sensor = "kinect";
+  double max_trace = 1.0;
   double speed = 0.5;
   double arrive_radius = 0.3;
   double ack_timeout = 60.0;
   std::string out = "fly-plans-output";
+  bool plan_only = false;
   std::string lcm_url;
 };
 
@@ -111,11 +113,11 @@ int run(const Options& o) {
         throw CLI::ValidationError("--pairs", fmt::format("{} has pairs 1 to {}", name, worlds.back().pairs.size()));
   }
   // Before any thread: every flight's processes share this private network, and nothing leaves the host.
-  try {
-    spdlog::info("private network: {}", launch::to_string(launch::enter_private_network()));
-  } catch (const launch::IsolationError& e) {
-    throw UnavailableError(std::string(e.what()) + " (kestrel fly-plans runs its processes in a private network)");
-  }
+  if (!o.plan_only) try {
+      spdlog::info("private network: {}", launch::to_string(launch::enter_private_network()));
+    } catch (const launch::IsolationError& e) {
+      throw UnavailableError(std::string(e.what()) + " (kestrel fly-plans runs its processes in a private network)");
+    }
   const auto& interrupted = catch_interrupts();
   const std::string url = transport::resolve_lcm_url(o.lcm_url);
   const fs::path tool_dir = fs::canonical("/proc/self/exe").parent_path();
@@ -147,6 +149,7 @@ int run(const Options& o) {
       for (const std::string& spec : o.planners) {
         const auto colon = spec.find(':');
         planner::eval::Setting setting{spec.substr(0, colon), spec.substr(colon + 1), o.samples};
+        setting.max_trace = o.max_trace;
         PlannedFlight plan{setting.planner + "-" + setting.sampler, {}, {}};
         plan.trial = planner::eval::run_trial(sc, setting, start, goal, o.first_seed * 1000003ull + static_cast<uint64_t>(pair) * 1009ull);
         if (plan.trial.found) plan.covariances = planner::eval::node_covariances(plan.trial.path, model, sc.start_covariance);
@@ -156,6 +159,16 @@ int run(const Options& o) {
           planned.nodes.push_back(planner::position(plan.trial.path[i]));
           planned.predicted_trace.push_back(plan.covariances[i].topLeftCorner<3, 3>().trace());
           max_trace = std::max(max_trace, planned.predicted_trace.back());
+        }
+        if (o.plan_only) {
+          std::cout << fmt::format("{} pair {} {}: {}", world_name, pair, plan.name,
+                                   plan.trial.found ? fmt::format("{:.1f} m, {} nodes, predicted position tr(Sigma) at the goal {:.5f} m², largest {:.5f} m²",
+                                                                  plan.trial.length_m, plan.trial.path.size(),
+                                                                  planned.predicted_trace.back(), max_trace)
+                                                    : std::string("no path"))
+                    << std::endl;
+          plans.push_back(std::move(plan));
+          continue;
         }
         for (int k = 0; k < o.seeds; ++k) {
           if (interrupted) return kExitInterrupted;
@@ -286,12 +299,18 @@ int main(int argc, char** argv) {
   app.add_option("--sensor", o.sensor, "The belief model's sensor: kinect (the flown camera) or camera (the paper's)")
       ->check(CLI::IsMember({"kinect", "camera"}))
       ->capture_default_str();
+  app.add_option("--max-trace", o.max_trace,
+                 "BRM: the shortest path whose tr(Sigma) (x, y, z, yaw) stays below this at every node; 0: the least "
+                 "uncertain goal, however long the way")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   app.add_option("--speed", o.speed, "The follower's cruise speed (m/s)")->check(cli::Positive)->capture_default_str();
   app.add_option("--arrive-radius", o.arrive_radius, "Arrived: the true end this close to the goal (m)")
       ->check(cli::Positive)
       ->capture_default_str();
   app.add_option("--ack-timeout", o.ack_timeout, "Lock-step: the longest wait for a process (s)")->check(cli::Positive)->capture_default_str();
   app.add_option("--out", o.out, "Folder for report.md, flights.json, the pictures and each flight's logs")->capture_default_str();
+  app.add_flag("--plan-only", o.plan_only, "Plan and draw each pair's plans, fly nothing");
   app.add_option("--lcm-url", o.lcm_url, "LCM URL inside the private network (default: $LCM_DEFAULT_URL or kestrel's)");
   return app.run(argc, argv, [&] { return run(o); });
 }
