@@ -145,7 +145,9 @@ int main(int argc, char** argv) {
       std::cout << text_report(inputs, evaluation, options);
     }
     if (!plot_path.empty()) {
-      image::write_png(plot_path, render_plot(evaluation, options, est.source + "  vs  " + gt.source));
+      // File names only: a plot is looked at elsewhere, and a folder says nothing there.
+      const auto shown = [](const std::string& source) { return std::filesystem::path(source).filename().string(); };
+      image::write_png(plot_path, render_plot(evaluation, options, shown(est.source) + "  vs  " + shown(gt.source)));
       spdlog::info("wrote {}", plot_path);
     }
     return kExitOk;
