@@ -29,22 +29,14 @@ ReplayReport replay_lockstep(transport::LogReader& log, const LockstepOptions& o
   const std::string url = transport::resolve_lcm_url(options.lcm_url);
   lcm::LCM lcm(url);
   if (!lcm.good()) throw NetworkUnavailable("cannot start LCM on '" + url + "'");
-  DriverOptions d;
-  d.expect = options.expect;
-  d.discovery_timeout_s = options.discovery_timeout_s;
-  d.settle_s = options.settle_s;
-  d.begin_period_s = options.begin_period_s;
-  d.reset = options.reset;
-  d.ack_timeout_s = options.ack_timeout_s;
-  d.record_path = options.record_path;
   LockstepDriver driver(
-      lcm, [&lcm](int ms) { lcm.handleTimeout(ms); }, d, [&interrupted] { return interrupted.load(); });
+      lcm, [&lcm](int ms) { lcm.handleTimeout(ms); }, options.driver, [&interrupted] { return interrupted.load(); });
   if (!driver.begin()) {
     report.interrupted = true;
     return report;
   }
   report.processes = driver.processes();
-  report.record_path = options.record_path;
+  report.record_path = options.driver.record_path;
   // A channel that a discovered process publishes is not replayed from the log unless asked.
   EventFilter filter(options.selection, [&driver](const std::string& c) { return driver.publishers(c); });
   const auto wall_start = std::chrono::steady_clock::now();

@@ -31,22 +31,22 @@ int main(int argc, char** argv) {
   bool json = false;
   app.add_option("log", log_path, "LCM log to replay")->required();
   app.add_option("--lcm-url", lockstep.lcm_url, "LCM URL (default: $LCM_DEFAULT_URL or kestrel's)");
-  app.add_option("--record", lockstep.record_path,
+  app.add_option("--record", lockstep.driver.record_path,
                  "Lock-step: write every message the processes publish to this LCM log, in a "
                  "canonical order, stamped with the input event's time");
-  app.add_option("--expect", lockstep.expect, "Lock-step: processes that must take part (a,b,c)")
+  app.add_option("--expect", lockstep.driver.expect, "Lock-step: processes that must take part (a,b,c)")
       ->delimiter(',');
-  app.add_flag("--reset,!--no-reset", lockstep.reset, "Lock-step: reset every process before the first event (default; --no-reset keeps their state)")
+  app.add_flag("--reset,!--no-reset", lockstep.driver.reset, "Lock-step: reset every process before the first event (default; --no-reset keeps their state)")
       ->capture_default_str();
-  app.add_option("--ack-timeout", lockstep.ack_timeout_s,
+  app.add_option("--ack-timeout", lockstep.driver.ack_timeout_s,
                  "Lock-step: seconds without progress on one event before giving up")
       ->check(cli::Positive)
       ->capture_default_str();
-  app.add_option("--discovery-timeout", lockstep.discovery_timeout_s,
+  app.add_option("--discovery-timeout", lockstep.driver.discovery_timeout_s,
                  "Lock-step: seconds to wait for the --expect processes")
       ->check(cli::Positive)
       ->capture_default_str();
-  app.add_option("--settle", lockstep.settle_s,
+  app.add_option("--settle", lockstep.driver.settle_s,
                  "Lock-step: seconds the set of processes must stay unchanged before starting")
       ->check(cli::Positive)
       ->capture_default_str();
@@ -75,7 +75,7 @@ int main(int argc, char** argv) {
 
   return app.run(argc, argv, [&]() -> int {
     const bool timed = realtime || speed > 0.0;
-    if (timed && !lockstep.record_path.empty())
+    if (timed && !lockstep.driver.record_path.empty())
       throw CLI::ValidationError("--record", "records only in lock-step mode (not with --realtime/--speed)");
     const auto& interrupted = catch_interrupts();
     transport::LogReader log(log_path);

@@ -30,15 +30,9 @@ class NetworkUnavailable : public std::runtime_error {
 };
 
 struct LockstepOptions {
-  std::string lcm_url;                 ///< "" = $LCM_DEFAULT_URL or kestrel's default
-  std::vector<std::string> expect;     ///< process names that must take part
-  double discovery_timeout_s = 10.0;   ///< give up finding `expect` after this
-  double settle_s = 1.0;               ///< the process set must not change for this long
-  double begin_period_s = 0.2;         ///< BEGIN is repeated this often while discovering
-  bool reset = true;                   ///< RESET every process before the first event
-  double ack_timeout_s = 10.0;         ///< longest wait without progress on one event
+  std::string lcm_url;  ///< "" = $LCM_DEFAULT_URL or kestrel's default
+  DriverOptions driver;  ///< discovery, reset, timeouts, recording (a replay's set is fixed)
   SelectionOptions selection;
-  std::string record_path;             ///< "" = do not record
 };
 
 struct TimedOptions {
