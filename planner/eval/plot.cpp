@@ -15,15 +15,30 @@ cv::Scalar track_colour(double value, double full_scale) {
   return s < 0.5 ? cv::Scalar(0, 170 + 60 * s, 460 * s) : cv::Scalar(0, 200 - 400 * (s - 0.5), 230 - 20 * (s - 0.5));
 }
 
+cv::Point to_pixel(const Environment& env, const Eigen::Vector3d& p, double ppm) {
+  const Eigen::AlignedBox3d b = env.bounds();
+  return {static_cast<int>((p.x() - b.min().x()) * ppm), static_cast<int>((b.max().y() - p.y()) * ppm)};
+}
+
+cv::Mat crop_to(const cv::Mat& image, const Environment& env, const std::vector<Eigen::Vector3d>& points,
+                double margin_m, double ppm) {
+  if (points.empty()) return image;
+  cv::Rect box(to_pixel(env, points.front(), ppm), cv::Size(1, 1));
+  for (const Eigen::Vector3d& p : points) box |= cv::Rect(to_pixel(env, p, ppm), cv::Size(1, 1));
+  const int margin = static_cast<int>(std::ceil(margin_m * ppm));
+  box -= cv::Point(margin, margin);
+  box += cv::Size(2 * margin, 2 * margin);
+  box &= cv::Rect(0, 0, image.cols, image.rows);
+  return box.area() > 0 ? image(box).clone() : image;
+}
+
 cv::Mat draw_plans(const Environment& env, const std::vector<Config>& samples, const std::vector<DrawnPath>& paths,
                    double z_m, double ppm, const std::vector<DrawnTrack>& tracks) {
   const Eigen::AlignedBox3d b = env.bounds();
   const int w = static_cast<int>(std::ceil((b.max().x() - b.min().x()) * ppm));
   const int h = static_cast<int>(std::ceil((b.max().y() - b.min().y()) * ppm));
   cv::Mat img(h, w, CV_8UC3);
-  const auto px = [&](const Eigen::Vector3d& p) {
-    return cv::Point(static_cast<int>((p.x() - b.min().x()) * ppm), static_cast<int>((b.max().y() - p.y()) * ppm));
-  };
+  const auto px = [&](const Eigen::Vector3d& p) { return to_pixel(env, p, ppm); };
   for (int r = 0; r < h; ++r)
     for (int c = 0; c < w; ++c) {
       const Eigen::Vector3d p(b.min().x() + (c + 0.5) / ppm, b.max().y() - (r + 0.5) / ppm, z_m);

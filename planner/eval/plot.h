@@ -33,4 +33,11 @@ cv::Mat draw_plans(const Environment& env, const std::vector<Config>& samples, c
 /// The colour draw_plans gives `value` on a track of `full_scale` (BGR).
 cv::Scalar track_colour(double value, double full_scale);
 
+/// Where draw_plans puts world point `p` (x right, y up) at `pixels_per_m`.
+cv::Point to_pixel(const Environment& env, const Eigen::Vector3d& p, double pixels_per_m);
+
+/// The part of a draw_plans image around `points`, `margin_m` beyond them on every side.
+cv::Mat crop_to(const cv::Mat& image, const Environment& env, const std::vector<Eigen::Vector3d>& points,
+                double margin_m, double pixels_per_m);
+
 }  // namespace kestrel::planner::eval

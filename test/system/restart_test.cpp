@@ -488,6 +488,9 @@ TEST(System, AnEstimatorKilledWhileTheVehicleHoversTakesTheMapsWorldAtOnce) {
   const std::string restarted = test::read_file(dir / "estimator2.txt");
   EXPECT_NE(restarted.find("1 moved the world onto SLAM's"), std::string::npos) << restarted;
   EXPECT_NE(sim.find("contacts: 0"), std::string::npos) << sim;
+  // The simulator's lock-step let the dead estimator go and took the new one in.
+  EXPECT_NE(sim.find("process estimator left the lock-step session"), std::string::npos) << sim;
+  EXPECT_NE(sim.find("process estimator joined the lock-step session"), std::string::npos) << sim;
 
   // STATE against the truth (the body's position, at the same utime): the new filter's
   // states from its first one on.

@@ -243,10 +243,15 @@ int run(const Options& o) {
       for (const PlannedFlight& p : plans)
         if (p.trial.found)
           drawn.push_back({p.trial.path, p.covariances, p.name.rfind("prm", 0) == 0 ? cv::Scalar(0, 0, 220) : cv::Scalar(200, 0, 0)});
-      const Eigen::AlignedBox3d b = sc.env->bounds();
-      const double extent = std::max(b.sizes().x(), b.sizes().y());
+      // The pair's part of the world, 3 m round the plans and the tracks, at 40 px/m.
+      std::vector<Eigen::Vector3d> shown;
+      for (const auto& d : drawn)
+        for (const planner::Config& q : d.nodes) shown.push_back(planner::position(q));
+      for (const auto& t : tracks) shown.insert(shown.end(), t.points.begin(), t.points.end());
+      const double ppm = 40.0;
       const fs::path png = out / fmt::format("{}_pair{}.png", world_name, pair);
-      image::write_png(png.string(), planner::eval::draw_plans(*sc.env, {}, drawn, start[2], std::min(40.0, 2400.0 / extent), tracks));
+      image::write_png(png.string(), planner::eval::crop_to(planner::eval::draw_plans(*sc.env, {}, drawn, start[2], ppm, tracks),
+                                                            *sc.env, shown, 3.0, ppm));
       spdlog::info("wrote {}", png.string());
     }
     report += "## " + world_name + "\n\n" + flights::markdown_table(rows, world_name) + "\n";
