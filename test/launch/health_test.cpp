@@ -46,7 +46,7 @@ TEST(HealthBoard, FollowsEachProcessThroughItsLife) {
   EXPECT_EQ(rows[0].state, "silent 3.5 s");
   EXPECT_FALSE(rows[0].healthy);
 
-  board.ended("vo", "killed by SIGSEGV");
+  board.ended("vo", "killed by SIGSEGV", t0 + milliseconds(3000));
   EXPECT_EQ(board.rows(t0 + milliseconds(4000))[0].state, "ended: killed by SIGSEGV");
   // A restart forgets the old pid's heartbeats.
   board.started("vo", 200, t0 + milliseconds(5000));
@@ -84,8 +84,27 @@ TEST(HealthBoard, ASourceWithoutHeartbeatsIsRunningUntilItEnds) {
   board.heartbeat(beat("vo", 1, process_status_t::STATE_RUNNING), t0 + milliseconds(100));
   EXPECT_TRUE(board.all_running(t0 + milliseconds(200)));
   EXPECT_EQ(board.rows(t0 + milliseconds(5000))[1].state, "running");
-  board.ended("source", "exited with status 0");
+  board.ended("source", "exited with status 0", t0 + milliseconds(4000));
   EXPECT_EQ(board.rows(t0 + milliseconds(5000))[1].state, "ended: exited with status 0");
+}
+
+TEST(HealthBoard, CpuIsAShareOfOneCoreOverTheProcesssLife) {
+  HealthBoard board(3.0);
+  const auto t0 = Clock::now();
+  board.started("vo", 1, t0);
+  board.started("mapper", 2, t0);
+  EXPECT_FALSE(board.rows(t0 + milliseconds(100))[0].cpu_percent.has_value());  // not measured yet
+  board.cpu("vo", 0.5);  // 0.5 s of CPU in its first 2 s: 25 %
+  EXPECT_NEAR(*board.rows(t0 + milliseconds(2000))[0].cpu_percent, 25.0, 1e-9);
+  // Ended after 4 s with 3 s of CPU: 75 %, however long after its end the table is drawn.
+  board.ended("vo", "exited with status 0", t0 + milliseconds(4000), 3.0);
+  board.cpu("vo", 9.0);  // a stale reading after its end changes nothing
+  EXPECT_NEAR(*board.rows(t0 + milliseconds(9000))[0].cpu_percent, 75.0, 1e-9);
+  board.ended("mapper", "exited with status 0", t0 + milliseconds(1000));  // CPU unknown
+  EXPECT_FALSE(board.rows(t0 + milliseconds(9000))[1].cpu_percent.has_value());
+  const std::string table = board.table(t0 + milliseconds(9000));
+  EXPECT_NE(table.find("cpu %"), std::string::npos) << table;
+  EXPECT_NE(table.find("   3.00   75.0  ended: exited with status 0"), std::string::npos) << table;
 }
 
 TEST(HealthBoard, AProcessThatNeverBeatsIsNamed) {

@@ -8,6 +8,8 @@
 #include <sys/wait.h>
 
 #include <fstream>
+#include <map>
+#include <optional>
 #include <sstream>
 #include <thread>
 
@@ -66,6 +68,36 @@ TEST(Supervisor, ReportsHowEachChildEndedAndKeepsItsOutput) {
   std::stringstream log;
   log << std::ifstream(o.log_dir / "fails.log").rdbuf();
   EXPECT_EQ(log.str(), "why: seen\n");
+}
+
+// The kernel's count of a child's CPU: while it runs (/proc) and when it ends (wait4). A busy
+// loop uses CPU, a sleep almost none, whatever else the machine does.
+TEST(Supervisor, CountsTheCpuEachChildUsed) {
+  TempDir dir;
+  SupervisorOptions o;
+  o.log_dir = dir / "logs";
+  const ProcessSet set{shell("busy", "i=0; while [ $i -lt 400000 ]; do i=$((i+1)); done"),
+                       shell("sleeps", "sleep 0.3")};
+  Supervisor s(set, {"/bin/sh", "/bin/sh"}, o);
+  s.start_all();
+  const pid_t busy = s.find("busy")->pid;
+  std::optional<double> running_cpu;
+  for (int i = 0; i < 200 && s.find("busy")->pid == busy; ++i) {
+    if (const auto c = process_cpu_seconds(busy)) running_cpu = c;
+    if (running_cpu && *running_cpu > 0.02) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  ASSERT_TRUE(running_cpu.has_value()) << "no /proc/<pid>/stat for a running child";
+  std::map<std::string, double> cpu;
+  for (const auto& e : poll_until(s, ChildEvent::kEnded, 2))
+    if (e.kind == ChildEvent::kEnded) cpu[e.name] = e.ending.cpu_s;
+  ASSERT_EQ(cpu.size(), 2u);
+  EXPECT_GT(cpu["busy"], 0.05);
+  EXPECT_GE(cpu["busy"], *running_cpu);
+  EXPECT_GE(cpu["sleeps"], 0.0);
+  EXPECT_LT(cpu["sleeps"], 0.05);
+  EXPECT_FALSE(process_cpu_seconds(busy).has_value());  // reaped: gone from /proc
+  EXPECT_GE(process_cpu_seconds(::getpid()).value_or(-1.0), 0.0);  // this one: readable
 }
 
 TEST(Supervisor, RestartsADeadChildUpToTheLimit) {

@@ -20,6 +20,7 @@ ReplayReport sample() {
   r.wall_s = 0.5;
   r.record_path = "out.lcmlog";
   r.recorded = {{"CAMERA_RGBD_Z", 4}};
+  r.latency = {{"CAMERA_RGBD", "codec", "CAMERA_RGBD", 4, 1.5, 2.5, 3.0}};
   return r;
 }
 
@@ -30,6 +31,8 @@ TEST(ReplayReport, TextNamesEveryCount) {
   EXPECT_NE(text.find("PROCESS_STATUS"), std::string::npos);
   EXPECT_NE(text.find("truncated last event"), std::string::npos);
   EXPECT_NE(text.find("recorded 4 messages to out.lcmlog"), std::string::npos);
+  EXPECT_NE(text.find("CAMERA_RGBD      codec        CAMERA_RGBD            4      1.50      2.50      3.00"),
+            std::string::npos) << text;
 }
 
 TEST(ReplayReport, JsonCarriesTheSameFigures) {
@@ -38,6 +41,7 @@ TEST(ReplayReport, JsonCarriesTheSameFigures) {
   EXPECT_EQ(j["replayed"]["IMU"], 8);
   EXPECT_EQ(j["skipped"]["PROCESS_STATUS"]["events"], 3);
   EXPECT_DOUBLE_EQ(j["speedup"].get<double>(), 4.0);
+  EXPECT_DOUBLE_EQ(j["latency"][0]["p95_ms"].get<double>(), 2.5);
   EXPECT_EQ(j["record"]["messages"], 4);
   EXPECT_EQ(j["record"]["channels"]["CAMERA_RGBD_Z"], 4);
   EXPECT_FALSE(j["interrupted"].get<bool>());

@@ -29,9 +29,17 @@ void HealthBoard::started(const std::string& name, pid_t pid, Clock::time_point 
   e.heartbeats = heartbeats;
 }
 
-void HealthBoard::ended(const std::string& name, const std::string& how) {
+void HealthBoard::ended(const std::string& name, const std::string& how, Clock::time_point now, double cpu_s) {
   auto it = entries_.find(name);
-  if (it != entries_.end()) it->second.ended = how;
+  if (it == entries_.end()) return;
+  it->second.ended = how;
+  it->second.ended_at = now;
+  if (cpu_s >= 0.0) it->second.cpu_s = cpu_s;
+}
+
+void HealthBoard::cpu(const std::string& name, double cpu_s) {
+  auto it = entries_.find(name);
+  if (it != entries_.end() && !it->second.ended) it->second.cpu_s = cpu_s;
 }
 
 void HealthBoard::heartbeat(const process_status_t& status, Clock::time_point now) {
@@ -53,8 +61,13 @@ std::vector<HealthBoard::Row> HealthBoard::rows(Clock::time_point now) const {
   std::vector<Row> out;
   for (const auto& name : order_) {
     const Entry& e = entries_.at(name);
-    Row r{name, e.pid, "", false, e.last};
+    Row r{name, e.pid, "", false, e.last, std::nullopt, std::nullopt};
     const double since_start = std::chrono::duration<double>(now - e.since).count();
+    const double wall_s = std::chrono::duration<double>((e.ended ? e.ended_at : now) - e.since).count();
+    if (e.launched && e.cpu_s >= 0.0) {
+      r.cpu_s = e.cpu_s;
+      if (wall_s > 0.0) r.cpu_percent = 100.0 * e.cpu_s / wall_s;
+    }
     if (e.ended) {
       r.state = "ended: " + *e.ended;
     } else if (!e.last && !e.heartbeats) {
@@ -78,15 +91,17 @@ std::vector<HealthBoard::Row> HealthBoard::rows(Clock::time_point now) const {
 
 std::string HealthBoard::table(Clock::time_point now) const {
   // The state goes last but one: "ended: killed by SIGSEGV" is long, the counters are not.
-  std::string s = fmt::format("{:<16} {:>7} {:>9} {:>9} {:>8}  {:<16} {}\n", "process", "pid", "in",
-                              "out", "rejected", "state", "message");
+  std::string s = fmt::format("{:<16} {:>7} {:>9} {:>9} {:>8} {:>7} {:>6}  {:<16} {}\n", "process", "pid", "in",
+                              "out", "rejected", "cpu s", "cpu %", "state", "message");
   for (const Row& r : rows(now)) {
     const auto& l = r.last;
     // A heartbeat's strings are any bytes a process (or a corrupt message) put there: the
     // terminal gets them escaped (found by fuzzing, fuzz/corpus/lcm-process_status_t/).
-    s += fmt::format("{:<16} {:>7} {:>9} {:>9} {:>8}  {:<16} {}\n", cli::printable(r.name), r.pid,
+    s += fmt::format("{:<16} {:>7} {:>9} {:>9} {:>8} {:>7} {:>6}  {:<16} {}\n", cli::printable(r.name), r.pid,
                      l ? std::to_string(l->messages_in) : "-", l ? std::to_string(l->messages_out) : "-",
-                     l ? std::to_string(l->messages_rejected) : "-", r.state,
+                     l ? std::to_string(l->messages_rejected) : "-",
+                     r.cpu_s ? fmt::format("{:.2f}", *r.cpu_s) : "-",
+                     r.cpu_percent ? fmt::format("{:.1f}", *r.cpu_percent) : "-", r.state,
                      l ? cli::printable(l->message) : "");
   }
   return s;

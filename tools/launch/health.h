@@ -1,6 +1,7 @@
 #pragma once
 // What the launcher knows of each process's health: its latest heartbeat (PROCESS_STATUS),
-// matched to the child by pid, and how long ago it came. Rendered as a small table.
+// matched to the child by pid, and how long ago it came; and the CPU each one uses, from the
+// launcher (the kernel's count, not the process's word). Rendered as a small table.
 //
 // Invariants: a process is "silent" when its last heartbeat is older than `silent_after_s`
 // (or it never sent one that long after starting); heartbeats of processes the launcher did
@@ -28,8 +29,11 @@ class HealthBoard {
   /// such as `kestrel replay` need not heartbeat (`heartbeats` false): it is then "running"
   /// until it ends, and all_running() does not wait for it.
   void started(const std::string& name, pid_t pid, Clock::time_point now, bool heartbeats = true);
-  /// A process that ended, with how ("exited with status 1").
-  void ended(const std::string& name, const std::string& how);
+  /// A process that ended at `now`, with how ("exited with status 1") and the CPU time it
+  /// used (s; negative when unknown).
+  void ended(const std::string& name, const std::string& how, Clock::time_point now, double cpu_s = -1.0);
+  /// The CPU time (s) a running process has used so far.
+  void cpu(const std::string& name, double cpu_s);
   void heartbeat(const process_status_t& status, Clock::time_point now);
 
   struct Row {
@@ -38,9 +42,12 @@ class HealthBoard {
     std::string state;  ///< RUNNING, DEGRADED..., "silent 4.2 s", "no heartbeat", "ended: ..."
     bool healthy = false;
     std::optional<process_status_t> last;
+    std::optional<double> cpu_s;  ///< CPU time used (user + system), s
+    /// CPU time over wall time since it started (until it ended), in % of one core.
+    std::optional<double> cpu_percent;
   };
   std::vector<Row> rows(Clock::time_point now) const;
-  /// One line per process: name, pid, state, messages in/out/rejected, message.
+  /// One line per process: name, pid, messages in/out/rejected, CPU s and %, state, message.
   std::string table(Clock::time_point now) const;
   /// True once every started, running process has sent a RUNNING heartbeat.
   bool all_running(Clock::time_point now) const;
@@ -52,6 +59,8 @@ class HealthBoard {
     std::optional<process_status_t> last;
     Clock::time_point last_at{};
     std::optional<std::string> ended;
+    Clock::time_point ended_at{};
+    double cpu_s = -1.0;
     bool launched = false;
     bool heartbeats = true;
   };

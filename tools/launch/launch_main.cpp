@@ -134,7 +134,7 @@ int launch(const Options& o) {
           board.started(e.name, e.pid, Clock::now(), /*heartbeats=*/e.name != "source");
           break;
         case ChildEvent::kEnded:
-          board.ended(e.name, e.ending.description);
+          board.ended(e.name, e.ending.description, Clock::now(), e.ending.cpu_s);
           if (e.name == "source" && !stopping) {
             source_ending = e.ending;
             spdlog::info("the source {}", e.ending.description);
@@ -172,6 +172,9 @@ int launch(const Options& o) {
     if (o.status_period_s > 0 && now >= next_status) {
       next_status = now + std::chrono::duration_cast<Clock::duration>(
                               std::chrono::duration<double>(o.status_period_s));
+      for (const auto& c : supervisor.children())
+        if (c.pid > 0)
+          if (const auto cpu = process_cpu_seconds(c.pid)) board.cpu(c.spec.name, *cpu);
       fmt::print("{}", board.table(now));
       std::fflush(stdout);
     }

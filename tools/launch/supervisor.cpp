@@ -4,12 +4,14 @@
 #include <signal.h>
 #include <cstring>
 #include <sys/prctl.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <cerrno>
 #include <cstdlib>
 #include <fstream>
+#include <sstream>
 #include <stdexcept>
 #include <thread>
 
@@ -38,6 +40,24 @@ Ending describe_wait_status(int wait_status) {
     return {128 + sig, std::string("killed by SIG") + (abbrev ? abbrev : std::to_string(sig).c_str())};
   }
   return {1, "ended (wait status " + std::to_string(wait_status) + ")"};
+}
+
+std::optional<double> process_cpu_seconds(pid_t pid) {
+  std::ifstream in("/proc/" + std::to_string(pid) + "/stat");
+  std::string stat;
+  if (!std::getline(in, stat)) return std::nullopt;
+  // "pid (comm) state ppid ...": comm may hold spaces and parentheses, so fields are counted
+  // after its last ')'; utime and stime are fields 14 and 15 (proc(5)), in clock ticks.
+  const size_t close = stat.rfind(')');
+  if (close == std::string::npos) return std::nullopt;
+  std::istringstream fields(stat.substr(close + 1));
+  std::string field;
+  double ticks = 0.0;
+  for (int i = 3; i <= 15 && fields >> field; ++i)
+    if (i >= 14) ticks += std::strtod(field.c_str(), nullptr);
+  if (!fields) return std::nullopt;
+  const long per_second = ::sysconf(_SC_CLK_TCK);
+  return per_second > 0 ? ticks / static_cast<double>(per_second) : std::optional<double>{};
 }
 
 Supervisor::Supervisor(const ProcessSet& set, const std::vector<std::filesystem::path>& executables,
@@ -120,12 +140,17 @@ std::vector<ChildEvent> Supervisor::start_all() {
 std::optional<ChildEvent> Supervisor::reap(Child& child, bool block) {
   if (child.pid < 0) return std::nullopt;
   int status = 0;
-  const pid_t r = ::waitpid(child.pid, &status, block ? 0 : WNOHANG);
+  struct rusage usage {};
+  const pid_t r = ::wait4(child.pid, &status, block ? 0 : WNOHANG, &usage);
   if (r == 0) return std::nullopt;
   if (r < 0 && errno == EINTR) return std::nullopt;
   const pid_t pid = child.pid;
   child.pid = -1;
   child.last_ending = r < 0 ? Ending{1, "vanished"} : describe_wait_status(status);
+  if (r > 0) {
+    auto seconds = [](const timeval& t) { return static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_usec); };
+    child.last_ending->cpu_s = seconds(usage.ru_utime) + seconds(usage.ru_stime);
+  }
   ::kill(-pid, SIGKILL);  // anything it left behind in its group
   return ChildEvent{ChildEvent::kEnded, child.spec.name, pid, *child.last_ending};
 }

@@ -68,6 +68,7 @@ ReplayReport replay_lockstep(transport::LogReader& log, const LockstepOptions& o
   driver.close();
   report.recorded = driver.recorded();
   report.unannounced = driver.unannounced();
+  report.latency = driver.latency();
   return report;
 }
 

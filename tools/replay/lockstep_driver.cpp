@@ -170,6 +170,7 @@ bool LockstepDriver::publish(const std::string& channel, const uint8_t* data, si
   inputs_.insert(channel);
   if (recorder_ && o_.record_inputs.count(channel)) recorder_->add(channel, data, size);
   ledger_->publish(channel);
+  latency_.begin_event(channel, now_s());
   if (lcm_.publish(channel, data, static_cast<unsigned>(size)) != 0)
     throw PeerError("cannot publish " + label + " on LCM");
   if (!wait_settled(label)) return false;
@@ -227,6 +228,7 @@ void LockstepDriver::on_ack(const kestrel::replay_ack_t& ack) {
     ledger_->announce(ack.output_channels);  // joined during this event: it owed nothing
   } else {
     ledger_->acknowledge(ack.process, ack.channel, ack.output_channels);
+    latency_.acknowledge(ack.process, ack.channel, now_s());
   }
   last_progress_s_ = now_s();
 }

@@ -30,6 +30,7 @@
 #include "kestrel/process_status_t.hpp"
 #include "kestrel/replay_ack_t.hpp"
 #include "tools/replay/ack_ledger.h"
+#include "tools/replay/latency.h"
 #include "tools/replay/output_recorder.h"
 #include "tools/replay/process_table.h"
 
@@ -102,6 +103,9 @@ class LockstepDriver {
   /// dynamic_membership: processes dropped (stopped or silent) and joined since begin().
   int64_t dropped() const { return dropped_; }
   int64_t joined() const { return joined_; }
+  /// Per input channel and process: the time from publishing an event to its acknowledgement
+  /// of each input (latency.h).
+  std::vector<LatencyRow> latency() const { return latency_.rows(); }
 
  private:
   static void on_message(const lcm::ReceiveBuffer* rbuf, const std::string& channel, LockstepDriver* self);
@@ -146,6 +150,7 @@ class LockstepDriver {
   bool membership_changed_ = false;
   double last_invite_s_ = 0.0;
   int64_t dropped_ = 0, joined_ = 0;
+  LatencyLedger latency_;
 };
 
 }  // namespace kestrel::replay

@@ -40,6 +40,8 @@ std::string format_text(const ReplayReport& r) {
       s += fmt::format("  {} of them were published outside any handler (not lock-step)\n",
                        r.unannounced);
   }
+  if (!r.latency.empty())
+    s += "latency, from publishing an event to each acknowledgement (wall clock):\n" + format_latency(r.latency);
   return s;
 }
 
@@ -67,6 +69,13 @@ nlohmann::json to_json(const ReplayReport& r) {
                    {"messages", sum(r.recorded)},
                    {"channels", r.recorded},
                    {"unannounced", r.unannounced}};
+  }
+  if (!r.latency.empty()) {
+    nlohmann::json rows = nlohmann::json::array();
+    for (const auto& l : r.latency)
+      rows.push_back({{"input", l.input}, {"process", l.process}, {"handled", l.handled}, {"events", l.count},
+                      {"median_ms", l.median_ms}, {"p95_ms", l.p95_ms}, {"max_ms", l.max_ms}});
+    j["latency"] = rows;
   }
   return j;
 }

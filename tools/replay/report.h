@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "tools/replay/event_filter.h"
+#include "tools/replay/latency.h"
 
 namespace kestrel::replay {
 
@@ -30,6 +31,7 @@ struct ReplayReport {
   std::string record_path;
   std::map<std::string, int64_t> recorded;            ///< channel -> messages
   int64_t unannounced = 0;  ///< outputs received that no acknowledgement announced
+  std::vector<LatencyRow> latency;  ///< lock-step: publication -> each acknowledgement (wall clock)
   bool interrupted = false;
 
   double speedup() const { return wall_s > 0.0 ? data_s / wall_s : 0.0; }

@@ -1,0 +1,56 @@
+#include "tools/replay/latency.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace kestrel::replay {
+
+void LatencyLedger::begin_event(const std::string& input, double t_s) {
+  input_ = input;
+  started_s_ = t_s;
+  in_event_ = true;
+  seen_.clear();
+}
+
+void LatencyLedger::acknowledge(const std::string& process, const std::string& handled, double t_s) {
+  if (!in_event_) return;
+  if (!seen_.emplace(std::make_pair(process, handled), true).second) return;  // not the first
+  samples_ms_[{input_, process, handled}].push_back(1e3 * (t_s - started_s_));
+}
+
+double quantile(std::vector<double> values, double q) {
+  if (values.empty()) return std::numeric_limits<double>::quiet_NaN();
+  std::sort(values.begin(), values.end());
+  // Nearest rank: the smallest value with at least q of the samples at or below it.
+  const double rank = std::ceil(std::clamp(q, 0.0, 1.0) * static_cast<double>(values.size()));
+  const size_t i = rank < 1.0 ? 0 : static_cast<size_t>(rank) - 1;
+  return values[std::min(i, values.size() - 1)];
+}
+
+std::vector<LatencyRow> LatencyLedger::rows() const {
+  std::vector<LatencyRow> out;
+  for (const auto& [key, ms] : samples_ms_) {
+    const auto& [input, process, handled] = key;
+    out.push_back({input, process, handled, static_cast<int64_t>(ms.size()), quantile(ms, 0.5),
+                   quantile(ms, 0.95), *std::max_element(ms.begin(), ms.end())});
+  }
+  std::stable_sort(out.begin(), out.end(), [](const LatencyRow& a, const LatencyRow& b) {
+    return std::tie(a.input, a.median_ms) < std::tie(b.input, b.median_ms);
+  });
+  return out;
+}
+
+std::string format_latency(const std::vector<LatencyRow>& rows) {
+  if (rows.empty()) return "";
+  std::string s = fmt::format("{:<16} {:<12} {:<16} {:>7} {:>9} {:>9} {:>9}\n", "input", "process",
+                              "handled", "events", "median ms", "p95 ms", "max ms");
+  for (const auto& r : rows)
+    s += fmt::format("{:<16} {:<12} {:<16} {:>7} {:>9.2f} {:>9.2f} {:>9.2f}\n", r.input, r.process,
+                     r.handled, r.count, r.median_ms, r.p95_ms, r.max_ms);
+  return s;
+}
+
+}  // namespace kestrel::replay
