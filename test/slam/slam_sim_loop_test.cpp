@@ -15,31 +15,21 @@
 #include <cmath>
 #include <iostream>
 
-#include "common/geometry/align.h"
 #include "common/numbers.h"
 #include "drivers/sim/flights.h"
 #include "drivers/sim/simulation.h"
 #include "drivers/sim/world_catalog.h"
 #include "slam/place/builtin_vocabulary.h"
 #include "slam/sequence_run.h"
+#include "tools/eval/evaluate.h"
 
 namespace kestrel::slam {
 namespace {
 
-// RMSE of the positions after rigid alignment (kestrel-eval's ATE), at the estimate's frames.
+// kestrel eval's ATE (RMSE after the rigid alignment, at the estimate's frames, the ground
+// truth interpolated within 20 ms): the one ATE of the project.
 double ate_rmse(const Trajectory& estimate, const Trajectory& truth) {
-  Eigen::Matrix3Xd E(3, static_cast<Eigen::Index>(estimate.size())), G(3, E.cols());
-  Eigen::Index k = 0;
-  for (const StampedPose& p : estimate.poses()) {
-    const auto T = truth.at(p.utime, 0);
-    if (!T) continue;
-    E.col(k) = p.T.translation();
-    G.col(k++) = T->translation();
-  }
-  E.conservativeResize(3, k);
-  G.conservativeResize(3, k);
-  const Eigen::Isometry3d T = align_rigid(E, G).value();
-  return std::sqrt(((T * E) - G).colwise().squaredNorm().mean());
+  return eval::evaluate(eval::frame_times(estimate), estimate, truth, eval::EvalOptions{}).ate.error_m.rmse;
 }
 
 TEST(SlamSimLoop, FloorLoopCutsTheOdometryDriftWithNoFalseClosure) {

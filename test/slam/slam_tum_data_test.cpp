@@ -10,32 +10,20 @@
 #include <cmath>
 #include <tuple>
 
-#include "common/geometry/align.h"
 #include "common/numbers.h"
 #include "slam/place/builtin_vocabulary.h"
 #include "slam/sequence_run.h"
 #include "test/support/test_support.h"
+#include "tools/eval/evaluate.h"
 #include "vo/sequence_run.h"
 
 namespace kestrel::slam {
 namespace {
 
-// RMSE of the positions after rigid alignment, over frames with ground truth within 20 ms.
+// kestrel eval's ATE (RMSE after the rigid alignment, at the estimate's frames, the ground
+// truth interpolated within 20 ms): the one ATE of the project.
 double ate_rmse(const Trajectory& estimate, const Trajectory& truth) {
-  std::vector<Eigen::Vector3d> est, gt;
-  for (const StampedPose& p : estimate.poses()) {
-    if (const auto T = truth.at(p.utime, 20'000)) {
-      est.push_back(p.T.translation());
-      gt.push_back(T->translation());
-    }
-  }
-  Eigen::Matrix3Xd E(3, static_cast<Eigen::Index>(est.size())), G(3, E.cols());
-  for (size_t k = 0; k < est.size(); ++k) {
-    E.col(static_cast<Eigen::Index>(k)) = est[k];
-    G.col(static_cast<Eigen::Index>(k)) = gt[k];
-  }
-  const Eigen::Isometry3d T = align_rigid(E, G).value();
-  return std::sqrt(((T * E) - G).colwise().squaredNorm().mean());
+  return eval::evaluate(eval::frame_times(estimate), estimate, truth, eval::EvalOptions{}).ate.error_m.rmse;
 }
 
 class SlamOnTum : public ::testing::TestWithParam<std::tuple<const char*, bool>> {};

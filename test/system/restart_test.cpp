@@ -44,6 +44,7 @@
 #include "kestrel/state_t.hpp"
 #include "kestrel/vo_update_t.hpp"
 #include "test/support/test_support.h"
+#include "tools/eval/alignment.h"
 
 namespace kestrel {
 namespace {
@@ -53,7 +54,7 @@ struct Sample {
   Eigen::Vector3d p = Eigen::Vector3d::Zero();
 };
 
-// The rigid transform that best maps `from` onto `to` (Horn / Umeyama without scale), and the
+// The rigid transform that best maps `from` onto `to` (kestrel eval's ATE alignment), and the
 // RMS of what is left.
 double rigid_fit_rms(const std::vector<Eigen::Vector3d>& from, const std::vector<Eigen::Vector3d>& to) {
   Eigen::Matrix3Xd a(3, from.size()), b(3, to.size());
@@ -61,8 +62,7 @@ double rigid_fit_rms(const std::vector<Eigen::Vector3d>& from, const std::vector
     a.col(static_cast<Eigen::Index>(i)) = from[i];
     b.col(static_cast<Eigen::Index>(i)) = to[i];
   }
-  const Eigen::Matrix4d T = Eigen::umeyama(a, b, false);
-  const Eigen::Matrix3Xd moved = (T.topLeftCorner<3, 3>() * a).colwise() + T.topRightCorner<3, 1>();
+  const Eigen::Matrix3Xd moved = eval::align_positions(a, b).T_gt_est * a;
   return std::sqrt((moved - b).colwise().squaredNorm().mean());
 }
 
@@ -360,8 +360,7 @@ TEST(System, AVoKilledInFlightLeavesTheStateAndTheGraphInOneWorld) {
     a.col(static_cast<Eigen::Index>(i)) = est[i];
     b.col(static_cast<Eigen::Index>(i)) = gt[i];
   }
-  const Eigen::Matrix4d fit = Eigen::umeyama(a, b, false);
-  const Eigen::Matrix3Xd errors = ((fit.topLeftCorner<3, 3>() * a).colwise() + fit.topRightCorner<3, 1>()) - b;
+  const Eigen::Matrix3Xd errors = eval::align_positions(a, b).T_gt_est * a - b;
   const double rms = std::sqrt(errors.colwise().squaredNorm().mean());
   const double worst = errors.colwise().norm().maxCoeff();
   std::printf("states under one rigid fit: RMS %.4f m, worst %.4f m over %zu states\n", rms, worst, est.size());
