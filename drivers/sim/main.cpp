@@ -336,10 +336,7 @@ int run(const Options& o) {
               << "lockstep dropped: " << driver->dropped() << "\n"
               << "lockstep joined: " << driver->joined() << "\n";
     for (const auto& [channel, n] : driver->recorded()) std::cout << "recorded " << channel << ": " << n << "\n";
-    const auto latency = driver->latency();
-    if (!latency.empty())
-      std::cout << "lockstep latency, from publishing an event to each acknowledgement (wall clock):\n"
-                << replay::format_latency(latency);
+    std::cout << replay::format_latency(driver->latency());
   }
   std::cout << "contacts: " << contact.contacts() << "\n"
             << "min clearance: " << contact.min_clearance_m() << " m\n";

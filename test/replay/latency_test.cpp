@@ -32,11 +32,21 @@ TEST(LatencyLedger, TimesEachProcessFromThePublicationOfItsEvent) {
     ledger.acknowledge("vo", "CAMERA_RGBD", t0 + 1e-3 * vo_ms[k]);
     ledger.acknowledge("estimator", "VO_UPDATE", t0 + 1e-3 * (vo_ms[k] + 1));
     ledger.acknowledge("estimator", "VO_UPDATE", t0 + 0.5);  // a second one: only the first counts
+    ledger.end_event();
+    ledger.acknowledge("vo", "CAMERA_RGBD", t0 + 0.9);  // after the event settled: not counted
   }
   ledger.begin_event("IMU", 20.0);
   ledger.acknowledge("estimator", "IMU", 20.0002);
+  ledger.end_event();
 
-  const auto rows = ledger.rows();
+  std::vector<LatencyRow> rows, all;  // per handled channel; per process, done with the event
+  for (const auto& r : ledger.rows()) (r.handled == LatencyLedger::kAll ? all : rows).push_back(r);
+  ASSERT_EQ(all.size(), 3u);
+  EXPECT_EQ(all[0].process, "vo");
+  EXPECT_NEAR(all[0].median_ms, 5.0, 1e-9);  // vo's only acknowledgement
+  EXPECT_EQ(all[1].process, "estimator");
+  EXPECT_NEAR(all[1].median_ms, 500.0, 1e-9);  // its last one, the second VO_UPDATE's
+  EXPECT_EQ(all[2].input, "IMU");
   ASSERT_EQ(rows.size(), 3u);
   EXPECT_EQ(rows[0].input, "CAMERA_RGBD");
   EXPECT_EQ(rows[0].process, "vo");  // ordered by median within an input
@@ -52,6 +62,7 @@ TEST(LatencyLedger, TimesEachProcessFromThePublicationOfItsEvent) {
   EXPECT_NEAR(rows[2].median_ms, 0.2, 1e-9);
 
   const std::string table = format_latency(rows);
+  EXPECT_EQ(table.rfind("latency, from publishing an event", 0), 0u) << table;
   EXPECT_NE(table.find("CAMERA_RGBD      estimator    VO_UPDATE              3      6.00      7.00      7.00"),
             std::string::npos)
       << table;

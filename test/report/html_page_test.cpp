@@ -41,7 +41,7 @@ TEST(RenderPage, EmbedsTheImagesItNamesAndRendersTablesAndCode) {
       "# kestrel demo\n\n| metric | VO |\n|---|---|\n| ATE (m) | 0.0039 |\n\n"
       "```\nkestrel-vo: info: 601 frames <ok>\n```\n\n"
       "![vo](vo.png) ![pair](flights/room%20pair.png) ![gone](missing.png)\n"
-      "![web](https://example.org/x.png) ![abs](/etc/x.png)\n";
+      "![web](https://example.org/x.png) ![abs](/etc/x.png) ![other](plot.webp)\n";
   const HtmlPage page = render_page(md, "kestrel <demo>", read);
 
   EXPECT_NE(page.html.find("<title>kestrel &lt;demo&gt;</title>"), std::string::npos);
@@ -53,6 +53,7 @@ TEST(RenderPage, EmbedsTheImagesItNamesAndRendersTablesAndCode) {
   EXPECT_NE(page.html.find("src=\"missing.png\""), std::string::npos);  // kept as a link
   EXPECT_NE(page.html.find("src=\"https://example.org/x.png\""), std::string::npos);
   EXPECT_NE(page.html.find("src=\"/etc/x.png\""), std::string::npos);
+  EXPECT_NE(page.html.find("src=\"plot.webp\""), std::string::npos);  // a type not embedded: a link, not missing
   EXPECT_EQ(page.embedded, (std::vector<std::string>{"vo.png", "flights/room pair.png"}));
   EXPECT_EQ(page.missing, (std::vector<std::string>{"missing.png"}));
   // Only relative paths are looked up: never a URL or an absolute path.

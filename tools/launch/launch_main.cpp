@@ -134,7 +134,7 @@ int launch(const Options& o) {
           board.started(e.name, e.pid, Clock::now(), /*heartbeats=*/e.name != "source");
           break;
         case ChildEvent::kEnded:
-          board.ended(e.name, e.ending.description, Clock::now(), e.ending.cpu_s);
+          board.ended(e.name, e.ending.description, e.ending.at, e.ending.cpu_s);
           if (e.name == "source" && !stopping) {
             source_ending = e.ending;
             spdlog::info("the source {}", e.ending.description);

@@ -47,13 +47,14 @@ std::optional<double> process_cpu_seconds(pid_t pid) {
   std::string stat;
   if (!std::getline(in, stat)) return std::nullopt;
   // "pid (comm) state ppid ...": comm may hold spaces and parentheses, so fields are counted
-  // after its last ')'; utime and stime are fields 14 and 15 (proc(5)), in clock ticks.
+  // after its last ')'; utime, stime, cutime and cstime are fields 14 to 17 (proc(5)), in
+  // clock ticks.
   const size_t close = stat.rfind(')');
   if (close == std::string::npos) return std::nullopt;
   std::istringstream fields(stat.substr(close + 1));
   std::string field;
   double ticks = 0.0;
-  for (int i = 3; i <= 15 && fields >> field; ++i)
+  for (int i = 3; i <= 17 && fields >> field; ++i)
     if (i >= 14) ticks += std::strtod(field.c_str(), nullptr);
   if (!fields) return std::nullopt;
   const long per_second = ::sysconf(_SC_CLK_TCK);
@@ -147,6 +148,7 @@ std::optional<ChildEvent> Supervisor::reap(Child& child, bool block) {
   const pid_t pid = child.pid;
   child.pid = -1;
   child.last_ending = r < 0 ? Ending{1, "vanished"} : describe_wait_status(status);
+  child.last_ending->at = Clock::now();
   if (r > 0) {
     auto seconds = [](const timeval& t) { return static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_usec); };
     child.last_ending->cpu_s = seconds(usage.ru_utime) + seconds(usage.ru_stime);

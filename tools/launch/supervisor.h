@@ -36,12 +36,16 @@ struct SupervisorOptions {
 struct Ending {
   int code = 0;  ///< exit status, or 128 + signal number (the shell's convention)
   std::string description;
-  double cpu_s = -1.0;  ///< CPU time it used (user + system, its own), s; -1 when unknown
+  /// CPU time it used (user + system; with its children it waited for, as wait4 counts), s;
+  /// -1 when unknown.
+  double cpu_s = -1.0;
+  std::chrono::steady_clock::time_point at{};  ///< when it was reaped
 };
 Ending describe_wait_status(int wait_status);
 
-/// CPU time (user + system) a running process has used so far, from /proc/<pid>/stat;
-/// nullopt if that cannot be read (it has ended, or no /proc).
+/// CPU time (user + system) a running process has used so far, with that of its children it
+/// waited for (as wait4 will count it at its end), from /proc/<pid>/stat; nullopt if that
+/// cannot be read (it has ended, or no /proc).
 std::optional<double> process_cpu_seconds(pid_t pid);
 
 /// The last `lines` lines of a child's log, each indented as "    | ": usually the reason it

@@ -13,12 +13,21 @@ void LatencyLedger::begin_event(const std::string& input, double t_s) {
   started_s_ = t_s;
   in_event_ = true;
   seen_.clear();
+  last_s_.clear();
 }
 
 void LatencyLedger::acknowledge(const std::string& process, const std::string& handled, double t_s) {
   if (!in_event_) return;
-  if (!seen_.emplace(std::make_pair(process, handled), true).second) return;  // not the first
+  double& last = last_s_.emplace(process, t_s).first->second;
+  last = std::max(last, t_s);
+  if (!seen_.emplace(process, handled).second) return;  // not the first of this channel
   samples_ms_[{input_, process, handled}].push_back(1e3 * (t_s - started_s_));
+}
+
+void LatencyLedger::end_event() {
+  if (!in_event_) return;
+  for (const auto& [process, t_s] : last_s_) samples_ms_[{input_, process, kAll}].push_back(1e3 * (t_s - started_s_));
+  in_event_ = false;
 }
 
 double quantile(std::vector<double> values, double q) {
@@ -45,7 +54,8 @@ std::vector<LatencyRow> LatencyLedger::rows() const {
 
 std::string format_latency(const std::vector<LatencyRow>& rows) {
   if (rows.empty()) return "";
-  std::string s = fmt::format("{:<16} {:<12} {:<16} {:>7} {:>9} {:>9} {:>9}\n", "input", "process",
+  std::string s = "latency, from publishing an event to each acknowledgement (wall clock):\n";
+  s += fmt::format("{:<16} {:<12} {:<16} {:>7} {:>9} {:>9} {:>9}\n", "input", "process",
                               "handled", "events", "median ms", "p95 ms", "max ms");
   for (const auto& r : rows)
     s += fmt::format("{:<16} {:<12} {:<16} {:>7} {:>9.2f} {:>9.2f} {:>9.2f}\n", r.input, r.process,

@@ -174,6 +174,7 @@ bool LockstepDriver::publish(const std::string& channel, const uint8_t* data, si
   if (lcm_.publish(channel, data, static_cast<unsigned>(size)) != 0)
     throw PeerError("cannot publish " + label + " on LCM");
   if (!wait_settled(label)) return false;
+  latency_.end_event();
   unannounced_ += ledger_->finish_event();
   if (recorder_) recorder_->flush_event(timestamp, depths(channel));
   return true;

@@ -41,7 +41,7 @@ std::string format_text(const ReplayReport& r) {
                        r.unannounced);
   }
   if (!r.latency.empty())
-    s += "latency, from publishing an event to each acknowledgement (wall clock):\n" + format_latency(r.latency);
+    s += format_latency(r.latency);
   return s;
 }
 

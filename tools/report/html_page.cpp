@@ -119,13 +119,14 @@ HtmlPage render_page(const std::string& markdown, const std::string& title, cons
     const std::string path = url_to_path(url);
     const std::string mime = image_mime_type(path);
     std::optional<std::string> bytes;
-    if (is_relative_path(path) && !mime.empty()) bytes = read_file(path);
+    const bool embeddable = is_relative_path(path) && !mime.empty();
+    if (embeddable) bytes = read_file(path);
     if (bytes) {
       out += "data:" + mime + ";base64," + base64(*bytes);
       page.embedded.push_back(path);
     } else {
       out += url;
-      if (is_relative_path(path)) page.missing.push_back(path);
+      if (embeddable) page.missing.push_back(path);
     }
     at = end;
   }

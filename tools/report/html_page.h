@@ -5,8 +5,9 @@
 // mailed, attached to an issue or opened from anywhere, and still shows its figures.
 //
 // Invariants: the output is the md4c rendering, changed only in the src of <img> elements
-// whose image was found (embedded) and by the page's head and foot; raw HTML in the Markdown
-// passes through as md4c passes it. Absolute paths and URLs are left as they are.
+// whose image was found (embedded) and by the page's head and foot. Raw HTML passes through
+// as md4c passes it, so a raw <img src="..."> (src first) is embedded too. Absolute paths,
+// URLs and files of other types (not a PNG, JPEG, SVG or GIF) are left as links.
 
 #include <functional>
 #include <optional>
@@ -21,7 +22,7 @@ using ReadFile = std::function<std::optional<std::string>(const std::string& rel
 struct HtmlPage {
   std::string html;
   std::vector<std::string> embedded;  ///< images put in the page, as the report names them
-  std::vector<std::string> missing;   ///< images named but not found (their links are kept)
+  std::vector<std::string> missing;   ///< images it would embed but could not read (kept as links)
 };
 
 /// `markdown` rendered as a page titled `title`. Throws std::runtime_error if md4c fails.

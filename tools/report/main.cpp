@@ -33,7 +33,8 @@ int main(int argc, char** argv) {
   cli::App app("report",
                "Renders a Markdown report as one HTML page that needs no other file: every image it "
                "names by a relative path is embedded. Exit: 0 written; 1 an image it names is missing "
-               "(the page is written, with the link); 3 the report cannot be read or the page written.");
+               "(the page is written, with the link); 2 --out is the report itself; 3 the report cannot be read "
+               "or the page written.");
   std::string input, output, title;
   app.add_option("report", input, "The Markdown report")->required();
   app.add_option("--out", output, "The HTML page (default: the report's name with .html)");
@@ -43,19 +44,26 @@ int main(int argc, char** argv) {
     const fs::path in(input);
     const auto markdown = read_bytes(in);
     if (!markdown) throw InputError(input + ": cannot be read");
-    if (title.empty()) {
+    if (title.empty()) {  // the first level-1 heading, outside fenced code
       std::istringstream lines(*markdown);
-      for (std::string line; std::getline(lines, line);)
-        if (line.rfind("# ", 0) == 0) {
+      bool fenced = false;
+      for (std::string line; std::getline(lines, line);) {
+        if (!line.empty() && line.back() == '\r') line.pop_back();
+        if (line.rfind("```", 0) == 0) fenced = !fenced;
+        if (!fenced && line.rfind("# ", 0) == 0) {
           title = line.substr(2);
           break;
         }
+      }
       if (title.empty()) title = in.stem().string();
     }
     const fs::path folder = in.has_parent_path() ? in.parent_path() : fs::path(".");
     const report::HtmlPage page = report::render_page(
         *markdown, title, [&folder](const std::string& relative) { return read_bytes(folder / relative); });
     const fs::path out = output.empty() ? fs::path(in).replace_extension(".html") : fs::path(output);
+    std::error_code same_error;
+    if (out == in || fs::equivalent(out, in, same_error))
+      throw CLI::ValidationError("--out", "is the report itself: it would be overwritten");
     AtomicFile file(out.string());
     file.stream() << page.html;
     file.commit();
