@@ -41,6 +41,7 @@ const std::map<std::string, std::vector<std::string>>& required_arguments() {
       {"goto", {"--goal", "1", "2", "1.5", "0.25"}},
       {"eval", {"--est", "{file}"}},
       {"replay", {"{file}"}},
+      {"report", {"{file}"}},
       {"launch", {"all"}},
   };
   return kArgs;
