@@ -17,7 +17,7 @@
 namespace kestrel {
 
 /// The sensor models a source names in RgbdFrame::sensor. Consumers key their timing and
-/// noise profiles by them (vo/sensor_profile.h); the name travels with every frame, so a log
+/// noise profiles by them (sensors/profiles/<name>.yaml); the name travels with every frame, so a log
 /// replays with the model of the camera that recorded it.
 namespace sensor_model {
 inline constexpr const char* kSimulator = "simulator";  ///< kestrel-sim's rendered camera

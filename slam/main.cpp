@@ -18,7 +18,7 @@
 #include "slam/memory_policy.h"
 #include "slam/place/builtin_vocabulary.h"
 #include "slam/slam_adapter.h"
-#include "vo/sensor_profile.h"
+#include "sensors/profile_file.h"
 #if KESTREL_SLAM_OFFLINE
 #include "common/numbers.h"
 #include "drivers/tum/tum_sequence.h"
@@ -35,7 +35,7 @@ using namespace kestrel::slam;
 struct Options {
   std::string vocabulary = "builtin";
   std::string kernel = "dcs";
-  std::string sensor;  // a vo::SensorProfile name; empty: the TUM folder's, else each frame's
+  std::string sensor;  // a sensor profile's name or file; empty: the TUM folder's, else each frame's
   // Offline.
   std::string tum, out, vo_out;
   // Process.
@@ -76,10 +76,11 @@ void add_options(cli::App& app, Options& o, SlamOptions& s) {
       ->check(CLI::IsMember({"none", "huber", "cauchy", "dcs"}))->capture_default_str();
   app.add_option("--sensor", o.sensor,
                  "Camera profile, as kestrel-vo's (its timing corrects the keyframes' features, its noise "
-                 "floors the loops'): simulator (global shutter) or kinect1 (rolling shutter, depth before "
-                 "colour, loops 1 degree uncertain); by default the one "
-                 "each frame's sensor model names (with --tum the folder's: kinect1 for freiburg1)")
-      ->check(CLI::IsMember({vo::to_string(vo::SensorProfile::kSimulator), vo::to_string(vo::SensorProfile::kKinect1)}));
+                 "floors the loops'): a built-in one (simulator: global shutter; kinect1: rolling shutter, "
+                 "depth before colour, loops 1 degree uncertain) or a profile file of your own "
+                 "(sensors/README.md); by default the one each frame's sensor model names (with --tum the "
+                 "folder's: kinect1 for freiburg1)")
+      ->check(CLI::Validator([](std::string& name) { return sensors::check_sensor_profile_name(name); }, "PROFILE"));
   app.add_option("--tum", o.tum, "Offline: run VO + SLAM over this TUM RGB-D folder");
   app.add_option("--out", o.out, "Offline: write the optimised camera trajectory here (TUM format)");
   app.add_option("--vo-out", o.vo_out, "Offline: write the odometry-only trajectory here too");
@@ -104,8 +105,8 @@ int run_offline(const Options& o, const SlamOptions& options, std::shared_ptr<co
   // Frames are decoded one at a time: a long sequence (e.g. a sim flight) need not fit in memory.
   const tum::TumSequence sequence(o.tum);
   // The camera's profile: as told, else the folder's (as kestrel-vo --tum).
-  const vo::SensorProfile sensor = o.sensor.empty() ? vo::tum_sensor(o.tum) : *vo::parse_sensor_profile(o.sensor);
-  std::cout << "camera profile: " << vo::to_string(sensor) << "\n";
+  const sensors::SensorProfile sensor = o.sensor.empty() ? vo::tum_sensor(o.tum) : sensors::load_sensor_profile(o.sensor);
+  std::cout << "camera profile: " << sensor.name << "\n";
   const SlamRun run = run_slam_sequence(
       sequence.size(), [&sequence](size_t i) { return sequence.frame(i); }, sensor, vo::VoOptions{}, options,
       std::move(vocabulary));
@@ -142,7 +143,7 @@ int run_offline(const Options& o, const SlamOptions& options, std::shared_ptr<co
 int serve(const Options& o, const SlamOptions& options, std::shared_ptr<const Vocabulary> vocabulary) {
   if (!o.out.empty() || !o.vo_out.empty()) throw CLI::ValidationError("--out/--vo-out", "only with --tum");
   AdapterOptions adapter_options = o.adapter;
-  if (!o.sensor.empty()) adapter_options.sensor = vo::parse_sensor_profile(o.sensor);
+  if (!o.sensor.empty()) adapter_options.sensor = sensors::load_sensor_profile(o.sensor);
   spdlog::info("camera profile: {}", o.sensor.empty() ? "each frame's sensor model" : o.sensor);
   SlamAdapter adapter(options, std::move(vocabulary), adapter_options);
   std::unique_ptr<transport::Node> node;

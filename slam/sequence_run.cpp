@@ -8,17 +8,18 @@
 #include "common/geometry/se3.h"
 #include "slam/backend/odometry_chain.h"
 #include "vo/odometry.h"
+#include "vo/sensor_profile.h"
 
 namespace kestrel::slam {
 
-SlamRun run_slam_sequence(const std::vector<RgbdFrame>& frames, vo::SensorProfile sensor,
+SlamRun run_slam_sequence(const std::vector<RgbdFrame>& frames, const sensors::SensorProfile& sensor,
                           const vo::VoOptions& vo_options, const SlamOptions& options,
                           std::shared_ptr<const Vocabulary> vocabulary) {
   return run_slam_sequence(
       frames.size(), [&frames](size_t i) { return frames[i]; }, sensor, vo_options, options, std::move(vocabulary));
 }
 
-SlamRun run_slam_sequence(size_t count, const std::function<RgbdFrame(size_t)>& frame_at, vo::SensorProfile sensor,
+SlamRun run_slam_sequence(size_t count, const std::function<RgbdFrame(size_t)>& frame_at, const sensors::SensorProfile& sensor,
                           const vo::VoOptions& base_vo_options, const SlamOptions& options,
                           std::shared_ptr<const Vocabulary> vocabulary) {
   const vo::VoOptions vo_options = vo::with_sensor(sensor, base_vo_options);

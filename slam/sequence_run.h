@@ -67,13 +67,13 @@ std::vector<LoopError> loop_errors(const SlamRun& run, const Trajectory& ground_
 
 /// `sensor`: the camera's profile, which sets the odometry's options (vo::with_sensor() of
 /// `vo_options`; the keyframes' timing) and the noise of SLAM's loops (Slam::add).
-SlamRun run_slam_sequence(const std::vector<RgbdFrame>& frames, vo::SensorProfile sensor,
+SlamRun run_slam_sequence(const std::vector<RgbdFrame>& frames, const sensors::SensorProfile& sensor,
                           const vo::VoOptions& vo_options, const SlamOptions& options,
                           std::shared_ptr<const Vocabulary> vocabulary);
 
 /// The same over `count` frames decoded one at a time by `frame_at(i)` (a long sequence need
 /// not fit in memory: 1.5 MB a VGA frame).
-SlamRun run_slam_sequence(size_t count, const std::function<RgbdFrame(size_t)>& frame_at, vo::SensorProfile sensor,
+SlamRun run_slam_sequence(size_t count, const std::function<RgbdFrame(size_t)>& frame_at, const sensors::SensorProfile& sensor,
                           const vo::VoOptions& vo_options, const SlamOptions& options,
                           std::shared_ptr<const Vocabulary> vocabulary);
 

@@ -8,6 +8,7 @@
 #include "common/geometry/so3.h"
 #include "common/transport/convert.h"
 #include "common/transport/rgbd_codec.h"
+#include "sensors/builtin_profiles.h"
 
 namespace kestrel::slam {
 
@@ -228,7 +229,7 @@ AdapterOutputs SlamAdapter::process(const kestrel::rgbd_frame_t& message, const 
     odometry_covariance = chain_.relative_covariance(*keyframe_pose_, chained);
   }
   // The features' timing: the odometry's motion from the previous update (not across a restart).
-  const vo::SensorProfile sensor = options_.sensor.value_or(vo::profile_of_sensor(frame.sensor));
+  const sensors::SensorProfile& sensor = options_.sensor ? *options_.sensor : sensors::profile_of_sensor(frame.sensor);
   vo::FrameMotion motion;
   if (link == OdometryLink::kContinuous && waiting.previous_utime != 0) {
     motion = keyframe_motion(vo::with_sensor(sensor, vo::VoOptions{}).depth, frame.utime, frame.depth_utime,

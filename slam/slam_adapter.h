@@ -55,6 +55,7 @@
 #include "kestrel/state_t.hpp"
 #include "slam/slam_messages.h"
 #include "vo/options.h"
+#include "sensors/sensor_profile.h"
 #include "vo/sensor_profile.h"
 
 namespace kestrel::slam {
@@ -72,8 +73,8 @@ struct AdapterOptions {
   double max_bridge_s = 10.0;             ///< longest VO outage the estimator's motion may bridge
   /// The camera's profile, whose timing (depth offset, rolling shutter) the keyframes'
   /// features are corrected with as the VO corrects them (kestrel-slam --sensor); unset: each
-  /// frame's sensor model names it (vo::profile_of_sensor).
-  std::optional<vo::SensorProfile> sensor;
+  /// frame's sensor model names it (sensors::profile_of_sensor).
+  std::optional<sensors::SensorProfile> sensor;
 };
 
 struct AdapterOutputs {

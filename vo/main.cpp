@@ -24,6 +24,8 @@
 #include "common/transport/node.h"
 #include "common/transport/rgbd_codec.h"
 #include "kestrel/rgbd_frame_t.hpp"
+#include "sensors/builtin_profiles.h"
+#include "sensors/profile_file.h"
 #include "vo/option_keys.h"
 #include "vo/sensor_profile.h"
 #include "vo/sequence_run.h"
@@ -37,7 +39,7 @@ using namespace kestrel;
 struct Options {
   std::string variant = "default";
   std::vector<std::string> settings;  // KEY=VALUE over the variant
-  std::string sensor;                 // a SensorProfile name; empty: the TUM folder's, else the frames'
+  std::string sensor;                 // a sensor profile's name or file; empty: the TUM folder's, else the frames'
   // Offline.
   std::string tum;
   std::string out;
@@ -51,7 +53,7 @@ struct Options {
 
 // The pipeline's options for camera profile `sensor`: the variant's, then the profile's, then
 // each --set (which may change what the profile set).
-vo::VoOptions configured(const Options& o, vo::SensorProfile sensor) {
+vo::VoOptions configured(const Options& o, const sensors::SensorProfile& sensor) {
   vo::VoOptions options;
   try {
     options = vo::with_sensor(sensor, vo::variant(o.variant).options);
@@ -109,19 +111,19 @@ int run_offline(const Options& o, const vo::VoOptions& options) {
 // sensor model names (a log keeps it, so a replay runs as the live camera did). It is made at
 // the first frame and made again when the model changes (another source: the motion cannot be
 // chained across it, so the odometry restarts, as after a lost frame).
-int serve(const Options& o, std::optional<vo::SensorProfile> forced) {
+int serve(const Options& o, const std::optional<sensors::SensorProfile>& forced) {
   if (!o.out.empty() || !o.stats.empty()) throw CLI::ValidationError("--out/--stats", "only with --tum");
-  std::optional<vo::SensorProfile> profile;
+  std::optional<sensors::SensorProfile> profile;
   std::unique_ptr<vo::VisualOdometry> odometry;
   auto odometry_for = [&](const RgbdFrame& frame) -> vo::VisualOdometry& {
-    const vo::SensorProfile wanted = forced.value_or(vo::profile_of_sensor(frame.sensor));
-    if (odometry && wanted == *profile) return *odometry;
+    const sensors::SensorProfile& wanted = forced ? *forced : sensors::profile_of_sensor(frame.sensor);
+    if (odometry && wanted.name == profile->name) return *odometry;
     const std::string why = forced ? "--sensor" : "the frames' sensor '" + frame.sensor + "'";
     if (odometry) {
       spdlog::warn("{}: frame {}: the camera is now {} ({}): the odometry restarts", o.in_channel, frame.utime,
-                   vo::to_string(wanted), why);
+                   wanted.name, why);
     } else {
-      spdlog::info("camera profile: {} ({})", vo::to_string(wanted), why);
+      spdlog::info("camera profile: {} ({})", wanted.name, why);
     }
     odometry = std::make_unique<vo::VisualOdometry>(configured(o, wanted));
     profile = wanted;
@@ -174,10 +176,11 @@ int main(int argc, char** argv) {
                  "Change one option of the variant, KEY=VALUE (repeatable; --list-options shows them)");
   bool list = false;
   app.add_option("--sensor", o.sensor,
-                 "Camera profile: simulator (global shutter) or kinect1 (rolling shutter, depth before "
-                 "colour, larger covariance floors); by default the one each frame's sensor model "
-                 "names (with --tum the folder's: kinect1 for freiburg1)")
-      ->check(CLI::IsMember({vo::to_string(vo::SensorProfile::kSimulator), vo::to_string(vo::SensorProfile::kKinect1)}));
+                 "Camera profile: a built-in one (simulator: global shutter; kinect1: rolling shutter, depth "
+                 "before colour, larger covariance floors) or a profile file of your own (sensors/README.md); "
+                 "by default the one each frame's sensor model names (with --tum the folder's: kinect1 for "
+                 "freiburg1)")
+      ->check(CLI::Validator([](std::string& name) { return sensors::check_sensor_profile_name(name); }, "PROFILE"));
   app.add_flag("--list-options", list, "Print every pipeline option of the variant with its value and exit");
   app.add_option("--tum", o.tum, "Offline: TUM RGB-D sequence folder to run over");
   app.add_option("--out", o.out, "Offline: write the camera trajectory here (TUM format)");
@@ -188,22 +191,25 @@ int main(int argc, char** argv) {
   app.add_option("--out-channel", o.out_channel, "Channel of vo_update_t")->capture_default_str();
   return app.run(argc, argv, [&]() -> int {
     // The camera's profile: as told, else the TUM folder's; live, else each frame's (serve()).
-    std::optional<vo::SensorProfile> forced;
+    std::optional<sensors::SensorProfile> forced;
     if (!o.sensor.empty()) {
-      forced = *vo::parse_sensor_profile(o.sensor);
+      forced = sensors::load_sensor_profile(o.sensor);  // a bad file: InputError, exit 3
     } else if (!o.tum.empty()) {
       forced = vo::tum_sensor(o.tum);
     }
     // Every profile the run may take is checked now, so a bad --set is a usage error at the start.
-    for (const vo::SensorProfile p : {vo::SensorProfile::kSimulator, vo::SensorProfile::kKinect1})
-      if (!forced || p == *forced) configured(o, p);
-    const vo::VoOptions options = configured(o, forced.value_or(vo::SensorProfile::kSimulator));
+    if (forced) {
+      configured(o, *forced);
+    } else {
+      for (const sensors::SensorProfile& p : sensors::builtin_profiles()) configured(o, p);
+    }
+    const vo::VoOptions options = configured(o, forced ? *forced : sensors::builtin_profile("simulator"));
     if (list) {
       for (const std::string& line : vo::describe_options(options)) std::cout << line << "\n";
       return kExitOk;
     }
     if (!o.tum.empty()) {
-      spdlog::info("camera profile: {}", vo::to_string(*forced));
+      spdlog::info("camera profile: {}", forced->name);
       return run_offline(o, options);
     }
     return serve(o, forced);

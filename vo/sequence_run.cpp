@@ -8,6 +8,7 @@
 #include "common/error.h"
 #include "common/time.h"
 #include "drivers/tum/tum_sequence.h"
+#include "sensors/builtin_profiles.h"
 #include "tools/eval/evaluate.h"
 #include "vo/pose_chain.h"
 
@@ -70,8 +71,8 @@ LoadedSequence load_tum_sequence(const std::string& folder) {
   return out;
 }
 
-SensorProfile tum_sensor(const std::string& folder) {
-  return profile_of_sensor(tum::sensor_model_of(tum::detect_camera(folder)));
+const sensors::SensorProfile& tum_sensor(const std::string& folder) {
+  return sensors::profile_of_sensor(tum::sensor_model_of(tum::detect_camera(folder)));
 }
 
 VoOptions with_tum_sensor(const std::string& folder, VoOptions options) {

@@ -66,10 +66,10 @@ struct LoadedSequence {
 /// (tum::TumSequence).
 LoadedSequence load_tum_sequence(const std::string& folder);
 
-/// The sensor profile of the recording in `folder`: kKinect1 for a freiburg1 recording (named
-/// as TUM names them, tum::detect_camera); kSimulator for any other -- freiburg2/3, whose
+/// The sensor profile of the recording in `folder`: kinect1's for a freiburg1 recording (named
+/// as TUM names them, tum::detect_camera); the simulator's for any other -- freiburg2/3, whose
 /// timing was not measured, and the simulator's TUM-format exports.
-SensorProfile tum_sensor(const std::string& folder);
+const sensors::SensorProfile& tum_sensor(const std::string& folder);
 
 /// `options` with the profile of the recording in `folder` (tum_sensor()). Every offline run
 /// (kestrel-vo --tum, the ablation, the data tests, the benchmark) applies it before any --set.

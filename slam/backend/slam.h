@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "common/rgbd_frame.h"
+#include "sensors/sensor_profile.h"
 #include "slam/backend/slam_options.h"
 #include "slam/posegraph/pose_graph.h"
 #include "vo/frame_motion.h"
@@ -46,7 +47,7 @@ struct Keyframe {
   Eigen::Isometry3d T_camera_depth = Eigen::Isometry3d::Identity();
   /// How its odometry pose relates to the previous keyframe's (the first's: kContinuous).
   OdometryLink link = OdometryLink::kContinuous;
-  vo::SensorProfile sensor = vo::SensorProfile::kSimulator;  ///< its camera's (loop noise)
+  sensors::SensorProfile sensor;  ///< its camera's profile (its loops' noise); empty: none
   FrameFeatures features;
 };
 
@@ -92,7 +93,7 @@ class Slam {
   SlamStep add(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera,
                OdometryLink link = OdometryLink::kContinuous,
                const std::optional<Matrix6d>& odometry_covariance = std::nullopt,
-               const vo::FrameMotion& motion = {}, vo::SensorProfile sensor = vo::SensorProfile::kSimulator);
+               const vo::FrameMotion& motion = {}, const sensors::SensorProfile& sensor = {});
 
   const std::vector<Keyframe>& keyframes() const { return keyframes_; }
   /// Vertices are keyframes (poses T_world_camera); edges odometry and loop closures.

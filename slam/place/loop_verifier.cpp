@@ -99,10 +99,11 @@ Matrix6d edge_information(const Eigen::Isometry3d& T_a_b, const Matrix6d& covari
   return 0.5 * (info + info.transpose());
 }
 
-VerificationOptions loop_verification(VerificationOptions options, vo::SensorProfile a, vo::SensorProfile b) {
-  if (a == vo::SensorProfile::kKinect1 || b == vo::SensorProfile::kKinect1) {
-    options.rotation_sigma_floor_rad = std::max(options.rotation_sigma_floor_rad, kKinect1LoopRotationFloorRad);
-  }
+VerificationOptions loop_verification(VerificationOptions options, const sensors::SensorProfile& a,
+                                      const sensors::SensorProfile& b) {
+  for (const sensors::SensorProfile* p : {&a, &b})
+    if (p->slam.loop_rotation_floor_rad)
+      options.rotation_sigma_floor_rad = std::max(options.rotation_sigma_floor_rad, *p->slam.loop_rotation_floor_rad);
   return options;
 }
 

@@ -18,7 +18,7 @@
 #include "common/numbers.h"
 #include "slam/place/frame_features.h"
 #include "slam/place/two_view_adjustment.h"
-#include "vo/sensor_profile.h"
+#include "sensors/sensor_profile.h"
 
 namespace kestrel::slam {
 
@@ -39,18 +39,17 @@ struct VerificationOptions {
   TwoViewOptions adjustment;
 };
 
-/// A Kinect (v1) loop's rotation floor, per axis. On freiburg1 every verified loop is 0.8 to
-/// 1.2 degrees off the motion capture (7 loops over fr1_xyz and fr1_rpy), about as far as the
-/// odometry's own two-frame estimate between the same frames (0.6 to 1.0 degrees): per-frame
-/// errors of the sensor (colour/depth misregistration, timing) that a chain of frame-to-frame
-/// motions partly cancels but a two-frame measurement carries whole. With the simulator's
-/// 0.005 rad such a loop outweighed the odometry between its ends (slam/README.md, "Loop
-/// noise").
-constexpr double kKinect1LoopRotationFloorRad = kPi / 180.0;
-
-/// `options` for a loop between keyframes of cameras `a` and `b`: the Kinect's rotation floor
-/// when either is one (the larger of it and options.rotation_sigma_floor_rad).
-VerificationOptions loop_verification(VerificationOptions options, vo::SensorProfile a, vo::SensorProfile b);
+/// `options` for a loop between keyframes of cameras `a` and `b`: the rotation floor is the
+/// largest of options.rotation_sigma_floor_rad and the two profiles' loop floors
+/// (sensors/profiles/*.yaml, slam.loop_rotation_floor_deg). Why a camera has one: on freiburg1
+/// every verified Kinect loop is 0.8 to 1.2 degrees off the motion capture (7 loops over fr1_xyz
+/// and fr1_rpy), about as far as the odometry's own two-frame estimate between the same frames
+/// (0.6 to 1.0 degrees): per-frame errors of the sensor (colour/depth misregistration, timing)
+/// that a chain of frame-to-frame motions partly cancels but a two-frame measurement carries
+/// whole. With the simulator's 0.005 rad such a loop outweighed the odometry between its ends
+/// (slam/README.md, "Loop noise").
+VerificationOptions loop_verification(VerificationOptions options, const sensors::SensorProfile& a,
+                                      const sensors::SensorProfile& b);
 
 struct LoopConstraint {
   bool accepted = false;

@@ -13,6 +13,7 @@
 #include "common/error.h"
 #include "common/geometry/se3.h"
 #include "common/numbers.h"
+#include "sensors/builtin_profiles.h"
 #include "slam/place/loop_verifier.h"
 #include "slam/place/place_recognizer.h"
 #include "test/slam/synthetic_room.h"
@@ -75,18 +76,16 @@ TEST(LoopVerifier, AcceptsTheSamePlaceFromAnotherViewWithTheTrueRelativePose) {
 // A loop with a Kinect keyframe at either end takes the Kinect's 1 degree rotation floor (its
 // per-frame errors, loop_verifier.h); the simulator's camera keeps the options' own floors.
 TEST(LoopVerifier, AKinectsLoopTakesTheKinectsRotationFloor) {
-  using vo::SensorProfile;
+  const sensors::SensorProfile& sim_camera = sensors::builtin_profile("simulator");
+  const sensors::SensorProfile& kinect = sensors::builtin_profile("kinect1");
   VerificationOptions o;
   o.rotation_sigma_floor_rad = 0.001;
-  EXPECT_EQ(loop_verification(o, SensorProfile::kSimulator, SensorProfile::kSimulator).rotation_sigma_floor_rad, 0.001);
-  EXPECT_EQ(loop_verification(o, SensorProfile::kKinect1, SensorProfile::kSimulator).rotation_sigma_floor_rad,
-            kPi / 180.0);
-  EXPECT_EQ(loop_verification(o, SensorProfile::kSimulator, SensorProfile::kKinect1).rotation_sigma_floor_rad,
-            kPi / 180.0);
-  EXPECT_EQ(loop_verification(o, SensorProfile::kKinect1, SensorProfile::kKinect1).translation_sigma_floor_m,
-            o.translation_sigma_floor_m);
+  EXPECT_EQ(loop_verification(o, sim_camera, sim_camera).rotation_sigma_floor_rad, 0.001);
+  EXPECT_EQ(loop_verification(o, kinect, sim_camera).rotation_sigma_floor_rad, kPi / 180.0);  // kinect1.yaml's 1 degree
+  EXPECT_EQ(loop_verification(o, sim_camera, kinect).rotation_sigma_floor_rad, kPi / 180.0);
+  EXPECT_EQ(loop_verification(o, kinect, kinect).translation_sigma_floor_m, o.translation_sigma_floor_m);
   o.rotation_sigma_floor_rad = 0.05;  // a larger floor of the options' own stays
-  EXPECT_EQ(loop_verification(o, SensorProfile::kKinect1, SensorProfile::kKinect1).rotation_sigma_floor_rad, 0.05);
+  EXPECT_EQ(loop_verification(o, kinect, kinect).rotation_sigma_floor_rad, 0.05);
 
   // On a real pair: the same constraint, its rotation at least 1 degree uncertain per axis (the
   // edge's covariance, the information's inverse; its rotation error is vec(q), half the
@@ -97,7 +96,7 @@ TEST(LoopVerifier, AKinectsLoopTakesTheKinectsRotationFloor) {
   const VerificationOptions sim;
   const LoopConstraint a = verify_loop(views[1].features, views[0].features, sim, 7);
   const LoopConstraint b = verify_loop(views[1].features, views[0].features,
-                                       loop_verification(sim, SensorProfile::kKinect1, SensorProfile::kKinect1), 7);
+                                       loop_verification(sim, kinect, kinect), 7);
   ASSERT_TRUE(a.accepted && b.accepted) << a.reason << " / " << b.reason;
   EXPECT_TRUE(a.T_candidate_query.isApprox(b.T_candidate_query));
   const Eigen::Vector3d sim_var = a.information.inverse().diagonal().tail<3>();

@@ -13,6 +13,7 @@
 #include "common/numbers.h"
 #include "common/transport/convert.h"
 #include "common/transport/rgbd_codec.h"
+#include "sensors/builtin_profiles.h"
 #include "slam/slam_adapter.h"
 #include "test/slam/synthetic_room.h"
 #include "vo/sensor_profile.h"
@@ -340,7 +341,7 @@ TEST_F(AdapterTest, PairsFramesAndUpdatesInEitherOrderAndPublishesTheGraph) {
 // profile when it has one; frames that name no model get the simulator's, which corrects nothing.
 TEST_F(AdapterTest, KeyframeFeaturesTakeTheCamerasTimingAndTheOdometrysMotion) {
   AdapterOptions kinect;
-  kinect.sensor = vo::SensorProfile::kKinect1;
+  kinect.sensor = sensors::builtin_profile("kinect1");
   SlamAdapter timed(SlamOptions{}, nullptr), told(SlamOptions{}, nullptr, kinect);
   auto kinect_frame = [this](int k) {
     kestrel::rgbd_frame_t m = frame(k);
@@ -361,7 +362,7 @@ TEST_F(AdapterTest, KeyframeFeaturesTakeTheCamerasTimingAndTheOdometrysMotion) {
   const FeatureExtractor extractor(SlamOptions{}.features);
   const RgbdFrame f0 = transport::decode_rgbd(frame(0), "test"), f3 = transport::decode_rgbd(frame(3), "test");
   const vo::FrameMotion motion =
-      keyframe_motion(vo::with_sensor(vo::SensorProfile::kKinect1, vo::VoOptions{}).depth, f3.utime, f3.depth_utime,
+      keyframe_motion(vo::with_sensor(sensors::builtin_profile("kinect1"), vo::VoOptions{}).depth, f3.utime, f3.depth_utime,
                       utime(2), pose(2).inverse() * pose(3));
   ASSERT_TRUE(motion.known);
   EXPECT_NEAR(motion.twist_per_s.head<3>().norm(), 1.0, 1e-9);

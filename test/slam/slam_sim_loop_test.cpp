@@ -19,6 +19,7 @@
 #include "drivers/sim/flights.h"
 #include "drivers/sim/simulation.h"
 #include "drivers/sim/world_catalog.h"
+#include "sensors/builtin_profiles.h"
 #include "slam/place/builtin_vocabulary.h"
 #include "slam/sequence_run.h"
 #include "tools/eval/evaluate.h"
@@ -47,7 +48,7 @@ TEST(SlamSimLoop, FloorLoopCutsTheOdometryDriftWithNoFalseClosure) {
     truth.push_back(utime, sim.T_world_camera(sim.seconds(utime)));
   }
   const SlamRun run = run_slam_sequence(
-      kFrames, [&sim](size_t i) { return sim.render(static_cast<int64_t>(i)); }, vo::SensorProfile::kSimulator,
+      kFrames, [&sim](size_t i) { return sim.render(static_cast<int64_t>(i)); }, sensors::builtin_profile("simulator"),
       vo::VoOptions{}, SlamOptions{},
       builtin_vocabulary());
   ASSERT_GT(run.vo.size(), kFrames * 95 / 100) << "the odometry lost the camera";

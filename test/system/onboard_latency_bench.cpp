@@ -24,6 +24,7 @@
 #include "drivers/sim/world_catalog.h"
 #include "estimator/messages.h"
 #include "estimator/state_estimator.h"
+#include "sensors/builtin_profiles.h"
 #include "vo/sensor_profile.h"
 #include "vo/update_message.h"
 #include "vo/variants.h"
@@ -62,7 +63,7 @@ const std::vector<Input>& flight() {
 
 void BM_FrameToState(benchmark::State& state) {
   const std::vector<Input>& inputs = flight();
-  const vo::VoOptions vo_options = vo::with_sensor(vo::SensorProfile::kSimulator, vo::variant("default").options);
+  const vo::VoOptions vo_options = vo::with_sensor(sensors::builtin_profile("simulator"), vo::variant("default").options);
   std::vector<double> medians, p95s;
   size_t frames = 0;
   for (auto _ : state) {

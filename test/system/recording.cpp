@@ -1,3 +1,4 @@
+#include "sensors/builtin_profiles.h"
 #include "test/system/recording.h"
 
 #include <gtest/gtest.h>
@@ -86,7 +87,7 @@ void expect_map_agrees_with_truth(const kestrel::slam_graph_t& graph, const Traj
     // its colour: by its stamps' difference and the profile's extra latency, the VO's timing
     // model), as the mapper places it (slam_keyframe_t.T_camera_depth). Interpolated across
     // the motion capture's gaps too: fr1_xyz has one of 0.11 s where a keyframe's depth falls.
-    const vo::DepthOptions timing = vo::with_sensor(vo::profile_of_sensor(frame.sensor), vo::VoOptions{}).depth;
+    const vo::DepthOptions timing = vo::with_sensor(sensors::profile_of_sensor(frame.sensor), vo::VoOptions{}).depth;
     const int64_t depth_time =
         utime + std::llround(1e6 * vo::depth_time_offset_s(timing, utime, frame.depth_utime != 0 ? frame.depth_utime : utime));
     const std::optional<Eigen::Isometry3d> T = true_camera.at(depth_time, 120'000);

@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "common/geometry/se3.h"
+#include "sensors/builtin_profiles.h"
 #include "test/vo/synthetic_scene.h"
 #include "vo/depth_lookup.h"
 #include "vo/sequence_run.h"
@@ -105,18 +106,20 @@ TEST(DepthTimeOffset, TakenFromTheStampsOrTheConfiguredValue) {
 // TUM-format exports (global shutter, one capture time) nor to the unmeasured freiburg2/3.
 TEST(DepthTimeOffset, TheKinectTimingIsForFreiburg1RecordingsOnly) {
   const VoOptions given;
-  EXPECT_EQ(tum_sensor("../data/tum/rgbd_dataset_freiburg1_rpy"), SensorProfile::kKinect1);
+  EXPECT_EQ(tum_sensor("../data/tum/rgbd_dataset_freiburg1_rpy").name, "kinect1");
   const VoOptions fr1 = with_tum_sensor("../data/tum/rgbd_dataset_freiburg1_rpy", given);
+  // The values of sensors/profiles/kinect1.yaml, as the VO's options.
   EXPECT_TRUE(fr1.depth.compensate_time_offset);
   EXPECT_TRUE(fr1.depth.time_offset_from_stamps);
-  EXPECT_DOUBLE_EQ(fr1.depth.time_offset_s, -kKinect1DepthExtraLatencyS);
-  EXPECT_DOUBLE_EQ(fr1.depth.rolling_shutter_readout_s, kKinect1RollingShutterReadoutS);
-  EXPECT_DOUBLE_EQ(fr1.covariance.translation_floor_m, kKinect1TranslationFloorM);
-  EXPECT_DOUBLE_EQ(fr1.covariance.rotation_floor_rad, kKinect1RotationFloorRad);
-  EXPECT_DOUBLE_EQ(fr1.covariance.translation_per_rad_m, kKinect1TranslationPerRadM);
-  EXPECT_DOUBLE_EQ(fr1.covariance.rotation_per_rad, kKinect1RotationPerRad);
+  EXPECT_DOUBLE_EQ(fr1.depth.time_offset_s, -0.015);
+  EXPECT_DOUBLE_EQ(fr1.depth.rolling_shutter_readout_s, 0.015);
+  EXPECT_DOUBLE_EQ(fr1.covariance.translation_floor_m, 0.001);
+  EXPECT_DOUBLE_EQ(fr1.covariance.rotation_floor_rad, 0.002);
+  EXPECT_DOUBLE_EQ(fr1.covariance.translation_per_rad_m, 0.10);
+  EXPECT_DOUBLE_EQ(fr1.covariance.rotation_per_rad, 0.085);
+  EXPECT_DOUBLE_EQ(fr1.dense.weight, 2.0);
   for (const char* other : {"/tmp/sim_room_export", "rgbd_dataset_freiburg2_desk", "rgbd_dataset_freiburg3_office"}) {
-    EXPECT_EQ(tum_sensor(other), SensorProfile::kSimulator) << other;
+    EXPECT_EQ(tum_sensor(other).name, "simulator") << other;
     const VoOptions o = with_tum_sensor(other, given);
     EXPECT_FALSE(o.depth.compensate_time_offset) << other;
     EXPECT_DOUBLE_EQ(o.depth.rolling_shutter_readout_s, 0.0) << other;
@@ -124,21 +127,32 @@ TEST(DepthTimeOffset, TheKinectTimingIsForFreiburg1RecordingsOnly) {
   }
 }
 
-// The profiles by name, as `kestrel vo --sensor` and `kestrel launch` give them.
-TEST(SensorProfiles, NamedAndAppliedByName) {
-  for (const SensorProfile p : {SensorProfile::kSimulator, SensorProfile::kKinect1})
-    EXPECT_EQ(parse_sensor_profile(to_string(p)), p);
-  EXPECT_FALSE(parse_sensor_profile("kinect2").has_value());
-  const VoOptions given;
-  const VoOptions sim = with_sensor(SensorProfile::kSimulator, given);
+// The built-in profiles applied: the simulator's changes nothing, the Kinect's what its file
+// says; a field a profile leaves out keeps the options' value.
+TEST(SensorProfiles, AppliedToTheOptions) {
+  VoOptions given;
+  given.dense.weight = 0.7;
+  const VoOptions sim = with_sensor(sensors::builtin_profile("simulator"), given);
   EXPECT_DOUBLE_EQ(sim.covariance.translation_floor_m, given.covariance.translation_floor_m);
+  EXPECT_DOUBLE_EQ(sim.dense.weight, 0.7);
   EXPECT_FALSE(sim.depth.compensate_time_offset);
-  const VoOptions kinect = with_sensor(SensorProfile::kKinect1, given);
+  const VoOptions kinect = with_sensor(sensors::builtin_profile("kinect1"), given);
   EXPECT_GT(kinect.covariance.translation_floor_m, given.covariance.translation_floor_m);
   EXPECT_GT(kinect.covariance.rotation_floor_rad, given.covariance.rotation_floor_rad);
-  EXPECT_DOUBLE_EQ(kinect.depth.rolling_shutter_readout_s, kKinect1RollingShutterReadoutS);
+  EXPECT_DOUBLE_EQ(kinect.depth.rolling_shutter_readout_s, 0.015);
+  EXPECT_DOUBLE_EQ(kinect.dense.weight, 2.0);
   EXPECT_GT(sim.keyframe.min_inliers_to_keep_near, 0) << "a hovering simulated camera keeps its keyframe";
-  EXPECT_EQ(kinect.keyframe.min_inliers_to_keep_near, 150) << "so does a hovering Kinect (sensor_profile.h)";
+  EXPECT_EQ(kinect.keyframe.min_inliers_to_keep_near, 150) << "so does a hovering Kinect (kinect1.yaml)";
+
+  // Only the depth's latency given: compensated, from the options' own stamp rule.
+  sensors::SensorProfile latency_only;
+  latency_only.name = "x";
+  latency_only.timing.depth_extra_latency_s = 0.004;
+  const VoOptions l = with_sensor(latency_only, given);
+  EXPECT_TRUE(l.depth.compensate_time_offset);
+  EXPECT_EQ(l.depth.time_offset_from_stamps, given.depth.time_offset_from_stamps);
+  EXPECT_DOUBLE_EQ(l.depth.time_offset_s, -0.004);
+  EXPECT_DOUBLE_EQ(l.depth.rolling_shutter_readout_s, given.depth.rolling_shutter_readout_s);
 }
 
 }  // namespace

@@ -12,6 +12,7 @@
 #include "common/transport/log_file.h"
 #include "common/transport/rgbd_codec.h"
 #include "kestrel/vo_update_t.hpp"
+#include "sensors/builtin_profiles.h"
 #include "test/support/test_support.h"
 #include "test/vo/synthetic_scene.h"
 #include "vo/options.h"
@@ -121,7 +122,7 @@ TEST(VoProcess, TakesTheCameraProfileTheFramesName) {
       kestrel::test::run_isolated(script, 120.0);
   ASSERT_EQ(r.exit_code, 0) << r.err;
 
-  const VoOptions simulator, kinect = with_sensor(SensorProfile::kKinect1, VoOptions{});
+  const VoOptions simulator, kinect = with_sensor(sensors::builtin_profile("kinect1"), VoOptions{});
   ASSERT_NE(simulator.covariance.translation_floor_m, kinect.covariance.translation_floor_m);
   const auto named = updates((dir / "named.lcmlog").string()), told = updates((dir / "told.lcmlog").string());
   ASSERT_EQ(named.size(), 6u);

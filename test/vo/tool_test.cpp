@@ -90,6 +90,34 @@ TEST(VoTool, APartlyUsableFolderIsScoredAndSaysHowManyFramesWereUsed) {
   EXPECT_TRUE(fs::exists(dir / "t.txt"));
 }
 
+// A camera profile of the user's own (sensors/README.md): a file is taken as it is named; a
+// copy of a built-in profile under another name runs exactly as the built-in one; a bad file is
+// bad input naming the field, a name that is neither built in nor a file a usage error.
+TEST(VoTool, TheCameraProfileComesFromAFileOfTheUsersOwn) {
+  TempDir dir;
+  TumFolderSpec spec;
+  spec.frames = 6;
+  const fs::path folder = write_tum_folder(dir.path(), spec);
+  const RunResult builtin = run_vo(folder, dir / "a.txt", {"--sensor", "kinect1"});
+  ASSERT_EQ(builtin.exit_code, kExitOk) << builtin.err;
+  std::string copy = ::kestrel::test::read_file(::kestrel::test::source_dir() / "sensors/profiles/kinect1.yaml");
+  copy.replace(copy.find("name: kinect1"), 13, "name: my_kinect");
+  write_text(dir / "my_kinect.yaml", copy);
+  const RunResult own = run_vo(folder, dir / "b.txt", {"--sensor", (dir / "my_kinect.yaml").string()});
+  ASSERT_EQ(own.exit_code, kExitOk) << own.err;
+  EXPECT_NE(own.err.find("camera profile: my_kinect"), std::string::npos) << own.err;
+  EXPECT_EQ(::kestrel::test::read_file(dir / "a.txt"), ::kestrel::test::read_file(dir / "b.txt"));
+
+  write_text(dir / "bad.yaml", "name: cam\ntiming: {rolling_shutter_readout_s: slow}\n");
+  const RunResult bad = run_vo(folder, dir / "c.txt", {"--sensor", (dir / "bad.yaml").string()});
+  EXPECT_EQ(bad.exit_code, kExitBadInput) << bad.err;
+  EXPECT_NE(bad.err.find("timing.rolling_shutter_readout_s' is not a number"), std::string::npos) << bad.err;
+  EXPECT_FALSE(fs::exists(dir / "c.txt"));
+  const RunResult unknown = run_vo(folder, dir / "d.txt", {"--sensor", "kinect2"});
+  EXPECT_EQ(unknown.exit_code, kExitUsage) << unknown.err;
+  EXPECT_NE(unknown.err.find("neither a built-in sensor profile (kinect1, simulator)"), std::string::npos) << unknown.err;
+}
+
 TEST(VoTool, UnreadableListsAndImagesExitThreeNamingTheFileAndLine) {
   struct Case {
     const char* what;

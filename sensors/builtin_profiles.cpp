@@ -1,0 +1,54 @@
+#include "sensors/builtin_profiles.h"
+
+#include <algorithm>
+#include <stdexcept>
+#include <utility>
+
+namespace kestrel::sensors {
+
+// The embedded files, {file name, text} (generated: sensors/CMakeLists.txt).
+const std::vector<std::pair<std::string, std::string>>& builtin_profile_texts();
+
+const std::vector<SensorProfile>& builtin_profiles() {
+  static const std::vector<SensorProfile> profiles = [] {
+    std::vector<SensorProfile> out;
+    for (const auto& [file, text] : builtin_profile_texts()) {
+      try {
+        out.push_back(parse_sensor_profile(text, "built-in sensors/profiles/" + file));
+      } catch (const std::invalid_argument& e) {
+        throw std::logic_error(e.what());  // a shipped file that does not parse is a bug
+      }
+    }
+    std::sort(out.begin(), out.end(), [](const SensorProfile& a, const SensorProfile& b) { return a.name < b.name; });
+    return out;
+  }();
+  return profiles;
+}
+
+std::vector<std::string> builtin_profile_names() {
+  std::vector<std::string> names;
+  for (const auto& p : builtin_profiles()) names.push_back(p.name);
+  return names;
+}
+
+std::optional<SensorProfile> find_builtin_profile(const std::string& name) {
+  for (const auto& p : builtin_profiles())
+    if (p.name == name) return p;
+  return std::nullopt;
+}
+
+const SensorProfile& builtin_profile(const std::string& name) {
+  for (const auto& p : builtin_profiles())
+    if (p.name == name) return p;
+  std::string known;
+  for (const auto& n : builtin_profile_names()) known += (known.empty() ? "" : ", ") + n;
+  throw std::invalid_argument("no built-in sensor profile '" + name + "' (built in: " + known + ")");
+}
+
+const SensorProfile& profile_of_sensor(const std::string& sensor_model) {
+  for (const auto& p : builtin_profiles())
+    if (p.name == sensor_model) return p;
+  return builtin_profile("simulator");
+}
+
+}  // namespace kestrel::sensors
