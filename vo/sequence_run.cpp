@@ -9,7 +9,7 @@
 #include "common/time.h"
 #include "drivers/tum/tum_sequence.h"
 #include "sensors/builtin_profiles.h"
-#include "tools/eval/evaluate.h"
+#include "metrics/evaluate.h"
 #include "vo/pose_chain.h"
 
 namespace kestrel::vo {
@@ -109,11 +109,11 @@ RunFigures score(const SequenceRun& run, const Trajectory& gt) {
     return f;
   }
 
-  const eval::EvalOptions options;
-  eval::Evaluation e;
+  const metrics::EvalOptions options;
+  metrics::Evaluation e;
   try {
-    e = eval::evaluate(run.frame_utimes, run.trajectory, gt, options);
-  } catch (const eval::NoOverlapError& error) {
+    e = metrics::evaluate(run.frame_utimes, run.trajectory, gt, options);
+  } catch (const metrics::NoOverlapError& error) {
     f.not_scored = error.what();
     return f;
   }

@@ -11,7 +11,7 @@
 #include "common/numbers.h"
 #include "test/support/figures.h"
 #include "test/support/test_support.h"
-#include "tools/eval/evaluate.h"
+#include "metrics/evaluate.h"
 #include "tools/eval/trajectory_input.h"
 
 namespace kestrel::eval {
@@ -40,7 +40,7 @@ void expect_baseline(double value_si, const std::string& id) {
   EXPECT_TRUE(test::within_limit(value_si, test::figure(id)));
 }
 
-void expect_baselines(const Evaluation& e, const std::string& sequence) {
+void expect_baselines(const metrics::Evaluation& e, const std::string& sequence) {
   const std::string id = "eval." + sequence + ".no_motion.";
   expect_baseline(e.ate.error_m.rmse, id + "ate_rmse");
   expect_baseline(e.rpe.translation_mps.rmse, id + "rpe_translation");
@@ -52,7 +52,7 @@ void expect_baselines(const Evaluation& e, const std::string& sequence) {
 TEST(EvalData, NoMotionReproducesTheBaselineOnFr1Xyz) {
   KESTREL_REQUIRE_TUM(dir, "rgbd_dataset_freiburg1_xyz");
   const Sequence s = load(dir);
-  const Evaluation e = evaluate(s.frames, no_motion(s), s.gt, EvalOptions{});
+  const metrics::Evaluation e = metrics::evaluate(s.frames, no_motion(s), s.gt, metrics::EvalOptions{});
   EXPECT_EQ(e.association.frames.size(), 190u);
   // Kept frames 125-128 have no sample within 20 ms on one side (0.11 s mocap gap).
   EXPECT_EQ(e.association.no_gt_in_gap, 4u);
@@ -64,7 +64,7 @@ TEST(EvalData, NoMotionReproducesTheBaselineOnFr1Xyz) {
 TEST(EvalData, NoMotionReproducesTheBaselineOnFr1Rpy) {
   KESTREL_REQUIRE_TUM(dir, "rgbd_dataset_freiburg1_rpy");
   const Sequence s = load(dir);
-  const Evaluation e = evaluate(s.frames, no_motion(s), s.gt, EvalOptions{});
+  const metrics::Evaluation e = metrics::evaluate(s.frames, no_motion(s), s.gt, metrics::EvalOptions{});
   EXPECT_EQ(e.association.scored, 200u);
   expect_baselines(e, "fr1_rpy");
   EXPECT_EQ(e.velocity.gross.total(), 0u);
@@ -90,7 +90,7 @@ TEST(EvalData, GaussianPositionNoiseGivesTheExpectedErrors) {
   KESTREL_REQUIRE_TUM(dir, "rgbd_dataset_freiburg1_xyz");
   const Sequence s = load(dir);
   const double sigma = 0.01;
-  EvalOptions options;
+  metrics::EvalOptions options;
 
   // The frames with ground truth and the pairs of consecutive ones, from the data alone.
   Trajectory truth;
@@ -123,7 +123,7 @@ TEST(EvalData, GaussianPositionNoiseGivesTheExpectedErrors) {
       const Eigen::Vector3d n_k(noise(rng), noise(rng), noise(rng));
       est.push_back(p.utime, Eigen::Translation3d(n_k) * p.T);
     }
-    const Evaluation e = evaluate(s.frames, est, s.gt, options);
+    const metrics::Evaluation e = metrics::evaluate(s.frames, est, s.gt, options);
     EXPECT_EQ(e.velocity.gross.no_estimate, 4u);
     EXPECT_EQ(e.velocity.gross.after_gt_gap, 0u);  // the frame before it has no estimate
     too_fast += e.velocity.gross.too_fast;

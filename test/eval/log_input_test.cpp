@@ -18,7 +18,7 @@
 #include "test/eval/known_log.h"
 #include "test/eval/synthetic.h"
 #include "test/support/test_support.h"
-#include "tools/eval/evaluate.h"
+#include "metrics/evaluate.h"
 
 namespace kestrel::eval {
 namespace {
@@ -60,7 +60,7 @@ TEST(EvalLog, VoIsChainedAndScoresPerfectly) {
   TrajectoryInput gt = read_log_input(dir / "run.lcmlog", {"GROUND_TRUTH"});
   EXPECT_EQ(gt.frame, PoseFrame::kCamera);
   EXPECT_EQ(reconcile_frames(gt, est), "camera poses");
-  const Evaluation e = evaluate(est.frame_utimes, est.trajectory, gt.trajectory, EvalOptions{});
+  const metrics::Evaluation e = metrics::evaluate(est.frame_utimes, est.trajectory, gt.trajectory, metrics::EvalOptions{});
   EXPECT_EQ(e.association.scored, log.frames.size() - 1);
   EXPECT_LT(e.ate.error_m.max, 1e-9);
   EXPECT_LT(e.velocity.error_mps.max, 1e-9);
@@ -77,7 +77,7 @@ TEST(EvalLog, BodyGroundTruthIsComparedInTheCameraFrame) {
   EXPECT_EQ(gt.frame, PoseFrame::kBody);
   EXPECT_EQ(reconcile_frames(gt, est),
             "camera poses (ground truth converted from body with T_body_camera)");
-  const Evaluation e = evaluate(est.frame_utimes, est.trajectory, gt.trajectory, EvalOptions{});
+  const metrics::Evaluation e = metrics::evaluate(est.frame_utimes, est.trajectory, gt.trajectory, metrics::EvalOptions{});
   EXPECT_LT(e.ate.error_m.max, 1e-9);
   EXPECT_LT(e.velocity.error_mps.max, 1e-9);
 }

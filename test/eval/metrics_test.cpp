@@ -6,12 +6,13 @@
 #include <limits>
 
 #include "test/eval/synthetic.h"
-#include "tools/eval/evaluate.h"
-#include "tools/eval/statistics.h"
+#include "metrics/evaluate.h"
+#include "metrics/statistics.h"
 
-namespace kestrel::eval {
+namespace kestrel::eval {  // beside kestrel eval's other tests, whose helpers (test::) it shares
 namespace {
 
+using namespace kestrel::metrics;
 using test::frame_times;
 using test::helix;
 using test::kFrame_us;

@@ -22,7 +22,7 @@
 #include "sensors/builtin_profiles.h"
 #include "slam/place/builtin_vocabulary.h"
 #include "slam/sequence_run.h"
-#include "tools/eval/evaluate.h"
+#include "metrics/evaluate.h"
 
 namespace kestrel::slam {
 namespace {
@@ -30,7 +30,7 @@ namespace {
 // kestrel eval's ATE (RMSE after the rigid alignment, at the estimate's frames, the ground
 // truth interpolated within 20 ms): the one ATE of the project.
 double ate_rmse(const Trajectory& estimate, const Trajectory& truth) {
-  return eval::evaluate(eval::frame_times(estimate), estimate, truth, eval::EvalOptions{}).ate.error_m.rmse;
+  return metrics::evaluate(metrics::frame_times(estimate), estimate, truth, metrics::EvalOptions{}).ate.error_m.rmse;
 }
 
 TEST(SlamSimLoop, FloorLoopCutsTheOdometryDriftWithNoFalseClosure) {

@@ -14,7 +14,7 @@
 #include "slam/place/builtin_vocabulary.h"
 #include "slam/sequence_run.h"
 #include "test/support/test_support.h"
-#include "tools/eval/evaluate.h"
+#include "metrics/evaluate.h"
 #include "vo/sequence_run.h"
 
 namespace kestrel::slam {
@@ -23,7 +23,7 @@ namespace {
 // kestrel eval's ATE (RMSE after the rigid alignment, at the estimate's frames, the ground
 // truth interpolated within 20 ms): the one ATE of the project.
 double ate_rmse(const Trajectory& estimate, const Trajectory& truth) {
-  return eval::evaluate(eval::frame_times(estimate), estimate, truth, eval::EvalOptions{}).ate.error_m.rmse;
+  return metrics::evaluate(metrics::frame_times(estimate), estimate, truth, metrics::EvalOptions{}).ate.error_m.rmse;
 }
 
 class SlamOnTum : public ::testing::TestWithParam<std::tuple<const char*, bool>> {};

@@ -44,7 +44,7 @@
 #include "kestrel/state_t.hpp"
 #include "kestrel/vo_update_t.hpp"
 #include "test/support/test_support.h"
-#include "tools/eval/alignment.h"
+#include "metrics/alignment.h"
 
 namespace kestrel {
 namespace {
@@ -62,7 +62,7 @@ double rigid_fit_rms(const std::vector<Eigen::Vector3d>& from, const std::vector
     a.col(static_cast<Eigen::Index>(i)) = from[i];
     b.col(static_cast<Eigen::Index>(i)) = to[i];
   }
-  const Eigen::Matrix3Xd moved = eval::align_positions(a, b).T_gt_est * a;
+  const Eigen::Matrix3Xd moved = metrics::align_positions(a, b).T_gt_est * a;
   return std::sqrt((moved - b).colwise().squaredNorm().mean());
 }
 
@@ -360,7 +360,7 @@ TEST(System, AVoKilledInFlightLeavesTheStateAndTheGraphInOneWorld) {
     a.col(static_cast<Eigen::Index>(i)) = est[i];
     b.col(static_cast<Eigen::Index>(i)) = gt[i];
   }
-  const Eigen::Matrix3Xd errors = eval::align_positions(a, b).T_gt_est * a - b;
+  const Eigen::Matrix3Xd errors = metrics::align_positions(a, b).T_gt_est * a - b;
   const double rms = std::sqrt(errors.colwise().squaredNorm().mean());
   const double worst = errors.colwise().norm().maxCoeff();
   std::printf("states under one rigid fit: RMS %.4f m, worst %.4f m over %zu states\n", rms, worst, est.size());

@@ -33,7 +33,7 @@
 #include "test/support/figures.h"
 #include "test/support/test_support.h"
 #include "test/system/recording.h"
-#include "tools/eval/evaluate.h"
+#include "metrics/evaluate.h"
 #include "tools/eval/log_input.h"
 
 namespace kestrel {
@@ -51,7 +51,7 @@ void expect_visual_only_state(const std::string& recorded, const Trajectory& tru
     poses.push_back(StampedPose{s.utime, transport::from_message(s.T_world_body, "STATE")});
   }
   const Trajectory estimated(std::move(poses));
-  const eval::Evaluation scored = eval::evaluate(eval::frame_times(estimated), estimated, truth, eval::EvalOptions{});
+  const metrics::Evaluation scored = metrics::evaluate(metrics::frame_times(estimated), estimated, truth, metrics::EvalOptions{});
   EXPECT_TRUE(test::no_worse_than(scored.ate.error_m.rmse, test::figure("estimator.fr1_xyz.visual_only.state_ate")));
 
   // Velocity against the motion capture's, differenced over +-50 ms, in the estimate's world
@@ -125,7 +125,7 @@ TEST(System, ReplayedTumRecordingRunsWithItsCamerasProfileAndMapsTheScene) {
   // Scored as `kestrel eval --gt source --est recorded` scores it; every frame has its truth
   // (tum-play brackets the frames with the motion capture's samples).
   const Trajectory truth = eval::read_log_input(source, {channel::kGroundTruth}).trajectory;  // T_world_camera
-  const eval::Evaluation scored = eval::evaluate(eval::frame_times(replayed), replayed, truth, eval::EvalOptions{});
+  const metrics::Evaluation scored = metrics::evaluate(metrics::frame_times(replayed), replayed, truth, metrics::EvalOptions{});
   EXPECT_EQ(scored.association.no_gt_before_start + scored.association.no_gt_after_end, 0u);
   std::cout << "VO ATE " << scored.ate.error_m.rmse << " m over " << scored.ate.error_m.count << " frames (offline run's trajectory to "
             << worst_m << " m)\n";

@@ -12,7 +12,7 @@
 #include "common/error.h"
 #include "common/image/image_io.h"
 #include "common/transport/channels.h"
-#include "tools/eval/evaluate.h"
+#include "metrics/evaluate.h"
 #include "tools/eval/log_input.h"
 #include "tools/eval/plot.h"
 #include "tools/eval/report.h"
@@ -125,7 +125,7 @@ int main(int argc, char** argv) {
     TrajectoryInput gt = read_input("--gt", gt_spec, gt_channel, {channel::kGroundTruth});
     const std::string compared = reconcile_frames(gt, est);
 
-    EvalOptions options;
+    metrics::EvalOptions options;
     options.gt_max_gap_us = to_utime(gt_max_gap_s);
     options.est_max_gap_us = to_utime(est_max_gap_s);
     options.align = !no_align;
@@ -135,7 +135,7 @@ int main(int argc, char** argv) {
     options.gross_after_gt_gap = !no_gap_failures;
     const std::vector<int64_t> frames =
         frames_path.empty() ? est.frame_utimes : read_frame_list(frames_path);
-    const Evaluation evaluation = evaluate(frames, est.trajectory, gt.trajectory, options);
+    const metrics::Evaluation evaluation = metrics::evaluate(frames, est.trajectory, gt.trajectory, options);
 
     const ReportInputs inputs{gt, est, frames_path.empty() ? "the estimate" : frames_path,
                               compared};

@@ -93,11 +93,11 @@ void polyline(cv::Mat& img, const Axes& axes, const std::vector<cv::Point2d>& po
   }
 }
 
-void top_view(cv::Mat& img, const cv::Rect& area, const Evaluation& e, bool aligned) {
+void top_view(cv::Mat& img, const cv::Rect& area, const metrics::Evaluation& e, bool aligned) {
   const Eigen::Isometry3d& T_gt_est = e.ate.alignment.T_gt_est;
   std::vector<cv::Point2d> gt, est;
   std::vector<bool> keep;
-  for (const FramePoses& f : e.association.frames) {
+  for (const metrics::FramePoses& f : e.association.frames) {
     keep.push_back(f.scored());
     Eigen::Vector3d p_gt = Eigen::Vector3d::Zero();
     Eigen::Vector3d p_est = Eigen::Vector3d::Zero();
@@ -200,10 +200,10 @@ void time_series(cv::Mat& img, const cv::Rect& area, int64_t t0_us, double durat
 
 }  // namespace
 
-cv::Mat render_plot(const Evaluation& e, const EvalOptions& options, const std::string& title) {
+cv::Mat render_plot(const metrics::Evaluation& e, const metrics::EvalOptions& options, const std::string& title) {
   cv::Mat img(1390, kWidth, CV_8UC3, kWhite);
   text(img, title, cv::Point(20, 30), 0.6, kInk, 1);
-  const GrossFailures& g = e.velocity.gross;
+  const metrics::GrossFailures& g = e.velocity.gross;
   text(img,
        fmt::format("ATE {:.3f} m   RPE {:.3f} m/s, {:.2f} deg/s   velocity error {:.3f} m/s   "
                    "gross failures {:.2f} %",

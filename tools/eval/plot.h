@@ -7,12 +7,12 @@
 #include <opencv2/core.hpp>
 #include <string>
 
-#include "tools/eval/evaluate.h"
-#include "tools/eval/options.h"
+#include "metrics/evaluate.h"
+#include "metrics/options.h"
 
 namespace kestrel::eval {
 
 /// The picture (8-bit BGR, 1000 px wide); `title` is printed above the figures.
-cv::Mat render_plot(const Evaluation& e, const EvalOptions& options, const std::string& title);
+cv::Mat render_plot(const metrics::Evaluation& e, const metrics::EvalOptions& options, const std::string& title);
 
 }  // namespace kestrel::eval

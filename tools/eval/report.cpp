@@ -9,7 +9,7 @@
 namespace kestrel::eval {
 namespace {
 
-nlohmann::json to_json(const Summary& s) {
+nlohmann::json to_json(const metrics::Summary& s) {
   return {
       {"count", s.count}, {"rmse", s.rmse}, {"mean", s.mean}, {"median", s.median}, {"max", s.max}};
 }
@@ -35,7 +35,7 @@ nlohmann::json to_json(const TrajectoryInput& in) {
 
 std::string number(double v) { return std::isfinite(v) ? fmt::format("{:.4f}", v) : "-"; }
 
-std::string row(const std::string& name, const Summary& s, bool with_max = true) {
+std::string row(const std::string& name, const metrics::Summary& s, bool with_max = true) {
   return fmt::format("{:<30} {:>5} {:>9} {:>9} {:>9} {:>9}\n", name, s.count, number(s.rmse),
                      number(s.mean), number(s.median), with_max ? number(s.max) : "");
 }
@@ -49,9 +49,9 @@ std::string describe(const TrajectoryInput& in) {
 
 }  // namespace
 
-std::string text_report(const ReportInputs& in, const Evaluation& e, const EvalOptions& o) {
-  const Association& a = e.association;
-  const GrossFailures& g = e.velocity.gross;
+std::string text_report(const ReportInputs& in, const metrics::Evaluation& e, const metrics::EvalOptions& o) {
+  const metrics::Association& a = e.association;
+  const metrics::GrossFailures& g = e.velocity.gross;
   std::string s;
   s += fmt::format("{:<14}{}\n", "ground truth", describe(in.gt));
   s += fmt::format("{:<14}{}\n", "estimate", describe(in.est));
@@ -65,7 +65,7 @@ std::string text_report(const ReportInputs& in, const Evaluation& e, const EvalO
       "frames", a.frames.size(), in.frames_source, a.scored, a.no_estimate, a.no_ground_truth(),
       a.no_gt_before_start, a.no_gt_after_end, a.no_gt_in_gap,
       1e-3 * static_cast<double>(o.gt_max_gap_us));
-  s += fmt::format("{:<14}{} of {} positions\n", "alignment", to_string(e.ate.alignment.kind),
+  s += fmt::format("{:<14}{} of {} positions\n", "alignment", metrics::to_string(e.ate.alignment.kind),
                    e.ate.error_m.count);
   s += "\n";
   s += fmt::format("{:<30} {:>5} {:>9} {:>9} {:>9} {:>9}\n", "metric", "n", "rmse", "mean",
@@ -84,12 +84,12 @@ std::string text_report(const ReportInputs& in, const Evaluation& e, const EvalO
   return s;
 }
 
-nlohmann::json json_report(const ReportInputs& in, const Evaluation& e, const EvalOptions& o) {
-  const Association& a = e.association;
-  const GrossFailures& g = e.velocity.gross;
+nlohmann::json json_report(const ReportInputs& in, const metrics::Evaluation& e, const metrics::EvalOptions& o) {
+  const metrics::Association& a = e.association;
+  const metrics::GrossFailures& g = e.velocity.gross;
   nlohmann::json ate = to_json(e.ate.error_m);
   ate["aligned"] = o.align;
-  ate["alignment"] = to_string(e.ate.alignment.kind);
+  ate["alignment"] = metrics::to_string(e.ate.alignment.kind);
   return {
       {"ground_truth", to_json(in.gt)},
       {"estimate", to_json(in.est)},

@@ -6,8 +6,8 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "tools/eval/evaluate.h"
-#include "tools/eval/options.h"
+#include "metrics/evaluate.h"
+#include "metrics/options.h"
 #include "tools/eval/trajectory_input.h"
 
 namespace kestrel::eval {
@@ -21,7 +21,7 @@ struct ReportInputs {
   std::string compared;
 };
 
-std::string text_report(const ReportInputs& inputs, const Evaluation& e, const EvalOptions& o);
-nlohmann::json json_report(const ReportInputs& inputs, const Evaluation& e, const EvalOptions& o);
+std::string text_report(const ReportInputs& inputs, const metrics::Evaluation& e, const metrics::EvalOptions& o);
+nlohmann::json json_report(const ReportInputs& inputs, const metrics::Evaluation& e, const metrics::EvalOptions& o);
 
 }  // namespace kestrel::eval

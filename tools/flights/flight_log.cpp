@@ -11,7 +11,7 @@
 #include "kestrel/slam_graph_t.hpp"
 #include "kestrel/state_t.hpp"
 #include "kestrel/vo_update_t.hpp"
-#include "tools/eval/evaluate.h"
+#include "metrics/evaluate.h"
 #include "tools/eval/log_input.h"
 #include "tools/eval/trajectory_input.h"
 
@@ -59,11 +59,11 @@ FlightRecord read_flight_log(const std::string& path) {
     eval::TrajectoryInput gt = eval::read_log_input(path, {channel::kGroundTruth});
     const eval::TrajectoryInput vo = eval::read_log_input(path, {channel::kVoUpdate});
     eval::reconcile_frames(gt, vo);
-    eval::EvalOptions options;
+    metrics::EvalOptions options;
     try {
       r.vo_gross = static_cast<int64_t>(
-          eval::evaluate(vo.frame_utimes, vo.trajectory, gt.trajectory, options).velocity.gross.total());
-    } catch (const eval::NoOverlapError&) {
+          metrics::evaluate(vo.frame_utimes, vo.trajectory, gt.trajectory, options).velocity.gross.total());
+    } catch (const metrics::NoOverlapError&) {
       r.vo_gross = r.vo_frames;
     }
   }

@@ -12,10 +12,10 @@
 
 #include <cstddef>
 
-#include "tools/eval/association.h"
-#include "tools/eval/statistics.h"
+#include "metrics/association.h"
+#include "metrics/statistics.h"
 
-namespace kestrel::eval {
+namespace kestrel::metrics {
 
 struct RpeResult {
   Summary translation_mps;
@@ -26,4 +26,4 @@ struct RpeResult {
 
 RpeResult compute_rpe(const Association& association, double delta_s, double tolerance_s);
 
-}  // namespace kestrel::eval
+}  // namespace kestrel::metrics

@@ -1,8 +1,8 @@
-#include "tools/eval/velocity.h"
+#include "metrics/velocity.h"
 
 #include "common/time.h"
 
-namespace kestrel::eval {
+namespace kestrel::metrics {
 
 bool is_gross(Verdict verdict) {
   return verdict == Verdict::kNoEstimate || verdict == Verdict::kTooFast ||
@@ -46,4 +46,4 @@ VelocityResult compute_velocity(const Association& association, const EvalOption
   return result;
 }
 
-}  // namespace kestrel::eval
+}  // namespace kestrel::metrics

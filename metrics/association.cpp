@@ -1,8 +1,8 @@
-#include "tools/eval/association.h"
+#include "metrics/association.h"
 
 #include <stdexcept>
 
-namespace kestrel::eval {
+namespace kestrel::metrics {
 
 Association associate(const std::vector<int64_t>& frame_utimes, const Trajectory& est,
                       const Trajectory& gt, const EvalOptions& options) {
@@ -34,4 +34,4 @@ Association associate(const std::vector<int64_t>& frame_utimes, const Trajectory
   return a;
 }
 
-}  // namespace kestrel::eval
+}  // namespace kestrel::metrics

@@ -22,11 +22,11 @@
 #include <cstdint>
 #include <vector>
 
-#include "tools/eval/association.h"
-#include "tools/eval/options.h"
-#include "tools/eval/statistics.h"
+#include "metrics/association.h"
+#include "metrics/options.h"
+#include "metrics/statistics.h"
 
-namespace kestrel::eval {
+namespace kestrel::metrics {
 
 enum class Verdict {
   kChecked,     ///< velocity error computed and within the threshold
@@ -61,4 +61,4 @@ struct VelocityResult {
 
 VelocityResult compute_velocity(const Association& association, const EvalOptions& options);
 
-}  // namespace kestrel::eval
+}  // namespace kestrel::metrics

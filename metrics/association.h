@@ -13,9 +13,9 @@
 #include <vector>
 
 #include "common/trajectory.h"
-#include "tools/eval/options.h"
+#include "metrics/options.h"
 
-namespace kestrel::eval {
+namespace kestrel::metrics {
 
 /// Why a frame has no ground truth.
 enum class GtMissing { kNone, kBeforeStart, kAfterEnd, kInGap };
@@ -42,4 +42,4 @@ struct Association {
 Association associate(const std::vector<int64_t>& frame_utimes, const Trajectory& est,
                       const Trajectory& gt, const EvalOptions& options);
 
-}  // namespace kestrel::eval
+}  // namespace kestrel::metrics

@@ -1,11 +1,11 @@
-#include "tools/eval/alignment.h"
+#include "metrics/alignment.h"
 
 #include <Eigen/Eigenvalues>
 #include <stdexcept>
 
 #include "common/geometry/align.h"
 
-namespace kestrel::eval {
+namespace kestrel::metrics {
 namespace {
 
 // Positions closer than this to their mean count as one point (metres).
@@ -56,4 +56,4 @@ const char* to_string(AlignmentKind kind) {
   return "?";
 }
 
-}  // namespace kestrel::eval
+}  // namespace kestrel::metrics

@@ -13,7 +13,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
-namespace kestrel::eval {
+namespace kestrel::metrics {
 
 enum class AlignmentKind {
   kNone,         ///< not aligned (disabled)
@@ -33,4 +33,4 @@ Alignment align_positions(const Eigen::Matrix3Xd& p_est, const Eigen::Matrix3Xd&
 
 const char* to_string(AlignmentKind kind);
 
-}  // namespace kestrel::eval
+}  // namespace kestrel::metrics

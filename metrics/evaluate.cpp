@@ -1,11 +1,11 @@
-#include "tools/eval/evaluate.h"
+#include "metrics/evaluate.h"
 
 #include <cmath>
 #include <string>
 
 #include "common/time.h"
 
-namespace kestrel::eval {
+namespace kestrel::metrics {
 namespace {
 
 void check(const EvalOptions& o) {
@@ -50,4 +50,4 @@ Evaluation evaluate(const std::vector<int64_t>& frame_utimes, const Trajectory& 
   return e;
 }
 
-}  // namespace kestrel::eval
+}  // namespace kestrel::metrics

@@ -7,13 +7,13 @@
 #include <vector>
 
 #include "common/trajectory.h"
-#include "tools/eval/association.h"
-#include "tools/eval/ate.h"
-#include "tools/eval/options.h"
-#include "tools/eval/rpe.h"
-#include "tools/eval/velocity.h"
+#include "metrics/association.h"
+#include "metrics/ate.h"
+#include "metrics/options.h"
+#include "metrics/rpe.h"
+#include "metrics/velocity.h"
 
-namespace kestrel::eval {
+namespace kestrel::metrics {
 
 /// No frame has both an estimate and ground truth: nothing can be scored.
 class NoOverlapError : public std::runtime_error {
@@ -37,4 +37,4 @@ Evaluation evaluate(const std::vector<int64_t>& frame_utimes, const Trajectory& 
 /// The time stamps of `trajectory`: the default frame list.
 std::vector<int64_t> frame_times(const Trajectory& trajectory);
 
-}  // namespace kestrel::eval
+}  // namespace kestrel::metrics

@@ -5,7 +5,7 @@
 #include <cstddef>
 #include <vector>
 
-namespace kestrel::eval {
+namespace kestrel::metrics {
 
 struct Summary {
   size_t count = 0;
@@ -18,4 +18,4 @@ struct Summary {
 /// Statistics of `values` (taken by value: the median sorts a copy).
 Summary summarize(std::vector<double> values);
 
-}  // namespace kestrel::eval
+}  // namespace kestrel::metrics

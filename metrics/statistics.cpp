@@ -1,10 +1,10 @@
-#include "tools/eval/statistics.h"
+#include "metrics/statistics.h"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
-namespace kestrel::eval {
+namespace kestrel::metrics {
 
 Summary summarize(std::vector<double> values) {
   Summary s;
@@ -30,4 +30,4 @@ Summary summarize(std::vector<double> values) {
   return s;
 }
 
-}  // namespace kestrel::eval
+}  // namespace kestrel::metrics

@@ -1,4 +1,4 @@
-#include "tools/eval/rpe.h"
+#include "metrics/rpe.h"
 
 #include <algorithm>
 #include <cmath>
@@ -7,7 +7,7 @@
 #include "common/geometry/so3.h"
 #include "common/time.h"
 
-namespace kestrel::eval {
+namespace kestrel::metrics {
 namespace {
 
 constexpr double kDegPerRad = 180.0 / 3.14159265358979323846;
@@ -54,4 +54,4 @@ RpeResult compute_rpe(const Association& association, double delta_s, double tol
   return result;
 }
 
-}  // namespace kestrel::eval
+}  // namespace kestrel::metrics

@@ -1,15 +1,15 @@
 #pragma once
 // Absolute trajectory error: the distance between each scored frame's ground-truth position
-// and its estimated position after the rigid alignment of tools/eval/alignment.h (or none).
+// and its estimated position after the rigid alignment of metrics/alignment.h (or none).
 
 #include <cstdint>
 #include <vector>
 
-#include "tools/eval/alignment.h"
-#include "tools/eval/association.h"
-#include "tools/eval/statistics.h"
+#include "metrics/alignment.h"
+#include "metrics/association.h"
+#include "metrics/statistics.h"
 
-namespace kestrel::eval {
+namespace kestrel::metrics {
 
 struct AteResult {
   Alignment alignment;           ///< maps the estimate's world into the ground truth's
@@ -22,4 +22,4 @@ struct AteResult {
 /// as it is. No scored frame gives an empty summary.
 AteResult compute_ate(const Association& association, bool align);
 
-}  // namespace kestrel::eval
+}  // namespace kestrel::metrics

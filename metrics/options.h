@@ -4,7 +4,7 @@
 
 #include <cstdint>
 
-namespace kestrel::eval {
+namespace kestrel::metrics {
 
 struct EvalOptions {
   /// Ground truth is interpolated at a frame's time only when the samples on both sides lie
@@ -26,4 +26,4 @@ struct EvalOptions {
   bool gross_after_gt_gap = true;
 };
 
-}  // namespace kestrel::eval
+}  // namespace kestrel::metrics

@@ -1,6 +1,6 @@
-#include "tools/eval/ate.h"
+#include "metrics/ate.h"
 
-namespace kestrel::eval {
+namespace kestrel::metrics {
 
 AteResult compute_ate(const Association& association, bool align) {
   AteResult result;
@@ -23,4 +23,4 @@ AteResult compute_ate(const Association& association, bool align) {
   return result;
 }
 
-}  // namespace kestrel::eval
+}  // namespace kestrel::metrics
