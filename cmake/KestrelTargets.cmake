@@ -39,16 +39,22 @@ set(_KESTREL_STD_HEADERS <algorithm> <cmath> <cstdint> <functional> <limits> <me
 set(_KESTREL_LIBRARY_PCH_DEPS Eigen3::Eigen opencv_core)
 set(_KESTREL_TOOL_PCH_DEPS Eigen3::Eigen opencv_core CLI11::CLI11 spdlog::spdlog)
 
-# kestrel_library(name [ALGORITHM] SOURCES ... [DEPS ...]) — a component library; headers are
-# included from the repository root ("vo/feature_detector.h"). ALGORITHM marks a library that
-# knows nothing of LCM, files or clocks: the layering test (test/common/layering_test.cpp)
-# fails on any include of it into LCM, tools/, drivers/ or common/transport/, and on any
-# library's include of a component it does not link.
+# kestrel_library(name [ALGORITHM] SOURCES ... [DEPS ...] [PUBLIC_HEADERS ...]) — a component
+# library; headers are included from the repository root ("vo/feature_detector.h"). ALGORITHM
+# marks a library that knows nothing of LCM, files or clocks: the layering test
+# (test/common/layering_test.cpp) fails on any include of it into LCM, tools/, drivers/ or
+# common/transport/, and on any library's include of a component it does not link.
+# PUBLIC_HEADERS (relative to the library's folder) are what another component's libraries may
+# include; the rest are its internals (the layering test fails on such an include). Without
+# it every header of the library is public.
 function(kestrel_library name)
-  cmake_parse_arguments(ARG "ALGORITHM" "" "SOURCES;DEPS" ${ARGN})
+  cmake_parse_arguments(ARG "ALGORITHM" "" "SOURCES;DEPS;PUBLIC_HEADERS" ${ARGN})
   add_library(${name} STATIC ${ARG_SOURCES})
   set_property(GLOBAL APPEND PROPERTY KESTREL_LIBRARIES ${name})
   set_target_properties(${name} PROPERTIES KESTREL_ALGORITHM ${ARG_ALGORITHM})
+  if(ARG_PUBLIC_HEADERS)
+    set_target_properties(${name} PROPERTIES KESTREL_PUBLIC_HEADERS "${ARG_PUBLIC_HEADERS}")
+  endif()
   target_include_directories(${name} PUBLIC ${PROJECT_SOURCE_DIR})
   target_link_libraries(${name} PUBLIC ${ARG_DEPS} PRIVATE kestrel_options)
   set_target_properties(${name} PROPERTIES POSITION_INDEPENDENT_CODE ON)
@@ -203,7 +209,19 @@ function(kestrel_write_layering_manifest file)
     else()
       set(algorithm false)
     endif()
-    list(APPEND entries "  {\"name\": \"${target}\", \"kind\": \"${kind}\", \"dir\": \"${dir}\", \"algorithm\": ${algorithm},\n   \"sources\": [${source_json}],\n   \"links\": [${link_json}]}")
+    set(public_json "null")
+    if(NOT target IN_LIST tools)
+      get_target_property(public ${target} KESTREL_PUBLIC_HEADERS)
+      if(public)
+        set(public_list "")
+        foreach(header IN LISTS public)
+          list(APPEND public_list "\"${dir}/${header}\"")
+        endforeach()
+        list(JOIN public_list ", " public_json)
+        set(public_json "[${public_json}]")
+      endif()
+    endif()
+    list(APPEND entries "  {\"name\": \"${target}\", \"kind\": \"${kind}\", \"dir\": \"${dir}\", \"algorithm\": ${algorithm},\n   \"sources\": [${source_json}],\n   \"links\": [${link_json}],\n   \"public\": ${public_json}}")
   endforeach()
   list(JOIN entries ",\n" body)
   file(WRITE ${file} "[\n${body}\n]\n")

@@ -4,7 +4,10 @@
 //     generated types, <lcm/...>), of tools/, drivers/ or common/transport/;
 //  2. every library includes only its own headers and those of the kestrel libraries it links
 //     (directly or through them), so that the dependency graph in the CMake files is the
-//     real one.
+//     real one;
+//  3. a library of another component includes only a library's public headers, when it
+//     declares them (kestrel_library's PUBLIC_HEADERS): the others are its internals. A
+//     component is a top-level folder (vo/, slam/), or one below tools/, drivers/ or common/.
 // A header belongs to the target that compiles the .cpp of the same name; a header without
 // one belongs to the first library declared in its folder (or the nearest folder above).
 #include <gtest/gtest.h>
@@ -17,6 +20,7 @@
 #include <map>
 #include <optional>
 #include <regex>
+#include <iterator>
 #include <set>
 #include <sstream>
 #include <string>
@@ -34,6 +38,7 @@ struct Target {
   std::string dir;                   // relative to the source root
   std::vector<std::string> sources;  // relative to the source root
   std::vector<std::string> links;    // kestrel libraries linked directly
+  std::optional<std::set<std::string>> public_headers;  // relative to the root; none: all public
 };
 
 std::vector<Target> parse_manifest(const nlohmann::json& j) {
@@ -48,6 +53,8 @@ std::vector<Target> parse_manifest(const nlohmann::json& j) {
     for (const auto& l : e.at("links")) {
       if (l.get<std::string>() != "kestrel_options") t.links.push_back(l.get<std::string>());
     }
+    if (e.contains("public") && e.at("public").is_array())
+      t.public_headers = e.at("public").get<std::set<std::string>>();
     targets.push_back(std::move(t));
   }
   return targets;
@@ -83,6 +90,18 @@ std::vector<std::string> angle_includes(const std::string& text) {
 
 bool starts_with(const std::string& s, const std::string& prefix) {
   return s.compare(0, prefix.size(), prefix) == 0;
+}
+
+/// The component a folder belongs to: its first part ("slam/place" -> "slam"), or its first two
+/// below tools/, drivers/ and common/ ("tools/eval", "drivers/sim", "common/transport").
+std::string component_of(const std::string& dir) {
+  const fs::path p(dir);
+  auto it = p.begin();
+  if (it == p.end()) return "";
+  const std::string first = it->string();
+  if ((first == "tools" || first == "drivers" || first == "common") && std::next(it) != p.end())
+    return first + "/" + std::next(it)->string();
+  return first;
 }
 
 /// Every broken rule, one line each: "<file> (<target>): <what>". `read(path)` returns a
@@ -156,6 +175,15 @@ std::vector<std::string> layering_violations(
                                ", which " + t.name + " does not link");
           continue;
         }
+        if (o != t.name && in_tree) {
+          const Target& owner_target = *by_name.at(o);
+          if (owner_target.public_headers && !owner_target.public_headers->count(inc) &&
+              component_of(owner_target.dir) != component_of(t.dir)) {
+            violations.push_back(file + " (" + t.name + "): includes \"" + inc + "\", an internal header of " +
+                                 o + " (not among its PUBLIC_HEADERS)");
+            continue;
+          }
+        }
         // A header of its own library: its includes are the library's too.
         if (o == t.name && in_tree) todo.push_back(inc);
       }
@@ -208,6 +236,13 @@ TEST(Layering, TheCheckerFindsEachKindOfViolationInAHandMadeTree) {
       {"other/b.cpp", "#include \"other/b.h\"\n#include \"tools/eval/x.h\"\n"},
       {"tools/eval/x.h", "#pragma once\n"},
       {"tools/eval/x.cpp", "#include \"tools/eval/x.h\"\n"},
+      // A component with public headers: its own folder may use its internals, another may not.
+      {"pub/api.h", "#pragma once\n"},
+      {"pub/api.cpp", "#include \"pub/api.h\"\n#include \"pub/detail.h\"\n"},
+      {"pub/detail.h", "#pragma once\n"},
+      {"pub/detail.cpp", "#include \"pub/detail.h\"\n"},
+      {"pub/io/io.cpp", "#include \"pub/detail.h\"\n"},
+      {"user/u.cpp", "#include \"pub/api.h\"\n#include \"pub/detail.h\"\n"},
   };
   auto read = [&](const std::string& p) -> std::optional<std::string> {
     const auto it = files.find(p);
@@ -215,9 +250,12 @@ TEST(Layering, TheCheckerFindsEachKindOfViolationInAHandMadeTree) {
     return it->second;
   };
   std::vector<Target> targets = {
-      {"lib_algo", false, true, "algo", {"algo/a.cpp"}, {}},
-      {"lib_other", false, false, "other", {"other/b.cpp"}, {}},
-      {"lib_eval", false, false, "tools/eval", {"tools/eval/x.cpp"}, {}},
+      {"lib_algo", false, true, "algo", {"algo/a.cpp"}, {}, std::nullopt},
+      {"lib_other", false, false, "other", {"other/b.cpp"}, {}, std::nullopt},
+      {"lib_eval", false, false, "tools/eval", {"tools/eval/x.cpp"}, {}, std::nullopt},
+      {"lib_pub", false, false, "pub", {"pub/api.cpp", "pub/detail.cpp"}, {}, std::set<std::string>{"pub/api.h"}},
+      {"lib_pub_io", false, false, "pub/io", {"pub/io/io.cpp"}, {"lib_pub"}, std::nullopt},
+      {"lib_user", false, false, "user", {"user/u.cpp"}, {"lib_pub"}, std::nullopt},
   };
   const std::vector<std::string> v = layering_violations(targets, read);
   auto found = [&](const std::string& part) {
@@ -228,12 +266,15 @@ TEST(Layering, TheCheckerFindsEachKindOfViolationInAHandMadeTree) {
   EXPECT_TRUE(found("algo/a.h (lib_algo, an algorithm library): includes \"kestrel/state_t.hpp\""));
   EXPECT_TRUE(found("algo/a.h (lib_algo, an algorithm library): includes <lcm/lcm-cpp.hpp>"));
   EXPECT_TRUE(found("other/b.cpp (lib_other): includes \"tools/eval/x.h\" of lib_eval"));
-  EXPECT_EQ(v.size(), 4u);
+  EXPECT_TRUE(found("user/u.cpp (lib_user): includes \"pub/detail.h\", an internal header of lib_pub"));
+  EXPECT_FALSE(found("pub/io/io.cpp")) << "the component's own libraries may include its internals";
+  EXPECT_EQ(v.size(), 5u);
 
   // Linking what it includes mends the non-algorithm library; the algorithm one stays wrong
   // for LCM whatever it links.
   targets[0].links = {"lib_other"};
   targets[1].links = {"lib_eval"};
+  targets[3].public_headers->insert("pub/detail.h");  // declared public: no longer internal
   const std::vector<std::string> mended = layering_violations(targets, read);
   EXPECT_EQ(mended.size(), 2u);
 }
