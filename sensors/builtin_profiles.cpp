@@ -11,15 +11,21 @@ const std::vector<std::pair<std::string, std::string>>& builtin_profile_texts();
 
 const std::vector<SensorProfile>& builtin_profiles() {
   static const std::vector<SensorProfile> profiles = [] {
+    // A shipped file that breaks the header's invariants is a bug: std::logic_error.
     std::vector<SensorProfile> out;
     for (const auto& [file, text] : builtin_profile_texts()) {
       try {
         out.push_back(parse_sensor_profile(text, "built-in sensors/profiles/" + file));
       } catch (const std::invalid_argument& e) {
-        throw std::logic_error(e.what());  // a shipped file that does not parse is a bug
+        throw std::logic_error(e.what());
       }
+      if (file != out.back().name + ".yaml")
+        throw std::logic_error("sensors/profiles/" + file + " names its profile '" + out.back().name + "'");
     }
     std::sort(out.begin(), out.end(), [](const SensorProfile& a, const SensorProfile& b) { return a.name < b.name; });
+    const bool has_simulator =
+        std::any_of(out.begin(), out.end(), [](const SensorProfile& p) { return p.name == "simulator"; });
+    if (!has_simulator) throw std::logic_error("sensors/profiles/ has no simulator.yaml");
     return out;
   }();
   return profiles;

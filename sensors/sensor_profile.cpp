@@ -1,10 +1,12 @@
 #include "sensors/sensor_profile.h"
 
+#include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
 #include <set>
 #include <stdexcept>
+#include <vector>
 
 #include "common/numbers.h"
 
@@ -19,8 +21,10 @@ namespace {
 void check_keys(const YAML::Node& node, const std::set<std::string>& known, const std::string& source,
                 const std::string& where) {
   if (!node.IsMap()) fail(source, (where.empty() ? "the profile" : "'" + where.substr(0, where.size() - 1) + "'") + " must be a map of fields");
+  std::set<std::string> seen;
   for (const auto& kv : node) {
     const std::string key = kv.first.as<std::string>();
+    if (!seen.insert(key).second) fail(source, "field '" + where + key + "' is given twice");
     if (!known.count(key)) {
       std::string list;
       for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
@@ -29,8 +33,11 @@ void check_keys(const YAML::Node& node, const std::set<std::string>& known, cons
   }
 }
 
+// Which ends of a field's range are open: the VO's options take some only strictly inside.
+enum class Range { kClosed, kOpenAbove, kOpen };
+
 std::optional<double> number(const YAML::Node& parent, const std::string& key, double lo, double hi,
-                             const std::string& source, const std::string& where) {
+                             const std::string& source, const std::string& where, Range range = Range::kClosed) {
   const YAML::Node n = parent[key];
   if (!n) return std::nullopt;
   double v = 0.0;
@@ -39,29 +46,37 @@ std::optional<double> number(const YAML::Node& parent, const std::string& key, d
   } catch (const YAML::Exception&) {
     fail(source, "'" + where + key + "' is not a number");
   }
-  if (!std::isfinite(v) || v < lo || v > hi)
-    fail(source, "'" + where + key + "' is " + n.as<std::string>() + ": must be in [" + std::to_string(lo) + ", " +
-                     std::to_string(hi) + "]");
+  const bool below = range == Range::kOpen ? v <= lo : v < lo;
+  const bool above = range == Range::kClosed ? v > hi : v >= hi;
+  if (!std::isfinite(v) || below || above)
+    fail(source, fmt::format("'{}{}' is {}: must be in {}{:g}, {:g}{}", where, key, n.as<std::string>(),
+                             range == Range::kOpen ? "(" : "[", lo, hi, range == Range::kClosed ? "]" : ")"));
   return v;
 }
 
 }  // namespace
 
 SensorProfile parse_sensor_profile(const std::string& yaml_text, const std::string& source) try {
-  const YAML::Node root = YAML::Load(yaml_text);
+  const std::vector<YAML::Node> documents = YAML::LoadAll(yaml_text);
+  if (documents.size() > 1) fail(source, "holds " + std::to_string(documents.size()) + " YAML documents: a profile is one");
+  const YAML::Node root = documents.empty() ? YAML::Node() : documents.front();
   check_keys(root, {"name", "description", "timing", "vo", "slam"}, source, "");
   SensorProfile p;
   if (!root["name"]) fail(source, "no 'name' (the sensor model its frames carry)");
+  if (!root["name"].IsScalar()) fail(source, "'name' is not a word");
   p.name = root["name"].as<std::string>();
   if (p.name.empty()) fail(source, "'name' is empty");
   for (const char c : p.name)
     if (!((c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_' || c == '-'))
       fail(source, "'name' is '" + p.name + "': only lower-case letters, digits, '_' and '-'");
-  if (root["description"]) p.description = root["description"].as<std::string>();
+  if (root["description"]) {
+    if (!root["description"].IsScalar()) fail(source, "'description' is not a line of text");
+    p.description = root["description"].as<std::string>();
+  }
 
   if (const YAML::Node t = root["timing"]) {
     check_keys(t, {"rolling_shutter_readout_s", "depth_time_from_stamps", "depth_extra_latency_s"}, source, "timing.");
-    p.timing.rolling_shutter_readout_s = number(t, "rolling_shutter_readout_s", 0.0, 0.1, source, "timing.");
+    p.timing.rolling_shutter_readout_s = number(t, "rolling_shutter_readout_s", 0.0, 0.1, source, "timing.", Range::kOpenAbove);
     if (t["depth_time_from_stamps"]) {
       try {
         p.timing.depth_time_from_stamps = t["depth_time_from_stamps"].as<bool>();
@@ -69,7 +84,7 @@ SensorProfile parse_sensor_profile(const std::string& yaml_text, const std::stri
         fail(source, "'timing.depth_time_from_stamps' is not true or false");
       }
     }
-    p.timing.depth_extra_latency_s = number(t, "depth_extra_latency_s", -0.1, 0.1, source, "timing.");
+    p.timing.depth_extra_latency_s = number(t, "depth_extra_latency_s", -0.1, 0.1, source, "timing.", Range::kOpen);
   }
   if (const YAML::Node v = root["vo"]) {
     check_keys(v, {"translation_floor_m", "rotation_floor_rad", "translation_per_rad_m", "rotation_per_rad",

@@ -47,8 +47,9 @@ struct SensorProfile {
 };
 
 /// The profile in `yaml_text`; `source` names it in errors (a file's path, "built-in kinect1").
-/// Throws std::invalid_argument naming the source and the field for malformed YAML, an unknown
-/// key, a value of the wrong type, a non-finite number or one out of its range.
+/// Throws std::invalid_argument naming the source and the field for malformed YAML, more than
+/// one document, an unknown or repeated key, a value of the wrong type, a non-finite number or
+/// one out of its range (the ranges the consumers' options accept).
 SensorProfile parse_sensor_profile(const std::string& yaml_text, const std::string& source);
 
 }  // namespace kestrel::sensors

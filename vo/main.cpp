@@ -56,9 +56,14 @@ struct Options {
 vo::VoOptions configured(const Options& o, const sensors::SensorProfile& sensor) {
   vo::VoOptions options;
   try {
-    options = vo::with_sensor(sensor, vo::variant(o.variant).options);
+    options = vo::variant(o.variant).options;
   } catch (const std::invalid_argument& e) {
     throw CLI::ValidationError("--variant", e.what());
+  }
+  try {
+    options = vo::with_sensor(sensor, options);
+  } catch (const std::invalid_argument& e) {
+    throw CLI::ValidationError("--sensor", "profile '" + sensor.name + "': " + e.what());
   }
   for (const std::string& kv : o.settings) {
     const auto eq = kv.find('=');

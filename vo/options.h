@@ -129,7 +129,7 @@ struct DenseOptions {
 /// The defaults are the simulator's camera (global shutter, one capture time; its errors are
 /// correlated over a frame: depth quantised on whole surfaces, rendering), fitted so the mean
 /// NEES is near 6 on the room figure-eight and checked on two other flights (vo/README.md,
-/// "Covariance"); a Kinect's are larger (sensor_profile.h).
+/// "Covariance"); a Kinect's are larger (sensors/profiles/kinect1.yaml).
 struct CovarianceOptions {
   double model_scale = 1.0;              ///< multiplies the refinement's covariance
   double translation_floor_m = 0.0006;   ///< per-axis sigma added in quadrature, metres

@@ -78,7 +78,14 @@ TEST(ParseSensorProfile, EveryKindOfBadFileIsRefusedNamingTheField) {
       {"name: a\nvo: {translation_floor_m: -1}\n", "vo.translation_floor_m"},
       {"name: a\nvo: {min_inliers_to_keep_near: 1.5}\n", "whole number"},
       {"name: a\nslam: {loop_rotation_floor_deg: 90}\n", "slam.loop_rotation_floor_deg"},
-      {"name: {x: 1}\n", "not a sensor profile"},
+      {"name: {x: 1}\n", "'name' is not a word"},
+      {"name:\n", "'name' is not a word"},  // YAML's null, not a profile called "null"
+      {"name: a\ndescription: [x]\n", "'description' is not a line of text"},
+      {"name: a\nname: b\n", "field 'name' is given twice"},
+      {"name: a\nvo: {dense_weight: 1, dense_weight: 2}\n", "field 'vo.dense_weight' is given twice"},
+      {"name: a\n---\nname: b\n", "holds 2 YAML documents"},
+      {"name: a\ntiming: {rolling_shutter_readout_s: 0.1}\n", "must be in [0, 0.1)"},  // the VO's bound
+      {"name: a\ntiming: {depth_extra_latency_s: -0.1}\n", "must be in (-0.1, 0.1)"},
   };
   for (const auto& [text, words] : cases) {
     try {

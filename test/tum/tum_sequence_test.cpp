@@ -101,7 +101,7 @@ TEST(TumSequence, IntrinsicsAndSensorModelFollowTheFolderNameOrTheOverride) {
     EXPECT_EQ(s.camera().cy, c.cy);
     EXPECT_EQ(s.camera().width, 640);
     EXPECT_EQ(s.frame(0).camera.fx, c.fx);
-    // Only freiburg1's Kinect has a measured profile (vo/sensor_profile.h) for its frames to name.
+    // Only freiburg1's Kinect has a measured profile (sensors/profiles/kinect1.yaml) for its frames to name.
     EXPECT_EQ(s.frame(0).sensor, c.camera == TumCamera::kFreiburg1 ? "kinect1" : "") << c.name;
   }
   const TumFixture fx(dir.path(), 1, "rgbd_dataset_freiburg1_o");

@@ -1,6 +1,6 @@
 #pragma once
 // Trajectories from LCM logs: the LCM side of the evaluation (library kestrel_eval_log; the
-// metrics in kestrel_eval know nothing of LCM).
+// metrics, kestrel_metrics, and the rest of kestrel_eval know nothing of LCM).
 //
 // A channel holds one of four message types, each giving a trajectory:
 //  * ground_truth_t (GROUND_TRUTH): T_world_frame, of the body or the camera as the message
