@@ -141,6 +141,12 @@ std::vector<std::string> layering_violations(
   };
 
   std::vector<std::string> violations;
+  // A declared public header that is not there (renamed, moved) would leave a hole in rule 3.
+  for (const Target& t : targets) {
+    if (!t.public_headers) continue;
+    for (const std::string& h : *t.public_headers)
+      if (!read(h)) violations.push_back(h + " (" + t.name + "): declared in PUBLIC_HEADERS but not there");
+  }
   for (const Target& t : targets) {
     if (t.tool || starts_with(t.dir, "test")) continue;
     // The library's sources and the headers that belong to it.
@@ -253,7 +259,8 @@ TEST(Layering, TheCheckerFindsEachKindOfViolationInAHandMadeTree) {
       {"lib_algo", false, true, "algo", {"algo/a.cpp"}, {}, std::nullopt},
       {"lib_other", false, false, "other", {"other/b.cpp"}, {}, std::nullopt},
       {"lib_eval", false, false, "tools/eval", {"tools/eval/x.cpp"}, {}, std::nullopt},
-      {"lib_pub", false, false, "pub", {"pub/api.cpp", "pub/detail.cpp"}, {}, std::set<std::string>{"pub/api.h"}},
+      {"lib_pub", false, false, "pub", {"pub/api.cpp", "pub/detail.cpp"}, {},
+       std::set<std::string>{"pub/api.h", "pub/gone.h"}},
       {"lib_pub_io", false, false, "pub/io", {"pub/io/io.cpp"}, {"lib_pub"}, std::nullopt},
       {"lib_user", false, false, "user", {"user/u.cpp"}, {"lib_pub"}, std::nullopt},
   };
@@ -268,13 +275,14 @@ TEST(Layering, TheCheckerFindsEachKindOfViolationInAHandMadeTree) {
   EXPECT_TRUE(found("other/b.cpp (lib_other): includes \"tools/eval/x.h\" of lib_eval"));
   EXPECT_TRUE(found("user/u.cpp (lib_user): includes \"pub/detail.h\", an internal header of lib_pub"));
   EXPECT_FALSE(found("pub/io/io.cpp")) << "the component's own libraries may include its internals";
-  EXPECT_EQ(v.size(), 5u);
+  EXPECT_TRUE(found("pub/gone.h (lib_pub): declared in PUBLIC_HEADERS but not there"));
+  EXPECT_EQ(v.size(), 6u);
 
   // Linking what it includes mends the non-algorithm library; the algorithm one stays wrong
   // for LCM whatever it links.
   targets[0].links = {"lib_other"};
   targets[1].links = {"lib_eval"};
-  targets[3].public_headers->insert("pub/detail.h");  // declared public: no longer internal
+  targets[3].public_headers = std::set<std::string>{"pub/api.h", "pub/detail.h"};  // public now; gone.h gone
   const std::vector<std::string> mended = layering_violations(targets, read);
   EXPECT_EQ(mended.size(), 2u);
 }
