@@ -37,6 +37,12 @@ std::vector<std::string> builtin_profile_names() {
   return names;
 }
 
+std::string builtin_profile_list() {
+  std::string list;
+  for (const auto& n : builtin_profile_names()) list += (list.empty() ? "" : ", ") + n;
+  return list;
+}
+
 std::optional<SensorProfile> find_builtin_profile(const std::string& name) {
   for (const auto& p : builtin_profiles())
     if (p.name == name) return p;
@@ -46,9 +52,7 @@ std::optional<SensorProfile> find_builtin_profile(const std::string& name) {
 const SensorProfile& builtin_profile(const std::string& name) {
   for (const auto& p : builtin_profiles())
     if (p.name == name) return p;
-  std::string known;
-  for (const auto& n : builtin_profile_names()) known += (known.empty() ? "" : ", ") + n;
-  throw std::invalid_argument("no built-in sensor profile '" + name + "' (built in: " + known + ")");
+  throw std::invalid_argument("no built-in sensor profile '" + name + "' (built in: " + builtin_profile_list() + ")");
 }
 
 const SensorProfile& profile_of_sensor(const std::string& sensor_model) {

@@ -17,6 +17,8 @@ namespace kestrel::sensors {
 const std::vector<SensorProfile>& builtin_profiles();
 /// Their names, for help texts and errors.
 std::vector<std::string> builtin_profile_names();
+/// The same as one list, "kinect1, simulator".
+std::string builtin_profile_list();
 /// The built-in profile called `name`, or nothing.
 std::optional<SensorProfile> find_builtin_profile(const std::string& name);
 /// The built-in profile called `name`; std::invalid_argument naming the built-in ones if none is.

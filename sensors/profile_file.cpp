@@ -14,9 +14,8 @@ std::string check_sensor_profile_name(const std::string& name_or_path) {
   if (find_builtin_profile(name_or_path)) return "";
   std::error_code ec;
   if (std::filesystem::is_regular_file(name_or_path, ec)) return "";
-  std::string known;
-  for (const auto& n : builtin_profile_names()) known += (known.empty() ? "" : ", ") + n;
-  return "'" + name_or_path + "' is neither a built-in sensor profile (" + known + ") nor a profile file";
+  return "'" + name_or_path + "' is neither a built-in sensor profile (" + builtin_profile_list() +
+         ") nor a profile file";
 }
 
 SensorProfile load_sensor_profile(const std::string& name_or_path) {
