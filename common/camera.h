@@ -5,7 +5,7 @@
 // images as the source delivers them (zero when it undistorted them or its lens has none;
 // TUM's freiburg1 reports its calibration with raw images). project()/backproject() are the
 // pinhole model of ideal (undistorted) pixels and do not apply it: a consumer of raw pixels
-// maps them to ideal ones first (vo::Lens, which the VO and SLAM's keyframe features use), or
+// maps them to ideal ones first (sensors::Lens, which the VO and SLAM's keyframe features use), or
 // reads each ideal pixel's value at its raw pixel, distort() (the mapper's decimated grid).
 
 #include <Eigen/Core>

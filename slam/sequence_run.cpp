@@ -58,7 +58,7 @@ SlamRun run_slam_sequence(size_t count, const std::function<RgbdFrame(size_t)>& 
     std::optional<OdometryPose> before = previous_pose;
     previous_pose = *pose;
     if (slam.wants_keyframe(pose->T_odom_camera, link)) {
-      vo::FrameMotion motion;
+      sensors::FrameMotion motion;
       if (before && !pose->broken) {
         motion = keyframe_motion(vo_options.depth, frame.utime, frame.depth_utime, before->utime,
                                  before->T_odom_camera.inverse() * pose->T_odom_camera);

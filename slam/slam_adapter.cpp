@@ -230,7 +230,7 @@ AdapterOutputs SlamAdapter::process(const kestrel::rgbd_frame_t& message, const 
   }
   // The features' timing: the odometry's motion from the previous update (not across a restart).
   const sensors::SensorProfile& sensor = options_.sensor ? *options_.sensor : sensors::profile_of_sensor(frame.sensor);
-  vo::FrameMotion motion;
+  sensors::FrameMotion motion;
   if (link == OdometryLink::kContinuous && waiting.previous_utime != 0) {
     motion = keyframe_motion(vo::with_sensor(sensor, vo::VoOptions{}).depth, frame.utime, frame.depth_utime,
                              waiting.previous_utime, waiting.T_previous_current);

@@ -103,7 +103,7 @@ void block_depths(const cv::Mat& depth_mm, const DepthOptions& o, int level, boo
   }
 }
 
-void build_dense_depth(const cv::Mat& depth_mm, const Lens& lens, const DepthOptions& o, int level,
+void build_dense_depth(const cv::Mat& depth_mm, const sensors::Lens& lens, const DepthOptions& o, int level,
                        DenseDepth& out) {
   const int s = 1 << level;
   out.scale = s;

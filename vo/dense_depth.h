@@ -13,7 +13,7 @@
 #include <opencv2/core/mat.hpp>
 #include <vector>
 
-#include "vo/lens.h"
+#include "sensors/lens.h"
 #include "vo/options.h"
 
 namespace kestrel::vo {
@@ -33,7 +33,7 @@ struct DenseDepth {
 };
 
 /// Fills `out` from the registered depth image (millimetres) at grid level `level`.
-void build_dense_depth(const cv::Mat& depth_mm, const Lens& lens, const DepthOptions& depth,
+void build_dense_depth(const cv::Mat& depth_mm, const sensors::Lens& lens, const DepthOptions& depth,
                        int level, DenseDepth& out);
 
 /// The grid's depths (metres, 0 = invalid) at `level`, row-major: the mean of the central half

@@ -15,7 +15,7 @@
 
 #include "vo/dense_depth.h"
 #include "vo/descriptor.h"
-#include "vo/frame_motion.h"
+#include "sensors/frame_motion.h"
 #include "vo/image_pyramid.h"
 
 namespace kestrel::vo {
@@ -55,7 +55,7 @@ struct Frame {
   int64_t seq = 0;
   ImagePyramid pyramid;
   cv::Mat coarse;  ///< heavily down-sampled grey image for the rotation prior
-  FrameMotion motion;  ///< predicted motion used for its timing corrections
+  sensors::FrameMotion motion;  ///< predicted motion used for its timing corrections
   std::vector<Feature> features;
   std::array<int, kMaxLevels + 1> level_begin{};
   DescriptorSet descriptors;

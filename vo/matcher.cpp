@@ -3,13 +3,13 @@
 #include <cmath>
 #include <limits>
 
-#include "vo/depth_lookup.h"
+#include "sensors/depth_image.h"
 #include "vo/subpixel.h"
 
 namespace kestrel::vo {
 
 void Matcher::match(const Frame& ref, const Frame& cur, const std::vector<Eigen::Vector2f>& predicted,
-                    const Lens& lens, const MatchOptions& options, std::vector<Match>& matches) {
+                    const sensors::Lens& lens, const MatchOptions& options, std::vector<Match>& matches) {
   matches.clear();
   const size_t n_ref = ref.features.size(), n_cur = cur.features.size();
   constexpr int kNone = std::numeric_limits<int>::max();
@@ -64,7 +64,7 @@ void Matcher::match(const Frame& ref, const Frame& cur, const std::vector<Eigen:
           cur.pyramid.level(fc.level), Eigen::Vector2f(fc.u, fc.v), options.window_size,
           static_cast<float>(options.max_subpixel_shift_px));
       if (!r.ok) continue;
-      m.cur_point = point_at_frame_time(lens, cur.motion, to_level0(r.position.x(), fc.level),
+      m.cur_point = sensors::point_at_frame_time(lens, cur.motion, to_level0(r.position.x(), fc.level),
                                         to_level0(r.position.y(), fc.level), fc.depth_m, &m.cur_ideal);
     }
     matches.push_back(m);

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "vo/frame.h"
-#include "vo/lens.h"
+#include "sensors/lens.h"
 #include "vo/options.h"
 
 namespace kestrel::vo {
@@ -29,7 +29,7 @@ class Matcher {
   /// `predicted[i]`: where reference feature i should appear in the current image, raw level-0
   /// pixels (non-finite: not expected in view). Replaces `matches`.
   void match(const Frame& ref, const Frame& cur, const std::vector<Eigen::Vector2f>& predicted,
-             const Lens& lens, const MatchOptions& options, std::vector<Match>& matches);
+             const sensors::Lens& lens, const MatchOptions& options, std::vector<Match>& matches);
 
  private:
   std::vector<int> best_cur_, best_ref_;

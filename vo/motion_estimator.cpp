@@ -25,7 +25,7 @@ std::vector<int> MotionEstimator::find_inliers(const VoOptions& options, uint64_
 }
 
 MotionEstimate MotionEstimator::estimate(const Frame& ref, const Frame& cur,
-                                         const std::vector<Match>& matches, const Lens& lens,
+                                         const std::vector<Match>& matches, const sensors::Lens& lens,
                                          const VoOptions& options, uint64_t seed) {
   MotionEstimate out;
   out.num_matches = static_cast<int>(matches.size());

@@ -14,7 +14,7 @@
 
 #include "common/geometry/se3.h"
 #include "vo/frame.h"
-#include "vo/lens.h"
+#include "sensors/lens.h"
 #include "vo/matcher.h"
 #include "vo/max_clique.h"
 #include "vo/motion_refinement.h"
@@ -39,7 +39,7 @@ class MotionEstimator {
  public:
   /// Estimates T_ref_cur from `matches` between `ref` and `cur`; `seed` drives RANSAC.
   MotionEstimate estimate(const Frame& ref, const Frame& cur, const std::vector<Match>& matches,
-                          const Lens& lens, const VoOptions& options, uint64_t seed);
+                          const sensors::Lens& lens, const VoOptions& options, uint64_t seed);
 
   /// The correspondences and final inliers of the last estimate (for diagnostics and tests).
   const std::vector<Correspondence>& correspondences() const { return correspondences_; }

@@ -164,12 +164,12 @@ VoResult VisualOdometry::process(const RgbdFrame& input) {
   // The motion since the previous frame, predicted; it also carries depth to RGB time.
   Eigen::Isometry3d T_prev_cur_predicted = Eigen::Isometry3d::Identity();
   if (previous_ != nullptr) T_prev_cur_predicted = predict_prev_cur(cur);
-  FrameMotion motion;
+  sensors::FrameMotion motion;
   if (previous_ != nullptr) {
     const double dt = 1e-6 * double(cur.utime - previous_->utime);
     motion.known = dt > 0.0;
     motion.twist_per_s = se3::log(T_prev_cur_predicted) / dt;
-    motion.depth_offset_s = depth_time_offset_s(options_.depth, input.utime, input.depth_utime);
+    motion.depth_offset_s = sensors::depth_time_offset_s(options_.depth.timing(), input.utime, input.depth_utime);
     motion.readout_s = options_.depth.rolling_shutter_readout_s;
   }
   cur.motion = motion;

@@ -26,7 +26,7 @@
 #include "common/rgbd_frame.h"
 #include "vo/feature_detector.h"
 #include "vo/frame.h"
-#include "vo/lens.h"
+#include "sensors/lens.h"
 #include "vo/matcher.h"
 #include "vo/motion_estimator.h"
 #include "vo/options.h"
@@ -87,7 +87,7 @@ class VisualOdometry {
   void finish(VoResult& result, const Frame& cur) const;
 
   VoOptions options_;
-  Lens lens_;
+  sensors::Lens lens_;
   FastThresholdController threshold_;
   FeatureDetector detector_;
   RotationPrior rotation_prior_;

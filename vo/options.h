@@ -8,6 +8,8 @@
 
 #include <string>
 
+#include "sensors/depth_image.h"
+
 namespace kestrel::vo {
 
 /// Grey image, Gaussian blur and pyramid (one octave per level).
@@ -51,6 +53,9 @@ struct DepthOptions {
   /// Colour rolling shutter, first-to-last row time; 0 = global shutter (the simulator's camera).
   /// A freiburg1 TUM run uses the Kinect's (with_tum_sensor(), vo/sequence_run.h).
   double rolling_shutter_readout_s = 0.0;
+
+  sensors::DepthValidity validity() const { return {min_m, max_m, max_discontinuity}; }
+  sensors::DepthTiming timing() const { return {time_offset_from_stamps, time_offset_s}; }
 };
 
 /// Initial rotation by aligning heavily down-sampled images (Mei et al.).

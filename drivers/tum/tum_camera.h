@@ -10,7 +10,7 @@
 // The images are not undistorted here (TUM's registered depth cannot be undistorted exactly):
 // freiburg1 reports TUM's calibrated lens distortion with its raw images (2-3 % radial over
 // most of the image, 5-8 px; up to ~25 px in the corners), for consumers that map raw pixels
-// to ideal ones (vo::Lens); freiburg2/3 and unknown folders report none (not measured here).
+// to ideal ones (sensors::Lens); freiburg2/3 and unknown folders report none (not measured here).
 
 #include <string>
 

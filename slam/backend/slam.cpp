@@ -130,7 +130,7 @@ void Slam::add_odometry_edge(const Keyframe& previous, const Keyframe& current, 
 }
 
 SlamStep Slam::add(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera, OdometryLink link,
-                   const std::optional<Matrix6d>& odometry_covariance, const vo::FrameMotion& motion,
+                   const std::optional<Matrix6d>& odometry_covariance, const sensors::FrameMotion& motion,
                    const sensors::SensorProfile& sensor) {
   const bool odometry_broken = link == OdometryLink::kBroken;
   if (have_frame_ && frame.utime <= last_utime_) {

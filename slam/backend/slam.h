@@ -26,7 +26,7 @@
 #include "sensors/sensor_profile.h"
 #include "slam/backend/slam_options.h"
 #include "slam/posegraph/pose_graph.h"
-#include "vo/frame_motion.h"
+#include "sensors/frame_motion.h"
 
 namespace kestrel::slam {
 
@@ -93,7 +93,7 @@ class Slam {
   SlamStep add(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera,
                OdometryLink link = OdometryLink::kContinuous,
                const std::optional<Matrix6d>& odometry_covariance = std::nullopt,
-               const vo::FrameMotion& motion = {}, const sensors::SensorProfile& sensor = {});
+               const sensors::FrameMotion& motion = {}, const sensors::SensorProfile& sensor = {});
 
   const std::vector<Keyframe>& keyframes() const { return keyframes_; }
   /// Vertices are keyframes (poses T_world_camera); edges odometry and loop closures.

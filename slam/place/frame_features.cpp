@@ -8,8 +8,8 @@
 #include <stdexcept>
 
 #include "common/geometry/se3.h"
-#include "vo/depth_lookup.h"
-#include "vo/lens.h"
+#include "sensors/depth_image.h"
+#include "sensors/lens.h"
 
 namespace kestrel::slam {
 
@@ -20,7 +20,7 @@ size_t FrameFeatures::num_points() const {
 
 struct FeatureExtractor::LensCache {
   std::mutex mutex;
-  std::shared_ptr<const vo::Lens> lens;  // the last camera's
+  std::shared_ptr<const sensors::Lens> lens;  // the last camera's
 };
 
 FeatureExtractor::FeatureExtractor(const FeatureOptions& options)
@@ -36,7 +36,7 @@ FeatureExtractor::FeatureExtractor(const FeatureOptions& options)
                          options.fast_threshold);
 }
 
-FrameFeatures FeatureExtractor::extract(const RgbdFrame& frame, const vo::FrameMotion& motion) const {
+FrameFeatures FeatureExtractor::extract(const RgbdFrame& frame, const sensors::FrameMotion& motion) const {
   cv::Mat grey;
   if (frame.rgb.empty()) {
     FrameFeatures none;
@@ -72,31 +72,31 @@ double FeatureExtractor::reliable_depth(const cv::Mat& depth_m, double u_px, dou
   return z;
 }
 
-std::shared_ptr<const vo::Lens> FeatureExtractor::lens_for(const PinholeCamera& camera) const {
+std::shared_ptr<const sensors::Lens> FeatureExtractor::lens_for(const PinholeCamera& camera) const {
   const std::lock_guard<std::mutex> lock(lens_cache_->mutex);
   if (!lens_cache_->lens || !lens_cache_->lens->prepared_for(camera, true)) {
-    auto lens = std::make_shared<vo::Lens>();
+    auto lens = std::make_shared<sensors::Lens>();
     lens->reset(camera, true);
     lens_cache_->lens = std::move(lens);
   }
   return lens_cache_->lens;
 }
 
-vo::FrameMotion keyframe_motion(const vo::DepthOptions& timing, int64_t utime, int64_t depth_utime,
+sensors::FrameMotion keyframe_motion(const vo::DepthOptions& timing, int64_t utime, int64_t depth_utime,
                                 int64_t previous_utime, const Eigen::Isometry3d& T_previous_current) {
-  vo::FrameMotion motion;
+  sensors::FrameMotion motion;
   const double dt = 1e-6 * static_cast<double>(utime - previous_utime);
   if (!(dt > 0.0)) return motion;
   motion.known = true;
   motion.twist_per_s = se3::log(T_previous_current) / dt;
   motion.depth_offset_s =
-      timing.compensate_time_offset ? vo::depth_time_offset_s(timing, utime, depth_utime) : 0.0;
+      timing.compensate_time_offset ? sensors::depth_time_offset_s(timing.timing(), utime, depth_utime) : 0.0;
   motion.readout_s = timing.rolling_shutter_readout_s;
   return motion;
 }
 
 FrameFeatures FeatureExtractor::extract(const cv::Mat& grey, const cv::Mat& depth_m,
-                                        const PinholeCamera& camera, const vo::FrameMotion& motion) const {
+                                        const PinholeCamera& camera, const sensors::FrameMotion& motion) const {
   FrameFeatures f;
   f.camera = camera;
   orb_->detectAndCompute(grey, cv::noArray(), f.keypoints, f.descriptors);
@@ -113,7 +113,7 @@ FrameFeatures FeatureExtractor::extract(const cv::Mat& grey, const cv::Mat& dept
   // The lens (top of frame_features.h): without distortion ideal pixels are the raw ones and
   // the untimed path below is the one keyframes always took.
   const bool distorted = camera.distorted();
-  const std::shared_ptr<const vo::Lens> lens = (timed || distorted) ? lens_for(camera) : nullptr;
+  const std::shared_ptr<const sensors::Lens> lens = (timed || distorted) ? lens_for(camera) : nullptr;
   for (size_t i = 0; i < f.keypoints.size(); ++i) {
     const cv::Point2f pt = f.keypoints[i].pt;  // raw: depth is read here
     Eigen::Vector2d ideal(pt.x, pt.y);
@@ -144,7 +144,7 @@ FrameFeatures FeatureExtractor::extract(const cv::Mat& grey, const cv::Mat& dept
     // Carried from its (raw) row's time to the middle row's (rolling shutter).
     Eigen::Vector2f pixel;
     const Eigen::Vector3d p =
-        vo::point_at_frame_time(*lens, motion, pt.x, pt.y, static_cast<float>(z), &pixel).cast<double>();
+        sensors::point_at_frame_time(*lens, motion, pt.x, pt.y, static_cast<float>(z), &pixel).cast<double>();
     if (!(p.z() >= options_.min_depth_m && p.z() <= options_.max_depth_m)) continue;
     f.points[i] = p;
     f.keypoints[i].pt = cv::Point2f(pixel.x(), pixel.y());

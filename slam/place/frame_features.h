@@ -9,9 +9,9 @@
 //
 // Timing (a Kinect: its depth image is captured at another time than the colour image, and
 // the colour image is read row by row): given the camera's motion around the keyframe
-// (vo::FrameMotion), each keypoint's depth is read where its point was at depth time and the
+// (sensors::FrameMotion), each keypoint's depth is read where its point was at depth time and the
 // point is then carried to the frame's time (the middle row's), exactly as the odometry does
-// (vo/depth_lookup.h: T_rgb_depth = exp(depth_offset_s * twist), vo::point_at_frame_time);
+// (sensors/depth_image.h: T_rgb_depth = exp(depth_offset_s * twist), sensors::point_at_frame_time);
 // the keypoint's pixel becomes that point's projection (its descriptor stays the one
 // computed at the raw pixel). Without a known motion, or with a global shutter and no depth
 // offset (the simulator's camera), points are read at the keypoint as they always were.
@@ -19,7 +19,7 @@
 // Lens (common/camera.h: a source may report the distortion of its raw images, as freiburg1
 // does): keypoints are detected and described on the raw image, and depth is read at the raw
 // pixel (the registered depth shares its grid), but the point lies on the ray of the ideal
-// pixel (vo::Lens with the camera's distortion) and the keypoint's pixel becomes that ideal
+// pixel (sensors::Lens with the camera's distortion) and the keypoint's pixel becomes that ideal
 // pixel (with timing, the point's projection): every pixel in FrameFeatures is an ideal
 // pinhole pixel of `camera`, which is what the loop verifier's two-frame adjustment projects
 // with. Without distortion (the simulator) nothing changes, bit for bit.
@@ -31,7 +31,7 @@
 // both offline (sequence_run.cpp) and in the process (slam_adapter.cpp, from consecutive
 // VO_UPDATEs); on fr1 the next frame's motion or the previous-to-next one did no better
 // (slam/README.md, "Missing"). Depth offset and readout are the VO's (vo::DepthOptions of the camera's
-// profile, vo/sensor_profile.h): depth_time_offset_s() of the frame's stamps when
+// profile, vo/sensor_profile.h): sensors::depth_time_offset_s() of the frame's stamps when
 // compensate_time_offset, else none; rolling_shutter_readout_s.
 
 #include <Eigen/Core>
@@ -44,8 +44,8 @@
 
 #include "common/camera.h"
 #include "common/rgbd_frame.h"
-#include "vo/frame_motion.h"
-#include "vo/lens.h"
+#include "sensors/frame_motion.h"
+#include "sensors/lens.h"
 #include "vo/options.h"
 
 namespace kestrel::slam {
@@ -77,10 +77,10 @@ class FeatureExtractor {
   explicit FeatureExtractor(const FeatureOptions& options = {});
   /// Features of a frame; a frame without colour gives none, without depth gives no points.
   /// `motion`: the camera's motion around the frame's time (see the top of this file).
-  FrameFeatures extract(const RgbdFrame& frame, const vo::FrameMotion& motion = {}) const;
+  FrameFeatures extract(const RgbdFrame& frame, const sensors::FrameMotion& motion = {}) const;
   /// Features of a grey image with an optional depth image in metres (CV_32FC1, NaN = none).
   FrameFeatures extract(const cv::Mat& grey, const cv::Mat& depth_m, const PinholeCamera& camera,
-                        const vo::FrameMotion& motion = {}) const;
+                        const sensors::FrameMotion& motion = {}) const;
 
  private:
   /// Depth in metres at pixel (u, v) (nearest), or 0 when it is outside the image (one pixel
@@ -88,7 +88,7 @@ class FeatureExtractor {
   double reliable_depth(const cv::Mat& depth_m, double u, double v) const;
   /// The lens map of `camera` with its distortion, built once per camera and shared by
   /// copies of this extractor (thread-safe; building one is a 640 x 480 table).
-  std::shared_ptr<const vo::Lens> lens_for(const PinholeCamera& camera) const;
+  std::shared_ptr<const sensors::Lens> lens_for(const PinholeCamera& camera) const;
 
   struct LensCache;
   FeatureOptions options_;
@@ -100,7 +100,7 @@ class FeatureExtractor {
 /// the odometry's motion from the previous frame (stamped `previous_utime`) to this one
 /// (`utime`, depth stamped `depth_utime`); `timing` the camera's (the VO's DepthOptions).
 /// Unknown when the interval is not positive.
-vo::FrameMotion keyframe_motion(const vo::DepthOptions& timing, int64_t utime, int64_t depth_utime,
+sensors::FrameMotion keyframe_motion(const vo::DepthOptions& timing, int64_t utime, int64_t depth_utime,
                                 int64_t previous_utime, const Eigen::Isometry3d& T_previous_current);
 
 }  // namespace kestrel::slam

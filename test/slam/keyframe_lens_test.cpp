@@ -60,7 +60,7 @@ TEST(KeyframeLens, PointOnTheIdealRayWithDepthReadAtTheRawPixel) {
       EXPECT_EQ(plain.points[i], raw_camera.backproject(static_cast<double>(raw.x), static_cast<double>(raw.y),
                                                         plain.points[i].z()));
     }
-    // The ideal pixel is the one the lens maps to the raw keypoint (vo::Lens: within 0.01 px).
+    // The ideal pixel is the one the lens maps to the raw keypoint (sensors::Lens: within 0.01 px).
     const Eigen::Vector2d back = camera.distort(static_cast<double>(ideal.x), static_cast<double>(ideal.y));
     EXPECT_NEAR(back.x(), raw.x, 1e-2) << "keypoint " << i;
     EXPECT_NEAR(back.y(), raw.y, 1e-2) << "keypoint " << i;
@@ -89,7 +89,7 @@ TEST(KeyframeLens, RollingShutterTakesTheRawRowsTime) {
   const double Z = 2.0, w = 1.0, readout = 0.015;
   const cv::Mat depth(camera.height, camera.width, CV_32FC1, cv::Scalar(Z));
   const cv::Mat grey = test::texture(camera, 11);
-  const vo::FrameMotion motion = test::moving({0, 0, 0}, {0, w, 0}, 0.0, readout);
+  const sensors::FrameMotion motion = test::moving({0, 0, 0}, {0, w, 0}, 0.0, readout);
   const FeatureExtractor extractor;
   const FrameFeatures plain = extractor.extract(grey, depth, raw_camera);
   const FrameFeatures still = extractor.extract(grey, depth, camera);

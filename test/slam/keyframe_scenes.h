@@ -7,7 +7,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "common/camera.h"
-#include "vo/frame_motion.h"
+#include "sensors/frame_motion.h"
 
 namespace kestrel::slam::test {
 
@@ -24,9 +24,9 @@ inline cv::Mat texture(const PinholeCamera& camera, int seed) {
 
 /// A camera moving with twist (rho, phi) per second, its depth image `depth_offset_s` after the
 /// colour image and its rows read out over `readout_s`.
-inline vo::FrameMotion moving(const Eigen::Vector3d& rho, const Eigen::Vector3d& phi, double depth_offset_s,
+inline sensors::FrameMotion moving(const Eigen::Vector3d& rho, const Eigen::Vector3d& phi, double depth_offset_s,
                               double readout_s) {
-  vo::FrameMotion m;
+  sensors::FrameMotion m;
   m.known = true;
   m.twist_per_s << rho, phi;
   m.depth_offset_s = depth_offset_s;

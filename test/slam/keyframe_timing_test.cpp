@@ -101,7 +101,7 @@ TEST(KeyframeTiming, MotionFromTheOdometryAndTheProfile) {
   T.translation() = Eigen::Vector3d(0.015, 0.0, -0.006);
   const int64_t utime = 1'000'000'000, previous = utime - 30'000, depth_utime = utime - 12'000;
   const vo::DepthOptions kinect = vo::with_sensor(sensors::builtin_profile("kinect1"), vo::VoOptions{}).depth;
-  const vo::FrameMotion m = keyframe_motion(kinect, utime, depth_utime, previous, T);
+  const sensors::FrameMotion m = keyframe_motion(kinect, utime, depth_utime, previous, T);
   ASSERT_TRUE(m.known);
   EXPECT_NEAR(m.twist_per_s(0), 0.5, 1e-12);
   EXPECT_NEAR(m.twist_per_s(2), -0.2, 1e-12);
@@ -110,7 +110,7 @@ TEST(KeyframeTiming, MotionFromTheOdometryAndTheProfile) {
   EXPECT_DOUBLE_EQ(m.readout_s, 0.015);  // kinect1.yaml's
 
   const vo::DepthOptions simulator = vo::with_sensor(sensors::builtin_profile("simulator"), vo::VoOptions{}).depth;
-  const vo::FrameMotion s = keyframe_motion(simulator, utime, depth_utime, previous, T);
+  const sensors::FrameMotion s = keyframe_motion(simulator, utime, depth_utime, previous, T);
   EXPECT_TRUE(s.known);
   EXPECT_EQ(s.depth_offset_s, 0.0);
   EXPECT_EQ(s.readout_s, 0.0);
@@ -124,7 +124,7 @@ TEST(KeyframeTiming, SimulatorProfileChangesNothing) {
   frame.depth_utime = frame.utime - 20'000;
   Eigen::Isometry3d T_previous_current = se3::exp((Eigen::Matrix<double, 6, 1>() << 0.02, 0.01, 0, 0.01, 0.03, 0).finished());
   const vo::DepthOptions simulator = vo::with_sensor(sensors::builtin_profile("simulator"), vo::VoOptions{}).depth;
-  const vo::FrameMotion motion = keyframe_motion(simulator, frame.utime, frame.depth_utime, frame.utime - 33'333, T_previous_current);
+  const sensors::FrameMotion motion = keyframe_motion(simulator, frame.utime, frame.depth_utime, frame.utime - 33'333, T_previous_current);
   ASSERT_TRUE(motion.known);
   const FeatureExtractor extractor;
   const FrameFeatures plain = extractor.extract(frame);

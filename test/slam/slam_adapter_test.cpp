@@ -361,7 +361,7 @@ TEST_F(AdapterTest, KeyframeFeaturesTakeTheCamerasTimingAndTheOdometrysMotion) {
   ASSERT_EQ(adapter_.slam().keyframes().size(), 2u);
   const FeatureExtractor extractor(SlamOptions{}.features);
   const RgbdFrame f0 = transport::decode_rgbd(frame(0), "test"), f3 = transport::decode_rgbd(frame(3), "test");
-  const vo::FrameMotion motion =
+  const sensors::FrameMotion motion =
       keyframe_motion(vo::with_sensor(sensors::builtin_profile("kinect1"), vo::VoOptions{}).depth, f3.utime, f3.depth_utime,
                       utime(2), pose(2).inverse() * pose(3));
   ASSERT_TRUE(motion.known);

@@ -20,7 +20,7 @@
 #include "mapper/map_compare.h"
 #include "mapper/mapper.h"
 #include "mapper/octree_io.h"
-#include "vo/depth_lookup.h"
+#include "sensors/depth_image.h"
 #include "vo/sensor_profile.h"
 
 namespace kestrel::test {
@@ -89,7 +89,7 @@ void expect_map_agrees_with_truth(const kestrel::slam_graph_t& graph, const Traj
     // the motion capture's gaps too: fr1_xyz has one of 0.11 s where a keyframe's depth falls.
     const vo::DepthOptions timing = vo::with_sensor(sensors::profile_of_sensor(frame.sensor), vo::VoOptions{}).depth;
     const int64_t depth_time =
-        utime + std::llround(1e6 * vo::depth_time_offset_s(timing, utime, frame.depth_utime != 0 ? frame.depth_utime : utime));
+        utime + std::llround(1e6 * sensors::depth_time_offset_s(timing.timing(), utime, frame.depth_utime != 0 ? frame.depth_utime : utime));
     const std::optional<Eigen::Isometry3d> T = true_camera.at(depth_time, 120'000);
     ASSERT_TRUE(T.has_value()) << "no true pose at the depth's time " << depth_time;
     reference.insert(frame, *T_slam_true * *T);

@@ -20,7 +20,7 @@ namespace {
 
 TEST(DenseDepth, WallGivesItsPointsAndNormal) {
   const PinholeCamera cam = test::test_camera();
-  Lens lens;
+  sensors::Lens lens;
   lens.reset(cam, false);
   const cv::Mat depth(cam.height, cam.width, CV_16UC1, cv::Scalar(1500));  // a wall at 1.5 m
   DenseDepth grid;
@@ -51,7 +51,7 @@ TEST(DenseDepth, WallGivesItsPointsAndNormal) {
 
 TEST(DenseDepth, DepthEdgeHasNoNormal) {
   const PinholeCamera cam = test::test_camera();
-  Lens lens;
+  sensors::Lens lens;
   lens.reset(cam, false);
   cv::Mat depth(cam.height, cam.width, CV_16UC1, cv::Scalar(1500));
   depth.colRange(0, 320).setTo(cv::Scalar(1000));  // a step at column 320 (a block boundary)
@@ -93,7 +93,7 @@ TEST(DenseDepth, Sse2BlockDepthsEqualTheScalarLoop) {
 TEST(DenseDepth, DistortionInvertsTheLensTable) {
   PinholeCamera cam = test::test_camera();
   cam.distortion = {0.2624, -0.9531, -0.0054, 0.0026, 1.1633};  // fr1's
-  Lens lens;
+  sensors::Lens lens;
   lens.reset(cam, true);
   for (double v = 20; v < cam.height - 20; v += 37) {
     for (double u = 20; u < cam.width - 20; u += 41) {
@@ -116,7 +116,7 @@ TEST(DenseRefinement, RecoversAKnownMotionFromDepthAlone) {
   const Eigen::Isometry3d T_ref_cur = se3::exp((Vector6d() << 0.03, 0.01, -0.02, 0.01, 0.02, -0.015).finished());
   const RgbdFrame ref_frame = scene.render(T_world_ref, cam, 0);
   const RgbdFrame cur_frame = scene.render(T_world_ref * T_ref_cur, cam, 33000);
-  Lens lens;
+  sensors::Lens lens;
   lens.reset(cam, false);
   DenseDepth ref, cur;
   build_dense_depth(ref_frame.depth_mm, lens, DepthOptions{}, 3, ref);

@@ -11,6 +11,7 @@
 
 #include "common/geometry/se3.h"
 #include "sensors/builtin_profiles.h"
+#include "sensors/depth_image.h"
 #include "test/vo/synthetic_scene.h"
 #include "vo/depth_lookup.h"
 #include "vo/sequence_run.h"
@@ -30,7 +31,7 @@ TEST(DepthTimeOffset, CompensatedLookupReadsTheDepthAtRgbTime) {
   const Eigen::Isometry3d T_world_depth = T_world_rgb * se3::exp(kDepthOffsetS * twist_per_s());
   const cv::Mat depth_at_rgb_time = scene.render(T_world_rgb, cam, 1000000).depth_mm;
   const cv::Mat depth_image = scene.render(T_world_depth, cam, 1000000).depth_mm;
-  Lens lens;
+  sensors::Lens lens;
   lens.reset(cam, true);
   Frame frame;
   for (int v = 40; v < 440; v += 20)
@@ -42,7 +43,7 @@ TEST(DepthTimeOffset, CompensatedLookupReadsTheDepthAtRgbTime) {
     }
   frame.level_begin.fill(int(frame.features.size()));
   frame.level_begin[0] = 0;
-  FrameMotion motion;
+  sensors::FrameMotion motion;
   motion.known = true;
   motion.twist_per_s = twist_per_s();
   motion.depth_offset_s = kDepthOffsetS;
@@ -60,7 +61,7 @@ TEST(DepthTimeOffset, CompensatedLookupReadsTheDepthAtRgbTime) {
     double sum = 0.0;
     int n = 0;
     for (const Feature& x : f.features) {
-      const float z_true = reliable_depth_m(depth_at_rgb_time, x.u0, x.v0, plain_options);
+      const float z_true = sensors::reliable_depth_m(depth_at_rgb_time, x.u0, x.v0, plain_options.validity());
       if (!(z_true > 0.0f)) continue;
       sum += std::pow(double(x.depth_m - z_true), 2);
       ++n;
@@ -82,20 +83,20 @@ TEST(DepthTimeOffset, CompensatedLookupReadsTheDepthAtRgbTime) {
 // capture 0.1 s or more away is not one capture: none), or the configured value alone.
 TEST(DepthTimeOffset, TakenFromTheStampsOrTheConfiguredValue) {
   DepthOptions options;
-  EXPECT_DOUBLE_EQ(depth_time_offset_s(options, 1'000'000, 988'000), -0.012);
-  EXPECT_DOUBLE_EQ(depth_time_offset_s(options, 1'000'000, 1'007'500), 0.0075);
-  EXPECT_DOUBLE_EQ(depth_time_offset_s(options, 1'000'000, 1'100'000), 0.0);
-  EXPECT_DOUBLE_EQ(depth_time_offset_s(options, 1'000'000, 850'000), 0.0);
+  EXPECT_DOUBLE_EQ(sensors::depth_time_offset_s(options.timing(), 1'000'000, 988'000), -0.012);
+  EXPECT_DOUBLE_EQ(sensors::depth_time_offset_s(options.timing(), 1'000'000, 1'007'500), 0.0075);
+  EXPECT_DOUBLE_EQ(sensors::depth_time_offset_s(options.timing(), 1'000'000, 1'100'000), 0.0);
+  EXPECT_DOUBLE_EQ(sensors::depth_time_offset_s(options.timing(), 1'000'000, 850'000), 0.0);
 
   options.time_offset_s = -0.015;  // the depth image arrives 15 ms later after its capture
-  EXPECT_NEAR(depth_time_offset_s(options, 1'000'000, 988'000), -0.027, 1e-12);
-  EXPECT_NEAR(depth_time_offset_s(options, 1'000'000, 1'007'500), -0.0075, 1e-12);
-  EXPECT_DOUBLE_EQ(depth_time_offset_s(options, 1'000'000, 1'100'000), 0.0);
+  EXPECT_NEAR(sensors::depth_time_offset_s(options.timing(), 1'000'000, 988'000), -0.027, 1e-12);
+  EXPECT_NEAR(sensors::depth_time_offset_s(options.timing(), 1'000'000, 1'007'500), -0.0075, 1e-12);
+  EXPECT_DOUBLE_EQ(sensors::depth_time_offset_s(options.timing(), 1'000'000, 1'100'000), 0.0);
 
   options.time_offset_from_stamps = false;
   options.time_offset_s = -0.012;
-  EXPECT_DOUBLE_EQ(depth_time_offset_s(options, 1'000'000, 1'000'000), -0.012);
-  EXPECT_DOUBLE_EQ(depth_time_offset_s(options, 1'000'000, 1'009'000), -0.012);
+  EXPECT_DOUBLE_EQ(sensors::depth_time_offset_s(options.timing(), 1'000'000, 1'000'000), -0.012);
+  EXPECT_DOUBLE_EQ(sensors::depth_time_offset_s(options.timing(), 1'000'000, 1'009'000), -0.012);
 
   VoOptions vo;
   vo.depth.time_offset_s = 0.15;

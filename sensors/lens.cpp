@@ -1,9 +1,9 @@
-#include "vo/lens.h"
+#include "sensors/lens.h"
 
 #include <algorithm>
 #include <cmath>
 
-namespace kestrel::vo {
+namespace kestrel::sensors {
 
 void Lens::reset(const PinholeCamera& camera, bool use_distortion) {
   camera_ = camera;
@@ -68,4 +68,4 @@ Eigen::Vector3f Lens::ray(float u, float v) const {
           (p.y() - float(camera_.cy)) / float(camera_.fy), 1.0f};
 }
 
-}  // namespace kestrel::vo
+}  // namespace kestrel::sensors

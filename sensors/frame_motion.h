@@ -6,7 +6,7 @@
 
 #include "common/geometry/se3.h"
 
-namespace kestrel::vo {
+namespace kestrel::sensors {
 
 /// The camera's motion around a frame's time, for the timing corrections.
 struct FrameMotion {
@@ -22,4 +22,4 @@ struct FrameMotion {
   }
 };
 
-}  // namespace kestrel::vo
+}  // namespace kestrel::sensors

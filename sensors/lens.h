@@ -14,7 +14,7 @@
 
 #include "common/camera.h"
 
-namespace kestrel::vo {
+namespace kestrel::sensors {
 
 class Lens {
  public:
@@ -47,4 +47,4 @@ class Lens {
   std::vector<Eigen::Vector2f> table_;
 };
 
-}  // namespace kestrel::vo
+}  // namespace kestrel::sensors
