@@ -1,19 +1,67 @@
 #include "test/vo/synthetic_scene.h"
 
 #include <cmath>
-#include <limits>
+#include <random>
+#include <sstream>
+
+#include "drivers/sim/renderer.h"
+#include "drivers/sim/world_file.h"
 
 namespace kestrel::vo::test {
 namespace {
 
-uint32_t hash(uint32_t a, uint32_t b, uint32_t c) {
-  uint32_t h = a * 0x9E3779B1u ^ (b + 0x7F4A7C15u) * 0x85EBCA77u ^ (c + 0x165667B1u) * 0xC2B2AE3Du;
-  h ^= h >> 15;
-  h *= 0x2C1B3C6Du;
-  h ^= h >> 12;
-  h *= 0x297A2D39u;
-  h ^= h >> 15;
-  return h;
+// The scene's frame (x right, y down, z forward) in the world file's (x forward, y left,
+// z up), with the room's corner at the world's origin: X = z + 1, Y = 2 - x, Z = 1.5 - y.
+Eigen::Isometry3d T_sim_scene() {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() << 0, 0, 1, -1, 0, 0, 0, -1, 0;
+  T.translation() = Eigen::Vector3d(1.0, 2.0, 1.5);
+  return T;
+}
+
+// The room as a world file: walls facing inwards (counter-clockwise outline), the back wall at
+// X = depth + 1. Its surfaces are the simulator's most detailed patterns (book shelves on the
+// walls, tiles above and below). What the seed places (a block standing in the room, for depth
+// discontinuities and parallax, and two posters on the back wall, each one of a kind) makes two
+// seeds two different places in texture and in geometry, a test's "another room": with the
+// book shelves alone, two seeds were one texture shifted, which the matcher took for motion.
+std::string room_world(unsigned seed, double depth_m) {
+  const double X = depth_m + 1.0;
+  std::mt19937 draw(seed);
+  const auto uniform = [&](double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(draw); };
+  const double bx = uniform(0.45, 0.65) * depth_m + 1.0, by = uniform(1.2, 2.3), bh = uniform(1.0, 1.6);
+  static const char* const kBlockPatterns[] = {"brick", "wood", "concrete"};
+  const char* block_pattern = kBlockPatterns[draw() % 3];
+  std::ostringstream posters;
+  for (int i = 0; i < 2; ++i) {
+    const double y0 = uniform(0.3, 2.5), z0 = uniform(0.4, 1.9);
+    posters << "panel poster " << X - 0.01 << " " << y0 << " " << X - 0.01 << " " << y0 + 1.2 << " " << z0 << " "
+            << z0 + 0.9 << "\n";
+  }
+  std::ostringstream w;
+  w << "kestrel-world 1\n"
+    << "name vo-test-room\n"
+    << "seed " << seed << "\n"
+    << "bounds 0 0 0 " << X << " 4 3\n"
+    << "start 1 2 1.5 0\n"
+    << "ambient 0.6\n"
+    << "material floor    floor_tiles color 0.42 0.40 0.38 contrast 1.5\n"
+    << "material ceiling  ceiling_tiles color 0.80 0.80 0.78 contrast 1.5\n"
+    << "material back     books color 0.62 0.48 0.36 contrast 1.5\n"
+    << "material poster   poster color 0.93 0.91 0.86 fit\n"
+    << "material side     books color 0.66 0.65 0.62 contrast 1.5\n"
+    << "material block    " << block_pattern << " color 0.55 0.38 0.22 contrast 1.5\n"
+    << "floor   floor   0 0 " << X << " 4 0\n"
+    << "ceiling ceiling 0 0 " << X << " 4 3\n"
+    << "wall side 0 0 " << X << " 0\n"
+    << "wall back " << X << " 0 " << X << " 4\n"
+    << "wall side " << X << " 4 0 4\n"
+    << "wall side 0 4 0 0\n"
+    << "box block " << bx << " " << by << " 0 " << bx + 0.5 << " " << by + 0.7 << " " << bh << "\n"
+    << posters.str()
+    << "light " << 0.5 * X << " 1.3 2.9\n"
+    << "light " << 0.5 * X << " 2.7 2.9\n";
+  return w.str();
 }
 
 }  // namespace
@@ -29,94 +77,44 @@ PinholeCamera test_camera() {
   return c;
 }
 
-SyntheticScene::SyntheticScene(unsigned seed, double depth_m) {
-  const double w = 2.0, h = 1.5;
-  auto add = [&](Eigen::Vector3d origin, Eigen::Vector3d u, Eigen::Vector3d v, double width,
-                 double height) {
-    Plane p;
-    p.origin = origin;
-    p.u = u.normalized();
-    p.v = v.normalized();
-    p.normal = p.u.cross(p.v);
-    p.width = width;
-    p.height = height;
-    p.seed = seed * 131u + static_cast<unsigned>(planes_.size());
-    planes_.push_back(p);
-  };
-  // Back wall, floor (y down is +y in the optical frame of a level camera), ceiling, sides.
-  add({-w, -h, depth_m}, {1, 0, 0}, {0, 1, 0}, 2 * w, 2 * h);
-  add({-w, h, -1.0}, {1, 0, 0}, {0, 0, 1}, 2 * w, depth_m + 1.0);
-  add({-w, -h, -1.0}, {1, 0, 0}, {0, 0, 1}, 2 * w, depth_m + 1.0);
-  add({-w, -h, -1.0}, {0, 1, 0}, {0, 0, 1}, 2 * h, depth_m + 1.0);
-  add({w, -h, -1.0}, {0, 1, 0}, {0, 0, 1}, 2 * h, depth_m + 1.0);
-  // A block standing in the room, for depth discontinuities and parallax.
-  const double bz = 0.55 * depth_m;
-  add({-0.9, 0.1, bz}, {1, 0, 0}, {0, 1, 0}, 0.7, h - 0.1);
-  add({-0.2, 0.1, bz}, {0, 0, 1}, {0, 1, 0}, 0.5, h - 0.1);
-}
+SyntheticScene::SyntheticScene(unsigned seed, double depth_m)
+    : seed_(seed),
+      world_(std::make_unique<sim::World>(sim::parse_world(room_world(seed, depth_m), "vo test room"))) {}
 
-double SyntheticScene::noise(unsigned seed, double s, double t, double cell) const {
-  const double x = s / cell, y = t / cell;
-  const double fx = std::floor(x), fy = std::floor(y);
-  const int ix = static_cast<int>(fx), iy = static_cast<int>(fy);
-  const double ax = x - fx, ay = y - fy;
-  auto value = [&](int i, int j) {
-    return double(hash(seed, static_cast<uint32_t>(i), static_cast<uint32_t>(j)) & 0xFFFFu) / 65535.0;
-  };
-  // Smoothstep weights: continuous gradients, so subpixel positions are well defined.
-  const double sx = ax * ax * (3 - 2 * ax), sy = ay * ay * (3 - 2 * ay);
-  const double top = (1 - sx) * value(ix, iy) + sx * value(ix + 1, iy);
-  const double bottom = (1 - sx) * value(ix, iy + 1) + sx * value(ix + 1, iy + 1);
-  return (1 - sy) * top + sy * bottom;
-}
-
-double SyntheticScene::intensity(int plane, const Eigen::Vector3d& p) const {
-  const Plane& pl = planes_[static_cast<size_t>(plane)];
-  const Eigen::Vector3d d = p - pl.origin;
-  const double s = d.dot(pl.u), t = d.dot(pl.v);
-  const double n = 0.65 * noise(pl.seed, s, t, 0.04) + 0.35 * noise(pl.seed + 7777u, s, t, 0.013);
-  return std::clamp(255.0 * (1.6 * (n - 0.5) + 0.5), 0.0, 255.0);
-}
+SyntheticScene::~SyntheticScene() = default;
 
 RgbdFrame SyntheticScene::render(const Eigen::Isometry3d& T_world_camera, const PinholeCamera& camera,
                                  int64_t utime) const {
-  RgbdFrame f;
-  f.utime = utime;
-  f.depth_utime = utime;
-  f.camera = camera;
-  f.rgb.create(camera.height, camera.width, CV_8UC3);
-  f.depth_mm.create(camera.height, camera.width, CV_16UC1);
-  const Eigen::Matrix3d R = T_world_camera.linear();
-  const Eigen::Vector3d c = T_world_camera.translation();
-  for (int y = 0; y < camera.height; ++y) {
-    for (int x = 0; x < camera.width; ++x) {
-      const Eigen::Vector3d ray_cam((x - camera.cx) / camera.fx, (y - camera.cy) / camera.fy, 1.0);
-      const Eigen::Vector3d ray = R * ray_cam;
-      double best = std::numeric_limits<double>::infinity();
-      int hit = -1;
-      for (size_t i = 0; i < planes_.size(); ++i) {
-        const Plane& p = planes_[i];
-        const double denom = p.normal.dot(ray);
-        if (std::abs(denom) < 1e-12) continue;
-        const double lambda = p.normal.dot(p.origin - c) / denom;
-        if (!(lambda > 1e-6) || lambda >= best) continue;
-        const Eigen::Vector3d q = c + lambda * ray - p.origin;
-        const double s = q.dot(p.u), t = q.dot(p.v);
-        if (s < 0 || t < 0 || s > p.width || t > p.height) continue;
-        best = lambda;
-        hit = static_cast<int>(i);
-      }
-      uint8_t grey = 0;
-      uint16_t mm = 0;
-      if (hit >= 0) {
-        grey = static_cast<uint8_t>(std::lround(intensity(hit, c + best * ray)));
-        const double z = best;  // ray_cam has unit z, so lambda is the optical-axis depth
-        mm = z < 65.0 ? static_cast<uint16_t>(std::lround(z * 1000.0)) : 0;
-      }
-      f.rgb.at<cv::Vec3b>(y, x) = cv::Vec3b(grey, grey, grey);
-      f.depth_mm.at<uint16_t>(y, x) = mm;
+  const auto same = [](const PinholeCamera& a, const PinholeCamera& b) {
+    return a.width == b.width && a.height == b.height && a.fx == b.fx && a.fy == b.fy && a.cx == b.cx &&
+           a.cy == b.cy;
+  };
+  if (!renderer_ || !renderer_camera_ || !same(*renderer_camera_, camera)) {
+    sim::CameraOptions options;
+    options.camera = camera;
+    options.camera.distortion = {};  // a pinhole, as the header says
+    options.near_m = 1e-3;
+    options.depth.noise = false;
+    options.rgb.noise = false;
+    options.rgb.vignetting = 0.0;
+    renderer_ = std::make_unique<sim::Renderer>(*world_, options, seed_);
+    renderer_camera_ = camera;
+  }
+  RgbdFrame f = renderer_->render(T_sim_scene() * T_world_camera, utime, 0);
+  // The exact depth, rather than the Kinect model's (quantised in disparity, with a range and
+  // shadows): the tests compare against the geometry to the millimetre.
+  const cv::Mat z = renderer_->ideal_depth();
+  f.depth_mm.create(z.rows, z.cols, CV_16UC1);
+  for (int y = 0; y < z.rows; ++y) {
+    for (int x = 0; x < z.cols; ++x) {
+      const float m = z.at<float>(y, x);
+      f.depth_mm.at<uint16_t>(y, x) = m > 0.0f && m < 65.0f ? static_cast<uint16_t>(std::lround(1000.0 * m)) : 0;
     }
   }
+  f.camera = camera;
+  f.utime = utime;
+  f.depth_utime = utime;
+  f.T_body_camera = Eigen::Isometry3d::Identity();
   return f;
 }
 

@@ -1,41 +1,49 @@
 #pragma once
-// A small synthetic world for the VO tests: a box room with textured walls, floor and a block,
-// rendered into RGB-D frames by ray casting, with exact depth and known poses.
+// A small synthetic world for the VO tests: a box room with textured walls, floor, ceiling and
+// a block, rendered into RGB-D frames by the simulator's renderer (drivers/sim/renderer.h),
+// with exact depth and known poses. It is one of the simulator's worlds (a world file made
+// here, drivers/sim/README.md), so the tests see the surfaces, texture and lighting that
+// kestrel-sim flies in, not a renderer of their own.
 //
-// Texture is value noise in the plane's own metric coordinates (two octaves, bilinear), so a
-// surface looks the same from every view and images have no aliasing at the distances used.
-// Invariants: depth_mm is the z (optical axis) distance, rounded to millimetres (0 where no
-// surface is hit); the colour image is grey (R = G = B); frames are seen by `camera`
-// (undistorted unless `distortion` is set on it, which then distorts the rendered pixels).
+// The scene's frame is the one the tests pose cameras in: x right, y down, z forward (a level
+// camera at the origin looks at the back wall, depth_m ahead); the room spans x in [-2, 2],
+// y in [-1.5, 1.5] and z in [-1, depth_m]. Invariants: depth_mm is the exact z (optical axis)
+// distance of the surface seen, rounded to millimetres (0 where none); the colour has no
+// sensor noise or vignetting; the same seed, pose and camera always give the same bytes.
+// `camera` is used as a pinhole (its distortion, if any, is not applied to the pixels).
 
 #include <Eigen/Geometry>
-#include <vector>
+#include <memory>
+#include <optional>
 
 #include "common/rgbd_frame.h"
+
+namespace kestrel::sim {
+class World;
+class Renderer;
+}  // namespace kestrel::sim
 
 namespace kestrel::vo::test {
 
 class SyntheticScene {
  public:
-  /// A room of `half_width` x `half_width` x `depth` metres in front of the origin, seeded.
+  /// The room, `depth_m` deep in front of the origin; `seed` keys the surfaces' appearance.
   explicit SyntheticScene(unsigned seed = 1, double depth_m = 3.0);
+  ~SyntheticScene();
+  SyntheticScene(const SyntheticScene&) = delete;
+  SyntheticScene& operator=(const SyntheticScene&) = delete;
 
   /// Renders the view of a camera at T_world_camera (optical frame: x right, y down, z forward).
+  /// Not thread-safe (the renderer keeps its buffers): one scene per thread.
   RgbdFrame render(const Eigen::Isometry3d& T_world_camera, const PinholeCamera& camera,
                    int64_t utime) const;
 
-  /// Grey level (0..255) of the texture at a world point on plane `plane`.
-  double intensity(int plane, const Eigen::Vector3d& p_world) const;
-
  private:
-  struct Plane {
-    Eigen::Vector3d origin, u, v, normal;  // u, v unit in-plane axes
-    double width, height;
-    unsigned seed;
-  };
-  double noise(unsigned seed, double s, double t, double cell) const;
-
-  std::vector<Plane> planes_;
+  unsigned seed_;
+  std::unique_ptr<sim::World> world_;
+  // Made for the camera of the last render; remade when another camera is asked for.
+  mutable std::unique_ptr<sim::Renderer> renderer_;
+  mutable std::optional<PinholeCamera> renderer_camera_;
 };
 
 /// The fr1 calibrated intrinsics used across the tests (no distortion).
