@@ -4,6 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <stdexcept>
+#include <vector>
+
 #include <opencv2/core.hpp>
 
 #include "common/error.h"
@@ -172,6 +175,35 @@ TEST(RgbdTranscoder, ResetForgetsTheStatistics) {
   EXPECT_EQ(t.stats().frames, 0);
   EXPECT_EQ(t.stats().bytes_in, 0);
   EXPECT_EQ(t.stats().bytes_out, 0);
+}
+
+}  // namespace
+}  // namespace kestrel::codec
+
+namespace kestrel::codec {
+namespace {
+
+TEST(FrameRateLimit, ThinsA30HzCameraToEveryThirdFrameDespiteJitter) {
+  FrameRateLimit limit(10.0);
+  std::vector<int> kept;
+  for (int i = 0; i < 12; ++i) {
+    const int64_t jitter = (i % 2 == 0) ? 2000 : -2000;  // +-2 ms on 33.3 ms
+    if (limit.keep(1'000'000 + i * 33'333 + jitter)) kept.push_back(i);
+  }
+  EXPECT_EQ(kept, (std::vector<int>{0, 3, 6, 9}));
+}
+
+TEST(FrameRateLimit, ZeroKeepsEveryFrameAndAStampBackInTimeStartsAgain) {
+  FrameRateLimit all(0.0);
+  for (int i = 0; i < 5; ++i) EXPECT_TRUE(all.keep(i));
+  FrameRateLimit limit(1.0);
+  EXPECT_TRUE(limit.keep(5'000'000));
+  EXPECT_FALSE(limit.keep(5'500'000));
+  EXPECT_TRUE(limit.keep(1'000'000));  // a restarted source
+  EXPECT_FALSE(limit.keep(1'100'000));
+  limit.reset();
+  EXPECT_TRUE(limit.keep(1'100'000));
+  EXPECT_THROW(FrameRateLimit(-1.0), std::invalid_argument);
 }
 
 }  // namespace

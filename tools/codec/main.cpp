@@ -28,6 +28,7 @@ struct Options {
   std::string depth = "zstd";
   int jpeg_quality = 90;
   int zstd_level = 1;
+  double max_rate_hz = 0;
 };
 
 int serve(const Options& o) {
@@ -39,18 +40,27 @@ int serve(const Options& o) {
   encoding.jpeg_quality = o.jpeg_quality;
   encoding.zstd_level = o.zstd_level;
   kestrel::codec::RgbdTranscoder transcoder(encoding);
+  kestrel::codec::FrameRateLimit limit(o.max_rate_hz);
+  int64_t thinned = 0;
   std::unique_ptr<kestrel::transport::Node> node;
   node = std::make_unique<kestrel::transport::Node>(o.name, o.lcm_url);  // UnavailableError: exit 4
   node->advertise(o.out_channel);
-  node->on_reset([&] { transcoder.reset(); });
+  node->on_reset([&] {
+    transcoder.reset();
+    limit.reset();
+  });
   node->subscribe<rgbd_frame_t>(o.in_channel, [&](const rgbd_frame_t& frame) {
+    if (!limit.keep(frame.utime)) {
+      ++thinned;
+      return;
+    }
     node->publish(o.out_channel, transcoder.transcode(frame, o.in_channel.c_str()));
   });
   spdlog::info("{}: {} -> {}", o.name, o.in_channel, o.out_channel);
   const int status = node->spin();
   const auto& s = transcoder.stats();
-  spdlog::info("{} frames, {:.1f} MB in, {:.1f} MB out, {} rejected", s.frames, s.bytes_in * 1e-6,
-               s.bytes_out * 1e-6, node->counters().messages_rejected);
+  spdlog::info("{} frames, {:.1f} MB in, {:.1f} MB out, {} rejected, {} left out by --max-rate", s.frames,
+               s.bytes_in * 1e-6, s.bytes_out * 1e-6, node->counters().messages_rejected, thinned);
   return status;
 }
 
@@ -77,6 +87,10 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--zstd-level", o.zstd_level, "zstd level (1 fast .. 19 small)")
       ->check(CLI::Range(1, 19))
+      ->capture_default_str();
+  app.add_option("--max-rate", o.max_rate_hz,
+                 "Publish at most this many frames per second of sensor time (0: every frame)")
+      ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   return app.run(argc, argv, [&] { return serve(o); });
 }

@@ -1,5 +1,6 @@
 #include "tools/codec/transcoder.h"
 
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -55,6 +56,18 @@ rgbd_frame_t RgbdTranscoder::transcode(const rgbd_frame_t& in, const char* what)
   stats_.bytes_in += in.getEncodedSize();
   stats_.bytes_out += out.getEncodedSize();
   return out;
+}
+
+FrameRateLimit::FrameRateLimit(double max_rate_hz) {
+  if (!std::isfinite(max_rate_hz) || max_rate_hz < 0)
+    throw std::invalid_argument("the frame rate limit must be finite and >= 0");
+  if (max_rate_hz > 0) min_gap_us_ = std::llround(0.9e6 / max_rate_hz);
+}
+
+bool FrameRateLimit::keep(int64_t utime) {
+  if (last_kept_ >= 0 && utime >= last_kept_ && utime - last_kept_ < min_gap_us_) return false;
+  last_kept_ = utime;
+  return true;
 }
 
 }  // namespace kestrel::codec

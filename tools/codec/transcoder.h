@@ -46,4 +46,21 @@ class RgbdTranscoder {
   TranscoderStats stats_;
 };
 
+/// Thins a stream of frames to at most `max_rate_hz` by their sensor time (utime): a frame is
+/// kept if it is the first, or at least 0.9 of a period after the last one kept, so a 30 Hz
+/// camera thinned to 10 Hz keeps every third frame despite jitter in the stamps. A frame
+/// stamped before the last one kept (a restarted source) is kept and starts again from it.
+/// `max_rate_hz` 0 keeps every frame. For the radio link: SLAM and the mapper need only
+/// the frames that become keyframes, and lossless depth at 30 Hz does not fit 20 Mbit/s.
+class FrameRateLimit {
+ public:
+  explicit FrameRateLimit(double max_rate_hz);  ///< throws std::invalid_argument if < 0 or not finite
+  bool keep(int64_t utime);
+  void reset() { last_kept_ = -1; }
+
+ private:
+  int64_t min_gap_us_ = 0;
+  int64_t last_kept_ = -1;
+};
+
 }  // namespace kestrel::codec

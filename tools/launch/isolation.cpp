@@ -88,6 +88,27 @@ IsolationMethod enter_private_network() {
   return IsolationMethod::kUserNetworkNamespace;
 }
 
+PrivateNetworkPair enter_private_network_pair() {
+  PrivateNetworkPair pair;
+  pair.method = enter_private_network();
+  pair.onboard_fd = ::open("/proc/self/ns/net", O_RDONLY | O_CLOEXEC);
+  if (pair.onboard_fd < 0) throw IsolationError("cannot open /proc/self/ns/net: " + errno_text());
+  // Inside the first namespace (and its user namespace, if one was needed) we may make more.
+  if (::unshare(CLONE_NEWNET) != 0) {
+    const std::string why = errno_text();
+    ::close(pair.onboard_fd);
+    throw IsolationError("cannot make the second private network namespace: " + why);
+  }
+  configure_loopback();
+  pair.offboard_fd = ::open("/proc/self/ns/net", O_RDONLY | O_CLOEXEC);
+  if (pair.offboard_fd < 0) {
+    const std::string why = errno_text();
+    ::close(pair.onboard_fd);
+    throw IsolationError("cannot open /proc/self/ns/net: " + why);
+  }
+  return pair;
+}
+
 std::string to_string(IsolationMethod method) {
   return method == IsolationMethod::kNetworkNamespace ? "network namespace"
                                                       : "user + network namespace";

@@ -30,6 +30,17 @@ enum class IsolationMethod {
 /// network namespace only applies to the calling thread). Throws IsolationError.
 IsolationMethod enter_private_network();
 
+/// Two private networks, each as enter_private_network() makes one, for the two sides of
+/// `kestrel launch --link`: the first (onboard) and the second (offboard) as open fds of
+/// their namespaces (close-on-exec; another process reaches one as /proc/PID/fd/FD). The
+/// calling process is left in the second. Same preconditions; throws IsolationError.
+struct PrivateNetworkPair {
+  int onboard_fd = -1;
+  int offboard_fd = -1;
+  IsolationMethod method = IsolationMethod::kNetworkNamespace;
+};
+PrivateNetworkPair enter_private_network_pair();
+
 /// "network namespace" or "user + network namespace".
 std::string to_string(IsolationMethod method);
 

@@ -5,11 +5,17 @@
 // that process ends.
 
 #include <fmt/chrono.h>
+#include <poll.h>
+#include <sched.h>
 #include <signal.h>
 #include <spdlog/spdlog.h>
 #include <unistd.h>
 
 #include <atomic>
+#include <cerrno>
+#include <cstring>
+#include <memory>
+#include <optional>
 #include <chrono>
 #include <ctime>
 #include <filesystem>
@@ -35,6 +41,9 @@ namespace fs = std::filesystem;
 using namespace kestrel::launch;
 using Clock = std::chrono::steady_clock;
 
+// Stands for the offboard namespace in the link's command until the launch has made it.
+const char* const kOffboardNetns = "{offboard_netns}";
+
 struct Options {
   std::string set;
   std::string sets_file = KESTREL_DEFAULT_PROCESS_SETS;
@@ -42,6 +51,9 @@ struct Options {
   std::string source;
   std::string lcm_url;
   bool isolated = false;
+  bool link = false;
+  std::string link_options;
+  double link_frame_rate = 10;
   bool restart = false;
   int max_restarts = 5;
   std::string log_dir;
@@ -71,6 +83,14 @@ int launch(const Options& o) {
   } catch (const kestrel::InputError& e) {  // a name on the command line, not in the file: usage
     throw CLI::ValidationError("--only/--without", e.what());
   }
+  if (o.link) {
+    // The link first, so that it hears the first messages; the codec onboard, so that frames
+    // cross compressed (the link carries CAMERA_RGBD_Z up as CAMERA_RGBD).
+    if (o.set != "all") throw CLI::ValidationError("--link", "joins onboard and offboard: use it with the set all");
+    std::vector<std::string> link_argv = {"link", "--offboard-netns", kOffboardNetns, "--stats", "{log_dir}/link.json"};
+    for (auto& a : split_command(o.link_options)) link_argv.push_back(std::move(a));
+    set.insert(set.begin(), {{"link", link_argv, "link"}, {"rgbd-codec", {"rgbd-codec", "--max-rate", fmt::format("{:g}", o.link_frame_rate)}, "onboard"}});
+  }
   if (!o.source.empty()) {
     set.push_back({"source", split_command(o.source), "source"});
   }
@@ -88,7 +108,17 @@ int launch(const Options& o) {
   }
 
   // Before any thread exists: a network namespace applies to the calling thread only.
-  if (o.isolated) {
+  std::optional<PrivateNetworkPair> sides;
+  if (o.link) {
+    try {
+      sides = enter_private_network_pair();
+      spdlog::info("private networks: onboard and offboard, each a {}, joined by kestrel-link",
+                   to_string(sides->method));
+    } catch (const IsolationError& e) {
+      spdlog::error("{}", e.what());
+      return kestrel::kExitUnavailable;
+    }
+  } else if (o.isolated) {
     try {
       spdlog::info("private network: {}", to_string(enter_private_network()));
     } catch (const IsolationError& e) {
@@ -97,10 +127,22 @@ int launch(const Options& o) {
     }
   }
   const std::string url = kestrel::transport::resolve_lcm_url(o.lcm_url);
-  lcm::LCM lcm(url);
-  if (!lcm.good()) {
-    spdlog::error("cannot open LCM at {}", url);
-    return kestrel::kExitUnavailable;
+  HealthBoard board;
+  HeartbeatListener listener{&board};
+  // One LCM per side with --link (each opens its sockets in the namespace it is made and
+  // subscribed in), else one.
+  std::vector<std::unique_ptr<lcm::LCM>> lcms;
+  for (int netns : sides ? std::vector<int>{sides->onboard_fd, sides->offboard_fd} : std::vector<int>{-1}) {
+    if (netns >= 0 && ::setns(netns, CLONE_NEWNET) != 0) {
+      spdlog::error("cannot enter a side's network namespace: {}", std::strerror(errno));
+      return kestrel::kExitUnavailable;
+    }
+    lcms.push_back(std::make_unique<lcm::LCM>(url));
+    if (!lcms.back()->good()) {
+      spdlog::error("cannot open LCM at {}", url);
+      return kestrel::kExitUnavailable;
+    }
+    lcms.back()->subscribe(kestrel::channel::kProcessStatus, &HeartbeatListener::handle, &listener);
   }
 
   SupervisorOptions so;
@@ -114,10 +156,17 @@ int launch(const Options& o) {
   const fs::path run_dir = so.log_dir / fmt::format("run-{:%Y%m%dT%H%M%S}-{}", fmt::gmtime(std::time(nullptr)), ::getpid());
   if (names_run_dir(set)) fs::create_directories(run_dir);
   set = with_run_dir(std::move(set), run_dir);
+  if (sides) {
+    so.netns_by_side = {{"onboard", sides->onboard_fd}, {"source", sides->onboard_fd},
+                        {"link", sides->onboard_fd}, {"offboard", sides->offboard_fd}};
+    const std::string offboard = "/proc/" + std::to_string(::getpid()) + "/fd/" + std::to_string(sides->offboard_fd);
+    for (auto& p : set)
+      for (auto& a : p.argv) {
+        if (a == kOffboardNetns) a = offboard;
+        if (a.rfind("{log_dir}", 0) == 0) a = (so.log_dir / a.substr(10)).string();
+      }
+  }
   Supervisor supervisor(set, executables, so);
-  HealthBoard board;
-  HeartbeatListener listener{&board};
-  lcm.subscribe(kestrel::channel::kProcessStatus, &HeartbeatListener::handle, &listener);
 
   const auto& interrupted = kestrel::catch_interrupts();
 
@@ -131,7 +180,7 @@ int launch(const Options& o) {
       switch (e.kind) {
         case ChildEvent::kStarted:
           spdlog::info("started {} (pid {})", e.name, e.pid);
-          board.started(e.name, e.pid, Clock::now(), /*heartbeats=*/e.name != "source");
+          board.started(e.name, e.pid, Clock::now(), /*heartbeats=*/e.name != "source" && e.name != "link");
           break;
         case ChildEvent::kEnded:
           board.ended(e.name, e.ending.description, e.ending.at, e.ending.cpu_s);
@@ -162,7 +211,11 @@ int launch(const Options& o) {
                                         std::chrono::duration<double>(o.status_period_s));
   bool announced_healthy = false;
   while (!interrupted && !source_ending) {
-    lcm.handleTimeout(100);
+    std::vector<pollfd> fds;
+    for (const auto& l : lcms) fds.push_back({l->getFileno(), POLLIN, 0});
+    if (::poll(fds.data(), fds.size(), 100) > 0)
+      for (size_t i = 0; i < fds.size(); ++i)
+        if (fds[i].revents & POLLIN) lcms[i]->handle();
     report(supervisor.poll(), false);
     const auto now = Clock::now();
     if (!announced_healthy && board.all_running(now)) {
@@ -216,6 +269,15 @@ int main(int argc, char** argv) {
                                          "(default: $LCM_DEFAULT_URL or kestrel's)");
   app.add_flag("--isolated", o.isolated,
                "Run the set in a private network namespace with multicast on loopback");
+  app.add_flag("--link", o.link,
+               "Run onboard (with the source) and offboard in two private networks joined by "
+               "kestrel-link, an emulated Wi-Fi link; frames cross compressed (rgbd-codec)");
+  app.add_option("--link-options", o.link_options,
+                 "Options of kestrel-link, e.g. \"--loss 10 --delay 30 --jitter 10 --rate 20 --seed 1\"");
+  app.add_option("--link-frame-rate", o.link_frame_rate,
+                 "--link: frames per second that cross, compressed (rgbd-codec --max-rate; 0: all)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   app.add_flag("--restart", o.restart, "Restart a process that dies");
   app.add_option("--max-restarts", o.max_restarts, "Give up on a process after this many restarts")
       ->capture_default_str()

@@ -1,6 +1,7 @@
 #include "tools/launch/supervisor.h"
 
 #include <fcntl.h>
+#include <sched.h>
 #include <signal.h>
 #include <cstring>
 #include <sys/prctl.h>
@@ -94,6 +95,8 @@ ChildEvent Supervisor::start(Child& child) {
   const int log_fd = ::open(child.log.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
   if (log_fd < 0) throw std::runtime_error(child.log.string() + ": " + std::strerror(errno));
   const pid_t launcher = ::getpid();
+  const auto netns = options_.netns_by_side.find(child.spec.side);
+  const int netns_fd = netns == options_.netns_by_side.end() ? -1 : netns->second;
 
   const pid_t pid = ::fork();
   if (pid < 0) {
@@ -117,6 +120,11 @@ ChildEvent Supervisor::start(Child& child) {
     if (::getppid() != launcher) ::_exit(kExitFailure);
     ::dup2(log_fd, STDOUT_FILENO);
     ::dup2(log_fd, STDERR_FILENO);
+    if (netns_fd >= 0 && ::setns(netns_fd, CLONE_NEWNET) != 0) {
+      const char msg[] = "kestrel launch: cannot enter the side's network namespace\n";
+      [[maybe_unused]] auto n = ::write(STDERR_FILENO, msg, sizeof msg - 1);
+      ::_exit(kExitUnavailable);
+    }
     const int devnull = ::open("/dev/null", O_RDONLY);
     if (devnull >= 0) ::dup2(devnull, STDIN_FILENO);
     ::execve(argv[0], argv.data(), envp.data());

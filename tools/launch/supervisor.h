@@ -15,6 +15,7 @@
 
 #include <chrono>
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -30,6 +31,10 @@ struct SupervisorOptions {
   double restart_delay_s = 1.0;
   int max_restarts = 5;
   double stop_timeout_s = 5.0;
+  /// A network namespace (an open fd of one, /proc/PID/ns/net) per side: a child of that side
+  /// enters it before exec (`kestrel launch --link`); a side not named here runs in the
+  /// launcher's namespace. A child that cannot enter its namespace exits 4 at once.
+  std::map<std::string, int> netns_by_side;
 };
 
 /// How a process ended: "exited with status 3", "killed by SIGSEGV".

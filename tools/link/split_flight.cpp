@@ -1,0 +1,155 @@
+#include "tools/link/split_flight.h"
+
+#include <fmt/format.h>
+
+#include <Eigen/Core>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <regex>
+#include <sstream>
+#include <vector>
+
+#include "common/transport/channels.h"
+#include "common/transport/convert.h"
+#include "common/transport/log_file.h"
+#include "common/transport/message.h"
+#include "kestrel/ground_truth_t.hpp"
+#include "kestrel/plan_t.hpp"
+
+namespace kestrel::link {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string quoted(const std::string& s) {
+  std::string out = "'";
+  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
+}
+
+std::string read_text(const fs::path& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// The last number that `pattern`'s first group matches in `text`, or -1.
+int last_match(const std::string& text, const std::string& pattern) {
+  const std::regex re(pattern);
+  int value = -1;
+  for (auto it = std::sregex_iterator(text.begin(), text.end(), re); it != std::sregex_iterator(); ++it)
+    value = std::stoi((*it)[1].str());
+  return value;
+}
+
+int64_t read_mark_us(const fs::path& path) {  // `date +%s%N` in microseconds, or -1
+  std::ifstream in(path);
+  long long ns = -1;
+  if (!(in >> ns)) return -1;
+  return ns / 1000;
+}
+
+}  // namespace
+
+SplitFlightResult fly_split(const SplitFlightOptions& o) {
+  SplitFlightResult r;
+  fs::create_directories(o.out_dir);
+  const fs::path out = fs::absolute(o.out_dir);
+  const Eigen::Vector3d start(8.0, 3.5, 1.3);  // the room's take-off pose
+  const Eigen::Vector3d back(9.0, 3.5, 1.3);   // where it returns: 1 m ahead of the start, so mapped
+  {
+    std::ofstream sets(out / "sets.yaml");
+    sets << "# the split flight's processes (tools/link/split_flight.h)\n"
+            "processes:\n"
+            "  - {name: vo, command: vo, side: onboard}\n"
+            "  - {name: estimator, command: \"estimator --await-world 1 --init-position 8,3.5,1.3\", side: onboard}\n"
+            "  - {name: follow, command: follow, side: onboard}\n"
+            "  - {name: slam, command: slam, side: offboard}\n"
+            "  - {name: mapper, command: \"mapper --publish-period 1\", side: offboard}\n"
+            "  - {name: planner, command: \"planner --height 1.3 --sensor kinect\", side: offboard}\n";
+  }
+  const auto bin = [&](const char* tool) { return quoted((o.bin_dir / (std::string("kestrel-") + tool)).string()); };
+  const std::string link_options = fmt::format("--loss {} --delay {} --jitter {} --rate {} --seed {}", o.loss_percent,
+                                               o.delay_ms, o.jitter_ms, o.rate_mbit, o.seed);
+  const std::string go = "--wait --arrive-radius 0.1 --timeout 25 --goal ";
+  const std::string script = fmt::format(
+      "cd {out}; rm -f status.txt mark_a mark_b; "
+      "{launch} all --link --link-options {link} --sets sets.yaml --status-period 0 --log-dir logs "
+      "--source {source} > launch.txt 2>&1 & P=$!; "
+      "pid_of() {{ sed -n \"s/.*started $1 (pid \\([0-9]*\\)).*/\\1/p\" launch.txt | head -n 1; }}; "
+      "for i in $(seq 300); do V=$(pid_of vo); M=$(pid_of mapper); [ -n \"$V\" ] && [ -n \"$M\" ] && break; sleep 0.1; done; "
+      "nsenter --net=/proc/$V/ns/net lcm-logger -q -c 'GROUND_TRUTH|STATE|PLAN|SLAM_CORRECTION' onboard.lcmlog & L=$!; "
+      "sleep {hover}; date +%s%N > mark_a; "
+      "nsenter --net=/proc/$M/ns/net {goto_} {go}9.5 3.5 1.3 0 > goto_out.txt 2>&1; G1=$?; "
+      "nsenter --net=/proc/$M/ns/net {goto_} {go}9 3.5 1.3 0 > goto_back.txt 2>&1; G2=$?; "
+      "date +%s%N > mark_b; wait $P; LAUNCH=$?; sleep 0.3; kill -INT $L; wait $L; "
+      "echo \"$LAUNCH $G1 $G2\" > status.txt",
+      fmt::arg("out", quoted(out.string())), fmt::arg("launch", bin("launch")), fmt::arg("link", quoted(link_options)),
+      fmt::arg("source", quoted(fmt::format("sim --world room --flight vehicle --duration {} --seed {} -q --rgb-encoding raw --depth-encoding raw",
+                                            o.duration_s, o.seed))),
+      fmt::arg("hover", o.hover_s), fmt::arg("goto_", bin("goto")), fmt::arg("go", go));
+  [[maybe_unused]] const int ignored = std::system(("sh -c " + quoted(script)).c_str());
+
+  auto problem = [&](const std::string& what) { r.problems += what + "\n"; };
+  {
+    std::ifstream status(out / "status.txt");
+    if (!(status >> r.launch_exit >> r.goto_out_exit >> r.goto_back_exit)) problem("no status.txt: the flight's script failed");
+  }
+  const int64_t mark_a = read_mark_us(out / "mark_a"), mark_b = read_mark_us(out / "mark_b");
+  if (mark_a < 0 || mark_b < 0) problem("no time marks");
+
+  // The onboard log: truth while holding, corrections and plans as they arrived.
+  int64_t first_truth = -1;
+  double sum = 0.0;
+  try {
+    transport::LogReader log((out / "onboard.lcmlog").string());
+    while (auto e = log.next()) {
+      const auto& data = e->data;
+      if (e->channel == channel::kGroundTruth) {
+        if (first_truth < 0) first_truth = e->timestamp;
+        const bool hold_start = e->timestamp >= first_truth + 3'000'000 && e->timestamp < mark_a;
+        const bool hold_back = e->timestamp >= mark_b + 2'000'000;
+        if (!hold_start && !hold_back) continue;
+        const auto m = transport::decode_message<kestrel::ground_truth_t>(data.data(), data.size(), "GROUND_TRUTH");
+        const double d =
+            (transport::from_message(m.T_world_frame, "GROUND_TRUTH").translation() - (hold_start ? start : back)).norm();
+        sum += d;
+        r.deviation_max_m = std::max(r.deviation_max_m, d);
+        ++r.hover_samples;
+      } else if (e->channel == channel::kSlamCorrection) {
+        ++r.corrections_received;
+      } else if (e->channel == channel::kPlan) {
+        r.plans_answered +=
+            transport::decode_message<kestrel::plan_t>(data.data(), data.size(), "PLAN").status == kestrel::plan_t::STATUS_OK;
+      }
+    }
+  } catch (const std::exception& e) {
+    problem(std::string("onboard log: ") + e.what());
+  }
+  if (r.hover_samples > 0) r.deviation_mean_m = sum / r.hover_samples;
+
+  const fs::path logs = out / "logs";
+  r.corrections_applied = last_match(read_text(logs / "estimator.log"), R"(corrections (\d+) applied)");
+  r.mapper_keyframes = last_match(read_text(logs / "mapper.log"), R"(\d+ frames \((\d+) inserted)");
+  r.slam_keyframes = last_match(read_text(logs / "slam.log"), R"((\d+) keyframes, \d+ loop closures)");
+  if (r.corrections_applied < 0) problem("no estimator counts in logs/estimator.log");
+  if (r.mapper_keyframes < 0) problem("no mapper counts in logs/mapper.log");
+  try {
+    const auto j = nlohmann::json::parse(read_text(logs / "link.json"));
+    for (const char* way : {"up", "down"}) {
+      r.datagrams_offered += j.at(way).at("offered").get<int64_t>();
+      r.datagrams_lost += j.at(way).at("lost").get<int64_t>();
+      r.datagrams_queue_full += j.at(way).at("queue_full").get<int64_t>();
+    }
+    const double seconds = j.at("seconds").get<double>();
+    if (seconds > 0) r.up_mbit_s = j.at("up").at("bytes_offered").get<double>() * 8e-6 / seconds;
+  } catch (const std::exception& e) {
+    problem(std::string("logs/link.json: ") + e.what());
+  }
+  return r;
+}
+
+}  // namespace kestrel::link
