@@ -5,17 +5,17 @@
 // (kestrel estimate's) on the same log. This is the whole process path: LCM decode, the
 // message conversions, Node's rejection of bad messages, acks and RESET. An IMU without a gyro
 // runs the visual-only estimator, or, in --mode imu, is refused with the heartbeat saying why.
+// The processes run under a LiveSystem (test/support/live_system.h), which hears their
+// heartbeats itself: a test waits for the heartbeat it needs rather than for a fixed time.
 
 #include <gtest/gtest.h>
 
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <cmath>
 #include <sstream>
 
 #include "common/transport/channels.h"
-#include "common/transport/lcm_url.h"
 #include "common/transport/log_file.h"
 #include "common/transport/message.h"
 #include "estimator/log_run.h"
@@ -23,27 +23,27 @@
 #include "kestrel/process_status_t.hpp"
 #include "kestrel/state_t.hpp"
 #include "test/estimator/synthetic_log.h"
+#include "test/support/live_system.h"
 #include "test/support/test_support.h"
 
 namespace kestrel::estimator {
 namespace {
 
+using kestrel::test::LiveSystem;
+
 TEST(EstimatorProcess, LockStepReplayIsDeterministicResetsAndEqualsTheLibrary) {
-  if (!kestrel::test::can_isolate_network()) KESTREL_SKIP_ENVIRONMENT() << "no network namespace available";
+  if (const std::string why = LiveSystem::isolate(); !why.empty())
+    KESTREL_SKIP_ENVIRONMENT() << "no network namespace available: " << why;
   if (!std::filesystem::exists(kestrel::test::tool("replay")))
     KESTREL_SKIP_ENVIRONMENT() << kestrel::test::tool("replay") << " is not built (tools/replay)";
   kestrel::test::TempDir dir;
+  LiveSystem live(dir.path() / "live", {});
   const std::string in = (dir / "in.lcmlog").string();
   test::write_log(in, 3.0, true);
-  const std::string estimator = kestrel::test::tool("estimator").string();
-  const std::string replay = kestrel::test::tool("replay").string();
-  const std::string script =
-      estimator + " --init-yaw 0.3 & P=$!; " + replay + " " + in + " --expect estimator --record " +
-      (dir / "a.lcmlog").string() + " || exit 11; " + replay + " " + in +
-      " --expect estimator --record " + (dir / "b.lcmlog").string() +
-      " || exit 12; kill -INT $P; wait $P";
-  const auto r = kestrel::test::run_isolated(script, 240.0);
-  ASSERT_EQ(r.exit_code, 0) << r.err;
+  live.start("estimator", {kestrel::test::tool("estimator").string(), "--init-yaw", "0.3"});
+  ASSERT_EQ(live.replay(in, "estimator", dir / "a.lcmlog", {}, 240.0), 0) << live.output("replay");
+  ASSERT_EQ(live.replay(in, "estimator", dir / "b.lcmlog", {}, 240.0), 0) << live.output("replay");
+  ASSERT_EQ(live.stop("estimator"), 0) << live.output("estimator");
   const std::string a = kestrel::test::read_file(dir / "a.lcmlog");
   ASSERT_FALSE(a.empty());
   EXPECT_EQ(a, kestrel::test::read_file(dir / "b.lcmlog")) << "the second replay (after RESET) must publish the same states";
@@ -74,10 +74,10 @@ TEST(EstimatorProcess, LockStepReplayIsDeterministicResetsAndEqualsTheLibrary) {
 // With --mode imu every sample is refused, no STATE is published, and the heartbeat says why
 // instead of "initialising".
 TEST(EstimatorProcess, AnImuWithoutAGyroRunsVisualOnlyOrIsRefusedInImuModeAndTheHealthSaysSo) {
-  if (!kestrel::test::can_isolate_network()) KESTREL_SKIP_ENVIRONMENT() << "no network namespace available";
+  if (const std::string why = LiveSystem::isolate(); !why.empty())
+    KESTREL_SKIP_ENVIRONMENT() << "no network namespace available: " << why;
   if (!std::filesystem::exists(kestrel::test::tool("replay")))
     KESTREL_SKIP_ENVIRONMENT() << kestrel::test::tool("replay") << " is not built (tools/replay)";
-  if (std::system("command -v lcm-logger > /dev/null 2>&1") != 0) KESTREL_SKIP_ENVIRONMENT() << "lcm-logger not found";
   kestrel::test::TempDir dir;
   const std::string in = (dir / "in.lcmlog").string();
   constexpr int kUpdates = 20;
@@ -101,18 +101,34 @@ TEST(EstimatorProcess, AnImuWithoutAGyroRunsVisualOnlyOrIsRefusedInImuModeAndThe
       log.write_message(channel::kVoUpdate, u.utime, test::vo_message(u));
     }
   }
-  const std::string logged = (dir / "heartbeats.lcmlog").string();
+  // The health is announced when it changes and repeated every heartbeat period (1 s): a
+  // datagram lost on a loaded machine is made good by the next period's, so each estimator
+  // runs until a heartbeat has said what the checks below look for.
+  LiveSystem live(dir.path() / "live", {});
   const std::string estimator = kestrel::test::tool("estimator").string();
-  const std::string replay = kestrel::test::tool("replay").string();
-  const std::string script =
-      "lcm-logger -q --lcm-url='" + std::string(transport::kDefaultLcmUrl) + "' -f " + logged +
-      " & L=$!; " + kestrel::test::wait_for_lcm_listener_sh() + "; " + estimator + " -q & P=$!; " + replay + " " + in +
-      " --expect estimator --record " + (dir / "visual.lcmlog").string() +
-      " >/dev/null || exit 11; sleep 1.2; kill -INT $P; wait $P; " + estimator + " -q --mode imu & P=$!; " +
-      replay + " " + in + " --expect estimator --record " + (dir / "imu.lcmlog").string() +
-      " >/dev/null; R=$?; sleep 1.2; kill -INT $P $L; wait $P; wait $L; exit $R";
-  const auto r = kestrel::test::run_isolated(script, 120.0);
-  ASSERT_EQ(r.exit_code, 0) << r.err;
+  live.start("estimator", {estimator, "-q"});
+  ASSERT_EQ(live.replay(in, "estimator", dir / "visual.lcmlog", {}, 120.0), 0) << live.output("replay");
+  live.wait_for<kestrel::process_status_t>(
+      channel::kProcessStatus,
+      [](const kestrel::process_status_t& s) {
+        return s.name == "estimator" && s.state == kestrel::process_status_t::STATE_RUNNING &&
+               s.message.find("visual only") != std::string::npos;
+      },
+      20.0, "a RUNNING heartbeat of the estimator saying 'visual only'");
+  live.stop("estimator");
+  const size_t second = live.received();
+  live.start("estimator", {estimator, "-q", "--mode", "imu"});
+  const int replayed = live.replay(in, "estimator", dir / "imu.lcmlog", {}, 120.0);
+  live.wait_for<kestrel::process_status_t>(
+      channel::kProcessStatus,
+      [](const kestrel::process_status_t& s) {
+        return s.name == "estimator" && s.state == kestrel::process_status_t::STATE_DEGRADED &&
+               s.message.find("lack the gyro") != std::string::npos;
+      },
+      20.0, "a DEGRADED heartbeat of the estimator (--mode imu) saying the samples lack the gyro", second);
+  live.stop("estimator");
+  live.finish();
+  ASSERT_EQ(replayed, 0) << live.output("replay");
 
   const auto states = transport::read_messages<kestrel::state_t>((dir / "visual.lcmlog").string(), channel::kState);
   ASSERT_EQ(states.size(), static_cast<size_t>(kUpdates));
@@ -131,12 +147,10 @@ TEST(EstimatorProcess, AnImuWithoutAGyroRunsVisualOnlyOrIsRefusedInImuModeAndThe
   EXPECT_NEAR(p[2], 0.0, 1e-6);
 
   EXPECT_TRUE(transport::read_messages<kestrel::state_t>((dir / "imu.lcmlog").string(), channel::kState).empty());
-  // The health is announced when it changes and repeated every heartbeat period (1 s): a
-  // datagram lost on a loaded machine is made good by the next period's, which the 1.2 s
-  // before each stop leaves room for.
   bool ran_visual = false;
   std::string last_degraded, heard;
-  for (const auto& s : transport::read_messages<kestrel::process_status_t>(logged, channel::kProcessStatus)) {
+  for (const auto& m : live.messages(channel::kProcessStatus)) {
+    const auto s = transport::decode_message<kestrel::process_status_t>(m.data.data(), m.data.size(), m.channel);
     if (s.name != "estimator") continue;
     heard += "\n  state " + std::to_string(s.state) + " '" + s.message + "'";
     if (s.state == kestrel::process_status_t::STATE_RUNNING && s.message.find("visual only") != std::string::npos)
@@ -151,10 +165,10 @@ TEST(EstimatorProcess, AnImuWithoutAGyroRunsVisualOnlyOrIsRefusedInImuModeAndThe
 // process refuses it, its heartbeat says why (DEGRADED, naming the accelerometer), and it
 // publishes exactly the states the library gives on the log without the spike.
 TEST(EstimatorProcess, AnImuSpikeIsRefusedWithTheHealthSayingWhyAndTheStatesAsWithoutIt) {
-  if (!kestrel::test::can_isolate_network()) KESTREL_SKIP_ENVIRONMENT() << "no network namespace available";
+  if (const std::string why = LiveSystem::isolate(); !why.empty())
+    KESTREL_SKIP_ENVIRONMENT() << "no network namespace available: " << why;
   if (!std::filesystem::exists(kestrel::test::tool("replay")))
     KESTREL_SKIP_ENVIRONMENT() << kestrel::test::tool("replay") << " is not built (tools/replay)";
-  if (std::system("command -v lcm-logger > /dev/null 2>&1") != 0) KESTREL_SKIP_ENVIRONMENT() << "lcm-logger not found";
   kestrel::test::TempDir dir;
   const std::string clean = (dir / "clean.lcmlog").string(), spiked = (dir / "spiked.lcmlog").string();
   const test::SyntheticLog written = test::write_log(clean, 3.0, false);
@@ -172,14 +186,18 @@ TEST(EstimatorProcess, AnImuSpikeIsRefusedWithTheHealthSayingWhyAndTheStatesAsWi
     }
     out.close();
   }
-  const std::string logged = (dir / "heartbeats.lcmlog").string();
-  const std::string script =
-      "lcm-logger -q --lcm-url='" + std::string(transport::kDefaultLcmUrl) + "' -f " + logged +
-      " & L=$!; " + kestrel::test::wait_for_lcm_listener_sh() + "; " + kestrel::test::tool("estimator").string() +
-      " -q & P=$!; " + kestrel::test::tool("replay").string() + " " + spiked + " --expect estimator --record " +
-      (dir / "out.lcmlog").string() + " >/dev/null; R=$?; sleep 1.2; kill -INT $P $L; wait $P; wait $L; exit $R";
-  const auto r = kestrel::test::run_isolated(script, 240.0);
-  ASSERT_EQ(r.exit_code, 0) << r.err;
+  LiveSystem live(dir.path() / "live", {});
+  live.start("estimator", {kestrel::test::tool("estimator").string(), "-q"});
+  const int replayed = live.replay(spiked, "estimator", dir / "out.lcmlog", {}, 240.0);
+  // The heartbeats after the refusal carry the count: the estimator runs until one has come.
+  live.wait_for<kestrel::process_status_t>(
+      channel::kProcessStatus,
+      [](const kestrel::process_status_t& s) { return s.name == "estimator" && s.messages_rejected >= 1; }, 20.0,
+      "a heartbeat of the estimator counting the refused spike");
+  live.stop("estimator");
+  live.finish();
+  ASSERT_EQ(replayed, 0) << live.output("replay");
+  const std::string said = live.output("estimator");
 
   const LogRunResult expected = run_log(clean, EstimatorOptions{});
   const auto states = transport::read_messages<kestrel::state_t>((dir / "out.lcmlog").string(), channel::kState);
@@ -194,18 +212,19 @@ TEST(EstimatorProcess, AnImuSpikeIsRefusedWithTheHealthSayingWhyAndTheStatesAsWi
   std::string heard;
   bool said_why = false;
   int64_t rejected = 0;
-  for (const auto& s : transport::read_messages<kestrel::process_status_t>(logged, channel::kProcessStatus)) {
+  for (const auto& m : live.messages(channel::kProcessStatus)) {
+    const auto s = transport::decode_message<kestrel::process_status_t>(m.data.data(), m.data.size(), m.channel);
     if (s.name != "estimator") continue;
     heard += "\n  state " + std::to_string(s.state) + " '" + s.message + "' rejected " + std::to_string(s.messages_rejected);
     said_why = said_why || (s.state == kestrel::process_status_t::STATE_DEGRADED &&
                             s.message.find("accelerometer") != std::string::npos);
     rejected = std::max<int64_t>(rejected, s.messages_rejected);
   }
-  const bool logged_why = r.err.find("rejected message #1 on IMU") != std::string::npos &&
-                          r.err.find("accelerometer") != std::string::npos;
+  const bool logged_why = said.find("rejected message #1 on IMU") != std::string::npos &&
+                          said.find("accelerometer") != std::string::npos;
   EXPECT_TRUE(said_why || (rejected == 1 && logged_why))
       << "no DEGRADED heartbeat naming the accelerometer (nor a count of 1 and the reason in the log); heard:"
-      << heard << "\nthe process said:\n" << r.err;
+      << heard << "\nthe process said:\n" << said;
   EXPECT_LE(rejected, 1) << "only the spike is refused; heard:" << heard;
 }
 

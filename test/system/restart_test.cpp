@@ -15,12 +15,18 @@
 // Live and timed: the simulator's recording is replayed at its own pace (lock-step replay
 // would stall on the dead process), so the figures vary a little from run to run; the bounds
 // leave room for that and still fail on a filter left in a world of its own.
+//
+// The processes run under a LiveSystem (test/support/live_system.h): the test hears their
+// messages itself, kills a process when the flight has reached the moment (GROUND_TRUTH's
+// time, a goto's second request, the new filter's first state), by the pid its heartbeat
+// gives, and never sleeps.
 
 #include <gtest/gtest.h>
 
 #include <Eigen/Cholesky>
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <csignal>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -39,10 +45,13 @@
 #include "common/transport/message.h"
 #include "kestrel/ground_truth_t.hpp"
 #include "kestrel/octomap_t.hpp"
+#include "kestrel/plan_request_t.hpp"
 #include "kestrel/plan_t.hpp"
+#include "kestrel/process_status_t.hpp"
 #include "kestrel/slam_graph_t.hpp"
 #include "kestrel/state_t.hpp"
 #include "kestrel/vo_update_t.hpp"
+#include "test/support/live_system.h"
 #include "test/support/test_support.h"
 #include "metrics/alignment.h"
 
@@ -77,37 +86,48 @@ std::optional<Eigen::Vector3d> true_camera_position(const std::map<int64_t, Eige
 }
 
 // Flies the room's figure-eight (16 s, replayed at its own pace) through `processes` under
-// `kestrel launch --restart` and kills `victim` 8 s after the set started (about 7 s into the
-// flight; by the pid the launcher reports, since other tests' processes may run beside it).
-// `channels` are recorded in dir/live.lcmlog; the launcher's output is dir/launch.txt, the
+// `kestrel launch --restart` and kills `victim` once the flight's ground truth has reached 7 s
+// (by the pid of the victim's heartbeat, since other tests' processes may run beside it).
+// `channels` are recorded in dir/live.lcmlog; the launcher's output is dir/launch.log, the
 // processes' logs are in dir/logs.
 void fly_and_kill(const test::TempDir& dir, const std::string& processes, const std::string& victim,
-                  const std::string& channels) {
+                  const std::vector<std::string>& channels) {
   const std::string source = (dir / "source.lcmlog").string();
   const auto sim = test::run({test::tool("sim").string(), "--world", "room", "--flight", "figure8", "--duration",
                               "16", "--seed", "1", "--log", source, "-q"},
                              300.0);
   ASSERT_EQ(sim.exit_code, 0) << sim.err;
-  const std::string launch_out = test::quoted((dir / "launch.txt").string());
-  const std::string script =
-      "lcm-logger -q -c '" + channels + "' -f " + test::quoted((dir / "live.lcmlog").string()) + " & L=$!; " +
-      test::wait_for_lcm_listener_sh() + " && (" + test::quoted(test::tool("launch").string()) + " all --only " +
-      processes + " --restart --status-period 0 --log-dir " + test::quoted((dir / "logs").string()) +
-      " --source " + test::quoted("replay " + source + " --realtime") + " > " + launch_out +
-      " 2>&1 & P=$!; sleep 8; kill -KILL $(sed -n 's/.*started " + victim + " (pid \\([0-9]*\\)).*/\\1/p' " +
-      launch_out + " | head -n 1); wait $P); sleep 0.5; kill $L";
-  const auto r = test::run_isolated(script, 200.0);
-  ASSERT_EQ(r.exit_code, 0) << r.err;
-  const std::string launch = test::read_file(dir / "launch.txt");
+  const auto flight = transport::read_messages<kestrel::ground_truth_t>(source, channel::kGroundTruth);
+  ASSERT_FALSE(flight.empty());
+  const int64_t kill_at = flight.front().utime + 7'000'000;
+  std::vector<std::string> heard = channels;
+  if (std::find(heard.begin(), heard.end(), channel::kGroundTruth) == heard.end())
+    heard.push_back(channel::kGroundTruth);
+  {
+    test::LiveSystem live(dir.path(), {heard, dir / "live.lcmlog", channels});
+    live.start("launch", {test::tool("launch").string(), "all", "--only", processes, "--restart", "--status-period",
+                          "0", "--log-dir", (dir / "logs").string(), "--source", "replay " + source + " --realtime"});
+    const pid_t pid = live.wait_heartbeat(victim, 60.0);
+    ASSERT_NE(pid, 0) << live.output("launch");
+    ASSERT_TRUE(live.wait_for<kestrel::ground_truth_t>(
+        channel::kGroundTruth, [&](const kestrel::ground_truth_t& m) { return m.utime >= kill_at; }, 60.0,
+        "the flight's 7th second"))
+        << live.output("launch");
+    test::LiveSystem::kill_pid(pid, SIGKILL);
+    const int status = live.exit_status("launch", 200.0);
+    live.finish();
+    ASSERT_EQ(status, 0) << live.output("launch");
+  }
+  const std::string launch = test::read_file(dir / "launch.log");
   ASSERT_NE(launch.find("started " + victim + " ("), std::string::npos) << launch;
   ASSERT_NE(launch.find("killed by SIGKILL"), std::string::npos) << launch;
 }
 
 TEST(System, AnEstimatorKilledInFlightRestartsInTheMapsWorld) {
-  if (!test::can_isolate_network()) KESTREL_SKIP_ENVIRONMENT() << "no network namespace available";
-  if (!std::filesystem::exists("/usr/bin/lcm-logger")) KESTREL_SKIP_ENVIRONMENT() << "lcm-logger is not installed";
+  if (const std::string why = test::LiveSystem::isolate(); !why.empty())
+    KESTREL_SKIP_ENVIRONMENT() << "no network namespace available: " << why;
   test::TempDir dir;
-  ASSERT_NO_FATAL_FAILURE(fly_and_kill(dir, "vo,estimator,slam", "estimator", "STATE|GROUND_TRUTH"));
+  ASSERT_NO_FATAL_FAILURE(fly_and_kill(dir, "vo,estimator,slam", "estimator", {"STATE", "GROUND_TRUTH"}));
   const std::string live = (dir / "live.lcmlog").string();
   const std::string estimator = test::read_file(dir / "logs" / "estimator.log");
   const std::string slam = test::read_file(dir / "logs" / "slam.log");
@@ -159,10 +179,10 @@ TEST(System, AnEstimatorKilledInFlightRestartsInTheMapsWorld) {
 }
 
 TEST(System, ASlamKilledInFlightStartsANewSessionInTheSameWorldAndTheMapKeepsBoth) {
-  if (!test::can_isolate_network()) KESTREL_SKIP_ENVIRONMENT() << "no network namespace available";
-  if (!std::filesystem::exists("/usr/bin/lcm-logger")) KESTREL_SKIP_ENVIRONMENT() << "lcm-logger is not installed";
+  if (const std::string why = test::LiveSystem::isolate(); !why.empty())
+    KESTREL_SKIP_ENVIRONMENT() << "no network namespace available: " << why;
   test::TempDir dir;
-  ASSERT_NO_FATAL_FAILURE(fly_and_kill(dir, "vo,estimator,slam,mapper", "slam", "GROUND_TRUTH|SLAM_GRAPH|VO_UPDATE"));
+  ASSERT_NO_FATAL_FAILURE(fly_and_kill(dir, "vo,estimator,slam,mapper", "slam", {"GROUND_TRUTH", "SLAM_GRAPH", "VO_UPDATE"}));
   const std::string live = (dir / "live.lcmlog").string();
   const std::string mapper = test::read_file(dir / "logs" / "mapper.log");
 
@@ -233,10 +253,10 @@ TEST(System, ASlamKilledInFlightStartsANewSessionInTheSameWorldAndTheMapKeepsBot
 // the map it had at once and carries on adding SLAM's keyframes; only those SLAM made while it
 // was down are missing. Without the journal it would start from nothing.
 TEST(System, AMapperKilledInFlightComesBackWithItsMapFromTheJournal) {
-  if (!test::can_isolate_network()) KESTREL_SKIP_ENVIRONMENT() << "no network namespace available";
-  if (!std::filesystem::exists("/usr/bin/lcm-logger")) KESTREL_SKIP_ENVIRONMENT() << "lcm-logger is not installed";
+  if (const std::string why = test::LiveSystem::isolate(); !why.empty())
+    KESTREL_SKIP_ENVIRONMENT() << "no network namespace available: " << why;
   test::TempDir dir;
-  ASSERT_NO_FATAL_FAILURE(fly_and_kill(dir, "vo,estimator,slam,mapper", "mapper", "SLAM_GRAPH|MAP_OCTOMAP"));
+  ASSERT_NO_FATAL_FAILURE(fly_and_kill(dir, "vo,estimator,slam,mapper", "mapper", {"SLAM_GRAPH", "MAP_OCTOMAP"}));
   const std::string mapper = test::read_file(dir / "logs" / "mapper.log");
 
   kestrel::slam_graph_t last_graph;
@@ -282,10 +302,10 @@ TEST(System, AMapperKilledInFlightComesBackWithItsMapFromTheJournal) {
 // world. (On this figure-eight the loop closures after the restart would also pull an
 // unbridged segment back; the bridge count says which one did it.)
 TEST(System, AVoKilledInFlightLeavesTheStateAndTheGraphInOneWorld) {
-  if (!test::can_isolate_network()) KESTREL_SKIP_ENVIRONMENT() << "no network namespace available";
-  if (!std::filesystem::exists("/usr/bin/lcm-logger")) KESTREL_SKIP_ENVIRONMENT() << "lcm-logger is not installed";
+  if (const std::string why = test::LiveSystem::isolate(); !why.empty())
+    KESTREL_SKIP_ENVIRONMENT() << "no network namespace available: " << why;
   test::TempDir dir;
-  ASSERT_NO_FATAL_FAILURE(fly_and_kill(dir, "vo,estimator,slam", "vo", "STATE|GROUND_TRUTH|SLAM_GRAPH|VO_UPDATE"));
+  ASSERT_NO_FATAL_FAILURE(fly_and_kill(dir, "vo,estimator,slam", "vo", {"STATE", "GROUND_TRUTH", "SLAM_GRAPH", "VO_UPDATE"}));
   const std::string slam = test::read_file(dir / "logs" / "slam.log");
   EXPECT_NE(slam.find("1 VO restarts bridged by the estimator"), std::string::npos) << slam;
 
@@ -394,33 +414,53 @@ TEST(System, AVoKilledInFlightLeavesTheStateAndTheGraphInOneWorld) {
 // again each second of frames. Before, goto waited out its timeout for an answer, and the new
 // planner answered "no map yet" for as long as the vehicle stood still, which was for ever.
 TEST(System, APlannerKilledWhileTheVehicleHoversPlansAgainOnceRestarted) {
-  if (!test::can_isolate_network()) KESTREL_SKIP_ENVIRONMENT() << "no network namespace available";
-  if (!std::filesystem::exists("/usr/bin/lcm-logger")) KESTREL_SKIP_ENVIRONMENT() << "lcm-logger is not installed";
+  if (const std::string why = test::LiveSystem::isolate(); !why.empty())
+    KESTREL_SKIP_ENVIRONMENT() << "no network namespace available: " << why;
   test::TempDir dir;
-  const auto bin = [](const char* name) { return test::quoted(test::tool(name).string()); };
-  const std::string out = test::quoted(dir.path().string());
-  const std::string planner = bin("planner") + " --height 1.3 --sensor kinect";
-  const std::string script =
-      "cd " + out + "; lcm-logger -q -c 'PLAN|MAP_OCTOMAP|GROUND_TRUTH' flight.lcmlog & L=$!; " +
-      bin("vo") + " -q & V=$!; " + bin("estimator") + " -q --init-position 8,3.5,1.3 & E=$!; " + bin("slam") +
-      " -q & S=$!; " + bin("mapper") + " --publish-period 1 > mapper.txt 2>&1 & M=$!; " + planner +
-      " > planner1.txt 2>&1 & P=$!; " + bin("follow") + " > follow.txt 2>&1 & F=$!; sleep 1; " + bin("sim") +
-      " -q --world room --flight vehicle --lockstep 5 --duration 30 > sim.txt 2>&1 & X=$!; "
-      "sleep 4; kill -KILL $P; " +
-      bin("goto") + " --goal 9.5 3.5 1.3 0 --wait --arrive-radius 0.1 --timeout 90 > goto.txt 2>&1 & G=$!; "
-      // The new planner once goto has given up on the first request (its resend is timed on
-      // STATE's sensor time, which under lock-step stands still while the dead planner is
-      // waited for).
-      "for i in $(seq 600); do grep -q 'no answer after' goto.txt && break; sleep 0.1; done; " + planner +
-      " > planner2.txt 2>&1 & Q=$!; "
-      "wait $X; SIM=$?; sleep 1; kill $G 2>/dev/null; wait $G; GOTO=$?; "
-      "kill -INT $V $E $S $M $Q $F $L; wait; echo \"$SIM $GOTO\" > status.txt";
-  const auto r = test::run_isolated(script, 300.0);
-  ASSERT_EQ(r.exit_code, 0) << r.err;
-  const std::string go = test::read_file(dir / "goto.txt");
-  EXPECT_EQ(test::read_file(dir / "status.txt"), "0 0\n")
-      << "sim, goto exit codes; goto said:\n" << go << "\nplanner said:\n" << test::read_file(dir / "planner2.txt")
-      << "\nsim said:\n" << test::read_file(dir / "sim.txt");
+  const auto bin = [](const char* name) { return test::tool(name).string(); };
+  const std::vector<std::string> planner = {bin("planner"), "--height", "1.3", "--sensor", "kinect"};
+  int sim_status = -1, goto_status = -1;
+  {
+    test::LiveSystem live(dir.path(), {{channel::kPlan, channel::kMapOctomap, channel::kGroundTruth, channel::kPlanRequest},
+                                       dir / "flight.lcmlog",
+                                       {channel::kPlan, channel::kMapOctomap, channel::kGroundTruth}});
+    live.start("vo", {bin("vo"), "-q"});
+    live.start("estimator", {bin("estimator"), "-q", "--init-position", "8,3.5,1.3"});
+    live.start("slam", {bin("slam"), "-q"});
+    live.start("mapper", {bin("mapper"), "--publish-period", "1"});
+    live.start("planner1", planner);
+    live.start("follow", {bin("follow")});
+    // The simulator's lock-step session takes in the processes that are there: all of them.
+    for (const char* name : {"vo", "estimator", "slam", "mapper", "planner", "follow"})
+      ASSERT_NE(live.wait_heartbeat(name), 0) << name;
+    live.start("sim", {bin("sim"), "-q", "--world", "room", "--flight", "vehicle", "--lockstep", "5", "--duration", "30"});
+    // The planner dies while the vehicle hovers at its take-off, once the mapper has sent a map.
+    ASSERT_TRUE(live.wait_for<kestrel::octomap_t>(channel::kMapOctomap, [](const kestrel::octomap_t&) { return true; },
+                                                  60.0, "the mapper's first map"))
+        << live.output("sim");
+    live.kill("planner1", SIGKILL);
+    live.start("goto", {bin("goto"), "--goal", "9.5", "3.5", "1.3", "0", "--wait", "--arrive-radius", "0.1",
+                        "--timeout", "90"});
+    // The new planner once goto has given up on the first request and sent it again (its resend
+    // is timed on STATE's sensor time, which under lock-step stands still while the dead planner
+    // is waited for).
+    int requests = 0;
+    ASSERT_TRUE(live.wait_for<kestrel::plan_request_t>(
+        channel::kPlanRequest, [&](const kestrel::plan_request_t&) { return ++requests == 2; }, 60.0,
+        "goto's second request"))
+        << live.output("goto");
+    live.start("planner2", planner);
+    sim_status = live.exit_status("sim", 300.0);
+    // goto has arrived by the end of the flight, or it never will: it is given a second more.
+    const std::optional<int> went = live.wait_exit("goto", 1.0);
+    goto_status = went ? *went : live.stop("goto", SIGTERM);
+    live.stop_all();
+    live.finish();
+  }
+  const std::string go = test::read_file(dir / "goto.log");
+  EXPECT_EQ(std::to_string(sim_status) + " " + std::to_string(goto_status), "0 0")
+      << "sim, goto exit codes; goto said:\n" << go << "\nplanner said:\n" << test::read_file(dir / "planner2.log")
+      << "\nsim said:\n" << test::read_file(dir / "sim.log");
   EXPECT_NE(go.find("no answer after"), std::string::npos) << "the first request went to the dead planner\n" << go;
   EXPECT_NE(go.find("arrived"), std::string::npos) << go;
 
@@ -446,7 +486,7 @@ TEST(System, APlannerKilledWhileTheVehicleHoversPlansAgainOnceRestarted) {
   std::printf("%d plans, %zu maps, %d sent again; the vehicle ended at (%.3f, %.3f, %.3f)\n", ok_plans, sent.size(),
               repeats, truth ? truth->x() : 0.0, truth ? truth->y() : 0.0, truth ? truth->z() : 0.0);
   EXPECT_GE(ok_plans, 1);
-  EXPECT_GE(repeats, 1) << "the hover's map went out again\n" << test::read_file(dir / "mapper.txt");
+  EXPECT_GE(repeats, 1) << "the hover's map went out again\n" << test::read_file(dir / "mapper.log");
   ASSERT_TRUE(truth.has_value());
   EXPECT_LT((*truth - Eigen::Vector3d(9.5, 3.5, 1.3)).norm(), 0.10) << "where the vehicle really ended";
 }
@@ -460,31 +500,73 @@ TEST(System, APlannerKilledWhileTheVehicleHoversPlansAgainOnceRestarted) {
 // nobody flies on it. Before, the new filter stayed 1.5 m off for as long as the vehicle
 // hovered, and the next goal was planned and flown from where the vehicle was not.
 TEST(System, AnEstimatorKilledWhileTheVehicleHoversTakesTheMapsWorldAtOnce) {
-  if (!test::can_isolate_network()) KESTREL_SKIP_ENVIRONMENT() << "no network namespace available";
-  if (!std::filesystem::exists("/usr/bin/lcm-logger")) KESTREL_SKIP_ENVIRONMENT() << "lcm-logger is not installed";
+  if (const std::string why = test::LiveSystem::isolate(); !why.empty())
+    KESTREL_SKIP_ENVIRONMENT() << "no network namespace available: " << why;
   test::TempDir dir;
-  const auto bin = [](const char* name) { return test::quoted(test::tool(name).string()); };
-  const std::string out = test::quoted(dir.path().string());
-  const std::string estimator = bin("estimator") + " --init-position 8,3.5,1.3 --await-world 1";  // as launched
-  const std::string go = bin("goto") + " --wait --arrive-radius 0.1 --timeout 60 --goal ";
-  const std::string script =
-      "cd " + out + "; lcm-logger -q -c 'STATE|GROUND_TRUTH' flight.lcmlog & L=$!; " + bin("vo") + " -q & V=$!; " +
-      estimator + " > estimator1.txt 2>&1 & E=$!; " + bin("slam") + " > slam.txt 2>&1 & S=$!; " + bin("mapper") +
-      " -q --publish-period 1 & M=$!; " + bin("planner") + " -q --height 1.3 --sensor kinect & P=$!; " +
-      bin("follow") + " -q & F=$!; sleep 1; " + bin("sim") +
-      " --world room --flight vehicle --lockstep 5 --duration 60 > sim.txt 2>&1 & X=$!; "
-      "sleep 3; " + go + "9.5 3.5 1.3 0 > goto1.txt 2>&1; G1=$?; sleep 2; kill -KILL $E; sleep 1; " + estimator +
-      " > estimator2.txt 2>&1 & E=$!; sleep 4; " + go + "10 3 1.3 0 > goto2.txt 2>&1; G2=$?; "
-      "wait $X; SIM=$?; kill -INT $V $E $S $M $P $F $L; wait; echo \"$SIM $G1 $G2\" > status.txt";
-  const auto r = test::run_isolated(script, 300.0);
-  ASSERT_EQ(r.exit_code, 0) << r.err;
-  const std::string sim = test::read_file(dir / "sim.txt");
-  EXPECT_EQ(test::read_file(dir / "status.txt"), "0 0 0\n")
-      << "sim, goto, goto exit codes; goto said:\n" << test::read_file(dir / "goto1.txt") << "\nthen:\n"
-      << test::read_file(dir / "goto2.txt") << "\nsim said:\n" << sim;
-  EXPECT_NE(test::read_file(dir / "slam.txt").find("1 estimator restarts"), std::string::npos)
-      << test::read_file(dir / "slam.txt");
-  const std::string restarted = test::read_file(dir / "estimator2.txt");
+  const auto bin = [](const char* name) { return test::tool(name).string(); };
+  const std::vector<std::string> estimator = {bin("estimator"), "--init-position", "8,3.5,1.3", "--await-world",
+                                              "1"};  // as launched
+  const auto go = [&](const char* x, const char* y) {
+    return std::vector<std::string>{bin("goto"), "--wait", "--arrive-radius", "0.1", "--timeout", "60", "--goal",
+                                    x, y, "1.3", "0"};
+  };
+  int sim_status = -1, goto1 = -1, goto2 = -1;
+  {
+    test::LiveSystem live(dir.path(), {{channel::kState, channel::kGroundTruth, channel::kMapOctomap},
+                                       dir / "flight.lcmlog",
+                                       {channel::kState, channel::kGroundTruth}});
+    live.start("vo", {bin("vo"), "-q"});
+    live.start("estimator1", estimator);
+    live.start("slam", {bin("slam")});
+    live.start("mapper", {bin("mapper"), "-q", "--publish-period", "1"});
+    live.start("planner", {bin("planner"), "-q", "--height", "1.3", "--sensor", "kinect"});
+    live.start("follow", {bin("follow"), "-q"});
+    // The simulator's lock-step session takes in the processes that are there: all of them.
+    for (const char* name : {"vo", "estimator", "slam", "mapper", "planner", "follow"})
+      ASSERT_NE(live.wait_heartbeat(name), 0) << name;
+    live.start("sim", {bin("sim"), "--world", "room", "--flight", "vehicle", "--lockstep", "5", "--duration", "60"});
+    // The first goal once the planner has a map to plan on (the mapper's first).
+    ASSERT_TRUE(live.wait_for<kestrel::octomap_t>(channel::kMapOctomap, [](const kestrel::octomap_t&) { return true; },
+                                                  60.0, "the mapper's first map"))
+        << live.output("sim");
+    goto1 = live.run("goto1", go("9.5", "3.5"), 120.0);
+    // Two seconds of the flight's time hovering at the goal, then the estimator dies.
+    const auto truths = live.messages(channel::kGroundTruth);
+    ASSERT_FALSE(truths.empty()) << live.output("sim");
+    const int64_t arrived = transport::decode_message<kestrel::ground_truth_t>(
+                                truths.back().data.data(), truths.back().data.size(), "GROUND_TRUTH").utime;
+    ASSERT_TRUE(live.wait_for<kestrel::ground_truth_t>(
+        channel::kGroundTruth, [&](const kestrel::ground_truth_t& m) { return m.utime >= arrived + 2'000'000; }, 60.0,
+        "two seconds of hover at the goal"))
+        << live.output("sim");
+    live.kill("estimator1", SIGKILL);
+    live.exit_status("estimator1", 10.0);
+    const pid_t restarted = live.start("estimator2", estimator);
+    // The second goal once the new filter is in the map's world: its first usable STATE after
+    // its first heartbeat (the dead filter's last states came before it).
+    ASSERT_TRUE(live.wait_for<kestrel::process_status_t>(
+        channel::kProcessStatus,
+        [&](const kestrel::process_status_t& m) { return m.name == "estimator" && m.pid == restarted; }, 20.0,
+        "the new estimator's heartbeat"));
+    ASSERT_TRUE(live.wait_for<kestrel::state_t>(
+        channel::kState,
+        [](const kestrel::state_t& m) {
+          return m.status == kestrel::state_t::STATUS_OK || m.status == kestrel::state_t::STATUS_DEGRADED;
+        },
+        60.0, "the new filter's first usable state", live.received()))
+        << live.output("estimator2");
+    goto2 = live.run("goto2", go("10", "3"), 120.0);
+    sim_status = live.exit_status("sim", 300.0);
+    live.stop_all();
+    live.finish();
+  }
+  const std::string sim = test::read_file(dir / "sim.log");
+  EXPECT_EQ(std::to_string(sim_status) + " " + std::to_string(goto1) + " " + std::to_string(goto2), "0 0 0")
+      << "sim, goto, goto exit codes; goto said:\n" << test::read_file(dir / "goto1.log") << "\nthen:\n"
+      << test::read_file(dir / "goto2.log") << "\nsim said:\n" << sim;
+  EXPECT_NE(test::read_file(dir / "slam.log").find("1 estimator restarts"), std::string::npos)
+      << test::read_file(dir / "slam.log");
+  const std::string restarted = test::read_file(dir / "estimator2.log");
   EXPECT_NE(restarted.find("1 moved the world onto SLAM's"), std::string::npos) << restarted;
   EXPECT_NE(sim.find("contacts: 0"), std::string::npos) << sim;
   // The simulator's lock-step let the dead estimator go and took the new one in.
