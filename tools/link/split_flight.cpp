@@ -98,11 +98,16 @@ SplitFlightResult fly_split(const SplitFlightOptions& o) {
     std::ifstream status(out / "status.txt");
     if (!(status >> r.launch_exit >> r.goto_out_exit >> r.goto_back_exit)) problem("no status.txt: the flight's script failed");
   }
+  // Where it holds at the end: where the last plan that was flown took it (a request that was
+  // never answered with a path leaves it where it was).
+  const Eigen::Vector3d out_goal(9.5, 3.5, 1.3);
+  const Eigen::Vector3d end_hold = r.goto_back_exit == 0 ? back : r.goto_out_exit == 0 ? out_goal : start;
   const int64_t mark_a = read_mark_us(out / "mark_a"), mark_b = read_mark_us(out / "mark_b");
   if (mark_a < 0 || mark_b < 0) problem("no time marks");
 
   // The onboard log: truth while holding, corrections and plans as they arrived.
   int64_t first_truth = -1;
+  int64_t last_state = 0;
   double sum = 0.0;
   try {
     transport::LogReader log((out / "onboard.lcmlog").string());
@@ -115,13 +120,17 @@ SplitFlightResult fly_split(const SplitFlightOptions& o) {
         if (!hold_start && !hold_back) continue;
         const auto m = transport::decode_message<kestrel::ground_truth_t>(data.data(), data.size(), "GROUND_TRUTH");
         const double d =
-            (transport::from_message(m.T_world_frame, "GROUND_TRUTH").translation() - (hold_start ? start : back)).norm();
+            (transport::from_message(m.T_world_frame, "GROUND_TRUTH").translation() - (hold_start ? start : end_hold)).norm();
         sum += d;
         r.deviation_max_m = std::max(r.deviation_max_m, d);
         ++r.hover_samples;
+      } else if (e->channel == channel::kState) {
+        if (r.states++ > 0) r.state_max_gap_s = std::max(r.state_max_gap_s, 1e-6 * static_cast<double>(e->timestamp - last_state));
+        last_state = e->timestamp;
       } else if (e->channel == channel::kSlamCorrection) {
         ++r.corrections_received;
       } else if (e->channel == channel::kPlan) {
+        ++r.plans_received;
         r.plans_answered +=
             transport::decode_message<kestrel::plan_t>(data.data(), data.size(), "PLAN").status == kestrel::plan_t::STATUS_OK;
       }
@@ -135,6 +144,9 @@ SplitFlightResult fly_split(const SplitFlightOptions& o) {
   r.corrections_applied = last_match(read_text(logs / "estimator.log"), R"(corrections (\d+) applied)");
   r.mapper_keyframes = last_match(read_text(logs / "mapper.log"), R"(\d+ frames \((\d+) inserted)");
   r.slam_keyframes = last_match(read_text(logs / "slam.log"), R"((\d+) keyframes, \d+ loop closures)");
+  const std::string vo = read_text(logs / "vo.log");
+  r.vo_frames = last_match(vo, R"((\d+) frames, \d+ with a motion)");
+  r.vo_motions = last_match(vo, R"(\d+ frames, (\d+) with a motion)");
   if (r.corrections_applied < 0) problem("no estimator counts in logs/estimator.log");
   if (r.mapper_keyframes < 0) problem("no mapper counts in logs/mapper.log");
   try {

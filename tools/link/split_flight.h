@@ -7,17 +7,18 @@
 // simulator is not in lock-step): the vehicle takes off holding its start (8, 3.5, 1.3) on
 // the estimator's STATE; after `hover_s` a ground-station user (kestrel goto, offboard) asks
 // for a plan to 1.5 m ahead and, once there, for one back to 1 m ahead of the start (the
-// start itself lies behind the first camera, and half a metre ahead inside its shortest
-// range: the planner never learns they are free); then it holds there until the end. The source sends raw frames, as a Kinect does, and rgbd-codec
-// compresses those that cross. Onboard, an lcm-logger records GROUND_TRUTH, STATE, PLAN and
-// SLAM_CORRECTION as they arrive there.
+// start lies behind the first camera, and half a metre ahead is inside its shortest range:
+// the planner never learns they are free); then it holds there until the end. The source
+// sends raw frames, as a Kinect does, and rgbd-codec compresses those that cross. Onboard,
+// an lcm-logger records GROUND_TRUTH, STATE, PLAN and SLAM_CORRECTION as they arrive there.
 //
-// What is measured: the true deviation while holding the start (from 3 s after the first
-// truth until the first request, and from 2 s after the return until the end): the distance
-// of the simulator's true body position from (8, 3.5, 1.3), then from (9, 3.5, 1.3). Corrections are those that
-// reached the onboard side (the log) and those the estimator applied (its log); plans those
-// that reached it with status OK; the mapper's keyframes those it inserted; the link's drops
-// are its lost and queue-full datagrams, both ways.
+// What is measured: the true deviation while holding (from 3 s after the first truth until
+// the first request, and from 2 s after the return until the end): the distance of the
+// simulator's true body position from (8, 3.5, 1.3), then from (9, 3.5, 1.3) (or, if a
+// request was not flown, from where the vehicle was told to hold instead). Corrections are
+// those that reached the onboard side (the log) and those the estimator applied (its log);
+// plans those that reached it with status OK; the mapper's keyframes those it inserted; the
+// link's drops are its lost and queue-full datagrams, both ways.
 //
 // Needs root (nsenter into the sides' namespaces) and lcm-logger; everything it writes goes
 // under `out_dir` (the launch's logs in out_dir/logs).
@@ -46,8 +47,12 @@ struct SplitFlightResult {
   int corrections_received = 0;   ///< SLAM_CORRECTION messages logged onboard
   int corrections_applied = -1;   ///< from the estimator's last lines (-1: not found)
   int plans_answered = 0;         ///< PLAN messages with status OK logged onboard
+  int plans_received = 0;         ///< PLAN messages of any status logged onboard (no path, ...)
   int mapper_keyframes = -1;      ///< frames the mapper inserted (-1: not found)
   int slam_keyframes = -1;        ///< (-1: not found)
+  int vo_frames = -1, vo_motions = -1;  ///< frames VO read and those it measured (-1: not found)
+  int states = 0;                 ///< STATE messages logged onboard
+  double state_max_gap_s = 0;     ///< the longest wall time between two of them (onboard never waits)
   int64_t datagrams_offered = 0, datagrams_lost = 0, datagrams_queue_full = 0;  ///< both ways
   double up_mbit_s = 0;           ///< mean offered rate up the link
   std::string problems;           ///< what could not be read, one per line (empty: all)
