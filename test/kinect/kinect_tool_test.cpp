@@ -1,7 +1,8 @@
 // kestrel-kinect and kestrel-tum-to-fakenect as processes, on TUM folders written by the test:
 // a fakenect recording made from known frames, replayed through Debian's fakenect library by
 // the unchanged driver, must come back as those frames. Also the driver's exit codes when
-// there is no device or no recording.
+// there is no device or no recording. Live publishing runs inside a private network namespace
+// under a LiveSystem (test/support/live_system.h), which hears the messages itself.
 
 #include <gtest/gtest.h>
 
@@ -12,7 +13,6 @@
 #include <set>
 
 #include "common/transport/channels.h"
-#include "common/transport/lcm_url.h"
 #include "common/transport/log_file.h"
 #include "common/transport/rgbd_codec.h"
 #include "drivers/kinect/accelerometer.h"
@@ -20,6 +20,7 @@
 #include "kestrel/imu_t.hpp"
 #include "kestrel/process_status_t.hpp"
 #include "test/kinect/fakenect_support.h"
+#include "test/support/live_system.h"
 #include "test/support/test_support.h"
 #include "test/tum/tum_fixture.h"
 
@@ -114,19 +115,24 @@ TEST(KinectTool, ADroppedFrameIsCountedAndTheRestPublished) {
 
 TEST(KinectTool, PublishesLiveWithHeartbeatsInsideANetworkNamespace) {
   KESTREL_REQUIRE_FAKENECT();
-  if (!test::can_isolate_network()) KESTREL_SKIP_ENVIRONMENT() << "cannot create a network namespace here";
+  if (const std::string why = test::LiveSystem::isolate(); !why.empty())
+    KESTREL_SKIP_ENVIRONMENT() << "cannot create a network namespace here: " << why;
   test::TempDir dir;
   const TumFixture fx(dir.path(), 3);
   const auto dump = dir / "dump";
   ASSERT_EQ(test::run({test::tool("tum-to-fakenect").string(), fx.folder().string(), dump.string()}).exit_code, 0);
   const auto log = dir / "live.lcmlog";
-  const auto r = test::run_isolated(
-      "lcm-logger -q --lcm-url=" + test::quoted(transport::kDefaultLcmUrl) + " -f " + test::quoted(log.string()) +
-      " & L=$!; " + test::wait_for_lcm_listener_sh() + "; LD_LIBRARY_PATH=" + test::quoted(test::fakenect_library_dir()) +
-      " FAKENECT_PATH=" + test::quoted(dump.string()) + " " + test::quoted(test::tool("kinect").string()) +
-      " --config " + test::quoted((dump / "kestrel-kinect.ini").string()) +
-      " --depth-encoding zstd; rc=$?; sleep 0.5; kill -INT $L; wait $L || exit 99; exit $rc");
-  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  {
+    // Listening before the driver starts; what it sent is all heard once it has exited.
+    test::LiveSystem live(dir / "processes", {{channel::kCameraRgbd, channel::kProcessStatus}, log, {}});
+    const int rc = live.run("kinect",
+                            {"env", "LD_LIBRARY_PATH=" + test::fakenect_library_dir(), "FAKENECT_PATH=" + dump.string(),
+                             test::tool("kinect").string(), "--config", (dump / "kestrel-kinect.ini").string(),
+                             "--depth-encoding", "zstd"},
+                            120.0);
+    live.finish();
+    ASSERT_EQ(rc, 0) << live.output("kinect");
+  }
   transport::LogReader reader(log.string());
   int frames = 0, heartbeats = 0;
   while (auto e = reader.next()) {

@@ -9,6 +9,7 @@
 #include <fstream>
 #include <cmath>
 #include <iterator>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -16,7 +17,9 @@
 #include "common/transport/channels.h"
 #include "common/transport/lcm_url.h"
 #include "common/transport/log_file.h"
+#include "kestrel/ground_truth_t.hpp"
 #include "kestrel/vehicle_command_t.hpp"
+#include "test/support/live_system.h"
 #include "test/support/test_support.h"
 
 namespace {
@@ -113,10 +116,12 @@ TEST(SimToolTest, LivePublishingReachesAnLcmLogger) {
 }
 
 // Closed loop over LCM: a VEHICLE_COMMAND (velocity 0.3 m/s along world x, played by the
-// stock lcm-logplayer half a second into the flight) moves the simulated vehicle, as its
-// GROUND_TRUTH recorded by lcm-logger shows; before it the vehicle holds its start.
+// stock lcm-logplayer once GROUND_TRUTH has reached half a second into the flight) moves the
+// simulated vehicle, as its GROUND_TRUTH recorded by a LiveSystem (test/support/live_system.h)
+// shows; before it the vehicle holds its start.
 TEST(SimToolTest, VehicleFliesAVehicleCommandReceivedOverLcm) {
-  if (!kestrel::test::can_isolate_network()) KESTREL_SKIP_ENVIRONMENT() << "cannot create a network namespace here";
+  if (const std::string why = kestrel::test::LiveSystem::isolate(); !why.empty())
+    KESTREL_SKIP_ENVIRONMENT() << "cannot create a network namespace here: " << why;
   if (!fs::exists(tool("eval"))) KESTREL_SKIP_ENVIRONMENT() << "kestrel-eval is not built";
   TempDir dir;
   const std::string log = (dir / "live.lcmlog").string(), commands = (dir / "command.lcmlog").string();
@@ -127,19 +132,26 @@ TEST(SimToolTest, VehicleFliesAVehicleCommandReceivedOverLcm) {
     kestrel::transport::LogWriter writer(commands);
     writer.write_message(kestrel::channel::kVehicleCommand, 0, c);
   }
-  const std::string pid = (dir / "pid").string();
-  const std::string script =
-      lcm_url_export() +
-      "(lcm-logger -f '" + log + "' >/dev/null 2>&1 & echo $! > '" + pid + "') && " +
-      kestrel::test::wait_for_lcm_listener_sh() + " && "
-      "('" + tool("sim").string() + "' --world office --flight vehicle --vehicle-feedback truth --duration 4 "
-      "--camera-rate 3 -q & "
-      // Once the flight is on the wire (so the sim has subscribed), half a second later.
-      "while [ $(stat -c %s '" + log + "') -lt 20000 ]; do sleep 0.05; done; sleep 0.5 && "
-      "lcm-logplayer '" + commands + "' >/dev/null 2>&1; wait) && sleep 1 && "
-      "kill $(cat '" + pid + "')";
-  const auto r = kestrel::test::run_isolated(script, 200.0);
-  ASSERT_EQ(r.exit_code, 0) << r.err;
+  {
+    kestrel::test::LiveSystem live(dir / "processes", {{kestrel::channel::kGroundTruth}, log, {}});
+    live.start("sim", {tool("sim").string(), "--world", "office", "--flight", "vehicle", "--vehicle-feedback", "truth",
+                       "--duration", "4", "--camera-rate", "3", "-q"});
+    // The flight is on the wire (so the sim has subscribed); half a second into it, the command.
+    std::optional<int64_t> start;
+    ASSERT_TRUE(live.wait_for<kestrel::ground_truth_t>(
+        kestrel::channel::kGroundTruth,
+        [&](const kestrel::ground_truth_t& m) {
+          if (!start) start = m.utime;
+          return m.utime >= *start + 500'000;
+        },
+        60.0, "the flight's first half second"))
+        << live.output("sim");
+    live.run("logplayer",
+             {"env", "LCM_DEFAULT_URL=" + std::string(kestrel::transport::kDefaultLcmUrl), "lcm-logplayer", commands},
+             60.0);
+    live.exit_status("sim", 200.0);
+    live.finish();
+  }
   const auto eval = run({tool("eval").string(), "--est", log + ":GROUND_TRUTH", "--to-tum", (dir / "gt.txt").string()});
   ASSERT_EQ(eval.exit_code, 0) << eval.err;
   std::ifstream in(dir / "gt.txt");

@@ -1,21 +1,23 @@
 // kestrel-tum-play as a process: the log it writes, its exit codes and one-line errors for
-// bad input, and live publishing inside a private network namespace.
+// bad input, and live publishing inside a private network namespace (a LiveSystem,
+// test/support/live_system.h, which hears the messages itself).
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <csignal>
 #include <filesystem>
 #include <functional>
 #include <map>
 
 #include "common/time.h"
 #include "common/transport/channels.h"
-#include "common/transport/lcm_url.h"
 #include "common/transport/log_file.h"
 #include "common/transport/rgbd_codec.h"
 #include "kestrel/ground_truth_t.hpp"
 #include "kestrel/imu_t.hpp"
 #include "kestrel/process_status_t.hpp"
+#include "test/support/live_system.h"
 #include "test/support/test_support.h"
 #include "test/tum/tum_fixture.h"
 
@@ -161,17 +163,19 @@ TEST(TumPlayTool, BadOptionsExitTwo) {
 }
 
 TEST(TumPlayTool, PublishesLiveWithHeartbeatsInsideANetworkNamespace) {
-  if (!test::can_isolate_network()) KESTREL_SKIP_ENVIRONMENT() << "cannot create a network namespace here";
+  if (const std::string why = test::LiveSystem::isolate(); !why.empty())
+    KESTREL_SKIP_ENVIRONMENT() << "cannot create a network namespace here: " << why;
   test::TempDir dir;
   const TumFixture fx(dir.path(), 3);
   const auto log = dir / "live.lcmlog";
-  // The logger must have subscribed before the player starts, and needs kestrel's receive
-  // buffer (the default URL) to take whole frames.
-  const auto r = test::run_isolated("lcm-logger -q --lcm-url='" + std::string(transport::kDefaultLcmUrl) + "' -f '" +
-                          log.string() + "' & L=$!; " + test::wait_for_lcm_listener_sh() + "; '" + play() + "' '" + fx.folder().string() +
-                          "' --rate 2 --rgb-encoding jpeg; rc=$?; sleep 0.5; kill -INT $L; wait $L || exit 99; "
-                          "exit $rc");
-  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  {
+    // Listening (on kestrel's default URL, whose receive buffer takes whole frames) before the
+    // player starts; what it sent is all heard once it has exited (finish()).
+    test::LiveSystem live(dir / "processes", {{channel::kCameraRgbd, channel::kProcessStatus}, log, {}});
+    const int rc = live.run("tum-play", {play(), fx.folder().string(), "--rate", "2", "--rgb-encoding", "jpeg"}, 120.0);
+    live.finish();
+    ASSERT_EQ(rc, 0) << live.output("tum-play");
+  }
   const LogContents c = read_log(log);
   EXPECT_EQ(c.count.count(channel::kCameraRgbd) ? c.count.at(channel::kCameraRgbd) : 0, 3);
   EXPECT_GE(c.count.count(channel::kProcessStatus) ? c.count.at(channel::kProcessStatus) : 0, 1);
@@ -190,13 +194,22 @@ TEST(TumPlayTool, PublishesLiveWithHeartbeatsInsideANetworkNamespace) {
 }
 
 TEST(TumPlayTool, SigintEndsALoopedPlaybackWithCode130) {
-  if (!test::can_isolate_network()) KESTREL_SKIP_ENVIRONMENT() << "cannot create a network namespace here";
+  if (const std::string why = test::LiveSystem::isolate(); !why.empty())
+    KESTREL_SKIP_ENVIRONMENT() << "cannot create a network namespace here: " << why;
   test::TempDir dir;
   const TumFixture fx(dir.path(), 2);
-  const auto r = test::run_isolated("'" + play() + "' '" + fx.folder().string() +
-                          "' --loop -q & P=$!; sleep 1.5; kill -INT $P; wait $P; echo \"exit=$?\"");
-  EXPECT_NE(r.out.find("exit=130"), std::string::npos) << r.out << r.err;
-  EXPECT_NE(r.out.find("frames published: "), std::string::npos) << r.out;
+  test::LiveSystem live(dir / "processes", {{channel::kCameraRgbd}, {}, {}});
+  live.start("tum-play", {play(), fx.folder().string(), "--loop", "-q"});
+  // Interrupted in its second pass over the two frames.
+  int frames = 0;
+  ASSERT_TRUE(live.wait_for<kestrel::rgbd_frame_t>(
+      channel::kCameraRgbd, [&](const kestrel::rgbd_frame_t&) { return ++frames == 3; }, 30.0,
+      "the looped playback's third frame"))
+      << live.output("tum-play");
+  const int rc = live.stop("tum-play", SIGINT);
+  const std::string out = live.output("tum-play");
+  EXPECT_EQ(rc, 130) << out;
+  EXPECT_NE(out.find("frames published: "), std::string::npos) << out;
 }
 
 }  // namespace
