@@ -3,6 +3,7 @@
 // has no <numbers>). One home also keeps them out of the files' anonymous namespaces, where
 // two copies in one unity batch (CMakeLists.txt) would be a redefinition.
 
+#include <cmath>
 #include <limits>
 
 namespace kestrel {
@@ -14,5 +15,11 @@ inline constexpr double kInf = std::numeric_limits<double>::infinity();
 
 /// v * v: a variance from a standard deviation, without writing the expression twice.
 constexpr double sq(double v) { return v * v; }
+
+/// An angle wrapped to (-pi, pi] (headings, yaw differences: the short way round).
+inline double wrap_angle(double a) {
+  a = std::remainder(a, kTwoPi);
+  return a <= -kPi ? a + kTwoPi : a;
+}
 
 }  // namespace kestrel

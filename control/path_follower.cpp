@@ -9,8 +9,6 @@
 namespace kestrel::control {
 namespace {
 
-double wrap_angle(double a) { return std::remainder(a, 2.0 * kPi); }
-
 void require(bool ok, const char* what) {
   if (!ok) throw std::invalid_argument(std::string("path follower: ") + what);
 }

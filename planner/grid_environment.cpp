@@ -10,11 +10,6 @@
 
 namespace kestrel::planner {
 
-double wrap_angle(double a) {
-  a = std::remainder(a, 2.0 * kPi);
-  return a <= -kPi ? a + 2.0 * kPi : a;
-}
-
 OccupancyGrid make_grid(int width, int height, double resolution, double x0, double y0) {
   OccupancyGrid g;
   g.width = width;

@@ -6,6 +6,7 @@
 #include <map>
 
 #include "common/gaussian/information.h"
+#include "common/numbers.h"
 
 namespace kestrel::planner {
 

@@ -15,7 +15,4 @@ using Rng = std::mt19937_64;      ///< every random draw goes through a seeded e
 /// Position part of a configuration.
 inline Eigen::Vector3d position(const Config& q) { return q.head<3>(); }
 
-/// Wraps an angle to (-pi, pi].
-double wrap_angle(double a);
-
 }  // namespace kestrel::planner

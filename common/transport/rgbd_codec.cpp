@@ -8,6 +8,7 @@
 #include <memory>
 
 #include "common/error.h"
+#include "common/numbers.h"
 #include "common/text.h"
 #include "common/transport/convert.h"
 
@@ -110,7 +111,7 @@ void check_plausible_camera(const PinholeCamera& c, const Eigen::Isometry3d& T_b
   auto fail = [&](const std::string& why) {
     throw InputError(std::string(what) + ": implausible camera: " + why);
   };
-  const double max_half_fov_rad = 85.0 * M_PI / 180.0, min_half_fov_rad = 0.005 * M_PI / 180.0;
+  const double max_half_fov_rad = 85.0 * kDegree, min_half_fov_rad = 0.005 * kDegree;
   auto check_focal = [&](const char* name, double f_px, int pixels, const char* side) {
     if (f_px < 0.5 * pixels / std::tan(max_half_fov_rad) || f_px > 0.5 * pixels / std::tan(min_half_fov_rad))
       fail(std::string(name) + " = " + number_text(f_px) + " px for images " + std::to_string(pixels) +

@@ -9,8 +9,6 @@
 namespace kestrel::sim {
 namespace {
 
-double wrap_angle(double a) { return std::remainder(a, 2.0 * kPi); }
-
 Eigen::Vector3d clamp_norm(const Eigen::Vector3d& x, double limit) {
   const double n = x.norm();
   return n > limit ? Eigen::Vector3d(x * (limit / n)) : x;

@@ -21,12 +21,6 @@
 
 namespace kestrel::slam {
 
-/// Angle wrapped to (-pi, pi].
-inline double wrap_angle(double a) {
-  a = std::remainder(a, 2.0 * kPi);
-  return a <= -kPi ? a + 2.0 * kPi : a;
-}
-
 /// The plane: a pose is (x, y, theta), T_a_b maps b into a as p_a = R(theta) p_b + (x, y).
 struct Se2 {
   static constexpr int kDim = 3;

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "common/error.h"
+#include "common/numbers.h"
 #include "common/transport/rgbd_codec.h"
 
 namespace kestrel::transport {
@@ -282,7 +283,7 @@ TEST(RgbdCodecDamage, ImpossibleCamerasAreRejectedAndPossibleOnesKept) {
       {"negative fy", [](rgbd_frame_t& m) { m.camera.fy = -60.0; }},
       {"fx 1e300", [](rgbd_frame_t& m) { m.camera.fx = 1e300; }},
       {"fy 1e-300", [](rgbd_frame_t& m) { m.camera.fy = 1e-300; }},
-      {"fx for a 175 deg view", [](rgbd_frame_t& m) { m.camera.fx = 32.0 / std::tan(87.5 * M_PI / 180.0); }},
+      {"fx for a 175 deg view", [](rgbd_frame_t& m) { m.camera.fx = 32.0 / std::tan(87.5 * kDegree); }},
       {"cx 1e12", [](rgbd_frame_t& m) { m.camera.cx = 1e12; }},
       {"cy two images up", [](rgbd_frame_t& m) { m.camera.cy = -96.0; }},
       {"zero width", [](rgbd_frame_t& m) { m.camera.width = 0; }},

@@ -12,6 +12,7 @@
 
 #include "common/atomic_file.h"
 #include "common/error.h"
+#include "common/numbers.h"
 #include "tools/launch/process_set.h"
 #include "tools/launch/supervisor.h"
 
@@ -39,7 +40,7 @@ double flight_duration_s(const std::vector<Eigen::Vector4d>& waypoints, double s
   double length = 0.0, turn = 0.0;
   for (size_t i = 1; i < waypoints.size(); ++i) {
     length += (waypoints[i].head<3>() - waypoints[i - 1].head<3>()).norm();
-    turn += std::abs(std::remainder(waypoints[i][3] - waypoints[i - 1][3], 2.0 * M_PI));
+    turn += std::abs(wrap_angle(waypoints[i][3] - waypoints[i - 1][3]));
   }
   // The estimator's still start (0.5 s) and the first keyframes, the path at cruise speed with
   // 40 % for corners and the stop, turning at 1 rad/s, then 5 s of hold at the goal.

@@ -1,11 +1,11 @@
 #include "tools/flights/flight_score.h"
 
-#include <Eigen/Cholesky>
-
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <unordered_map>
+
+#include "estimator/eval/consistency.h"
 
 namespace kestrel::flights {
 namespace {
@@ -45,14 +45,17 @@ FlightScore score_flight(const FlightRecord& r, const Eigen::Vector3d& goal, dou
     scored_states.push_back(&st);
     sum += d;
     s.error_max_m = std::isnan(s.error_max_m) ? d : std::max(s.error_max_m, d);
-    const Eigen::LLT<Eigen::Matrix3d> llt(st.P);  // fails unless positive definite
-    if (st.P.allFinite() && llt.info() == Eigen::Success) {
-      const double nees = e.dot(llt.solve(e));
-      if (std::isfinite(nees)) {
-        nees_sum += nees;
-        ++nees_count;
-        inside += nees < kChi2ThreeDof3Sigma;
-      }
+    if (!st.P.allFinite()) continue;
+    double nees = kNaN;
+    try {
+      nees = estimator::nees(e, st.P);
+    } catch (const std::invalid_argument&) {
+      continue;  // a covariance that is not positive definite says nothing of consistency
+    }
+    if (std::isfinite(nees)) {
+      nees_sum += nees;
+      ++nees_count;
+      inside += nees < kChi2ThreeDof3Sigma;
     }
   }
   s.states_scored = static_cast<int64_t>(s.errors_m.size());
