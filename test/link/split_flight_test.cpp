@@ -30,7 +30,7 @@ TEST(SplitFlight, OnboardAndOffboardOverALossyLinkHoldPositionAndStillGetCorrect
   o.bin_dir = test::tool("launch").parent_path();
   o.out_dir = dir / "flight";
   o.loss_percent = 10;
-  o.duration_s = 40;
+  o.duration_s = 50;
   const link::SplitFlightResult r = link::fly_split(o);
   const auto logs = [&](const char* name) { return test::read_file(dir / "flight" / "logs" / name); };
   std::printf("holding: %d truth samples, deviation mean %.1f cm, max %.1f cm; corrections %d received, %d applied; "

@@ -74,7 +74,7 @@ SplitFlightResult fly_split(const SplitFlightOptions& o) {
   const auto bin = [&](const char* tool) { return quoted((o.bin_dir / (std::string("kestrel-") + tool)).string()); };
   const std::string link_options = fmt::format("--loss {} --delay {} --jitter {} --rate {} --seed {}", o.loss_percent,
                                                o.delay_ms, o.jitter_ms, o.rate_mbit, o.seed);
-  const std::string go = "--wait --arrive-radius 0.1 --timeout 25 --goal ";
+  const std::string go = "--wait --arrive-radius 0.1 --timeout 35 --goal ";
   const std::string script = fmt::format(
       "cd {out}; rm -f status.txt mark_a mark_b; "
       "{launch} all --link --link-options {link} --sets sets.yaml --status-period 0 --log-dir logs "

@@ -35,8 +35,8 @@ struct SplitFlightOptions {
   double loss_percent = 10;
   double delay_ms = 30, jitter_ms = 10, rate_mbit = 20;
   uint64_t seed = 1;
-  double duration_s = 45;  ///< of the simulator's flight
-  double hover_s = 6;      ///< wall seconds from the start until the first request
+  double duration_s = 55;  ///< of the simulator's flight
+  double hover_s = 8;      ///< wall seconds from the start until the first request
 };
 
 struct SplitFlightResult {

@@ -24,7 +24,7 @@ struct Options {
   std::vector<double> losses = {0, 10, 30};
   std::string out;
   uint64_t seed = 1;
-  double duration_s = 45;
+  double duration_s = 55;
   double delay_ms = 30, jitter_ms = 10, rate_mbit = 20;
   std::string json;
 };
