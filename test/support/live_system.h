@@ -26,7 +26,8 @@
 //  * Every child started, and every process left behind by one (the test process is made a
 //    child subreaper), is killed and reaped by the destructor: a failed test leaves nothing
 //    running. Children still running are sent SIGINT first (a clean stop, flushing their
-//    logs), SIGKILL a few seconds later.
+//    logs), SIGKILL a few seconds later. A test process killed outright runs no destructor:
+//    its children are then sent SIGTERM by the kernel (PR_SET_PDEATHSIG).
 //  * Messages are kept in arrival order; wait_for() sees every message received since the
 //    LiveSystem started (or since the index `from` it is given), so a message that arrived
 //    before the wait is not missed.
