@@ -48,6 +48,8 @@ TEST(SplitFlight, OnboardAndOffboardOverALossyLinkHoldPositionAndStillGetCorrect
   EXPECT_GE(r.corrections_received, 1);
   EXPECT_GE(r.corrections_applied, 1) << logs("estimator.log");
   EXPECT_GE(r.plans_answered, 2);
+  std::printf("requests: %d out, %d back (a second when a plan was lost on its way down)\n", r.goto_out_attempts,
+              r.goto_back_attempts);
   EXPECT_GE(r.mapper_keyframes, 3) << logs("mapper.log");
   EXPECT_GT(r.datagrams_lost, 0) << "the link lost nothing at 10 %";
   // Nothing onboard waited on the link: VO measured every frame (30 Hz of the flight, less

@@ -6,7 +6,8 @@
 // The flight, live at the sensors' own pace (nothing onboard waits for the link; the
 // simulator is not in lock-step): the vehicle takes off holding its start (8, 3.5, 1.3) on
 // the estimator's STATE; after `hover_s` a ground-station user (kestrel goto, offboard) asks
-// for a plan to 1.5 m ahead and, once there, for one back to 1 m ahead of the start (the
+// for a plan to 1.5 m ahead (asking once more if it was not flown in 20 s: a PLAN lost on
+// the link is not sent again by anyone) and, once there, for one back to 1 m ahead of the start (the
 // start lies behind the first camera, and half a metre ahead is inside its shortest range:
 // the planner never learns they are free); then it holds there until the end. The source
 // sends raw frames, as a Kinect does, and rgbd-codec compresses those that cross. Onboard,
@@ -42,6 +43,7 @@ struct SplitFlightOptions {
 struct SplitFlightResult {
   int launch_exit = -1;
   int goto_out_exit = -1, goto_back_exit = -1;  ///< kestrel goto's exits (0: arrived)
+  int goto_out_attempts = 0, goto_back_attempts = 0;  ///< requests made (a second if the first was not flown)
   int hover_samples = 0;
   double deviation_mean_m = 0, deviation_max_m = 0;
   int corrections_received = 0;   ///< SLAM_CORRECTION messages logged onboard

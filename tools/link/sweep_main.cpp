@@ -53,11 +53,11 @@ int sweep(const Options& o) {
     if (!r.problems.empty()) spdlog::warn("{:g} %: {}", loss, r.problems);
     rows.push_back(fmt::format(
         "| {:g} % | {:.1f} / {:.1f} cm | {} received, {} applied | {} of {} | {} (SLAM {}) | {} of {} ({} lost, {} queue full) | "
-        "{:.1f} | {} {} {} |",
+        "{:.1f} | {}; {} ({}), {} ({}) |",
         loss, r.deviation_mean_m * 100, r.deviation_max_m * 100, r.corrections_received, r.corrections_applied,
         r.plans_answered, r.plans_received, r.mapper_keyframes, r.slam_keyframes, r.datagrams_lost + r.datagrams_queue_full,
         r.datagrams_offered, r.datagrams_lost, r.datagrams_queue_full, r.up_mbit_s, r.launch_exit, r.goto_out_exit,
-        r.goto_back_exit));
+        r.goto_out_attempts, r.goto_back_exit, r.goto_back_attempts));
     json_rows.push_back(fmt::format(
         "{{\"loss_percent\": {:g}, \"deviation_mean_m\": {:.4f}, \"deviation_max_m\": {:.4f}, \"hover_samples\": {}, "
         "\"corrections_received\": {}, \"corrections_applied\": {}, \"plans_answered\": {}, \"plans_received\": {}, \"mapper_keyframes\": {}, "
@@ -72,7 +72,7 @@ int sweep(const Options& o) {
   fmt::print("link {:g} ± {:g} ms, {:g} Mbit/s, seed {}, {:g} s flights; flights in {}\n\n", o.delay_ms, o.jitter_ms,
              o.rate_mbit, o.seed, o.duration_s, out.string());
   fmt::print("| loss | true deviation holding (mean / max) | SLAM corrections onboard | plans with a path, of those received | mapper keyframes "
-             "| datagrams dropped | up, Mbit/s | exits (launch, goto, goto) |\n"
+             "| datagrams dropped | up, Mbit/s | exits: launch; goto out (requests), back (requests) |\n"
              "|---|---|---|---|---|---|---|---|\n");
   for (const auto& row : rows) fmt::print("{}\n", row);
   if (!o.json.empty()) {
