@@ -60,47 +60,61 @@ SplitFlightResult fly_split(const SplitFlightOptions& o) {
   const fs::path out = fs::absolute(o.out_dir);
   const Eigen::Vector3d start(8.0, 3.5, 1.3);  // the room's take-off pose
   const Eigen::Vector3d back(9.0, 3.5, 1.3);   // where it returns: 1 m ahead of the start, so mapped
+  const auto bin = [&](const char* tool) { return (o.bin_dir / (std::string("kestrel-") + tool)).string(); };
+  const std::string go = bin("goto") + " --wait --arrive-radius 0.1 --timeout 20 --goal ";
   {
+    // The ground station's user, in the offboard namespace. A user asks again once when a
+    // request was not flown: a PLAN lost on its way down is sent again by no one (goto heard
+    // it at the ground station). Then it waits to be stopped with the others.
+    std::ofstream user(out / "user.sh");
+    user << "cd " << quoted(out.string()) << "\n"
+         << "sleep " << o.hover_s << "; date +%s%N > mark_a\n"
+         << "for i in 1 2; do " << go << "9.5 3.5 1.3 0 >> goto_out.txt 2>&1; G1=$?; [ $G1 -eq 0 ] && break; done\n"
+         << "echo $i > attempts_out\n"
+         << "for i in 1 2; do " << go << "9 3.5 1.3 0 >> goto_back.txt 2>&1; G2=$?; [ $G2 -eq 0 ] && break; done\n"
+         << "echo $i > attempts_back; date +%s%N > mark_b; echo \"$G1 $G2\" > goto_status.txt\n"
+         << "exec sleep 100000\n";
+  }
+  {
+    // The recorder onboard and the user offboard are processes of the set, so that the
+    // launcher puts them in their namespaces (no nsenter, no root). A process-set command
+    // is split on blanks: the folder's path must have none.
     std::ofstream sets(out / "sets.yaml");
     sets << "# the split flight's processes (tools/link/split_flight.h)\n"
             "processes:\n"
             "  - {name: vo, command: vo, side: onboard}\n"
             "  - {name: estimator, command: \"estimator --await-world 1 --init-position 8,3.5,1.3\", side: onboard}\n"
             "  - {name: follow, command: follow, side: onboard}\n"
+            "  - {name: recorder, command: \"lcm-logger -q -c GROUND_TRUTH|STATE|PLAN|SLAM_CORRECTION "
+         << (out / "onboard.lcmlog").string() << "\", side: onboard}\n"
             "  - {name: slam, command: slam, side: offboard}\n"
             "  - {name: mapper, command: \"mapper --publish-period 1\", side: offboard}\n"
-            "  - {name: planner, command: \"planner --height 1.3 --sensor kinect\", side: offboard}\n";
+            "  - {name: planner, command: \"planner --height 1.3 --sensor kinect\", side: offboard}\n"
+            "  - {name: user, command: \"sh "
+         << (out / "user.sh").string() << "\", side: offboard}\n";
   }
-  const auto bin = [&](const char* tool) { return quoted((o.bin_dir / (std::string("kestrel-") + tool)).string()); };
   const std::string link_options = fmt::format("--loss {} --delay {} --jitter {} --rate {} --seed {}", o.loss_percent,
                                                o.delay_ms, o.jitter_ms, o.rate_mbit, o.seed);
-  const std::string go = "--wait --arrive-radius 0.1 --timeout 20 --goal ";
   const std::string script = fmt::format(
-      "cd {out}; rm -f status.txt mark_a mark_b goto_out.txt goto_back.txt; "
+      "cd {out}; rm -f launch_status.txt goto_status.txt mark_a mark_b goto_out.txt goto_back.txt onboard.lcmlog; "
       "{launch} all --link --link-options {link} --sets sets.yaml --status-period 0 --log-dir logs "
-      "--source {source} > launch.txt 2>&1 & P=$!; "
-      "pid_of() {{ sed -n \"s/.*started $1 (pid \\([0-9]*\\)).*/\\1/p\" launch.txt | head -n 1; }}; "
-      "for i in $(seq 300); do V=$(pid_of vo); M=$(pid_of mapper); [ -n \"$V\" ] && [ -n \"$M\" ] && break; sleep 0.1; done; "
-      "nsenter --net=/proc/$V/ns/net lcm-logger -q -c 'GROUND_TRUTH|STATE|PLAN|SLAM_CORRECTION' onboard.lcmlog & L=$!; "
-      "sleep {hover}; date +%s%N > mark_a; "
-      // A user asks again once when a request was not flown: a PLAN lost on its way down is
-      // not sent again by anyone (goto heard it at the ground station).
-      "for i in 1 2; do nsenter --net=/proc/$M/ns/net {goto_} {go}9.5 3.5 1.3 0 >> goto_out.txt 2>&1; G1=$?; "
-      "[ $G1 -eq 0 ] && break; done; echo $i > attempts_out; "
-      "for i in 1 2; do nsenter --net=/proc/$M/ns/net {goto_} {go}9 3.5 1.3 0 >> goto_back.txt 2>&1; G2=$?; "
-      "[ $G2 -eq 0 ] && break; done; echo $i > attempts_back; "
-      "date +%s%N > mark_b; wait $P; LAUNCH=$?; sleep 0.3; kill -INT $L; wait $L; "
-      "echo \"$LAUNCH $G1 $G2\" > status.txt",
-      fmt::arg("out", quoted(out.string())), fmt::arg("launch", bin("launch")), fmt::arg("link", quoted(link_options)),
-      fmt::arg("source", quoted(fmt::format("sim --world room --flight vehicle --duration {} --seed {} -q --rgb-encoding raw --depth-encoding raw",
-                                            o.duration_s, o.seed))),
-      fmt::arg("hover", o.hover_s), fmt::arg("goto_", bin("goto")), fmt::arg("go", go));
+      "--source {source} > launch.txt 2>&1; echo $? > launch_status.txt",
+      fmt::arg("out", quoted(out.string())), fmt::arg("launch", quoted(bin("launch"))),
+      fmt::arg("link", quoted(link_options)),
+      fmt::arg("source", quoted(fmt::format("sim --world room --flight vehicle --duration {} --seed {} -q "
+                                            "--rgb-encoding raw --depth-encoding raw",
+                                            o.duration_s, o.seed))));
+  if (out.string().find_first_of(" \t") != std::string::npos) {
+    r.problems = "the flight's folder has a blank in its path: " + out.string() + "\n";
+    return r;
+  }
   [[maybe_unused]] const int ignored = std::system(("sh -c " + quoted(script)).c_str());
 
   auto problem = [&](const std::string& what) { r.problems += what + "\n"; };
   {
-    std::ifstream status(out / "status.txt");
-    if (!(status >> r.launch_exit >> r.goto_out_exit >> r.goto_back_exit)) problem("no status.txt: the flight's script failed");
+    std::ifstream launch(out / "launch_status.txt"), user(out / "goto_status.txt");
+    if (!(launch >> r.launch_exit)) problem("no launch_status.txt: the flight's script failed");
+    if (!(user >> r.goto_out_exit >> r.goto_back_exit)) problem("no goto_status.txt: the user's requests did not end");
   }
   // Where it holds at the end: where the last plan that was flown took it (a request that was
   // never answered with a path leaves it where it was).

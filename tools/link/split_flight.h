@@ -21,8 +21,10 @@
 // plans those that reached it with status OK; the mapper's keyframes those it inserted; the
 // link's drops are its lost and queue-full datagrams, both ways.
 //
-// Needs root (nsenter into the sides' namespaces) and lcm-logger; everything it writes goes
-// under `out_dir` (the launch's logs in out_dir/logs).
+// The recorder (lcm-logger, onboard) and the user (a shell script running goto, offboard)
+// are processes of the launch's set, so the flight needs only what `launch --link` needs
+// (root or user namespaces) and lcm-logger. Everything it writes goes under `out_dir`
+// (whose path must hold no blank; the launch's logs in out_dir/logs).
 
 #include <cstdint>
 #include <filesystem>

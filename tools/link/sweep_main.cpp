@@ -30,7 +30,6 @@ struct Options {
 };
 
 int sweep(const Options& o) {
-  if (::geteuid() != 0) throw kestrel::UnavailableError("the split flight enters namespaces with nsenter: run as root");
   const fs::path bin = fs::canonical("/proc/self/exe").parent_path();
   const fs::path out = o.out.empty() ? fs::temp_directory_path() / ("kestrel-link-sweep-" + std::to_string(::getpid()))
                                      : fs::path(o.out);
@@ -92,8 +91,8 @@ int main(int argc, char** argv) {
       "link-sweep",
       "Flies the system split over the emulated link (onboard and offboard in two namespaces, "
       "kestrel launch --link) once per loss rate, and prints a Markdown table: true deviation "
-      "while holding, corrections, plans, mapper keyframes, datagrams dropped. Needs root and "
-      "lcm-logger. Exit: 0 every flight ran; 1 one did not; 2 usage; 4 not root.");
+      "while holding, corrections, plans, mapper keyframes, datagrams dropped. Needs what "
+      "launch --link needs (root or user namespaces) and lcm-logger. Exit: 0 every flight ran; 1 one did not; 2 usage.");
   Options o;
   app.add_option("--losses", o.losses, "Loss rates to fly, %")->delimiter(',')->check(CLI::Range(0.0, 100.0))->capture_default_str();
   app.add_option("--out", o.out, "Folder for the flights (default: a new one in $TMPDIR)");
