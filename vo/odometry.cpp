@@ -1,12 +1,21 @@
 #include "vo/odometry.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <memory>
+#include <vector>
 #include <opencv2/imgproc.hpp>
 
 #include "common/error.h"
 #include "common/geometry/so3.h"
+#include "sensors/lens.h"
 #include "vo/depth_lookup.h"
+#include "vo/feature_detector.h"
+#include "vo/frame.h"
+#include "vo/matcher.h"
+#include "vo/motion_estimator.h"
+#include "vo/rotation_prior.h"
 
 namespace kestrel::vo {
 namespace {
@@ -35,7 +44,52 @@ void build_coarse(const ImagePyramid& pyramid, int level, cv::Mat& coarse, cv::M
 
 }  // namespace
 
-VisualOdometry::VisualOdometry(const VoOptions& options)
+// The odometry itself; VisualOdometry forwards to it.
+class VisualOdometry::Pipeline {
+ public:
+  explicit Pipeline(const VoOptions& options);
+  VoResult process(const RgbdFrame& input);
+  void reset();
+  const VoOptions& options() const { return options_; }
+
+ private:
+  struct Attempt {
+    MotionEstimate estimate;
+    const Frame* reference = nullptr;
+  };
+
+  Frame* acquire_frame();
+  std::string check_input(const RgbdFrame& frame) const;
+  Eigen::Isometry3d predict_prev_cur(const Frame& cur);
+  Attempt estimate_against(const Frame& ref, const Frame& cur, const Eigen::Isometry3d& T_ref_cur_predicted);
+
+  VoOptions options_;
+  sensors::Lens lens_;
+  FastThresholdController threshold_;
+  FeatureDetector detector_;
+  RotationPrior rotation_prior_;
+  Matcher matcher_;
+  MotionEstimator estimator_;
+
+  std::array<std::unique_ptr<Frame>, 3> pool_;
+  Frame* keyframe_ = nullptr;
+  Frame* previous_ = nullptr;
+  Eigen::Isometry3d T_key_prev_ = Eigen::Isometry3d::Identity();
+  // The last frame-to-frame motion and its duration, for the constant-velocity prediction.
+  Eigen::Isometry3d T_prev_cur_last_ = Eigen::Isometry3d::Identity();
+  double last_dt_s_ = 0.0;
+  bool have_velocity_ = false;
+  int consecutive_failures_ = 0;
+  int keyframe_first_inliers_ = 0;  // the keyframe's reprojection inliers at its first match; 0 = none yet
+  int64_t last_utime_ = 0;
+
+  std::vector<Eigen::Vector2f> predicted_;
+  std::vector<Match> matches_;
+  cv::Mat coarse_scratch_;            // the rotation prior's intermediate halvings
+  std::vector<uint16_t> coarse_row_;
+};
+
+VisualOdometry::Pipeline::Pipeline(const VoOptions& options)
     : options_(options),
       threshold_(options.fast),
       detector_(options.pyramid, options.bucket, options.match) {
@@ -43,7 +97,7 @@ VisualOdometry::VisualOdometry(const VoOptions& options)
   for (auto& f : pool_) f = std::make_unique<Frame>();
 }
 
-void VisualOdometry::reset() {
+void VisualOdometry::Pipeline::reset() {
   keyframe_ = nullptr;
   keyframe_first_inliers_ = 0;
   previous_ = nullptr;
@@ -56,13 +110,13 @@ void VisualOdometry::reset() {
   threshold_.reset();
 }
 
-Frame* VisualOdometry::acquire_frame() {
+Frame* VisualOdometry::Pipeline::acquire_frame() {
   for (auto& f : pool_)
     if (f.get() != keyframe_ && f.get() != previous_) return f.get();
   throw std::logic_error("VisualOdometry: frame pool exhausted");  // cannot happen with 3 frames
 }
 
-std::string VisualOdometry::check_input(const RgbdFrame& frame) const {
+std::string VisualOdometry::Pipeline::check_input(const RgbdFrame& frame) const {
   if (frame.rgb.empty()) return "frame has no colour image";
   if (frame.depth_mm.empty()) return "frame has no depth image";
   try {
@@ -79,7 +133,7 @@ std::string VisualOdometry::check_input(const RgbdFrame& frame) const {
   return {};
 }
 
-Eigen::Isometry3d VisualOdometry::predict_prev_cur(const Frame& cur) {
+Eigen::Isometry3d VisualOdometry::Pipeline::predict_prev_cur(const Frame& cur) {
   const double dt = 1e-6 * double(cur.utime - previous_->utime);
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
   if (have_velocity_ && last_dt_s_ > 0.0) T = se3::exp(se3::log(T_prev_cur_last_) * (dt / last_dt_s_));
@@ -95,7 +149,7 @@ Eigen::Isometry3d VisualOdometry::predict_prev_cur(const Frame& cur) {
   return T;
 }
 
-VisualOdometry::Attempt VisualOdometry::estimate_against(const Frame& ref, const Frame& cur,
+VisualOdometry::Pipeline::Attempt VisualOdometry::Pipeline::estimate_against(const Frame& ref, const Frame& cur,
                                                          const Eigen::Isometry3d& T_ref_cur_predicted) {
   const Eigen::Isometry3f T_cur_ref = T_ref_cur_predicted.inverse().cast<float>();
   const PinholeCamera& cam = lens_.camera();
@@ -121,7 +175,7 @@ VisualOdometry::Attempt VisualOdometry::estimate_against(const Frame& ref, const
   return a;
 }
 
-VoResult VisualOdometry::process(const RgbdFrame& input) {
+VoResult VisualOdometry::Pipeline::process(const RgbdFrame& input) {
   VoResult result;
   result.utime = input.utime;
   result.seq = input.seq;
@@ -273,5 +327,14 @@ VoResult VisualOdometry::process(const RgbdFrame& input) {
   previous_ = &cur;
   return result;
 }
+
+VisualOdometry::VisualOdometry(const VoOptions& options) : pipeline_(std::make_unique<Pipeline>(options)) {}
+VisualOdometry::~VisualOdometry() = default;
+VisualOdometry::VisualOdometry(VisualOdometry&&) noexcept = default;
+VisualOdometry& VisualOdometry::operator=(VisualOdometry&&) noexcept = default;
+
+VoResult VisualOdometry::process(const RgbdFrame& frame) { return pipeline_->process(frame); }
+void VisualOdometry::reset() { pipeline_->reset(); }
+const VoOptions& VisualOdometry::options() const { return pipeline_->options(); }
 
 }  // namespace kestrel::vo

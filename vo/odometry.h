@@ -17,20 +17,12 @@
 // became the reference with new_reference); a bad frame changes no state.
 
 #include <Eigen/Geometry>
-#include <array>
 #include <memory>
 #include <string>
-#include <vector>
 
 #include "common/geometry/se3.h"
 #include "common/rgbd_frame.h"
-#include "vo/feature_detector.h"
-#include "vo/frame.h"
-#include "sensors/lens.h"
-#include "vo/matcher.h"
-#include "vo/motion_estimator.h"
 #include "vo/options.h"
-#include "vo/rotation_prior.h"
 #include "vo/status.h"
 
 namespace kestrel::vo {
@@ -65,6 +57,9 @@ class VisualOdometry {
  public:
   /// Throws std::invalid_argument naming the field if `options` are unusable.
   explicit VisualOdometry(const VoOptions& options = {});
+  ~VisualOdometry();
+  VisualOdometry(VisualOdometry&&) noexcept;
+  VisualOdometry& operator=(VisualOdometry&&) noexcept;
 
   /// Processes the next frame of the stream.
   VoResult process(const RgbdFrame& frame);
@@ -72,44 +67,13 @@ class VisualOdometry {
   /// Forgets every frame: the next one becomes the first.
   void reset();
 
-  const VoOptions& options() const { return options_; }
+  const VoOptions& options() const;
 
  private:
-  struct Attempt {
-    MotionEstimate estimate;
-    const Frame* reference = nullptr;
-  };
-
-  Frame* acquire_frame();
-  std::string check_input(const RgbdFrame& frame) const;
-  Eigen::Isometry3d predict_prev_cur(const Frame& cur);
-  Attempt estimate_against(const Frame& ref, const Frame& cur, const Eigen::Isometry3d& T_ref_cur_predicted);
-  void finish(VoResult& result, const Frame& cur) const;
-
-  VoOptions options_;
-  sensors::Lens lens_;
-  FastThresholdController threshold_;
-  FeatureDetector detector_;
-  RotationPrior rotation_prior_;
-  Matcher matcher_;
-  MotionEstimator estimator_;
-
-  std::array<std::unique_ptr<Frame>, 3> pool_;
-  Frame* keyframe_ = nullptr;
-  Frame* previous_ = nullptr;
-  Eigen::Isometry3d T_key_prev_ = Eigen::Isometry3d::Identity();
-  // The last frame-to-frame motion and its duration, for the constant-velocity prediction.
-  Eigen::Isometry3d T_prev_cur_last_ = Eigen::Isometry3d::Identity();
-  double last_dt_s_ = 0.0;
-  bool have_velocity_ = false;
-  int consecutive_failures_ = 0;
-  int keyframe_first_inliers_ = 0;  // the keyframe's reprojection inliers at its first match; 0 = none yet
-  int64_t last_utime_ = 0;
-
-  std::vector<Eigen::Vector2f> predicted_;
-  std::vector<Match> matches_;
-  cv::Mat coarse_scratch_;            // the rotation prior's intermediate halvings
-  std::vector<uint16_t> coarse_row_;
+  // The pipeline's stages and the frames it keeps (odometry.cpp): internals, so that this
+  // header is all another component sees of the odometry.
+  class Pipeline;
+  std::unique_ptr<Pipeline> pipeline_;
 };
 
 }  // namespace kestrel::vo
