@@ -23,6 +23,8 @@
 #include "kestrel/pose3_t.hpp"
 #include "kestrel/pose_t.hpp"
 #include "kestrel/process_status_t.hpp"
+#include "kestrel/rejection_counts_t.hpp"
+#include "kestrel/rejection_reason_t.hpp"
 #include "kestrel/replay_ack_t.hpp"
 #include "kestrel/replay_control_t.hpp"
 #include "kestrel/rgbd_frame_t.hpp"
@@ -225,6 +227,41 @@ std::vector<kestrel::process_status_t> status_examples() {
   s.messages_rejected = 1;
   return {s};
 }
+
+// The launcher's: the counts on its board, then the table it prints at the end.
+void convert_rejections(const kestrel::rejection_counts_t& m) {
+  const auto now = std::chrono::steady_clock::now();
+  launch::HealthBoard board;
+  board.started(m.name, m.pid, now);
+  board.rejections(m);
+  const std::string table = board.rejections_table();
+  for (const char c : table) {
+    const auto u = static_cast<unsigned char>(c);
+    if ((u < 0x20 && c != '\n') || u == 0x7f) defect("lcm-rejection_counts_t", "a control byte reached the rejections table");
+  }
+}
+std::vector<kestrel::rejection_counts_t> rejections_examples() {
+  kestrel::rejection_counts_t r{};
+  r.utime = 1700000000000000;
+  r.name = "estimator";
+  r.pid = 4242;
+  r.rejected = 3;
+  kestrel::rejection_reason_t a{};
+  a.channel = "IMU";
+  a.reason = "accelerometer # m/s^2 beyond the sensor's range of # m/s^2";
+  a.count = 2;
+  a.last = "accelerometer 500 m/s^2 beyond the sensor's range of 160 m/s^2";
+  kestrel::rejection_reason_t b{};
+  b.channel = "VO_UPDATE";
+  b.reason = "reference keyframe # is unknown";
+  b.count = 1;
+  b.last = "reference keyframe 1700000000 is unknown";
+  r.reasons = {a, b};
+  r.num_reasons = 2;
+  return {r, kestrel::rejection_counts_t{}};
+}
+
+std::vector<kestrel::rejection_reason_t> reason_examples() { return rejections_examples().front().reasons; }
 
 std::vector<kestrel::replay_ack_t> ack_examples() {
   kestrel::replay_ack_t a{};
@@ -433,6 +470,10 @@ std::vector<Target> message_targets() {
       {"lcm-pose_t", "a pose_t with covariance", &run_message<pose_t, &convert_pose>, &encoded<pose_t, &pose_examples>},
       {"lcm-process_status_t", "PROCESS_STATUS, as kestrel launch shows it",
        &run_message<process_status_t, &convert_status>, &encoded<process_status_t, &status_examples>},
+      {"lcm-rejection_counts_t", "PROCESS_REJECTIONS, as kestrel launch shows it",
+       &run_message<rejection_counts_t, &convert_rejections>, &encoded<rejection_counts_t, &rejections_examples>},
+      {"lcm-rejection_reason_t", "a rejection_reason_t (decoded only)",
+       &run_message<rejection_reason_t, &decode_only<rejection_reason_t>>, &encoded<rejection_reason_t, &reason_examples>},
       {"lcm-replay_ack_t", "REPLAY_ACK (decoded only)", &run_message<replay_ack_t, &decode_only<replay_ack_t>>,
        &encoded<replay_ack_t, &ack_examples>},
       {"lcm-replay_control_t", "REPLAY_CONTROL (decoded only)",

@@ -15,6 +15,7 @@ inline constexpr const char* kPlanRequest = "PLAN_REQUEST";     // plan_request_
 inline constexpr const char* kPlan = "PLAN";                    // plan_t
 inline constexpr const char* kVehicleCommand = "VEHICLE_COMMAND"; // vehicle_command_t
 inline constexpr const char* kProcessStatus = "PROCESS_STATUS"; // process_status_t
+inline constexpr const char* kProcessRejections = "PROCESS_REJECTIONS"; // rejection_counts_t
 inline constexpr const char* kReplayControl = "REPLAY_CONTROL"; // replay_control_t
 inline constexpr const char* kReplayAck = "REPLAY_ACK";         // replay_ack_t
 

@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <csignal>
@@ -36,6 +37,8 @@ void install_signal_handlers() {
   }();
   (void)installed;
 }
+
+bool is_digit(char c) { return c >= '0' && c <= '9'; }
 
 int64_t wall_utime() {
   return std::chrono::duration_cast<std::chrono::microseconds>(
@@ -80,6 +83,41 @@ constexpr size_t kMaxChannelChars = LCM_MAX_CHANNEL_NAME_LENGTH;  // LCM refuses
 int64_t steady_microseconds() {
   const auto since_origin = std::chrono::steady_clock::now().time_since_epoch();
   return std::chrono::duration_cast<std::chrono::microseconds>(since_origin).count();
+}
+
+std::string rejection_reason_class(const std::string& reason) {
+  std::string out;
+  out.reserve(reason.size());
+  size_t i = 0;
+  while (i < reason.size()) {
+    const char c = reason[i];
+    // A number starts with a digit, or a sign or point before one, not inside a word ("x2").
+    const bool word_before = i > 0 && (std::isalnum(static_cast<unsigned char>(reason[i - 1])) || reason[i - 1] == '_');
+    size_t j = i;
+    if ((c == '-' || c == '+') && j + 1 < reason.size()) ++j;
+    if (reason[j] == '.' && j + 1 < reason.size()) ++j;
+    if (word_before || !is_digit(reason[j])) {
+      out += c;
+      ++i;
+      continue;
+    }
+    j = i + ((c == '-' || c == '+') ? 1 : 0);
+    while (j < reason.size() &&
+           (is_digit(reason[j]) || (reason[j] == '.' && j + 1 < reason.size() && is_digit(reason[j + 1]))))
+      ++j;
+    // An exponent: e or E, an optional sign, digits.
+    if (j + 1 < reason.size() && (reason[j] == 'e' || reason[j] == 'E')) {
+      size_t k = j + 1;
+      if (reason[k] == '-' || reason[k] == '+') ++k;
+      if (k < reason.size() && is_digit(reason[k])) {
+        while (k < reason.size() && is_digit(reason[k])) ++k;
+        j = k;
+      }
+    }
+    out += '#';
+    i = j;
+  }
+  return out;
 }
 
 std::string channel_name_problem(const std::string& channel) {
@@ -191,6 +229,12 @@ void Node::reject(const std::string& channel, const std::string& why) {
   const std::string reason = printable_reason(without_channel(channel, why));
   if (should_log(nth)) spdlog::warn("rejected message #{} on {}: {}", nth, channel, reason);
   rejecting_[channel] = Rejection{clock_(), counters_.messages_rejected, reason, false};
+  auto& classes = reasons_[channel];
+  std::string kind = rejection_reason_class(reason);
+  if (!classes.count(kind) && classes.size() >= kMaxReasonsPerChannel) kind = "other reasons";
+  ReasonCount& c = classes[kind];
+  ++c.count;
+  c.last = reason;
   publish_heartbeat_if_state_changed();
 }
 
@@ -323,6 +367,21 @@ void Node::maybe_heartbeat() {
   publish_heartbeat();
 }
 
+std::vector<kestrel::rejection_reason_t> Node::rejection_counts() const {
+  std::vector<kestrel::rejection_reason_t> out;
+  for (const auto& [channel, classes] : reasons_) {
+    for (const auto& [kind, c] : classes) {
+      kestrel::rejection_reason_t r;
+      r.channel = channel;
+      r.reason = kind;
+      r.count = c.count;
+      r.last = c.last;
+      out.push_back(std::move(r));
+    }
+  }
+  return out;
+}
+
 void Node::publish_heartbeat() {
   kestrel::process_status_t s;
   s.utime = wall_utime();
@@ -342,6 +401,15 @@ void Node::publish_heartbeat() {
   s.messages_rejected = counters_.messages_rejected;
   s.last_input_utime = counters_.last_input_utime;
   lcm_.publish(channel::kProcessStatus, &s);
+  if (reasons_.empty()) return;
+  kestrel::rejection_counts_t r;
+  r.utime = s.utime;
+  r.name = name_;
+  r.pid = s.pid;
+  r.rejected = counters_.messages_rejected;
+  r.reasons = rejection_counts();
+  r.num_reasons = static_cast<int32_t>(r.reasons.size());
+  lcm_.publish(channel::kProcessRejections, &r);
 }
 
 }  // namespace kestrel::transport

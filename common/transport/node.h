@@ -8,6 +8,10 @@
 //  * A message that cannot be decoded as the subscribed type, or whose handler throws
 //    InputError, is dropped, counted in the heartbeat and logged as one line naming the
 //    channel (rate-limited); the process carries on.
+//  * Every rejection is counted by channel and reason class (rejection_reason_class: the
+//    reason with its numbers replaced by '#', at most kMaxReasonsPerChannel classes a channel,
+//    the rest counted together); once anything was rejected, PROCESS_REJECTIONS
+//    (rejection_counts_t) goes out with every heartbeat with all the counts so far.
 //  * PROCESS_STATUS is published about once per heartbeat period with the counters, the
 //    subscribed and advertised channels, and the health set by set_health() - except while
 //    input is being rejected: then the state is DEGRADED and the message names the last
@@ -45,6 +49,7 @@
 
 #include "common/transport/message.h"
 #include "kestrel/process_status_t.hpp"
+#include "kestrel/rejection_counts_t.hpp"
 #include "kestrel/replay_control_t.hpp"
 
 namespace kestrel::transport {
@@ -55,6 +60,11 @@ struct NodeCounters {
   int64_t messages_rejected = 0;
   int64_t last_input_utime = 0;
 };
+
+/// A rejection's reason as a kind of fault: every number in it (integer, decimal, exponent,
+/// with its sign) becomes '#', so that "accelerometer 512.3 m/s^2" and "accelerometer 600
+/// m/s^2" count as one reason.
+std::string rejection_reason_class(const std::string& reason);
 
 /// Microseconds on the steady (monotonic) clock: the clock a Node measures time on by default.
 int64_t steady_microseconds();
@@ -127,6 +137,11 @@ class Node {
   bool stopping() const;
 
   const NodeCounters& counters() const { return counters_; }
+  /// Reason classes counted per channel; beyond this many on one channel, the rest are counted
+  /// as one ("other reasons"), so a stream of varied garbage cannot grow the message unbounded.
+  static constexpr size_t kMaxReasonsPerChannel = 16;
+  /// The counts PROCESS_REJECTIONS carries, sorted by channel then reason.
+  std::vector<kestrel::rejection_reason_t> rejection_counts() const;
   const std::string& name() const { return name_; }
   lcm::LCM& lcm() { return lcm_; }
 
@@ -174,6 +189,11 @@ class Node {
   int8_t reported_state_ = kestrel::process_status_t::STATE_STARTING;  // in the last heartbeat
   NodeCounters counters_;
   std::map<std::string, int64_t> rejections_per_channel_;
+  struct ReasonCount {
+    int64_t count = 0;
+    std::string last;
+  };
+  std::map<std::string, std::map<std::string, ReasonCount>> reasons_;  // channel -> class -> count
   std::map<std::string, Rejection> rejecting_;  // channels being rejected
   bool stopping_ = false;
 

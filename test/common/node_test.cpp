@@ -4,6 +4,7 @@
 // replay depends on.
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <ostream>
 #include <string>
@@ -15,6 +16,7 @@
 #include "common/transport/channels.h"
 #include "common/transport/node.h"
 #include "kestrel/imu_t.hpp"
+#include "kestrel/rejection_counts_t.hpp"
 #include "kestrel/replay_ack_t.hpp"
 #include "kestrel/vo_update_t.hpp"
 
@@ -84,6 +86,80 @@ TEST(Node, HeartbeatListsChannelsAndCounters) {
   EXPECT_EQ(s.subscriptions, std::vector<std::string>{"IMU"});
   EXPECT_NE(std::find(s.publications.begin(), s.publications.end(), "OUT"), s.publications.end());
   EXPECT_EQ(s.messages_in, 1);
+}
+
+// Every rejection counted by channel and kind of fault: the same fault with other numbers is
+// one reason, and PROCESS_REJECTIONS carries the counts with the latest rejection in full.
+TEST(Node, RejectionsAreCountedPerChannelAndReasonAndSentWithTheHeartbeat) {
+  Node node("counts", "memq://", 0.0);
+  Tap<kestrel::rejection_counts_t> counts(node.lcm(), channel::kProcessRejections);
+  node.subscribe<kestrel::imu_t>("IMU", [&](const kestrel::imu_t& m) {
+    if (m.utime < 0) throw InputError("accelerometer " + std::to_string(-m.utime) + ".5 m/s^2 beyond 160 m/s^2");
+  });
+  node.publish("IMU", imu(1));
+  drain(node);
+  EXPECT_TRUE(counts.got.empty()) << "nothing was refused: no PROCESS_REJECTIONS";
+  node.publish("IMU", imu(-500));
+  node.publish("IMU", imu(-1200));
+  const uint8_t garbage[3] = {1, 2, 3};
+  node.lcm().publish("IMU", garbage, 3);
+  node.publish("IMU", imu(-700));
+  drain(node);
+  ASSERT_FALSE(counts.got.empty());
+  const kestrel::rejection_counts_t& last = counts.got.back();
+  EXPECT_EQ(last.name, "counts");
+  EXPECT_EQ(last.pid, static_cast<int32_t>(::getpid()));
+  EXPECT_EQ(last.rejected, 4);
+  ASSERT_EQ(last.num_reasons, 2);
+  ASSERT_EQ(last.reasons.size(), 2u);
+  int64_t total = 0;
+  for (const auto& r : last.reasons) {
+    EXPECT_EQ(r.channel, "IMU");
+    total += r.count;
+    if (r.reason == "accelerometer # m/s^# beyond # m/s^#") {
+      EXPECT_EQ(r.count, 3);
+      EXPECT_EQ(r.last, "accelerometer 700.5 m/s^2 beyond 160 m/s^2");
+    } else {
+      EXPECT_EQ(r.count, 1) << r.reason;
+      EXPECT_NE(r.reason.find("too short"), std::string::npos) << r.reason;
+    }
+  }
+  EXPECT_EQ(total, 4);
+  EXPECT_EQ(node.rejection_counts().size(), 2u);
+}
+
+// Beyond kMaxReasonsPerChannel kinds on one channel the rest are counted together: a stream of
+// varied garbage cannot grow the message without bound.
+TEST(Node, ReasonsBeyondTheCapAreCountedTogether) {
+  Node node("cap", "memq://", 0.0);
+  const std::vector<std::string> words = {"alpha", "bravo", "charlie", "delta", "echo", "foxtrot", "golf",
+                                          "hotel", "india", "juliet", "kilo", "lima", "mike", "november",
+                                          "oscar", "papa", "quebec", "romeo", "sierra", "tango"};
+  node.subscribe<kestrel::imu_t>("IMU", [&](const kestrel::imu_t& m) {
+    throw InputError("fault " + words[static_cast<size_t>(m.utime) % words.size()]);
+  });
+  for (size_t i = 0; i < words.size(); ++i) node.publish("IMU", imu(static_cast<int64_t>(i)));
+  drain(node);
+  const auto counts = node.rejection_counts();
+  ASSERT_EQ(counts.size(), Node::kMaxReasonsPerChannel + 1);
+  int64_t total = 0, other = 0;
+  for (const auto& r : counts) {
+    total += r.count;
+    if (r.reason == "other reasons") other = r.count;
+  }
+  EXPECT_EQ(total, static_cast<int64_t>(words.size()));
+  EXPECT_EQ(other, static_cast<int64_t>(words.size() - Node::kMaxReasonsPerChannel));
+}
+
+TEST(RejectionReasonClass, NumbersBecomeHashesAndWordsStay) {
+  EXPECT_EQ(rejection_reason_class("accelerometer 512.25 m/s^2"), "accelerometer # m/s^#");
+  EXPECT_EQ(rejection_reason_class("utime -3 is negative"), "utime # is negative");
+  EXPECT_EQ(rejection_reason_class("gyro 1e300 rad/s, 1.5E-3 and +7"), "gyro # rad/s, # and #");
+  EXPECT_EQ(rejection_reason_class("range .5 m."), "range # m.");
+  EXPECT_EQ(rejection_reason_class("frame x2 of CAM3D"), "frame x2 of CAM3D");
+  EXPECT_EQ(rejection_reason_class("offset 12 ms - late"), "offset # ms - late");
+  EXPECT_EQ(rejection_reason_class("byte \\x1b"), "byte \\x1b");
+  EXPECT_EQ(rejection_reason_class(""), "");
 }
 
 TEST(Node, LockstepAcknowledgesEveryInputWithItsOutputs) {

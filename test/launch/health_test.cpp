@@ -76,6 +76,48 @@ TEST(HealthBoard, TheTableEscapesBytesThatDoNotPrint) {
   EXPECT_NE(table.find("be\\x08yond s\\xEA\\xA5 range\\nnext"), std::string::npos) << table;
 }
 
+rejection_reason_t reason(const std::string& channel, const std::string& kind, int64_t count, const std::string& last) {
+  rejection_reason_t r;
+  r.channel = channel;
+  r.reason = kind;
+  r.count = count;
+  r.last = last;
+  return r;
+}
+
+// What each process refused, under its launch name (matched by pid), each reason with its
+// count and the latest one in full, escaped; nothing refused, no table; a restart starts over.
+TEST(HealthBoard, TheRejectionsTableNamesEachProcessChannelAndReason) {
+  HealthBoard board(3.0);
+  const auto t0 = Clock::now();
+  board.started("estimator", 101, t0);
+  board.started("vo", 102, t0);
+  EXPECT_EQ(board.rejections_table(), "");
+  rejection_counts_t c{};
+  c.name = "estimator";
+  c.pid = 101;
+  c.rejected = 4;
+  c.reasons = {reason("IMU", "accelerometer # m/s^# beyond # m/s^#", 3, "accelerometer 700.5 m/s^2 beyond 160 m/s^2"),
+               reason("VO_UPDATE", "reference keyframe # is \x1b unknown", 1, "reference keyframe 12 is \x1b unknown")};
+  c.num_reasons = 2;
+  board.rejections(c);
+  const std::string table = board.rejections_table();
+  EXPECT_NE(table.find("rejected by"), std::string::npos) << table;
+  EXPECT_EQ(std::count(table.begin(), table.end(), '\n'), 5) << table;  // header, two lines per reason
+  EXPECT_NE(table.find("estimator        IMU                       3  accelerometer # m/s^# beyond # m/s^#"),
+            std::string::npos)
+      << table;
+  EXPECT_NE(table.find("last: accelerometer 700.5 m/s^2 beyond 160 m/s^2"), std::string::npos) << table;
+  EXPECT_EQ(table.find("vo "), std::string::npos) << "vo refused nothing:\n" << table;
+  for (const char ch : table) {
+    const auto u = static_cast<unsigned char>(ch);
+    EXPECT_FALSE((u < 0x20 && ch != '\n') || u >= 0x7f) << "byte " << int(u) << " in:\n" << table;
+  }
+  board.ended("estimator", "killed by SIGKILL", t0 + milliseconds(10));
+  board.started("estimator", 201, t0 + milliseconds(20));
+  EXPECT_EQ(board.rejections_table(), "") << "the restarted estimator has refused nothing yet";
+}
+
 TEST(HealthBoard, ASourceWithoutHeartbeatsIsRunningUntilItEnds) {
   HealthBoard board(3.0);
   const auto t0 = Clock::now();

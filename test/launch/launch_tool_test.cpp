@@ -12,6 +12,7 @@
 #include <regex>
 #include <thread>
 
+#include "common/transport/log_file.h"
 #include "test/replay/fixtures.h"
 #include "test/support/test_support.h"
 
@@ -139,6 +140,31 @@ TEST_F(LaunchTool, TheLaunchEndsWithItsSource) {
     ASSERT_TRUE(code.has_value());
     EXPECT_EQ(*code, 1) << l->err();
   }
+}
+
+// A process that refused input: when the launch ends, its table names the process, the
+// channel, how many of each kind and the latest in full (PROCESS_REJECTIONS). The source
+// replays three undecodable frames, then plays on past a heartbeat period so that the count
+// of all three has been sent.
+TEST_F(LaunchTool, TheLaunchEndsWithATableOfWhatEachProcessRefused) {
+  const std::string log = (dir / "bad.lcmlog").string();
+  {
+    transport::LogWriter w(log);
+    for (int i = 0; i < 3; ++i) w.write("CAMERA_RGBD", 1'000'000 + 100'000 * i, std::vector<uint8_t>(5 + i, 0x42));
+    w.write("UNHEARD", 3'500'000, {1});
+    w.close();
+  }
+  auto l = launch({"--source", tool("replay").string() + " " + log + " --realtime"});
+  const auto code = l->wait_exit(30);
+  ASSERT_TRUE(code.has_value()) << l->err();
+  EXPECT_EQ(*code, 0) << l->err();
+  const std::string out = l->out();
+  const size_t table = out.find("rejected by");
+  ASSERT_NE(table, std::string::npos) << out;
+  const std::regex row(R"(codec-a +CAMERA_RGBD +3  # bytes are too short for any message)");
+  EXPECT_TRUE(std::regex_search(out.substr(table), row)) << out.substr(table);
+  EXPECT_NE(out.find("last: 7 bytes are too short for any message", table), std::string::npos) << out.substr(table);
+  EXPECT_EQ(out.find("codec-b", table), std::string::npos) << "codec-b refused nothing:\n" << out.substr(table);
 }
 
 TEST_F(LaunchTool, ASourceThatEndsIsNeverSaidToRestart) {

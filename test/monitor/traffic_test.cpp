@@ -20,7 +20,7 @@ std::vector<uint8_t> imu_bytes(int64_t utime) {
 }
 
 TEST(MessageTypes, KnowEveryKestrelTypeByNameAndFingerprint) {
-  EXPECT_EQ(kestrel_types().size(), 19u);  // one per file in lcmtypes/
+  EXPECT_EQ(kestrel_types().size(), 21u);  // one per file in lcmtypes/
   ASSERT_NE(find_type("imu_t"), nullptr);
   EXPECT_EQ(find_type("kestrel.imu_t"), find_type("imu_t"));
   EXPECT_EQ(find_type("nothing_t"), nullptr);
@@ -35,7 +35,8 @@ TEST(MessageTypes, DefaultTableCoversTheReadmeChannels) {
   const auto table = default_channel_types();
   EXPECT_EQ(table.at("CAMERA_RGBD"), find_type("rgbd_frame_t"));
   EXPECT_EQ(table.at("PROCESS_STATUS"), find_type("process_status_t"));
-  EXPECT_EQ(table.size(), 14u);
+  EXPECT_EQ(table.at("PROCESS_REJECTIONS"), find_type("rejection_counts_t"));
+  EXPECT_EQ(table.size(), 15u);
   for (const auto& [channel, type] : table) EXPECT_NE(type, nullptr) << channel;
 }
 

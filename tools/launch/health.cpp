@@ -42,19 +42,42 @@ void HealthBoard::cpu(const std::string& name, double cpu_s) {
   if (it != entries_.end() && !it->second.ended) it->second.cpu_s = cpu_s;
 }
 
-void HealthBoard::heartbeat(const process_status_t& status, Clock::time_point now) {
+HealthBoard::Entry& HealthBoard::entry_of(pid_t pid, const std::string& name) {
   // By pid first: a launched process may call itself anything.
   auto it = std::find_if(entries_.begin(), entries_.end(), [&](const auto& kv) {
-    return kv.second.launched && kv.second.pid == status.pid && !kv.second.ended;
+    return kv.second.launched && kv.second.pid == pid && !kv.second.ended;
   });
   if (it == entries_.end()) {
-    const std::string key = status.name + " (not launched here)";
+    const std::string key = name + " (not launched here)";
     if (!entries_.count(key)) order_.push_back(key);
     it = entries_.emplace(key, Entry{}).first;
-    it->second.pid = status.pid;
+    it->second.pid = pid;
   }
-  it->second.last = status;
-  it->second.last_at = now;
+  return it->second;
+}
+
+void HealthBoard::heartbeat(const process_status_t& status, Clock::time_point now) {
+  Entry& e = entry_of(status.pid, status.name);
+  e.last = status;
+  e.last_at = now;
+}
+
+void HealthBoard::rejections(const rejection_counts_t& counts) { entry_of(counts.pid, counts.name).rejections = counts; }
+
+std::string HealthBoard::rejections_table() const {
+  std::string s;
+  for (const auto& name : order_) {
+    const Entry& e = entries_.at(name);
+    if (!e.rejections) continue;
+    for (const rejection_reason_t& r : e.rejections->reasons) {
+      // Any bytes a process (or a corrupt message) put there: escaped, as in table().
+      s += fmt::format("{:<16} {:<18} {:>8}  {}\n{:<16} {:<18} {:>8}  last: {}\n", cli::printable(name),
+                       cli::printable(r.channel), r.count, cli::printable(r.reason), "", "", "",
+                       cli::printable(r.last));
+    }
+  }
+  if (s.empty()) return s;
+  return fmt::format("{:<16} {:<18} {:>8}  {}\n", "rejected by", "channel", "count", "reason") + s;
 }
 
 std::vector<HealthBoard::Row> HealthBoard::rows(Clock::time_point now) const {

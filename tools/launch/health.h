@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "kestrel/process_status_t.hpp"
+#include "kestrel/rejection_counts_t.hpp"
 
 namespace kestrel::launch {
 
@@ -35,6 +36,8 @@ class HealthBoard {
   /// The CPU time (s) a running process has used so far.
   void cpu(const std::string& name, double cpu_s);
   void heartbeat(const process_status_t& status, Clock::time_point now);
+  /// A process's rejection counts (PROCESS_REJECTIONS), matched like its heartbeat.
+  void rejections(const rejection_counts_t& counts);
 
   struct Row {
     std::string name;
@@ -49,6 +52,9 @@ class HealthBoard {
   std::vector<Row> rows(Clock::time_point now) const;
   /// One line per process: name, pid, messages in/out/rejected, CPU s and %, state, message.
   std::string table(Clock::time_point now) const;
+  /// What each process refused, by channel and reason, with the count and the latest one in
+  /// full; "" when nothing was refused. A restarted process's table starts again.
+  std::string rejections_table() const;
   /// True once every started, running process has sent a RUNNING heartbeat.
   bool all_running(Clock::time_point now) const;
 
@@ -58,12 +64,17 @@ class HealthBoard {
     Clock::time_point since{};
     std::optional<process_status_t> last;
     Clock::time_point last_at{};
+    std::optional<rejection_counts_t> rejections;
     std::optional<std::string> ended;
     Clock::time_point ended_at{};
     double cpu_s = -1.0;
     bool launched = false;
     bool heartbeats = true;
   };
+  // The entry of the process with this pid (a launched one still running), else one kept
+  // under "<name> (not launched here)".
+  Entry& entry_of(pid_t pid, const std::string& name);
+
   double silent_after_s_;
   std::map<std::string, Entry> entries_;  // by launch name
   std::vector<std::string> order_;

@@ -75,6 +75,18 @@ struct HeartbeatListener {
   }
 };
 
+struct RejectionsListener {
+  HealthBoard* board;
+  void handle(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+    try {
+      board->rejections(kestrel::transport::decode_message<kestrel::rejection_counts_t>(rbuf->data, rbuf->data_size,
+                                                                                       channel));
+    } catch (const kestrel::InputError& e) {
+      spdlog::warn("{}", e.what());
+    }
+  }
+};
+
 int launch(const Options& o) {
   const ProcessSet declared = read_process_sets(o.sets_file);  // a bad file: InputError, exit 3
   ProcessSet set;
@@ -129,6 +141,7 @@ int launch(const Options& o) {
   const std::string url = kestrel::transport::resolve_lcm_url(o.lcm_url);
   HealthBoard board;
   HeartbeatListener listener{&board};
+  RejectionsListener rejections_listener{&board};
   // One LCM per side with --link (each opens its sockets in the namespace it is made and
   // subscribed in), else one.
   std::vector<std::unique_ptr<lcm::LCM>> lcms;
@@ -143,6 +156,7 @@ int launch(const Options& o) {
       return kestrel::kExitUnavailable;
     }
     lcms.back()->subscribe(kestrel::channel::kProcessStatus, &HeartbeatListener::handle, &listener);
+    lcms.back()->subscribe(kestrel::channel::kProcessRejections, &RejectionsListener::handle, &rejections_listener);
   }
 
   SupervisorOptions so;
@@ -241,6 +255,7 @@ int launch(const Options& o) {
   if (interrupted) spdlog::info("stopping on SIG{}", sigabbrev_np(kestrel::interrupt_signal()));
   report(supervisor.stop_all(), true);
   fmt::print("{}", board.table(Clock::now()));
+  if (const std::string rejected = board.rejections_table(); !rejected.empty()) fmt::print("\n{}", rejected);
   if (kestrel::interrupt_signal() == SIGINT) return kestrel::kExitInterrupted;
   if (source_ending) return source_ending->code == 0 && !unexpected_end ? kestrel::kExitOk : kestrel::kExitFailure;
   return unexpected_end ? kestrel::kExitFailure : kestrel::kExitOk;

@@ -13,6 +13,8 @@
 #include "kestrel/pose3_t.hpp"
 #include "kestrel/pose_t.hpp"
 #include "kestrel/process_status_t.hpp"
+#include "kestrel/rejection_counts_t.hpp"
+#include "kestrel/rejection_reason_t.hpp"
 #include "kestrel/replay_ack_t.hpp"
 #include "kestrel/replay_control_t.hpp"
 #include "kestrel/rgbd_frame_t.hpp"
@@ -50,7 +52,8 @@ const std::vector<MessageType>& kestrel_types() {
       type_of<kestrel::imu_t>(),             type_of<kestrel::octomap_t>(),
       type_of<kestrel::plan_request_t>(),    type_of<kestrel::plan_t>(),
       type_of<kestrel::pose3_t>(),           type_of<kestrel::pose_t>(),
-      type_of<kestrel::process_status_t>(),  type_of<kestrel::replay_ack_t>(),
+      type_of<kestrel::process_status_t>(),  type_of<kestrel::rejection_counts_t>(),
+      type_of<kestrel::rejection_reason_t>(), type_of<kestrel::replay_ack_t>(),
       type_of<kestrel::replay_control_t>(),  type_of<kestrel::rgbd_frame_t>(),
       type_of<kestrel::slam_correction_t>(), type_of<kestrel::slam_edge_t>(),
       type_of<kestrel::slam_graph_t>(),      type_of<kestrel::slam_keyframe_t>(),
@@ -86,6 +89,7 @@ std::map<std::string, const MessageType*> default_channel_types() {
       {ch::kPlanRequest, "plan_request_t"},       {ch::kPlan, "plan_t"},
       {ch::kVehicleCommand, "vehicle_command_t"}, {ch::kProcessStatus, "process_status_t"},
       {ch::kReplayControl, "replay_control_t"},   {ch::kReplayAck, "replay_ack_t"},
+      {ch::kProcessRejections, "rejection_counts_t"},
   };
   std::map<std::string, const MessageType*> map;
   for (const auto& [channel, type] : table) map[channel] = find_type(type);
