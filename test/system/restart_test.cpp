@@ -89,9 +89,15 @@ std::optional<Eigen::Vector3d> true_camera_position(const std::map<int64_t, Eige
 // `kestrel launch --restart` and kills `victim` once the flight's ground truth has reached 7 s
 // (by the pid of the victim's heartbeat, since other tests' processes may run beside it).
 // `channels` are recorded in dir/live.lcmlog; the launcher's output is dir/launch.log, the
-// processes' logs are in dir/logs.
+// processes' logs are in dir/logs. With `down`, the flight's time (GROUND_TRUTH utime) at
+// the kill and when the restarted victim's first heartbeat came: the window in which it heard
+// nothing, which depends on the machine's load.
+struct DownWindow {
+  int64_t from_utime = 0;
+  int64_t to_utime = 0;
+};
 void fly_and_kill(const test::TempDir& dir, const std::string& processes, const std::string& victim,
-                  const std::vector<std::string>& channels) {
+                  const std::vector<std::string>& channels, DownWindow* down = nullptr) {
   const std::string source = (dir / "source.lcmlog").string();
   const auto sim = test::run({test::tool("sim").string(), "--world", "room", "--flight", "figure8", "--duration",
                               "16", "--seed", "1", "--log", source, "-q"},
@@ -113,7 +119,21 @@ void fly_and_kill(const test::TempDir& dir, const std::string& processes, const 
         channel::kGroundTruth, [&](const kestrel::ground_truth_t& m) { return m.utime >= kill_at; }, 60.0,
         "the flight's 7th second"))
         << live.output("launch");
+    const size_t killed_at = live.received();
     test::LiveSystem::kill_pid(pid, SIGKILL);
+    if (down) {
+      down->from_utime = kill_at;
+      const auto back = live.wait_for<kestrel::process_status_t>(
+          channel::kProcessStatus,
+          [&](const kestrel::process_status_t& s) { return s.name == victim && s.pid != pid; }, 60.0,
+          "the restarted " + victim + "'s heartbeat", killed_at);
+      ASSERT_TRUE(back.has_value()) << live.output("launch");
+      const auto now = live.wait_for<kestrel::ground_truth_t>(
+          channel::kGroundTruth, [](const kestrel::ground_truth_t&) { return true; }, 30.0,
+          "the flight after the restart", live.received());
+      ASSERT_TRUE(now.has_value());
+      down->to_utime = now->utime;
+    }
     const int status = live.exit_status("launch", 200.0);
     live.finish();
     ASSERT_EQ(status, 0) << live.output("launch");
@@ -256,7 +276,8 @@ TEST(System, AMapperKilledInFlightComesBackWithItsMapFromTheJournal) {
   if (const std::string why = test::LiveSystem::isolate(); !why.empty())
     KESTREL_SKIP_ENVIRONMENT() << "no network namespace available: " << why;
   test::TempDir dir;
-  ASSERT_NO_FATAL_FAILURE(fly_and_kill(dir, "vo,estimator,slam,mapper", "mapper", {"SLAM_GRAPH", "MAP_OCTOMAP"}));
+  DownWindow down;
+  ASSERT_NO_FATAL_FAILURE(fly_and_kill(dir, "vo,estimator,slam,mapper", "mapper", {"SLAM_GRAPH", "MAP_OCTOMAP"}, &down));
   const std::string mapper = test::read_file(dir / "logs" / "mapper.log");
 
   kestrel::slam_graph_t last_graph;
@@ -290,7 +311,18 @@ TEST(System, AMapperKilledInFlightComesBackWithItsMapFromTheJournal) {
               after.back().size);
   EXPECT_EQ(rejected, 0) << mapper;
   EXPECT_GE(restored, 6) << "the keyframes of the first 7 s";
-  EXPECT_GE(restored + inserted, last_graph.num_keyframes - 6) << "only those made while the mapper was down are missing";
+  // Missing may be the keyframes whose frames came while no mapper listened: from a second
+  // before the kill (SLAM makes a keyframe a little after its frame) to the new mapper's first
+  // heartbeat. That window is 1-2 s on an idle machine and longer under load.
+  const int64_t missable = std::count_if(last_graph.keyframes.begin(), last_graph.keyframes.end(), [&](const auto& k) {
+    return k.utime >= down.from_utime - 1'000'000 && k.utime <= down.to_utime;
+  });
+  std::printf("mapper down from %.2f s to %.2f s after SLAM's first keyframe: %lld keyframes made meanwhile\n",
+              1e-6 * static_cast<double>(down.from_utime - last_graph.keyframes.front().utime),
+              1e-6 * static_cast<double>(down.to_utime - last_graph.keyframes.front().utime),
+              static_cast<long long>(missable));
+  EXPECT_GE(restored + inserted, last_graph.num_keyframes - missable)
+      << "only those made while the mapper was down are missing";
   // The first map of the restarted mapper is the map it had, published at once.
   EXPECT_GE(after.front().size, 0.9 * before.back().size);
   EXPECT_GE(after.back().size, after.front().size);
