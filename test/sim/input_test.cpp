@@ -61,7 +61,7 @@ TEST(WorldFileTest, AGeometryOnlyWorldAnswersCollisionQueriesAsTheWholeOne) {
   EXPECT_EQ(geometry.lights().size(), whole.lights().size());
   EXPECT_TRUE(geometry.bounds().isApprox(whole.bounds()));
   EXPECT_EQ(geometry.start(), whole.start());
-  for (const Eigen::Vector3d p : {Eigen::Vector3d(1.0, 1.0, 1.0), Eigen::Vector3d(2.0, 1.5, 0.5), Eigen::Vector3d(3.5, 0.2, 2.0)}) {
+  for (const Eigen::Vector3d& p : {Eigen::Vector3d(1.0, 1.0, 1.0), Eigen::Vector3d(2.0, 1.5, 0.5), Eigen::Vector3d(3.5, 0.2, 2.0)}) {
     EXPECT_EQ(geometry.clearance(p), whole.clearance(p));
     EXPECT_EQ(geometry.is_free(p, 0.2), whole.is_free(p, 0.2));
   }
