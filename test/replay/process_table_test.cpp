@@ -43,6 +43,15 @@ TEST(ProcessTable, KnowsConsumersAndPublishersWithoutProtocolChannels) {
   EXPECT_EQ(describe(table)[2], "vo (pid 1): CAMERA_RGBD -> VO_UPDATE");
 }
 
+// Heartbeats and rejection counts are telemetry of the processes, not their output: a
+// recording of a replay must not hold them (they carry the wall clock and, for the counts,
+// what earlier runs refused, so two replays of one log would differ).
+TEST(ProcessTable, TelemetryAndProtocolChannelsAreNotData) {
+  for (const char* c : {"PROCESS_STATUS", "PROCESS_REJECTIONS", "REPLAY_CONTROL", "REPLAY_ACK"})
+    EXPECT_TRUE(is_protocol_channel(c)) << c;
+  for (const char* c : {"STATE", "IMU", "PROCESS_STATUS_X"}) EXPECT_FALSE(is_protocol_channel(c)) << c;
+}
+
 TEST(ProcessTable, AProcessRemovedIsNoLongerAConsumerNorMissingFromOthers) {
   ProcessTable table;
   table.update(heartbeat("est", 3, {"IMU"}, {"STATE"}), 0.0);

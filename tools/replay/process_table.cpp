@@ -26,8 +26,8 @@ std::string cell(const std::vector<std::string>& items) {
 }  // namespace
 
 bool is_protocol_channel(const std::string& channel) {
-  return channel == channel::kProcessStatus || channel == channel::kReplayControl ||
-         channel == channel::kReplayAck;
+  return channel == channel::kProcessStatus || channel == channel::kProcessRejections ||
+         channel == channel::kReplayControl || channel == channel::kReplayAck;
 }
 
 bool ProcessTable::update(const kestrel::process_status_t& status, double now_s) {

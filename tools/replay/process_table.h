@@ -16,8 +16,8 @@
 
 namespace kestrel::replay {
 
-/// Channels of the replay protocol and heartbeats: never replayed, recorded or counted as
-/// data, whoever lists them.
+/// Channels of the replay protocol, heartbeats and rejection counts (telemetry stamped with
+/// the wall clock): never replayed, recorded or counted as data, whoever lists them.
 bool is_protocol_channel(const std::string& channel);
 
 struct ProcessInfo {
