@@ -159,5 +159,24 @@ TEST(HealthBoard, AProcessThatNeverBeatsIsNamed) {
   EXPECT_NE(table.find("no heartbeat"), std::string::npos);
 }
 
+// The launcher starts its source once this is empty: any heartbeat counts (a process waiting
+// for data says STARTING), a source that never beats and a process that ended do not wait.
+TEST(HealthBoard, NotYetHeardNamesTheProcessesStillToSendTheirFirstHeartbeat) {
+  HealthBoard board(3.0);
+  const auto t0 = Clock::now();
+  board.started("vo", 1, t0);
+  board.started("estimator", 2, t0);
+  board.started("mapper", 3, t0);
+  board.started("source", 4, t0, /*heartbeats=*/false);
+  EXPECT_EQ(board.not_yet_heard(), (std::vector<std::string>{"vo", "estimator", "mapper"}));
+  board.heartbeat(beat("estimator", 2, process_status_t::STATE_STARTING), t0 + milliseconds(100));
+  board.ended("mapper", "exited with status 1", t0 + milliseconds(200));
+  EXPECT_EQ(board.not_yet_heard(), std::vector<std::string>{"vo"});
+  board.heartbeat(beat("vo", 1, process_status_t::STATE_DEGRADED), t0 + milliseconds(300));
+  EXPECT_TRUE(board.not_yet_heard().empty());
+  board.started("vo", 5, t0 + milliseconds(400));  // restarted: its new pid has not beaten
+  EXPECT_EQ(board.not_yet_heard(), std::vector<std::string>{"vo"});
+}
+
 }  // namespace
 }  // namespace kestrel::launch

@@ -138,4 +138,13 @@ bool HealthBoard::all_running(Clock::time_point now) const {
   return true;
 }
 
+std::vector<std::string> HealthBoard::not_yet_heard() const {
+  std::vector<std::string> out;
+  for (const auto& name : order_) {
+    const Entry& e = entries_.at(name);
+    if (e.launched && !e.ended && e.heartbeats && !e.last) out.push_back(name);
+  }
+  return out;
+}
+
 }  // namespace kestrel::launch

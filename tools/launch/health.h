@@ -57,6 +57,10 @@ class HealthBoard {
   std::string rejections_table() const;
   /// True once every started, running process has sent a RUNNING heartbeat.
   bool all_running(Clock::time_point now) const;
+  /// The started, still running processes that heartbeat but have not sent one yet. A
+  /// process's first heartbeat follows its subscriptions, so once this is empty nothing a
+  /// source sends goes unheard.
+  std::vector<std::string> not_yet_heard() const;
 
  private:
   struct Entry {

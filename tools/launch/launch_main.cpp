@@ -5,6 +5,7 @@
 // that process ends.
 
 #include <fmt/chrono.h>
+#include <fmt/ranges.h>
 #include <poll.h>
 #include <sched.h>
 #include <signal.h>
@@ -219,8 +220,13 @@ int launch(const Options& o) {
     }
   };
 
-  // Consumers first, the source last, so that nothing it sends is lost.
-  report(supervisor.start_all(), false);
+  // Consumers first; the source once each has sent its first heartbeat (its subscriptions
+  // are made by then), so that nothing it sends is lost to a process still starting.
+  constexpr const char* kSource = "source";
+  report(supervisor.start_all(kSource), false);
+  const bool has_source = supervisor.find(kSource) != nullptr;
+  bool source_started = !has_source;
+  const auto source_deadline = Clock::now() + std::chrono::seconds(15);
   auto next_status = Clock::now() + std::chrono::duration_cast<Clock::duration>(
                                         std::chrono::duration<double>(o.status_period_s));
   bool announced_healthy = false;
@@ -232,6 +238,15 @@ int launch(const Options& o) {
         if (fds[i].revents & POLLIN) lcms[i]->handle();
     report(supervisor.poll(), false);
     const auto now = Clock::now();
+    if (!source_started) {
+      const auto waiting = board.not_yet_heard();
+      if (waiting.empty() || now >= source_deadline) {
+        if (!waiting.empty())
+          spdlog::warn("starting the source although {} has sent no heartbeat in 15 s", fmt::join(waiting, ", "));
+        report(supervisor.start_all(), false);
+        source_started = true;
+      }
+    }
     if (!announced_healthy && board.all_running(now)) {
       announced_healthy = true;
       spdlog::info("all processes running");
@@ -254,6 +269,17 @@ int launch(const Options& o) {
   }
   if (interrupted) spdlog::info("stopping on SIG{}", sigabbrev_np(kestrel::interrupt_signal()));
   report(supervisor.stop_all(), true);
+  // Each process's last heartbeat and rejection counts, sent as it stopped, are still queued.
+  for (bool any = true; any;) {
+    any = false;
+    for (const auto& l : lcms) {
+      pollfd fd{l->getFileno(), POLLIN, 0};
+      if (::poll(&fd, 1, 0) > 0 && (fd.revents & POLLIN)) {
+        l->handle();
+        any = true;
+      }
+    }
+  }
   fmt::print("{}", board.table(Clock::now()));
   if (const std::string rejected = board.rejections_table(); !rejected.empty()) fmt::print("\n{}", rejected);
   if (kestrel::interrupt_signal() == SIGINT) return kestrel::kExitInterrupted;

@@ -139,10 +139,10 @@ ChildEvent Supervisor::start(Child& child) {
   return {ChildEvent::kStarted, child.spec.name, pid, {}};
 }
 
-std::vector<ChildEvent> Supervisor::start_all() {
+std::vector<ChildEvent> Supervisor::start_all(const std::string& except) {
   std::vector<ChildEvent> events;
   for (auto& c : children_)
-    if (c.pid < 0) events.push_back(start(c));
+    if (c.pid < 0 && c.spec.name != except) events.push_back(start(c));
   return events;
 }
 

@@ -86,8 +86,8 @@ class Supervisor {
   Supervisor(const Supervisor&) = delete;
   Supervisor& operator=(const Supervisor&) = delete;
 
-  /// Starts every child, in set order.
-  std::vector<ChildEvent> start_all();
+  /// Starts every child not yet running, in set order, except the one named `except`.
+  std::vector<ChildEvent> start_all(const std::string& except = "");
   /// Reaps ended children and performs due restarts; never blocks.
   std::vector<ChildEvent> poll(Clock::time_point now = Clock::now());
   /// SIGTERM to every running child in reverse start order, waits, then SIGKILL.
