@@ -48,7 +48,7 @@ double flight_duration_s(const std::vector<Eigen::Vector4d>& waypoints, double s
 }
 
 FlightRun fly(const FlightSetup& s, const fs::path& tool_dir, const std::string& lcm_url,
-              const std::function<bool()>& interrupted) {
+              const std::function<bool()>& interrupted, const FlightWatch& watch) {
   std::error_code ec;
   fs::create_directories(s.dir, ec);
   if (ec) throw InputError(s.dir.string() + ": cannot make the folder: " + ec.message());
@@ -72,9 +72,14 @@ FlightRun fly(const FlightSetup& s, const fs::path& tool_dir, const std::string&
                                   csv(s.start[0], s.start[1], s.start[2]) + fmt::format(",{:.6f}", s.start[3]),
                                   "--seed", std::to_string(s.seed), "--duration", fmt::format("{:.3f}", s.duration_s),
                                   "--lockstep", fmt::format("{}", s.ack_timeout_s), "--expect",
-                                  "vo,estimator,follow,slam,mapper", "--record", run.recording.string(),
-                                  // the map is large and not scored: its MAP_OCTOMAP stays out
-                                  "--record-channels", "STATE|VO_UPDATE|SLAM_GRAPH|SLAM_CORRECTION|VEHICLE_COMMAND"};
+                                  "vo,estimator,follow,slam,mapper"};
+  if (s.record) {
+    // the map is large and not scored: its MAP_OCTOMAP stays out
+    sim.insert(sim.end(), {"--record", run.recording.string(), "--record-channels",
+                           "STATE|VO_UPDATE|SLAM_GRAPH|SLAM_CORRECTION|VEHICLE_COMMAND"});
+  } else {
+    run.recording.clear();
+  }
   if (!s.map.empty()) sim.insert(sim.end(), {"--map", s.map});
   set.push_back({"sim", sim, "source"});
   std::vector<fs::path> executables;
@@ -101,7 +106,9 @@ FlightRun fly(const FlightSetup& s, const fs::path& tool_dir, const std::string&
   while (!sim_ending && !interrupted()) {
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
     note(supervisor.poll(), false);
+    if (watch && !sim_ending) watch(supervisor, false);
   }
+  if (watch && sim_ending) watch(supervisor, true);
   note(supervisor.stop_all(), true);
   run.contacts = read_contacts(s.dir / "sim.log");
   if (interrupted()) {

@@ -8,7 +8,8 @@
 // The caller has made the network private (tools/launch/isolation.h) and gives the folder of
 // the kestrel tools. Everything of the flight stays in its folder: waypoints.txt, each
 // process's log (<name>.log) and the recording flight.lcmlog (GROUND_TRUTH and what the
-// processes published, but the map).
+// processes published, but the map). A watcher (`kestrel soak`) can look at the processes
+// while they fly.
 
 #include <Eigen/Core>
 
@@ -17,6 +18,8 @@
 #include <functional>
 #include <string>
 #include <vector>
+
+#include "tools/launch/supervisor.h"
 
 namespace kestrel::flights {
 
@@ -30,19 +33,26 @@ struct FlightSetup {
   double speed_m_s = 0.5;      ///< the follower's cruise speed
   double ack_timeout_s = 60.0;  ///< lock-step: longest wait for a process
   std::filesystem::path dir;    ///< made if absent
+  /// Write flight.lcmlog; a long flight goes without (STATE alone is ~0.4 MB per second).
+  bool record = true;
 };
 
 struct FlightRun {
   bool ok = false;      ///< every process ran to the end, the simulator exited 0
   std::string failure;  ///< else why, naming the process and its last log lines
   int contacts = -1;    ///< the simulator's count of touches of the world
-  std::filesystem::path recording;
+  std::filesystem::path recording;  ///< flight.lcmlog; empty when not recorded
 };
+
+/// Called on the flight's thread about every 50 ms while the processes run (their names and
+/// pids: Supervisor::children(), pid -1 once one has ended), and once more with `ending` true
+/// when the simulator has ended, before the others are stopped.
+using FlightWatch = std::function<void(const launch::Supervisor& processes, bool ending)>;
 
 /// Runs the flight; returns once the simulated `duration_s` is flown (or `interrupted()`).
 /// Throws InputError when a tool is missing or the folder cannot be written.
 FlightRun fly(const FlightSetup& setup, const std::filesystem::path& tool_dir, const std::string& lcm_url,
-              const std::function<bool()>& interrupted);
+              const std::function<bool()>& interrupted, const FlightWatch& watch = {});
 
 /// The flight time a plan needs: its length at `speed_m_s`, a margin for the turns, the
 /// controller's lag and the start, and a hold at the goal.
