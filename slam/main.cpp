@@ -55,6 +55,13 @@ void add_options(cli::App& app, Options& o, SlamOptions& s) {
       ->check(CLI::NonNegativeNumber)->capture_default_str();
   app.add_option("--keyframe-angle", s.keyframes.min_rotation_rad, "New keyframe after this rotation, rad")
       ->check(CLI::NonNegativeNumber)->capture_default_str();
+  app.add_flag("--reuse-keyframes,!--no-reuse-keyframes", s.coverage.reuse_keyframes,
+               "Where a keyframe already covers the view, locate the frame in it instead of making a new "
+               "keyframe (memory grows with the ground covered, not the time flown)")
+      ->capture_default_str();
+  app.add_option("--reuse-max-correction", s.coverage.max_correction_m,
+                 "A frame is located in a covering keyframe only within this of its estimate, m (more: a loop closure)")
+      ->check(CLI::NonNegativeNumber)->capture_default_str();
   app.add_option("--loop-min-age", s.loops.min_age_s, "Loop candidates are at least this much older, s")
       ->check(CLI::NonNegativeNumber)->capture_default_str();
   app.add_option("--loop-max-distance", s.loops.max_distance_m,
@@ -120,7 +127,8 @@ int run_offline(const Options& o, const SlamOptions& options, std::shared_ptr<co
   std::cout << "frames: " << sequence.size() << ", with a pose: " << run.slam.size() << "\n"
             << "keyframes: " << run.keyframes << ", loop closures: " << run.loop_closures
             << " (" << run.candidates_verified << " candidates verified, " << run.inconsistent_loops
-            << " verified but refused by the odometry check)\n";
+            << " verified but refused by the odometry check), re-anchored on a covering keyframe: "
+            << run.reanchors << "\n";
   if (!ms.empty()) {
     std::cout << "ms per keyframe: median " << ms[ms.size() / 2] << ", p95 " << ms[ms.size() * 95 / 100]
               << ", max " << ms.back() << "\n";
@@ -176,9 +184,10 @@ int serve(const Options& o, const SlamOptions& options, std::shared_ptr<const Vo
   spdlog::info("{}: {} + {} -> {}, {}", o.name, o.adapter.camera_channel, o.adapter.vo_channel,
                o.graph_channel, o.correction_channel);
   const int status = node->spin();
-  spdlog::info("{} keyframes, {} loop closures, {} VO restarts bridged by the estimator, {} estimator restarts, "
-               "{} messages rejected",
-               adapter.slam().keyframes().size(), adapter.slam().num_loop_closures(), adapter.bridges(),
+  spdlog::info("{} keyframes, {} loop closures, {} frames re-anchored on a covering keyframe, {} VO restarts "
+               "bridged by the estimator, {} estimator restarts, {} messages rejected",
+               adapter.slam().keyframes().size(), adapter.slam().num_loop_closures(), adapter.slam().num_reanchors(),
+               adapter.bridges(),
                adapter.estimator_restarts(), node->counters().messages_rejected);
   return status;
 }

@@ -27,13 +27,20 @@ SlamRun run_slam_sequence(size_t count, const std::function<RgbdFrame(size_t)>& 
   OdometryChain chain;
   Slam slam(options, std::move(vocabulary));
   SlamRun run;
+  // Each reference SLAM's odometry went from (a keyframe, or a frame re-anchored on one), and
+  // each frame with the reference it came after.
+  struct Reference {
+    OdometryReference reference;
+    bool continues_previous;  // one odometry segment from the previous reference to this one
+  };
+  std::vector<Reference> references;
   struct Placed {
     int64_t utime;
-    int keyframe;                        // newest keyframe when the frame came
-    Eigen::Isometry3d T_keyframe_camera;  // odometry since that keyframe
+    size_t reference;
+    Eigen::Isometry3d T_odom_camera;
   };
   std::vector<Placed> placed;
-  std::optional<OdometryPose> keyframe_pose;  // the chain's pose of the newest keyframe
+  std::optional<OdometryPose> reference_pose;  // the chain's pose of SLAM's reference
   std::optional<OdometryPose> previous_pose;  // the chain's pose of the previous frame with one
   for (size_t i = 0; i < count; ++i) {
     const RgbdFrame frame = frame_at(i);
@@ -65,30 +72,31 @@ SlamRun run_slam_sequence(size_t count, const std::function<RgbdFrame(size_t)>& 
       }
       const auto t0 = std::chrono::steady_clock::now();
       std::optional<Matrix6d> odometry_covariance;
-      if (link == OdometryLink::kContinuous && keyframe_pose) {
-        odometry_covariance = chain.relative_covariance(*keyframe_pose, *pose);
+      if (link == OdometryLink::kContinuous && reference_pose) {
+        odometry_covariance = chain.relative_covariance(*reference_pose, *pose);
       }
       const SlamStep step = slam.add(frame, pose->T_odom_camera, link, odometry_covariance, motion, sensor);
-      if (step.keyframe) keyframe_pose = *pose;
+      if (step.keyframe || step.reanchored) {
+        reference_pose = *pose;
+        references.push_back({slam.reference(), !references.empty() && link == OdometryLink::kContinuous});
+      }
       run.keyframe_ms.push_back(
           std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
       run.candidates_verified += step.candidates;
     }
-    const Keyframe& kf = slam.keyframes().back();
     run.vo.push_back(frame.utime, pose->T_odom_camera);
-    placed.push_back({frame.utime, static_cast<int>(kf.id), kf.T_odom_camera.inverse() * pose->T_odom_camera});
+    if (!references.empty()) placed.push_back({frame.utime, references.size() - 1, pose->T_odom_camera});
   }
+  // Each reference's odometry frame placed by the final graph; a frame moves between its
+  // reference's correction and the next's (place_frame).
   std::vector<KeyframeCorrection> corrections;
-  for (size_t k = 0; k < slam.keyframes().size(); ++k) {
-    const Keyframe& kf = slam.keyframes()[k];
-    corrections.push_back({kf.utime, slam.graph().poses[k] * kf.T_odom_camera.inverse(),
-                           k > 0 && kf.link == OdometryLink::kContinuous});
+  for (const Reference& r : references) {
+    const Eigen::Isometry3d T_world_reference =
+        slam.graph().poses[static_cast<size_t>(r.reference.keyframe_id)] * r.reference.T_keyframe_camera;
+    corrections.push_back({r.reference.utime, T_world_reference * r.reference.T_odom_camera.inverse(),
+                           r.continues_previous});
   }
-  for (const Placed& p : placed) {
-    const auto k = static_cast<size_t>(p.keyframe);
-    run.slam.push_back(p.utime, place_frame(corrections, k, p.utime,
-                                            slam.keyframes()[k].T_odom_camera * p.T_keyframe_camera));
-  }
+  for (const Placed& p : placed) run.slam.push_back(p.utime, place_frame(corrections, p.reference, p.utime, p.T_odom_camera));
   for (const auto& e : slam.graph().edges) {
     if (e.kind != EdgeKind::kLoopClosure) continue;
     run.loops.push_back({slam.keyframes()[static_cast<size_t>(e.from)].utime,
@@ -96,6 +104,7 @@ SlamRun run_slam_sequence(size_t count, const std::function<RgbdFrame(size_t)>& 
   }
   run.keyframes = static_cast<int>(slam.keyframes().size());
   run.loop_closures = slam.num_loop_closures();
+  run.reanchors = slam.num_reanchors();
   run.inconsistent_loops = slam.num_inconsistent_loops();
   return run;
 }

@@ -31,6 +31,7 @@ struct SlamRun {
   Trajectory slam;                 ///< the same frames placed by the optimised keyframe graph
   int keyframes = 0;
   int loop_closures = 0;
+  int reanchors = 0;               ///< frames located in a covering keyframe instead of becoming one
   int candidates_verified = 0;
   int inconsistent_loops = 0;      ///< verified loops refused as disagreeing with the odometry
   std::vector<double> keyframe_ms; ///< SLAM time per keyframe (features, loop search, optimisation)
@@ -45,19 +46,20 @@ struct LoopError {
   double rotation_rad = 0.0;
 };
 
-/// What the optimised graph says of the odometry at one keyframe: T_world_odom, the pose the
-/// graph gives the keyframe times the inverse of the odometry's.
+/// What the optimised graph says of the odometry at one reference (a keyframe, or a frame
+/// re-anchored on one: Slam::reference()): T_world_odom, the pose the graph gives it times the
+/// inverse of the odometry's.
 struct KeyframeCorrection {
   int64_t utime = 0;
   Eigen::Isometry3d T_world_odom = Eigen::Isometry3d::Identity();
-  bool continues_previous = false;  ///< one odometry segment from the previous keyframe to this one
+  bool continues_previous = false;  ///< one odometry segment from the previous reference to this one
 };
 
-/// A frame's pose by the graph: `T_odom_camera` after `keyframes[newest]` (the newest keyframe
-/// at its time, at or before `utime`), corrected by the keyframes' T_world_odom interpolated by
-/// time between that keyframe and the next, when the next continues its odometry segment;
-/// else by the keyframe's own. The odometry's error grows from each keyframe, so a loop's
-/// correction is spread along the segment instead of arriving as a jump at the next keyframe.
+/// A frame's pose by the graph: `T_odom_camera` after `keyframes[newest]` (the newest reference
+/// at its time, at or before `utime`), corrected by the references' T_world_odom interpolated by
+/// time between that reference and the next, when the next continues its odometry segment;
+/// else by the reference's own. The odometry's error grows from each reference, so a correction
+/// is spread along the segment instead of arriving as a jump at the next reference.
 Eigen::Isometry3d place_frame(const std::vector<KeyframeCorrection>& keyframes, size_t newest, int64_t utime,
                               const Eigen::Isometry3d& T_odom_camera);
 

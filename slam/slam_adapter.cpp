@@ -31,7 +31,7 @@ void SlamAdapter::reset() {
   odometry_fix_ = Eigen::Isometry3d::Identity();
   last_pose_.reset();
   previous_chained_.reset();
-  keyframe_pose_.reset();
+  reference_pose_.reset();
   bridges_ = 0;
   last_state_seq_ = -1;
   restart_correction_due_ = false;
@@ -169,9 +169,9 @@ std::optional<Eigen::Isometry3d> SlamAdapter::state_at(int64_t utime, bool ok_on
   return se3::interpolate(before->T_world_body, after->T_world_body, fraction);
 }
 
-void SlamAdapter::remember(const FramePose& frame, bool keyframe) {
+void SlamAdapter::remember(const FramePose& frame, bool reference) {
   if (anchored_) return;
-  if (keyframe) recent_.clear();  // world_pose() composes from the newest keyframe on
+  if (reference) recent_.clear();  // world_pose() composes from the newest reference on
   recent_.push_back(frame);
   while (static_cast<int>(recent_.size()) > options_.buffer_frames) recent_.pop_front();
 }
@@ -225,8 +225,8 @@ AdapterOutputs SlamAdapter::process(const kestrel::rgbd_frame_t& message, const 
   }
   const RgbdFrame frame = transport::decode_rgbd(message, options_.camera_channel.c_str());
   std::optional<Matrix6d> odometry_covariance;
-  if (link == OdometryLink::kContinuous && keyframe_pose_) {
-    odometry_covariance = chain_.relative_covariance(*keyframe_pose_, chained);
+  if (link == OdometryLink::kContinuous && reference_pose_) {
+    odometry_covariance = chain_.relative_covariance(*reference_pose_, chained);
   }
   // The features' timing: the odometry's motion from the previous update (not across a restart).
   const sensors::SensorProfile& sensor = options_.sensor ? *options_.sensor : sensors::profile_of_sensor(frame.sensor);
@@ -236,20 +236,22 @@ AdapterOutputs SlamAdapter::process(const kestrel::rgbd_frame_t& message, const 
                              waiting.previous_utime, waiting.T_previous_current);
   }
   const SlamStep step = slam_.add(frame, pose.T_odom_camera, link, odometry_covariance, motion, sensor);
-  if (step.keyframe) keyframe_pose_ = chained;
+  const bool new_reference = step.keyframe || step.reanchored;
+  if (new_reference) reference_pose_ = chained;
   lost_break_ = false;
-  remember(*last_pose_, step.keyframe);
-  if (!step.keyframe) {
+  remember(*last_pose_, new_reference);
+  if (!new_reference) {
     try_anchor(out);
     return out;
   }
-  out.graph = graph_message(slam_);
+  if (step.keyframe) out.graph = graph_message(slam_);
   out.step = step;
   try_anchor(out);
   // A correction is a pose in the estimator's world: none before the graph is anchored in it
-  // (in SLAM's odometry frame it would pull the state by the frames' difference).
+  // (in SLAM's odometry frame it would pull the state by the frames' difference). A frame
+  // re-anchored on the map is located in it: that is a correction too.
   const bool new_estimator_waits = restart_correction_due_ && message.utime >= restart_state_utime_;
-  if ((step.optimisation || new_estimator_waits) && anchored_) {
+  if ((step.optimisation || step.reanchored || new_estimator_waits) && anchored_) {
     out.correction = correction_message(slam_, options_.correction_sigma_m, options_.correction_sigma_rad);
     if (new_estimator_waits) restart_correction_due_ = false;
   }
@@ -259,8 +261,8 @@ AdapterOutputs SlamAdapter::process(const kestrel::rgbd_frame_t& message, const 
 void SlamAdapter::correct_new_estimator(int64_t utime, const ChainedPose& chained, OdometryLink link,
                                         AdapterOutputs& out) {
   if (!restart_correction_due_ || !anchored_ || utime < restart_state_utime_) return;
-  if (link != OdometryLink::kContinuous || !keyframe_pose_ || !last_pose_) return;
-  const std::optional<Matrix6d> odometry = chain_.relative_covariance(*keyframe_pose_, chained.pose);
+  if (link != OdometryLink::kContinuous || !reference_pose_ || !last_pose_) return;
+  const std::optional<Matrix6d> odometry = chain_.relative_covariance(*reference_pose_, chained.pose);
   if (!odometry) return;
   out.correction = correction_message(
       slam_, options_.correction_sigma_m, options_.correction_sigma_rad,

@@ -7,11 +7,11 @@
 // estimator's world (that one is gravity-aligned and fixed when the filter starts, maybe
 // seconds after the first frame). SLAM_CORRECTION poses are applied by the estimator as poses
 // in its own world, and the mapper's map must be in the frame the vehicle flies in, so the
-// first frame since the newest keyframe that the estimator's STATE covers (an OK state with
+// first frame since SLAM's newest reference (keyframe or re-anchored frame) that the estimator's STATE covers (an OK state with
 // its roll and pitch settled, or a visual-only one, whose tilt nothing re-measures, on each
 // side of its utime, at most max_state_gap_s apart, or the
 // newest carried on by its velocities for up to max_state_extrapolation_s) anchors the graph: the graph is moved
-// rigidly so that this frame's pose (the newest keyframe's composed with the odometry since)
+// rigidly so that this frame's pose (the reference's composed with the odometry since)
 // is the estimator's pose then. A hovering vehicle makes no keyframe after the first, so any
 // frame must do. Without STATE (offline runs) the world stays the odometry frame, and no
 // SLAM_CORRECTION is published until the graph is anchored: the estimator applies one as a
@@ -20,7 +20,7 @@
 // Estimator restarts: a restarted estimator (its STATE seq starts again) begins a world of its
 // own; SLAM keeps the map's, drops the old filter's states, and sends a SLAM_CORRECTION for the
 // next frame it processes that is not older than the new filter's first state (the pose of
-// the newest keyframe composed with the odometry since, Slam::world_pose), which the new
+// SLAM's reference composed with the odometry since, Slam::world_pose), which the new
 // filter takes as the map's world (estimator.h) without waiting for a loop closure, nor for a
 // keyframe, which a hovering vehicle never makes. Where the odometry since the keyframe has
 // no covariance (the VO restarted since), the correction waits for the next keyframe.
@@ -79,8 +79,8 @@ struct AdapterOptions {
 
 struct AdapterOutputs {
   std::optional<kestrel::slam_graph_t> graph;            ///< after a new keyframe or optimisation
-  std::optional<kestrel::slam_correction_t> correction;  ///< after an optimisation, or for a new estimator
-  std::optional<SlamStep> step;                          ///< what SLAM did (a keyframe was made)
+  std::optional<kestrel::slam_correction_t> correction;  ///< after an optimisation or a re-anchoring, or for a new estimator
+  std::optional<SlamStep> step;                          ///< what SLAM did (a keyframe was made or a frame re-anchored)
   bool anchored = false;  ///< the graph was just moved into the estimator's world
 };
 
@@ -124,8 +124,8 @@ class SlamAdapter {
   void trim_frames();
   /// Drops waiting poses [begin, end), remembering an odometry break among them.
   void drop_poses(std::map<int64_t, ChainedPose>::iterator end);
-  /// Keeps a processed frame for anchoring (frames since the newest keyframe).
-  void remember(const FramePose& frame, bool keyframe);
+  /// Keeps a processed frame for anchoring (frames since SLAM's newest reference).
+  void remember(const FramePose& frame, bool reference);
   /// Anchors the graph at the newest remembered frame that STATE brackets; fills `out`.
   void try_anchor(AdapterOutputs& out);
   /// The correction a new estimator waits for, at the frame just processed (not a keyframe;
@@ -150,14 +150,14 @@ class SlamAdapter {
   };
   std::deque<StateSample> states_;  ///< the last max_bridge_s (+1 s) of states
   std::optional<FramePose> last_pose_;  ///< the last processed frame
-  std::optional<OdometryPose> keyframe_pose_;  ///< the chain's pose of the newest keyframe
+  std::optional<OdometryPose> reference_pose_;  ///< the chain's pose of SLAM's reference (Slam::reference())
   Eigen::Isometry3d odometry_fix_ = Eigen::Isometry3d::Identity();  ///< chain -> SLAM's odometry frame
   int bridges_ = 0;
   int64_t last_state_seq_ = -1;
   bool restart_correction_due_ = false;  ///< a new estimator waits for the map's world
   int64_t restart_state_utime_ = 0;      ///< the new estimator's first state
   int estimator_restarts_ = 0;
-  std::deque<FramePose> recent_;  ///< frames since the newest keyframe, until anchored
+  std::deque<FramePose> recent_;  ///< frames since the newest reference, until anchored
 };
 
 }  // namespace kestrel::slam

@@ -72,27 +72,34 @@ Matrix6d body_covariance(const Eigen::Isometry3d& T_world_body, const Eigen::Iso
 kestrel::slam_correction_t correction_message(const Slam& slam, double sigma_translation_m,
                                               double sigma_rotation_rad,
                                               const std::optional<FrameSinceKeyframe>& frame) {
-  const Keyframe& kf = slam.keyframes().back();
+  const OdometryReference& reference = slam.reference();
+  const Keyframe& kf = slam.keyframes().at(static_cast<size_t>(reference.keyframe_id));
   kestrel::slam_correction_t m{};
-  m.utime = frame ? frame->utime : kf.utime;
+  m.utime = frame ? frame->utime : reference.utime;
   m.keyframe_id = published_id(slam, kf.id);
   m.graph_revision = published_revision(slam);
-  const Eigen::Isometry3d T_keyframe_camera =
-      frame ? kf.T_odom_camera.inverse() * frame->T_odom_camera : Eigen::Isometry3d::Identity();
-  const Eigen::Isometry3d T_body_camera = frame ? frame->T_body_camera : kf.T_body_camera;
-  const Eigen::Isometry3d T_world_body = slam.graph().poses.back() * T_keyframe_camera * T_body_camera.inverse();
+  // The camera in the reference frame, and in the reference's keyframe.
+  const Eigen::Isometry3d T_reference_camera =
+      frame ? reference.T_odom_camera.inverse() * frame->T_odom_camera : Eigen::Isometry3d::Identity();
+  const Eigen::Isometry3d T_keyframe_camera = reference.T_keyframe_camera * T_reference_camera;
+  const Eigen::Isometry3d T_body_camera = frame ? frame->T_body_camera : reference.T_body_camera;
+  const Eigen::Isometry3d T_world_body =
+      slam.graph().poses.at(static_cast<size_t>(kf.id)) * T_keyframe_camera * T_body_camera.inverse();
   m.T_world_body = transport::to_message(T_world_body);
-  // T_world_camera = T_world_keyframe * T_keyframe_camera: a right perturbation xi of the
-  // keyframe's pose is Ad(T_keyframe_camera^-1) xi of the camera's, and the odometry's own adds.
+  // T_world_camera = T_world_keyframe * T_keyframe_reference * T_reference_camera: a right
+  // perturbation of each factor is carried to the camera by the adjoint of the inverse of what
+  // follows it (the keyframe's marginal, the re-anchoring's covariance), and the odometry's own adds.
   const Matrix6d A = se3::adjoint(T_keyframe_camera.inverse());
-  const Matrix6d odometry = frame ? frame->odometry_covariance : Matrix6d::Zero();
+  const Matrix6d B = se3::adjoint(T_reference_camera.inverse());
+  const Matrix6d odometry = (frame ? frame->odometry_covariance : Matrix6d::Zero()) +
+                            B * reference.covariance * B.transpose();
   Matrix6d covariance = Matrix6d::Zero();
-  if (const auto& marginal = slam.newest_covariance()) {
+  if (const auto& marginal = slam.reference_marginal()) {
     covariance = body_covariance(T_world_body, T_body_camera, A * *marginal * A.transpose() + odometry);
   } else {
     covariance.diagonal().head<3>().setConstant(sigma_translation_m * sigma_translation_m);
     covariance.diagonal().tail<3>().setConstant(sigma_rotation_rad * sigma_rotation_rad);
-    if (frame) covariance += body_covariance(T_world_body, T_body_camera, odometry);
+    covariance += body_covariance(T_world_body, T_body_camera, odometry);
   }
   transport::covariance_to(covariance, m.covariance);
   return m;

@@ -39,9 +39,9 @@ kestrel::slam_graph_t graph_message(const Slam& slam);
 Matrix6d body_covariance(const Eigen::Isometry3d& T_world_body, const Eigen::Isometry3d& T_body_camera,
                          const Matrix6d& camera_covariance);
 
-/// A frame after the newest keyframe, for a correction at that frame: its pose in SLAM's
+/// A frame after SLAM's reference (Slam::reference()), for a correction at that frame: its pose in SLAM's
 /// odometry frame (the one the keyframes have), its camera mounting, and the covariance of the
-/// odometry's motion from the newest keyframe to it (right perturbation [rho; phi],
+/// odometry's motion from the reference to it (right perturbation [rho; phi],
 /// OdometryChain::relative_covariance).
 struct FrameSinceKeyframe {
   int64_t utime = 0;
@@ -50,13 +50,14 @@ struct FrameSinceKeyframe {
   Matrix6d odometry_covariance = Matrix6d::Zero();
 };
 
-/// The correction for the newest keyframe, or, given `frame`, for that frame (Slam::world_pose:
-/// the keyframe's optimised pose composed with the odometry since); the slam must have a
-/// keyframe. keyframe_id names the newest keyframe either way. Its covariance is the
-/// optimiser's marginal of that keyframe (Slam::newest_covariance), carried along the odometry
-/// to the frame with the odometry's own covariance added, then to the body frame in pose_t's
-/// convention; when there is no marginal, a diagonal one of the given standard deviations
-/// (metres, radians) stands for the keyframe's.
+/// The correction for SLAM's reference (the newest keyframe, or the frame re-anchored on a
+/// covering keyframe: Slam::reference()), or, given `frame`, for that later frame
+/// (Slam::world_pose: the reference's optimised pose composed with the odometry since, whose
+/// covariance frame->odometry_covariance is). keyframe_id names the reference's keyframe. Its
+/// covariance is the optimiser's marginal of that keyframe (Slam::reference_marginal) and the
+/// re-anchoring's, carried to the frame with the odometry's own added, then to the body frame
+/// in pose_t's convention; when there is no marginal, a diagonal one of the given standard
+/// deviations (metres, radians) stands for the keyframe's. The slam must have a keyframe.
 kestrel::slam_correction_t correction_message(const Slam& slam, double sigma_translation_m,
                                               double sigma_rotation_rad,
                                               const std::optional<FrameSinceKeyframe>& frame = std::nullopt);

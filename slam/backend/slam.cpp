@@ -1,9 +1,11 @@
 #include "slam/backend/slam.h"
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "common/error.h"
 #include "common/geometry/se3.h"
@@ -18,6 +20,10 @@ void check_options(const SlamOptions& o) {
   };
   require(o.keyframes.min_translation_m >= 0.0 && o.keyframes.min_rotation_rad >= 0.0,
           "keyframe thresholds must be >= 0");
+  const CoverageOptions& c = o.coverage;
+  require(c.max_translation_m >= 0.0 && c.max_rotation_rad >= 0.0 && c.max_correction_m >= 0.0 &&
+              c.max_correction_rad >= 0.0 && c.max_candidates >= 1,
+          "coverage distances must be >= 0 and max_candidates >= 1");
   require(o.loops.min_age_s >= 0.0, "loops.min_age_s must be >= 0");
   require(o.loops.max_candidates >= 1, "loops.max_candidates must be >= 1");
   const OdometryNoise& n = o.odometry;
@@ -63,6 +69,32 @@ Matrix6d reported_odometry_information(const Matrix6d& covariance, const Odometr
   return 0.5 * (info + info.transpose());
 }
 
+// The pose graph's error of a right perturbation [rho; phi] of a measurement is [rho; phi / 2]
+// (spaces.h): covariance <-> information of an edge.
+Matrix6d error_scale() {
+  Matrix6d S = Matrix6d::Identity();
+  S.bottomRightCorner<3, 3>() *= 0.5;
+  return S;
+}
+Matrix6d right_covariance(const Matrix6d& information) {
+  const Matrix6d S_inv = error_scale().inverse();
+  const Matrix6d cov = S_inv * information.inverse() * S_inv;
+  return 0.5 * (cov + cov.transpose());
+}
+Matrix6d information_of(const Matrix6d& right_covariance) {
+  const Matrix6d S = error_scale();
+  const Matrix6d info = (S * right_covariance * S).inverse();
+  return 0.5 * (info + info.transpose());
+}
+
+// The information of Z = A * B from A's (right-perturbation covariance) and B's (an edge's
+// information): A Exp(a) B Exp(b) = A B Exp(Ad(B^-1) a) Exp(b).
+Matrix6d composed_information(const Eigen::Isometry3d& B, const Matrix6d& covariance_A, const Matrix6d& information_B) {
+  if (covariance_A.isZero(0.0)) return information_B;
+  const Matrix6d Ad = se3::adjoint(B.inverse());
+  return information_of(Ad * covariance_A * Ad.transpose() + right_covariance(information_B));
+}
+
 }  // namespace
 
 Matrix6d odometry_edge_information(const Eigen::Isometry3d& T_prev_cur, const OdometryNoise& noise, OdometryLink link,
@@ -94,7 +126,9 @@ void Slam::reset() {
   last_utime_ = 0;
   have_frame_ = false;
   gate_by_pose_ = true;
-  newest_covariance_.reset();
+  reference_marginal_.reset();
+  reference_ = OdometryReference{};
+  reanchors_ = 0;
 }
 
 void Slam::change_world(const Eigen::Isometry3d& T_new_world) {
@@ -107,24 +141,31 @@ bool Slam::wants_keyframe(const Eigen::Isometry3d& T_odom_camera, OdometryLink l
   if (!T_odom_camera.matrix().allFinite()) return false;
   // After a restart the earlier keyframe's odometry ends: the edge must span only the gap.
   if (keyframes_.empty() || link != OdometryLink::kContinuous) return true;
-  const Eigen::Isometry3d T_last_cur = keyframes_.back().T_odom_camera.inverse() * T_odom_camera;
+  const Eigen::Isometry3d T_last_cur = reference_.T_odom_camera.inverse() * T_odom_camera;
   return T_last_cur.translation().norm() >= options_.keyframes.min_translation_m ||
          so3::angle(T_last_cur.linear()) >= options_.keyframes.min_rotation_rad;
 }
 
-Eigen::Isometry3d Slam::world_pose(const Eigen::Isometry3d& T_odom_camera) const {
-  if (keyframes_.empty()) return T_odom_camera;
-  return graph_.poses.back() * keyframes_.back().T_odom_camera.inverse() * T_odom_camera;
+Eigen::Isometry3d Slam::reference_world_pose() const {
+  return graph_.poses[static_cast<size_t>(reference_.keyframe_id)] * reference_.T_keyframe_camera;
 }
 
-void Slam::add_odometry_edge(const Keyframe& previous, const Keyframe& current, OdometryLink link,
-                             const std::optional<Matrix6d>& covariance) {
+Eigen::Isometry3d Slam::world_pose(const Eigen::Isometry3d& T_odom_camera) const {
+  if (keyframes_.empty()) return T_odom_camera;
+  return reference_world_pose() * reference_.T_odom_camera.inverse() * T_odom_camera;
+}
+
+void Slam::add_odometry_edge(const Keyframe& current, OdometryLink link, const std::optional<Matrix6d>& covariance) {
   // After a break the odometry poses of the two are unrelated: assume no motion, weakly.
-  const Eigen::Isometry3d T_prev_cur = link == OdometryLink::kBroken
-                                           ? Eigen::Isometry3d::Identity()
-                                           : previous.T_odom_camera.inverse() * current.T_odom_camera;
-  graph_.add_edge(static_cast<int>(previous.id), static_cast<int>(current.id), T_prev_cur,
-                  odometry_edge_information(T_prev_cur, options_.odometry, link, covariance), EdgeKind::kOdometry);
+  const Eigen::Isometry3d T_ref_cur = link == OdometryLink::kBroken
+                                          ? Eigen::Isometry3d::Identity()
+                                          : reference_.T_odom_camera.inverse() * current.T_odom_camera;
+  // From the reference's keyframe: through the frame located in it, when re-anchored.
+  const Eigen::Isometry3d T_prev_cur = reference_.T_keyframe_camera * T_ref_cur;
+  const Matrix6d information = composed_information(
+      T_ref_cur, reference_.covariance, odometry_edge_information(T_ref_cur, options_.odometry, link, covariance));
+  graph_.add_edge(static_cast<int>(reference_.keyframe_id), static_cast<int>(current.id), T_prev_cur, information,
+                  EdgeKind::kOdometry);
   gate_information_.resize(graph_.edges.size() - 1, Matrix6d::Identity());
   gate_information_.push_back(odometry_information(T_prev_cur, options_.odometry, link));
 }
@@ -146,6 +187,11 @@ SlamStep Slam::add(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camer
   SlamStep step;
   if (!wants_keyframe(T_odom_camera, link)) return step;
 
+  FrameFeatures features = extractor_.extract(frame, motion);
+  if (link == OdometryLink::kContinuous && !keyframes_.empty() && options_.coverage.reuse_keyframes &&
+      reanchor(frame, T_odom_camera, odometry_covariance, features, sensor, step)) {
+    return step;
+  }
   Keyframe kf;
   kf.id = static_cast<int64_t>(keyframes_.size());
   kf.utime = frame.utime;
@@ -154,12 +200,13 @@ SlamStep Slam::add(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camer
   kf.T_camera_depth = motion.T_rgb_depth();
   kf.link = keyframes_.empty() ? OdometryLink::kContinuous : link;
   kf.sensor = sensor;
-  kf.features = extractor_.extract(frame, motion);
+  kf.features = std::move(features);
   const Eigen::Isometry3d T_world_camera =
       keyframes_.empty() ? T_odom_camera
-                         : (odometry_broken ? graph_.poses.back() : world_pose(T_odom_camera));
+                         : (odometry_broken ? reference_world_pose() : world_pose(T_odom_camera));
   graph_.add_vertex(kf.id, T_world_camera, keyframes_.empty());
-  if (!keyframes_.empty()) add_odometry_edge(keyframes_.back(), kf, link, odometry_covariance);
+  if (!keyframes_.empty()) add_odometry_edge(kf, link, odometry_covariance);
+  reference_ = OdometryReference{kf.id, kf.utime, kf.T_odom_camera, kf.T_body_camera};
   keyframes_.push_back(std::move(kf));
   step.keyframe = true;
   step.keyframe_id = keyframes_.back().id;
@@ -208,12 +255,70 @@ SlamStep Slam::close_loop(SlamStep step) {
     step.loop_keyframe_id = earlier.id;
     ++loop_closures_;
     step.optimisation = optimize(graph_, options_.optimizer);
-    newest_covariance_ = marginal_covariance(graph_, static_cast<int>(query.id), options_.optimizer.kernel);
+    reference_marginal_ = marginal_covariance(graph_, static_cast<int>(query.id), options_.optimizer.kernel);
     ++revision_;
     gate_by_pose_ = true;
     break;  // the paper stops at the first success
   }
   return step;
+}
+
+bool Slam::reanchor(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera,
+                    const std::optional<Matrix6d>& odometry_covariance, const FrameFeatures& features,
+                    const sensors::SensorProfile& sensor, SlamStep& step) {
+  const CoverageOptions& c = options_.coverage;
+  // After an odometry break the estimate is no guide to which keyframes are near.
+  if (!gate_by_pose_) return false;
+  const Eigen::Isometry3d T_world_frame = world_pose(T_odom_camera);
+  std::vector<std::pair<double, size_t>> covering;  // (distance in units of the bounds, keyframe)
+  for (size_t k = 0; k < keyframes_.size(); ++k) {
+    const double d = se3::translation_distance(graph_.poses[k], T_world_frame);
+    const double a = se3::rotation_distance(graph_.poses[k], T_world_frame);
+    if (d < c.max_translation_m && a < c.max_rotation_rad)
+      covering.emplace_back(d / std::max(c.max_translation_m, 1e-9) + a / std::max(c.max_rotation_rad, 1e-9), k);
+  }
+  std::sort(covering.begin(), covering.end());
+  if (static_cast<int>(covering.size()) > c.max_candidates) covering.resize(static_cast<size_t>(c.max_candidates));
+  for (const auto& [distance, k] : covering) {
+    const Keyframe& kf = keyframes_[k];
+    // The seed depends on the pair only, so that a replay verifies identically.
+    const uint64_t seed = static_cast<uint64_t>(kf.id) * 1000003u + static_cast<uint64_t>(frame.utime);
+    const LoopConstraint located =
+        verify_loop(features, kf.features, loop_verification(options_.verification, kf.sensor, sensor), seed);
+    if (!located.accepted) continue;
+    // The frame where the features put it, against where the map and the odometry expect it:
+    // a small difference is the drift since the reference; a large one is a loop to close.
+    const Eigen::Isometry3d T_expected_located =
+        (graph_.poses[k].inverse() * T_world_frame).inverse() * located.T_candidate_query;
+    if (T_expected_located.translation().norm() > c.max_correction_m ||
+        so3::angle(T_expected_located.linear()) > c.max_correction_rad) {
+      step.loop = located;
+      return false;
+    }
+    // The frame in keyframe k twice: predicted (the reference and the odometry since, with
+    // their covariances) and located (the features'); the reference becomes their fusion, so
+    // a precise odometry is not replaced by a coarser location, and drift is still bounded.
+    const Eigen::Isometry3d T_ref_frame = reference_.T_odom_camera.inverse() * T_odom_camera;
+    const Eigen::Isometry3d T_k_predicted = graph_.poses[k].inverse() * T_world_frame;
+    const Matrix6d Ad = se3::adjoint(T_ref_frame.inverse());
+    const Matrix6d odometry = right_covariance(
+        odometry_edge_information(T_ref_frame, options_.odometry, OdometryLink::kContinuous, odometry_covariance));
+    const Matrix6d predicted = Ad * reference_.covariance * Ad.transpose() + odometry;
+    const Matrix6d measured = right_covariance(located.information);
+    const Matrix6d gain = predicted * (predicted + measured).inverse();
+    const Eigen::Isometry3d T_k_frame = T_k_predicted * se3::exp(gain * se3::log(T_expected_located));
+    Matrix6d fused = (Matrix6d::Identity() - gain) * predicted;
+    fused = 0.5 * (fused + fused.transpose());
+    const auto marginal = marginal_covariance(graph_, static_cast<int>(k), options_.optimizer.kernel);
+    reference_ = OdometryReference{kf.id, frame.utime, T_odom_camera, frame.T_body_camera, T_k_frame, fused};
+    reference_marginal_ = marginal;
+    step.reanchored = true;
+    step.reanchor_keyframe_id = kf.id;
+    step.loop = located;
+    ++reanchors_;
+    return true;
+  }
+  return false;
 }
 
 }  // namespace kestrel::slam

@@ -10,11 +10,17 @@
 // estimated pose; the best candidates are verified geometrically, best first, and the first
 // that passes adds a loop-closure edge and the graph is optimised.
 //
+// Covered ground (CoverageOptions): a frame that would be a keyframe where an older keyframe
+// already sees the same view, and whose features place it in that keyframe within a small
+// correction of its estimate, becomes the odometry's reference instead of a keyframe
+// (re-anchoring): later frames and the next keyframe's edge are measured from it.
+//
 // Frames: "world" is the odometry frame of the first keyframe, so before any loop closure the
 // optimised poses equal the odometry poses, until change_world() moves the whole graph into
 // another frame (the process puts it in the state estimator's world, slam_adapter.h).
-// Invariants: keyframe k is vertex k of graph(); vertex 0 is fixed; edge k - 1 -> k is
-// odometry; revision() grows by one with every change of the optimised poses other than
+// Invariants: keyframe k is vertex k of graph(); vertex 0 is fixed; the edge into keyframe
+// k > 0 from its reference (the previous keyframe, or the keyframe re-anchored on before it)
+// is odometry; revision() grows by one with every change of the optimised poses other than
 // appending a keyframe.
 
 #include <Eigen/Geometry>
@@ -51,10 +57,25 @@ struct Keyframe {
   FrameFeatures features;
 };
 
+/// What the odometry since is measured from: the newest keyframe, or a later frame located in
+/// a covering keyframe (CoverageOptions).
+struct OdometryReference {
+  int64_t keyframe_id = -1;
+  int64_t utime = 0;                                          ///< the frame's
+  Eigen::Isometry3d T_odom_camera = Eigen::Isometry3d::Identity();  ///< the frame's odometry pose
+  Eigen::Isometry3d T_body_camera = Eigen::Isometry3d::Identity();
+  /// The frame in the keyframe (identity: the keyframe itself), and its covariance (right
+  /// perturbation [rho; phi]; zero for the keyframe itself).
+  Eigen::Isometry3d T_keyframe_camera = Eigen::Isometry3d::Identity();
+  Matrix6d covariance = Matrix6d::Zero();
+};
+
 /// What one call of Slam::add did.
 struct SlamStep {
   bool keyframe = false;          ///< the frame became a keyframe
   int64_t keyframe_id = -1;
+  bool reanchored = false;        ///< instead, it was located in a covering keyframe...
+  int64_t reanchor_keyframe_id = -1;  ///< ...this one (`loop` holds the constraint)
   int candidates = 0;             ///< loop candidates verified
   int inconsistent = 0;           ///< of them, verified but refused as disagreeing with the odometry
   bool loop_closed = false;
@@ -76,16 +97,16 @@ class Slam {
   /// std::invalid_argument naming an unusable option.
   explicit Slam(const SlamOptions& options = {}, std::shared_ptr<const Vocabulary> vocabulary = nullptr);
 
-  /// Would a frame at this odometry pose become a keyframe? (false for a frame whose pose is
-  /// not finite; true after a restart of the odometry, bridged or not).
+  /// Would a frame at this odometry pose become a keyframe, or be re-anchored? (false for a
+  /// frame whose pose is not finite; true after a restart of the odometry, bridged or not).
   bool wants_keyframe(const Eigen::Isometry3d& T_odom_camera, OdometryLink link = OdometryLink::kContinuous) const;
 
   /// Adds a frame seen at T_odom_camera; `link` says how that pose relates to the previous
   /// frame's (a bridged restart gives an odometry edge with the bridge's larger uncertainty, a
   /// broken one a weak edge of no motion). Throws InputError when the frame's utime does not
   /// increase or the pose is not a finite rigid transform. `odometry_covariance`, when given
-  /// (continuous link only), is the odometry's own covariance of the motion from the previous
-  /// keyframe to this frame (right perturbation [rho; phi], OdometryChain::relative_covariance):
+  /// (continuous link only), is the odometry's own covariance of the motion from the
+  /// reference (reference()) to this frame (right perturbation [rho; phi], OdometryChain::relative_covariance):
   /// the odometry edge then takes it (OdometryNoise::use_reported) instead of the constant model.
   /// `motion`: the camera's motion around the frame, for its features' timing correction
   /// (keyframe_motion(), place/frame_features.h); unknown = no correction. `sensor`: the
@@ -100,15 +121,18 @@ class Slam {
   const PoseGraph3d& graph() const { return graph_; }
   int64_t revision() const { return revision_; }
   int num_loop_closures() const { return loop_closures_; }
+  /// Frames re-anchored on a covering keyframe instead of becoming keyframes.
+  int num_reanchors() const { return reanchors_; }
+  const OdometryReference& reference() const { return reference_; }
   /// Verified loops refused because they disagreed with the odometry (loop_consistency.h).
   int num_inconsistent_loops() const { return inconsistent_loops_; }
-  /// Marginal covariance of the newest keyframe's optimised T_world_camera after the last
-  /// optimisation (marginals.h: [rho; phi], right perturbation in the camera frame); nullopt
-  /// before any optimisation or when the graph did not determine it.
-  const std::optional<Matrix6d>& newest_covariance() const { return newest_covariance_; }
+  /// Marginal covariance of the reference keyframe's optimised T_world_camera after the last
+  /// optimisation or re-anchoring (marginals.h: [rho; phi], right perturbation in the camera
+  /// frame); nullopt before any, or when the graph did not determine it.
+  const std::optional<Matrix6d>& reference_marginal() const { return reference_marginal_; }
 
-  /// The optimised estimate of a camera seen at T_odom_camera after the newest keyframe: the
-  /// newest keyframe's optimised pose composed with the odometry since.
+  /// The optimised estimate of a camera seen at T_odom_camera after the reference: the
+  /// reference's optimised pose composed with the odometry since.
   Eigen::Isometry3d world_pose(const Eigen::Isometry3d& T_odom_camera) const;
 
   /// Re-expresses the map in another world frame: every optimised pose T_world_camera becomes
@@ -124,9 +148,14 @@ class Slam {
   /// Per graph edge: the constant model's information of each odometry edge (identity for
   /// loop closures), for the loop-consistency gate (loop_consistency.h).
   std::vector<Matrix6d> gate_information_;
-  void add_odometry_edge(const Keyframe& previous, const Keyframe& current, OdometryLink link,
-                         const std::optional<Matrix6d>& covariance);
+  void add_odometry_edge(const Keyframe& current, OdometryLink link, const std::optional<Matrix6d>& covariance);
   SlamStep close_loop(SlamStep step);
+  /// Locates the frame in a covering keyframe and makes it the reference; false (and nothing
+  /// changed) when no covering keyframe verifies within the correction bound.
+  bool reanchor(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera,
+                const std::optional<Matrix6d>& odometry_covariance, const FrameFeatures& features,
+                const sensors::SensorProfile& sensor, SlamStep& step);
+  Eigen::Isometry3d reference_world_pose() const;
 
   SlamOptions options_;
   std::shared_ptr<const Vocabulary> vocabulary_;
@@ -139,7 +168,9 @@ class Slam {
   int inconsistent_loops_ = 0;
   int64_t last_utime_ = 0;
   bool have_frame_ = false;
-  std::optional<Matrix6d> newest_covariance_;
+  std::optional<Matrix6d> reference_marginal_;
+  OdometryReference reference_;
+  int reanchors_ = 0;
   bool gate_by_pose_ = true;  ///< off from an odometry break until a loop closure re-anchors
 };
 

@@ -19,6 +19,22 @@ struct KeyframeOptions {
   double min_rotation_rad = 10.0 * kPi / 180.0;  ///< ...or turned this much since the last
 };
 
+/// Bounded memory: where a keyframe already covers the view, a frame that moved enough to be
+/// a keyframe is located against it (verified by its features, as a loop is) instead of
+/// becoming one, and the odometry goes on from there (Slam::reference()). Over ground already
+/// mapped nothing is added, so the keyframes (and the mapper's scans) grow with the ground
+/// covered, not with the time flown.
+struct CoverageOptions {
+  bool reuse_keyframes = true;
+  double max_translation_m = 0.25;               ///< a keyframe covers a view within this distance...
+  double max_rotation_rad = 10.0 * kPi / 180.0;  ///< ...and angle of its estimated pose
+  int max_candidates = 3;                        ///< covering keyframes verified, nearest first
+  /// The located pose may differ from the estimate by at most this; a larger correction is a
+  /// loop closure, through a new keyframe and an optimisation of the graph.
+  double max_correction_m = 0.05;
+  double max_correction_rad = 2.0 * kPi / 180.0;
+};
+
 struct LoopSearchOptions {
   double min_age_s = 4.0;       ///< candidates are keyframes at least this much older
   /// Candidates lie within this distance and angle of the current estimate; <= 0 disables the
@@ -56,6 +72,7 @@ struct OdometryNoise {
 
 struct SlamOptions {
   KeyframeOptions keyframes;
+  CoverageOptions coverage;
   LoopSearchOptions loops;
   /// A verified loop must agree with the odometry between its keyframes (when the estimate is
   /// trustworthy): rejects perceptual aliasing (loop_consistency.h).

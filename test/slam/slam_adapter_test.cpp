@@ -114,6 +114,41 @@ TEST_F(AdapterTest, AnchorsTheGraphInTheEstimatorsWorldAtTheFirstKeyframeItsStat
   EXPECT_FALSE(adapter_.on_state(state(6.5, Eigen::Isometry3d::Identity())).graph);
 }
 
+// Over ground already covered no keyframe is made (slam.h, CoverageOptions): out 0.6 m and
+// back, the frames where keyframes 1 and 0 were are located in them, and each sends the
+// estimator a correction with the frame's pose in its world.
+TEST_F(AdapterTest, AFrameOverCoveredGroundIsLocatedInItsKeyframeAndCorrectsTheEstimator) {
+  const Eigen::Isometry3d X = estimator_world();
+  const auto steps = [](int i) { return i <= 6 ? i : 12 - i; };  // 10 cm steps out and back
+  std::vector<int64_t> corrected;
+  for (int i = 0; i <= 12; ++i) {
+    kestrel::vo_update_t u = update(std::min(i, 1));  // the first has no reference, the rest OK
+    u.utime = utime(i);
+    u.reference_utime = i == 0 ? 0 : utime(i - 1);
+    u.T_reference_current = transport::to_message(i == 0 ? Eigen::Isometry3d::Identity()
+                                                         : pose(steps(i - 1)).inverse() * pose(steps(i)));
+    adapter_.on_frame(transport::encode_rgbd(room_.render(pose(steps(i)), test::test_camera(), utime(i))));
+    const AdapterOutputs out = adapter_.on_vo_update(u);
+    if (i <= 6) {
+      adapter_.on_state(state(i - 0.5, X));
+      adapter_.on_state(state(i + 0.05, X));
+    }
+    if (i > 6) EXPECT_FALSE(out.graph) << "frame " << i << ": the way back made a keyframe";
+    if (out.step && out.step->reanchored) {
+      ASSERT_TRUE(out.correction) << "frame " << i;
+      EXPECT_EQ(out.correction->utime, utime(i));
+      const Eigen::Isometry3d expected = X * pose(0).inverse() * pose(steps(i));
+      const Eigen::Isometry3d got = transport::from_message(out.correction->T_world_body, "test");
+      EXPECT_LT(se3::translation_distance(got, expected), 0.01) << "frame " << i;
+      EXPECT_LT(se3::rotation_distance(got, expected), 0.01) << "frame " << i;
+      corrected.push_back(out.step->reanchor_keyframe_id);
+    }
+  }
+  ASSERT_TRUE(adapter_.anchored());
+  EXPECT_EQ(adapter_.slam().keyframes().size(), 3u);
+  EXPECT_EQ(corrected, (std::vector<int64_t>{1, 0})) << "located in keyframe 1 (0.3 m), then 0";
+}
+
 // A SLAM process restarted in flight starts its keyframes from index 0 again; what it publishes
 // must not reuse an id of the session before, nor go back in revision, or the mapper would
 // move the old session's images to the new keyframes' poses (slam_messages.h).

@@ -11,8 +11,10 @@
 #include "common/error.h"
 #include "common/geometry/align.h"
 #include "common/geometry/se3.h"
+#include "common/numbers.h"
 #include "slam/backend/odometry_chain.h"
 #include "slam/backend/slam.h"
+#include "slam/place/builtin_vocabulary.h"
 #include "slam/posegraph/marginals.h"
 #include "test/slam/synthetic_room.h"
 
@@ -53,15 +55,19 @@ struct LoopRun {
   int loop_closures = 0;
   int false_closures = 0;
   int64_t last_loop_keyframe = -1;           ///< the newest keyframe when the last loop closed
-  std::optional<Matrix6d> loop_covariance;   ///< Slam::newest_covariance() then
+  std::optional<Matrix6d> loop_covariance;   ///< Slam::reference_marginal() then
   PoseGraph3d graph;                         ///< at the end
+  std::vector<size_t> keyframes;             ///< keyframes made after each frame
+  int reanchors = 0;
+  int bad_reanchors = 0;                     ///< located more than 2 cm / 1 degree from the truth
 };
 
-LoopRun run(const SyntheticRoom& room, const std::vector<Eigen::Isometry3d>& truth, double yaw_bias_rad) {
+LoopRun run(const SyntheticRoom& room, const std::vector<Eigen::Isometry3d>& truth, double yaw_bias_rad,
+            const SlamOptions& options = {}, std::shared_ptr<const Vocabulary> vocabulary = nullptr) {
   LoopRun r;
   r.truth = truth;
   r.odometry = drifting_odometry(truth, yaw_bias_rad, 0.004, 9);
-  Slam slam;
+  Slam slam(options, std::move(vocabulary));
   std::vector<std::pair<int, Eigen::Isometry3d>> placed;  // keyframe, T_keyframe_camera
   for (size_t k = 0; k < truth.size(); ++k) {
     const RgbdFrame frame = room.render(truth[k], test::test_camera(), 1'000'000 + 200'000 * static_cast<int64_t>(k));
@@ -69,7 +75,7 @@ LoopRun run(const SyntheticRoom& room, const std::vector<Eigen::Isometry3d>& tru
     if (step.loop_closed) {
       ++r.loop_closures;
       r.last_loop_keyframe = step.keyframe_id;
-      r.loop_covariance = slam.newest_covariance();
+      r.loop_covariance = slam.reference_marginal();
       // The closure's relative pose against the truth of the two keyframes' frames.
       const auto& kfs = slam.keyframes();
       const auto frame_of = [&](int64_t id) { return static_cast<size_t>((kfs[static_cast<size_t>(id)].utime - 1'000'000) / 200'000); };
@@ -80,8 +86,22 @@ LoopRun run(const SyntheticRoom& room, const std::vector<Eigen::Isometry3d>& tru
         ++r.false_closures;
       }
     }
-    const Keyframe& kf = slam.keyframes().back();
-    placed.emplace_back(static_cast<int>(kf.id), kf.T_odom_camera.inverse() * r.odometry[k]);
+    const auto frame_of = [&](int64_t utime) { return static_cast<size_t>((utime - 1'000'000) / 200'000); };
+    if (step.reanchored) {
+      ++r.reanchors;
+      // Where the frame was put in the keyframe it re-anchored on, against the truth.
+      const OdometryReference& ref = slam.reference();
+      const size_t kf_frame = frame_of(slam.keyframes()[static_cast<size_t>(ref.keyframe_id)].utime);
+      const Eigen::Isometry3d true_rel = truth[kf_frame].inverse() * truth[k];
+      if (se3::translation_distance(true_rel, ref.T_keyframe_camera) > 0.02 ||
+          se3::rotation_distance(true_rel, ref.T_keyframe_camera) > kPi / 180.0) {
+        ++r.bad_reanchors;
+      }
+    }
+    const OdometryReference& ref = slam.reference();
+    placed.emplace_back(static_cast<int>(ref.keyframe_id),
+                        ref.T_keyframe_camera * ref.T_odom_camera.inverse() * r.odometry[k]);
+    r.keyframes.push_back(slam.keyframes().size());
   }
   for (const auto& [kf, T] : placed) r.optimised.push_back(slam.graph().poses[static_cast<size_t>(kf)] * T);
   r.graph = slam.graph();
@@ -112,6 +132,34 @@ TEST(Slam, LoopClosureCutsTheDriftOfAClosedLoop) {
   const double open_m = std::sqrt(open->topLeftCorner<3, 3>().trace());
   EXPECT_LT(closed_m, 0.5 * open_m) << "position sigma with loops " << closed_m << " m, odometry only " << open_m << " m";
   std::cout << "newest keyframe position sigma: " << closed_m << " m (odometry only: " << open_m << " m)\n";
+}
+
+// Bounded memory (CoverageOptions): three laps of the same circle make the keyframes of about
+// one, where without re-anchoring every lap makes its own; every frame located in a covering
+// keyframe is where the truth says, and the trajectory is as good as with all the keyframes.
+TEST(Slam, LapsOverCoveredGroundAddNoKeyframes) {
+  const SyntheticRoom room(5, 3.0, 2.5, 2.5);
+  const auto laps = test::circle_path(180, 1.0, 3.0);
+  // The built-in vocabulary: an online one is retrained as keyframes come, most of the time here.
+  const LoopRun reuse = run(room, laps, 0.003, SlamOptions{}, builtin_vocabulary());
+  SlamOptions every_lap;
+  every_lap.coverage.reuse_keyframes = false;
+  const LoopRun grow = run(room, laps, 0.003, every_lap, builtin_vocabulary());
+  const size_t first_lap = reuse.keyframes[59];
+  std::cout << "keyframes after lap 1: " << first_lap << ", after 3 laps: " << reuse.keyframes.back() << " ("
+            << reuse.reanchors << " re-anchorings, " << reuse.loop_closures << " loops); without re-anchoring "
+            << grow.keyframes.back() << "\n";
+  EXPECT_GE(grow.keyframes.back(), 2 * grow.keyframes[59]) << "every lap should add keyframes without re-anchoring";
+  EXPECT_LE(reuse.keyframes.back(), first_lap + first_lap / 5) << "laps over covered ground made keyframes";
+  EXPECT_EQ(reuse.keyframes[179], reuse.keyframes[120]) << "the last lap added keyframes";
+  EXPECT_GE(reuse.reanchors, 45);
+  EXPECT_EQ(reuse.bad_reanchors, 0);
+  EXPECT_EQ(reuse.false_closures, 0);
+  const double vo = ate_rmse(reuse.odometry, reuse.truth);
+  const double with_reuse = ate_rmse(reuse.optimised, reuse.truth), with_all = ate_rmse(grow.optimised, grow.truth);
+  std::cout << "ATE: VO " << vo << " m, SLAM re-anchoring " << with_reuse << " m, every keyframe " << with_all << " m\n";
+  EXPECT_LE(with_reuse, 0.3 * vo);
+  EXPECT_LE(with_reuse, 1.5 * with_all + 0.01);
 }
 
 TEST(Slam, ALoopFreeRunClosesNoLoop) {
