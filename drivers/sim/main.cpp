@@ -56,6 +56,7 @@ struct Options {
   double tilt_deg = 10.0;
   double camera_rate_hz = 30.0;
   std::string feedback = "state";
+  bool hold_start_pose = false;
   std::vector<double> start;  // x, y, z, yaw of the vehicle; empty: the world's take-off pose
   double lockstep_s = 0.0;
   std::vector<std::string> expect;
@@ -80,6 +81,10 @@ void add_options(cli::App& app, Options& o) {
                  "usable STATE) or the truth")
       ->check(CLI::IsMember({"state", "truth"}))
       ->capture_default_str();
+  app.add_flag("--hold-start-pose", o.hold_start_pose,
+               "vehicle: hold the start pose in the sim's world until commanded (for an estimator started "
+               "there, --init-position); by default it holds where the first usable STATE says it is, in "
+               "the STATE's world");
   app.add_option("--start", o.start, "vehicle: where it starts, x,y,z,yaw (m, rad; default: the world's take-off pose)")
       ->expected(4)
       ->delimiter(',');
@@ -193,9 +198,11 @@ int run(const Options& o) {
   // IMU's 2 ms difference and half a motion-blurred exposure.
   std::optional<sim::VehicleLoop> loop;
   std::optional<sim::VehicleEstimate> estimate;  // the latest usable STATE
-  if (vehicle)
-    loop.emplace(*vehicle, 0.002 + vehicle->options().control_period_s +
-                               (o.motion_blur > 1 ? 0.5 * so.camera.rgb.exposure_time_s : 0.0));
+  const double loop_lookahead_s =
+      vehicle ? 0.002 + vehicle->options().control_period_s +
+                    (o.motion_blur > 1 ? 0.5 * so.camera.rgb.exposure_time_s : 0.0)
+              : 0.0;
+  if (vehicle) loop.emplace(*vehicle, loop_lookahead_s);
   transport::RgbdEncoding encoding;
   encoding.rgb = o.rgb_encoding == "raw" ? kestrel::rgbd_frame_t::RGB_RGB8 : kestrel::rgbd_frame_t::RGB_JPEG;
   encoding.depth = o.depth_encoding == "raw" ? kestrel::rgbd_frame_t::DEPTH_U16_MM : kestrel::rgbd_frame_t::DEPTH_U16_MM_ZSTD;
@@ -224,7 +231,9 @@ int run(const Options& o) {
       if (o.feedback == "state")
         sinks.node->subscribe<kestrel::state_t>(channel::kState, [&](const kestrel::state_t& m) {
           sim::VehicleEstimate e;
-          if (sim::vehicle_estimate(m, e)) estimate = e;
+          if (!sim::vehicle_estimate(m, e)) return;
+          if (!estimate && !o.hold_start_pose) loop->estimate_source_changed();
+          estimate = e;
         });
     }
     sinks.node->on_reset([&] { restart = true; });
@@ -268,7 +277,7 @@ int run(const Options& o) {
       contact.reset();
       if (vehicle) {
         vehicle->reset();
-        loop->set_command(sim::VehicleCommand{});  // hold where it starts
+        loop.emplace(*vehicle, loop_lookahead_s);  // holding where it starts, until the first STATE
         estimate.reset();
       }
       wall_start = Clock::now();

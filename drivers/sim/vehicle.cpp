@@ -134,6 +134,11 @@ VehicleLoop::VehicleLoop(VehicleFlight& vehicle, double lookahead_s)
 void VehicleLoop::set_command(const VehicleCommand& command) {
   command_ = command;
   latch_hold_ = command.mode == VehicleCommand::kHold;
+  commanded_ = true;
+}
+
+void VehicleLoop::estimate_source_changed() {
+  if (!commanded_) latch_hold_ = true;
 }
 
 void VehicleLoop::advance_to(double t_s, const VehicleEstimate& estimate) {

@@ -118,6 +118,11 @@ class VehicleLoop {
 
   /// kHold is latched into a position command at the next advance_to's estimate.
   void set_command(const VehicleCommand& command);
+  /// The estimates now come from another source (the first usable STATE after the truth stood
+  /// in). A hold no command has replaced yet is latched again at the next estimate: "hold where
+  /// it is" is then where the new source says it is, whatever its world (an estimator started
+  /// at its own origin does not share the sim's).
+  void estimate_source_changed();
   const VehicleCommand& command() const { return command_; }
   /// Commits control periods, each from `estimate`, until the path is final up to t_s.
   void advance_to(double t_s, const VehicleEstimate& estimate);
@@ -127,6 +132,7 @@ class VehicleLoop {
   double lookahead_s_;
   VehicleCommand command_;
   bool latch_hold_ = true;  // the vehicle starts holding where it is
+  bool commanded_ = false;  // a command has come (the start's hold is no longer in force)
 };
 
 /// A hold command at the world's start pose (x, y, z, yaw).

@@ -96,6 +96,34 @@ TEST(VehicleTest, TracksAVelocityCommandAndLatchesAHold) {
   EXPECT_LT((vehicle.point(9.0).p - held.p).norm(), 0.005);
 }
 
+// Flying on an estimator whose world is not the sim's (started at its own origin): the hold
+// latched on the truth before the first STATE is latched again on the first estimate of the
+// new source, so the vehicle stays where it is instead of flying to the truth's coordinates
+// in the estimator's world. Once commanded, a change of source changes nothing.
+TEST(VehicleTest, AChangeOfEstimateSourceLatchesTheStartsHoldAgainUntilCommanded) {
+  VehicleOptions o;
+  o.wind_sigma_m_s2 = 0.0;
+  const Eigen::Isometry3d T_estimator_sim(Eigen::Translation3d(-kStart.head<3>()));  // the estimator's origin at the start
+  const auto in_estimator = [&](const PathPoint& q) { return VehicleEstimate{T_estimator_sim * q.p, q.v, q.yaw}; };
+  VehicleFlight vehicle(kStart, o, 1);
+  VehicleLoop loop(vehicle, 0.003);
+  const double h = o.control_period_s;
+  double t = 0.0;
+  for (; t < 0.5; t += h) loop.advance_to(t, [&] { const PathPoint q = vehicle.point(t); return VehicleEstimate{q.p, q.v, q.yaw}; }());
+  loop.estimate_source_changed();
+  for (; t < 5.0; t += h) loop.advance_to(t, in_estimator(vehicle.point(t)));
+  EXPECT_LT((vehicle.point(5.0).p - kStart.head<3>()).norm(), 0.01) << "it flew to the truth's start in the estimator's world";
+
+  VehicleCommand go;  // in the estimator's world: 1 m along x from where it is
+  go.mode = VehicleCommand::kPosition;
+  go.position = Eigen::Vector3d(1.0, 0.0, 0.0);
+  go.yaw = kStart[3];
+  loop.set_command(go);
+  loop.estimate_source_changed();  // a commanded flight keeps its command
+  for (; t < 12.0; t += h) loop.advance_to(t, in_estimator(vehicle.point(t)));
+  EXPECT_LT((vehicle.point(12.0).p - (kStart.head<3>() + Eigen::Vector3d(1.0, 0.0, 0.0))).norm(), 0.02);
+}
+
 // A position command whose yaw turns at 0.5 rad/s: with that rate as feed-forward the yaw
 // follows it (zero steady error; only the yaw rate's 0.1 s lag while it builds up), without
 // it the yaw loop lags by rate / gain = 0.25 rad.

@@ -76,5 +76,38 @@ TEST(System, TheVehicleFliesToAGoalOnItsOwnMap) {
   EXPECT_LT(worst_estimate, 0.05) << "the estimator's worst position error on the way";
 }
 
+// The command the README and tools/launch/README.md give: the default process set flying the
+// sim's vehicle. Its estimator starts at its own origin (processes.yaml gives it no start), so
+// its world is not the sim's; the vehicle must still hold where it took off. It once held the
+// take-off pose's sim coordinates in the estimator's world and flew into a wall within 4 s.
+TEST(System, TheDefaultLaunchHoldsTheSimsVehicleWhereItTookOff) {
+  if (!test::can_isolate_network()) KESTREL_SKIP_ENVIRONMENT() << "no network namespace available";
+  if (!std::filesystem::exists("/usr/bin/lcm-logger")) KESTREL_SKIP_ENVIRONMENT() << "lcm-logger is not installed";
+  test::TempDir dir;
+  const std::string log = (dir / "truth.lcmlog").string(), logs = (dir / "logs").string();
+  const std::string script =
+      "export LCM_DEFAULT_URL='udpm://239.255.76.67:7667?ttl=0&recv_buf_size=4194304'; lcm-logger -f -c GROUND_TRUTH " + log +
+      " > /dev/null 2>&1 & L=$!; '" + test::tool("launch").string() + "' all --status-period 0 --log-dir " + logs +
+      " --source 'sim --world room --flight vehicle --duration 12'; R=$?; sleep 0.5; kill $L; wait $L; exit $R";
+  const auto r = test::run_isolated(script, 180.0);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string sim = test::read_file(dir / "logs" / "source.log");
+  EXPECT_NE(sim.find("contacts: 0"), std::string::npos) << sim;
+  std::optional<Eigen::Vector3d> first;
+  double farthest = 0.0;
+  int samples = 0;
+  transport::LogReader truth(log);
+  while (auto e = truth.next()) {
+    if (e->channel != channel::kGroundTruth) continue;
+    const auto m = transport::decode_message<kestrel::ground_truth_t>(e->data.data(), e->data.size(), "GROUND_TRUTH");
+    const Eigen::Vector3d p = transport::from_message(m.T_world_frame, "GROUND_TRUTH").translation();
+    if (!first) first = p;
+    farthest = std::max(farthest, (p - *first).norm());
+    ++samples;
+  }
+  EXPECT_GE(samples, 1000) << "12 s of GROUND_TRUTH at 200 Hz";
+  EXPECT_LT(farthest, 0.2) << "the vehicle left its take-off point by " << farthest << " m";
+}
+
 }  // namespace
 }  // namespace kestrel
