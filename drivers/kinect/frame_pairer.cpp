@@ -58,10 +58,7 @@ void FramePairer::add_depth(StreamFrame frame) {
   last_depth_us_ = frame.device_us;
   ++stats_.depth_frames;
   depths_.push_back(std::move(frame));
-  if (depths_.size() > kMaxWaitingDepth) {
-    depths_.pop_front();
-    ++stats_.unused_depth;
-  }
+  if (depths_.size() > kMaxWaitingDepth) drop_oldest_depth();
   if (waiting_rgb_ && depths_.back().device_us >= waiting_rgb_->device_us) decide();
 }
 
@@ -71,8 +68,15 @@ void FramePairer::poll(int64_t host_utime) {
 
 void FramePairer::flush() {
   if (waiting_rgb_) decide();
-  stats_.unused_depth += static_cast<int64_t>(depths_.size());
-  depths_.clear();
+  while (!depths_.empty()) drop_oldest_depth();
+}
+
+void FramePairer::drop_oldest_depth() {
+  if (served_us_ && depths_.front().device_us == *served_us_)
+    served_us_.reset();
+  else
+    ++stats_.unused_depth;
+  depths_.pop_front();
 }
 
 void FramePairer::decide() {
@@ -88,16 +92,17 @@ void FramePairer::decide() {
   }
   if (best < depths_.size()) {
     // Depth frames before the chosen one are older still: no later RGB frame can use them.
-    stats_.unused_depth += static_cast<int64_t>(best);
-    ready_.push_back({std::move(*waiting_rgb_), std::move(depths_[best])});
-    depths_.erase(depths_.begin(), depths_.begin() + static_cast<std::ptrdiff_t>(best) + 1);
+    for (size_t i = 0; i < best; ++i) drop_oldest_depth();
+    // The chosen one stays for the next RGB frame, which gets its own copy of the image.
+    StreamFrame depth = depths_.front();
+    depth.image = depth.image.clone();
+    if (served_us_ && *served_us_ == depth.device_us) ++stats_.shared_depth;
+    served_us_ = depth.device_us;
+    ready_.push_back({std::move(*waiting_rgb_), std::move(depth)});
     ++stats_.paired;
   } else {
     ++stats_.unpaired_rgb;
-    while (!depths_.empty() && depths_.front().device_us < t_rgb - options_.max_difference_us) {
-      depths_.pop_front();
-      ++stats_.unused_depth;
-    }
+    while (!depths_.empty() && depths_.front().device_us < t_rgb - options_.max_difference_us) drop_oldest_depth();
   }
   waiting_rgb_.reset();
 }

@@ -11,8 +11,11 @@
 // if one lies within max_difference_us; otherwise it is counted as unpaired and dropped. An
 // RGB frame is decided as soon as a depth frame at or after its time has arrived (no later
 // depth can be nearer), or when wait_us of host time have passed since it arrived (the next
-// depth frame was lost), or on flush(). Depth frames older than a decided RGB frame can no
-// longer be paired and are counted as unused. Each depth frame is used at most once.
+// depth frame was lost), or on flush(). Depth frames older than a decided RGB frame's can no
+// longer be paired and are counted as unused. A depth frame may serve two RGB frames (the
+// same rule as the TUM reader's, drivers/tum/association.h): when the next RGB frame's own
+// depth frame was lost or lies farther, it takes the one its predecessor took, and no frame
+// is lost at the door; each frame carries its depth's own time, which the VO corrects for.
 //
 // Lost frames: within a stream, a gap in device time of more than 1.5 frame periods counts
 // round(gap / period) - 1 dropped frames; a frame not after the previous one of its stream
@@ -62,7 +65,8 @@ struct PairerStats {
   int64_t depth_frames = 0;  ///< accepted depth frames
   int64_t paired = 0;
   int64_t unpaired_rgb = 0;  ///< no depth within max_difference_us
-  int64_t unused_depth = 0;
+  int64_t unused_depth = 0;  ///< depth frames that served no RGB frame
+  int64_t shared_depth = 0;  ///< depth frames that served a second RGB frame
   int64_t dropped_rgb = 0;   ///< inferred from gaps in device time
   int64_t dropped_depth = 0;
   int64_t out_of_order = 0;  ///< frames rejected for going back in time
@@ -85,12 +89,15 @@ class FramePairer {
 
  private:
   void decide();
+  /// Forgets the oldest waiting depth frame, counting it as unused unless it served a frame.
+  void drop_oldest_depth();
   void count_gap(int64_t gap_us, int64_t& dropped) const;
 
   PairerOptions options_;
   PairerStats stats_;
   std::optional<StreamFrame> waiting_rgb_;
-  std::deque<StreamFrame> depths_;  // unused depth frames, oldest first
+  std::deque<StreamFrame> depths_;  // depth frames that may still serve, oldest first
+  std::optional<int64_t> served_us_;  // device time of the depth frame that served the last RGB frame
   std::deque<PairedFrame> ready_;
   std::optional<int64_t> last_rgb_us_;
   std::optional<int64_t> last_depth_us_;

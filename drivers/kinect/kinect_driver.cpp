@@ -28,7 +28,8 @@ cv::Mat copy_of(const void* data, int type) {
 std::string summary(const PairerStats& s) {
   return "rgb " + std::to_string(s.rgb_frames) + ", depth " + std::to_string(s.depth_frames) +
          ", paired " + std::to_string(s.paired) + ", unpaired rgb " + std::to_string(s.unpaired_rgb) +
-         ", unused depth " + std::to_string(s.unused_depth) + ", dropped rgb " +
+         ", unused depth " + std::to_string(s.unused_depth) + ", shared depth " + std::to_string(s.shared_depth) +
+         ", dropped rgb " +
          std::to_string(s.dropped_rgb) + ", dropped depth " + std::to_string(s.dropped_depth) +
          ", out of order " + std::to_string(s.out_of_order);
 }

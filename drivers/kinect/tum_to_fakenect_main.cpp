@@ -14,6 +14,7 @@
 #include <iomanip>
 #include <iostream>
 #include <map>
+#include <set>
 #include <tuple>
 
 #include <opencv2/core.hpp>
@@ -149,6 +150,7 @@ int run(const Options& o, bool rgb_intrinsics_given) {
 
   kinect::FakenectDumpWriter dump(o.out);
   std::map<size_t, RgbdFrame> decoded;  // frames with one of their two entries still to write
+  std::set<int64_t> written_depth;      // depth time stamps written
   int64_t frames = 0, accel = 0, depth_in = 0, depth_out = 0;
   for (const Entry& e : entries) {
     if (e.type == 'a') {
@@ -158,7 +160,9 @@ int run(const Options& o, bool rgb_intrinsics_given) {
     }
     auto it = decoded.find(e.index);
     if (it == decoded.end()) it = decoded.emplace(e.index, sequence.frame(e.index)).first;
-    if (e.type == 'd') {
+    if (e.type == 'd' && !written_depth.insert(e.utime).second) {
+      it->second.depth_mm.release();  // shared with the previous frame (tum/association.h): the Kinect sent it once
+    } else if (e.type == 'd') {
       const cv::Mat raw = registration.unregister_mm(it->second.depth_mm);
       depth_in += cv::countNonZero(it->second.depth_mm);
       depth_out += static_cast<int64_t>(raw.total()) - cv::countNonZero(raw == kinect::DisparityModel::kNoReading);

@@ -94,9 +94,9 @@ int run(const Options& o) {
   const auto t0 = std::chrono::steady_clock::now();
   const tum::TumSequence sequence = open_sequence(o);
   const auto& a = sequence.association();
-  spdlog::info("{}: {} frames ({} camera, fx={}), {} unmatched RGB images, {} unused depth images",
+  spdlog::info("{}: {} frames ({} camera, fx={}), {} unmatched RGB images, {} unused depth images, {} shared",
                o.folder, a.frames, tum::camera_name(sequence.camera_model()), sequence.camera().fx,
-               a.unmatched_rgb, a.unused_depth);
+               a.unmatched_rgb, a.unused_depth, a.shared_depth);
   if (!sequence.has_ground_truth() && !o.no_ground_truth)
     spdlog::warn("{}: no groundtruth.txt, publishing no ground truth", o.folder);
   if (!sequence.has_accelerometer() && !o.no_imu)
@@ -147,6 +147,7 @@ int run(const Options& o) {
   std::cout << "frames published: " << stats.frames << "\n"
             << "unmatched RGB frames: " << a.unmatched_rgb << "\n"
             << "unused depth frames: " << a.unused_depth << "\n"
+            << "depth frames serving two RGB frames: " << a.shared_depth << "\n"
             << "IMU samples published: " << stats.imu_samples << "\n"
             << "ground-truth poses published: " << stats.ground_truth_poses << "\n"
             << "time taken: " << seconds << " s\n";

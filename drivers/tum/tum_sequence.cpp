@@ -70,6 +70,7 @@ TumSequence::TumSequence(const std::string& folder, SequenceOptions options)
   stats_.frames = frames_.size();
   stats_.unmatched_rgb = association.unmatched_a;
   stats_.unused_depth = association.unused_b;
+  stats_.shared_depth = association.shared_b;
 }
 
 std::string TumSequence::path_of(const ImageEntry& e) const {

@@ -5,8 +5,8 @@
 // The folder holds rgb.txt and depth.txt (required), groundtruth.txt and accelerometer.txt
 // (optional: TUM's validation sequences have no ground truth), and the PNGs they list. On
 // construction all text files are read and checked, every listed image is checked to exist,
-// and RGB frames are associated one-to-one with depth frames (association.h); at least one
-// pair must result. Images are only
+// and each RGB frame takes the nearest depth frame within the tolerance (association.h; a depth
+// frame may serve two); at least one pair must result. Images are only
 // decoded by frame(i), so opening a sequence is cheap and frame(i) may be called from several
 // threads at once.
 //
@@ -44,8 +44,9 @@ struct AssociationStats {
   size_t rgb_images = 0;    ///< lines in rgb.txt
   size_t depth_images = 0;  ///< lines in depth.txt
   size_t frames = 0;        ///< associated pairs
-  size_t unmatched_rgb = 0;
-  size_t unused_depth = 0;
+  size_t unmatched_rgb = 0;  ///< no depth image within the tolerance: not a frame
+  size_t unused_depth = 0;   ///< nearest to no RGB image
+  size_t shared_depth = 0;   ///< serving two (or more) RGB images
 };
 
 class TumSequence {

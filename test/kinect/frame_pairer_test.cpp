@@ -55,6 +55,25 @@ TEST(FramePairer, TheNearerOfTheTwoNeighboursWins) {
   EXPECT_EQ(p.stats().unused_depth, 1);  // the depth at 0 can serve no later RGB frame
 }
 
+// fr1_xyz around 1305031105.66 s (us after .5): the RGB frame at .643273 takes the depth at
+// .659104 (15.8 ms, against 16.1 ms for .627128), and so does the one at .675166, whose other
+// neighbour is 23 ms away: one depth frame serves two RGB frames, none is lost.
+TEST(FramePairer, ADepthFrameServesTwoRgbFramesWhenNearestToBoth) {
+  FramePairer p;
+  p.add_depth(frame(127128));
+  p.add_rgb(frame(143273));
+  p.add_depth(frame(159104));
+  p.add_rgb(frame(175166));
+  p.add_depth(frame(198235));
+  p.add_rgb(frame(211309));
+  p.flush();
+  EXPECT_EQ(drain(p), (Pairs{{143273, 159104}, {175166, 159104}, {211309, 198235}}));
+  EXPECT_EQ(p.stats().paired, 3);
+  EXPECT_EQ(p.stats().shared_depth, 1);
+  EXPECT_EQ(p.stats().unused_depth, 1);  // the one at .627128
+  EXPECT_EQ(p.stats().unpaired_rgb, 0);
+}
+
 TEST(FramePairer, RgbWithoutDepthWithinTheLimitIsCountedNotPaired) {
   FramePairer p;
   p.add_depth(frame(0));

@@ -110,7 +110,7 @@ TEST(KinectTool, ADroppedFrameIsCountedAndTheRestPublished) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("frames published: 4\n"), std::string::npos) << r.out;
   // Its depth frame has no RGB partner left and is reported unused.
-  EXPECT_NE(r.out.find("unused depth 1, dropped rgb 1, dropped depth 0"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("unused depth 1, shared depth 0, dropped rgb 1, dropped depth 0"), std::string::npos) << r.out;
 }
 
 TEST(KinectTool, PublishesLiveWithHeartbeatsInsideANetworkNamespace) {

@@ -116,16 +116,19 @@ TEST(TumData, Fr1RpyLogHoldsAllFramesImuAndGroundTruthInTimeOrder) {
 TEST(TumData, Fr1XyzAssociationFollowsTumsRule) {
   KESTREL_REQUIRE_TUM(seq, "rgbd_dataset_freiburg1_xyz");
   const tum::TumSequence s(seq.string());
-  // TUM's rule applied to these lists by an independent script: RGB image 30 (at
-  // 1305031105.675166) has no depth within 20 ms that a closer RGB image did not take.
+  // The rule applied to these lists by an independent script: every RGB image has a depth
+  // image within 20 ms; image 30 (at 1305031105.675166) shares image 29's, which TUM's
+  // one-to-one associate.py gives to image 29 alone (the depth at .627128 goes unused).
   EXPECT_EQ(s.association().rgb_images, 190u);
   EXPECT_TRUE(test::within_limit(static_cast<double>(s.association().frames), test::figure("tum.association.fr1_xyz")));
-  EXPECT_EQ(s.association().unmatched_rgb, 1u);
+  EXPECT_EQ(s.association().unmatched_rgb, 0u);
   EXPECT_EQ(s.association().unused_depth, 1u);
-  EXPECT_EQ(s.rgb_index(29), 29u);
-  EXPECT_EQ(s.rgb_index(30), 31u);
+  EXPECT_EQ(s.association().shared_depth, 1u);
+  EXPECT_EQ(s.rgb_index(30), 30u);
   EXPECT_EQ(s.utime(29), 1305031105643273);
   EXPECT_EQ(s.depth_utime(29), 1305031105659104);
+  EXPECT_EQ(s.utime(30), 1305031105675166);
+  EXPECT_EQ(s.depth_utime(30), 1305031105659104);
   EXPECT_EQ(s.camera_model(), tum::TumCamera::kFreiburg1);
 }
 
