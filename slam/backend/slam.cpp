@@ -188,8 +188,11 @@ SlamStep Slam::add(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camer
   if (!wants_keyframe(T_odom_camera, link)) return step;
 
   FrameFeatures features = extractor_.extract(frame, motion);
-  if (link == OdometryLink::kContinuous && !keyframes_.empty() && options_.coverage.reuse_keyframes &&
-      reanchor(frame, T_odom_camera, odometry_covariance, features, sensor, step)) {
+  // A VO restart the estimator bridged keeps a usable estimate: covered ground re-anchors it
+  // too (a flight with many restarts would otherwise make a keyframe at each). A broken one
+  // does not know where it is: a keyframe, and loop closure, place it.
+  if (link != OdometryLink::kBroken && !keyframes_.empty() && options_.coverage.reuse_keyframes &&
+      reanchor(frame, T_odom_camera, link, odometry_covariance, features, sensor, step)) {
     return step;
   }
   Keyframe kf;
@@ -263,7 +266,7 @@ SlamStep Slam::close_loop(SlamStep step) {
   return step;
 }
 
-bool Slam::reanchor(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera,
+bool Slam::reanchor(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera, OdometryLink link,
                     const std::optional<Matrix6d>& odometry_covariance, const FrameFeatures& features,
                     const sensors::SensorProfile& sensor, SlamStep& step) {
   const CoverageOptions& c = options_.coverage;
@@ -302,7 +305,7 @@ bool Slam::reanchor(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_came
     const Eigen::Isometry3d T_k_predicted = graph_.poses[k].inverse() * T_world_frame;
     const Matrix6d Ad = se3::adjoint(T_ref_frame.inverse());
     const Matrix6d odometry = right_covariance(
-        odometry_edge_information(T_ref_frame, options_.odometry, OdometryLink::kContinuous, odometry_covariance));
+        odometry_edge_information(T_ref_frame, options_.odometry, link, odometry_covariance));
     const Matrix6d predicted = Ad * reference_.covariance * Ad.transpose() + odometry;
     const Matrix6d measured = right_covariance(located.information);
     const Matrix6d gain = predicted * (predicted + measured).inverse();

@@ -152,7 +152,7 @@ class Slam {
   SlamStep close_loop(SlamStep step);
   /// Locates the frame in a covering keyframe and makes it the reference; false (and nothing
   /// changed) when no covering keyframe verifies within the correction bound.
-  bool reanchor(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera,
+  bool reanchor(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera, OdometryLink link,
                 const std::optional<Matrix6d>& odometry_covariance, const FrameFeatures& features,
                 const sensors::SensorProfile& sensor, SlamStep& step);
   Eigen::Isometry3d reference_world_pose() const;

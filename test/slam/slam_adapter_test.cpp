@@ -133,7 +133,9 @@ TEST_F(AdapterTest, AFrameOverCoveredGroundIsLocatedInItsKeyframeAndCorrectsTheE
       adapter_.on_state(state(i - 0.5, X));
       adapter_.on_state(state(i + 0.05, X));
     }
-    if (i > 6) EXPECT_FALSE(out.graph) << "frame " << i << ": the way back made a keyframe";
+    if (i > 6) {
+      EXPECT_FALSE(out.graph) << "frame " << i << ": the way back made a keyframe";
+    }
     if (out.step && out.step->reanchored) {
       ASSERT_TRUE(out.correction) << "frame " << i;
       EXPECT_EQ(out.correction->utime, utime(i));
@@ -273,10 +275,13 @@ TEST_F(AdapterTest, AHoveringVehicleIsAnchoredAtAFrameThatIsNoKeyframe) {
 
 TEST_F(AdapterTest, TheEstimatorsMotionBridgesAVoRestart) {
   // Frames 0-7 move 10 cm each; at frame 4 the VO restarts (no reference). Keyframes 0, 3, 4
-  // (a restart always makes one), 7.
+  // (a restart makes one where no keyframe covers it: here re-anchoring is off, or frame 4,
+  // 10 cm from keyframe 3, would be located in it), 7.
   const Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+  SlamOptions options;
+  options.coverage.reuse_keyframes = false;
   auto run = [&](bool with_states) {
-    SlamAdapter adapter(SlamOptions{}, nullptr);
+    SlamAdapter adapter(options, nullptr);
     std::optional<kestrel::slam_graph_t> last;
     for (int k = 0; k <= 7; ++k) {
       if (with_states) {

@@ -162,6 +162,27 @@ TEST(Slam, LapsOverCoveredGroundAddNoKeyframes) {
   EXPECT_LE(with_reuse, 1.5 * with_all + 0.01);
 }
 
+// A VO restart the estimator bridged still knows where it is: over covered ground it is
+// located in the covering keyframe like any frame; a broken one makes a keyframe.
+TEST(Slam, ABridgedRestartOverCoveredGroundIsReanchoredAndABrokenOneIsAKeyframe) {
+  const SyntheticRoom room(5, 3.0, 2.5, 2.5);
+  const auto path = test::circle_path(30, 1.0, 0.5);  // half a lap out...
+  Slam slam(SlamOptions{}, builtin_vocabulary());
+  int64_t utime = 1'000'000;
+  for (const auto& T : path) slam.add(room.render(T, test::test_camera(), utime += 200'000), T);
+  const size_t keyframes = slam.keyframes().size();
+  // ...then back at the start after a VO outage, bridged: located in keyframe 0.
+  const SlamStep bridged = slam.add(room.render(path.front(), test::test_camera(), utime += 200'000), path.front(),
+                                    OdometryLink::kBridged);
+  EXPECT_TRUE(bridged.reanchored);
+  EXPECT_EQ(bridged.reanchor_keyframe_id, 0);
+  EXPECT_EQ(slam.keyframes().size(), keyframes);
+  const SlamStep broken = slam.add(room.render(path[1], test::test_camera(), utime += 200'000), path[1],
+                                   OdometryLink::kBroken);
+  EXPECT_TRUE(broken.keyframe);
+  EXPECT_EQ(slam.keyframes().size(), keyframes + 1);
+}
+
 TEST(Slam, ALoopFreeRunClosesNoLoop) {
   const SyntheticRoom room(5, 7.0, 1.5, 2.5);
   const LoopRun r = run(room, test::straight_path(40, 12.0), 0.004);
