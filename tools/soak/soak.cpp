@@ -152,7 +152,7 @@ Summary summarise(const std::vector<ProcessSample>& samples, const std::vector<P
   }
   for (const auto& [name, ss] : by_process(samples)) s.processes.push_back(summarise_process(name, ss, criteria, s.sim_s));
   for (const auto& [name, how] : died) {
-    auto it = std::find_if(s.processes.begin(), s.processes.end(), [&](const ProcessSummary& p) { return p.process == name; });
+    auto it = std::find_if(s.processes.begin(), s.processes.end(), [&process = name](const ProcessSummary& p) { return p.process == process; });
     if (it == s.processes.end()) {
       s.processes.push_back({});
       it = std::prev(s.processes.end());
