@@ -82,10 +82,6 @@ function(kestrel_tool name)
     list(APPEND extra ${source})
   endforeach()
   set_property(GLOBAL APPEND PROPERTY KESTREL_TOOL_NAMES ${name})
-  set_property(GLOBAL APPEND PROPERTY KESTREL_TOOL_MAINS ${main})
-  set_property(GLOBAL APPEND PROPERTY KESTREL_TOOL_EXTRA_SOURCES ${extra})
-  set_property(GLOBAL APPEND PROPERTY KESTREL_TOOL_DEPS ${ARG_DEPS})
-  set_property(GLOBAL APPEND PROPERTY KESTREL_TOOL_DEFINITIONS ${ARG_DEFINITIONS})
   # The link, remade whenever the executable is (so that its time stamp follows the tool's).
   set(link ${CMAKE_RUNTIME_OUTPUT_DIRECTORY}/kestrel-${name})
   add_custom_command(OUTPUT ${link}
@@ -95,7 +91,9 @@ function(kestrel_tool name)
     DEPENDS kestrel-tools
     COMMENT "kestrel-${name} -> kestrel-tools")
   add_custom_target(kestrel-${name} ALL DEPENDS ${link})
-  set_target_properties(kestrel-${name} PROPERTIES KESTREL_TOOL_SOURCES "${main};${extra}")
+  set_target_properties(kestrel-${name} PROPERTIES KESTREL_TOOL_SOURCES "${main};${extra}"
+    KESTREL_TOOL_MAIN ${main} KESTREL_TOOL_EXTRA "${extra}" KESTREL_TOOL_DEPS "${ARG_DEPS}"
+    KESTREL_TOOL_DEFINITIONS "${ARG_DEFINITIONS}")
   set_property(GLOBAL APPEND PROPERTY KESTREL_TOOLS kestrel-${name})
 endfunction()
 
@@ -104,13 +102,67 @@ endfunction()
 # (all are include-guarded, so the tools' own #include lines are then no-ops), then each tool's
 # main file inside `namespace kestrel_tool_<name>`, where its `main` is an ordinary function;
 # tools/multicall/main.cpp calls the one argv[0] names.
+# KESTREL_TOOLS (tool names) and KESTREL_TOOLS_OF_TESTS (a test label: the tools the tests with
+# that label depend on, by their add_dependencies), when set, name the only tools compiled in,
+# with only the libraries they need: the sanitizer builds run a few of the tools
+# (`./kestrel test`) and compile only those. Every kestrel-<name> link is still made; a tool left
+# out says so when run. Called after the tests are added, for KESTREL_TOOLS_OF_TESTS.
 set(KESTREL_TOOLS_PER_BATCH 8)
+set(KESTREL_TOOLS "" CACHE STRING "The tools compiled into kestrel-tools (;-separated names); empty: every tool")
+set(KESTREL_TOOLS_OF_TESTS "" CACHE STRING
+    "A test label (e.g. sanitized): kestrel-tools holds the tools the tests with it depend on (and KESTREL_TOOLS)")
 function(kestrel_add_tools_executable)
-  get_property(names GLOBAL PROPERTY KESTREL_TOOL_NAMES)
-  get_property(mains GLOBAL PROPERTY KESTREL_TOOL_MAINS)
-  get_property(extra GLOBAL PROPERTY KESTREL_TOOL_EXTRA_SOURCES)
-  get_property(deps GLOBAL PROPERTY KESTREL_TOOL_DEPS)
-  get_property(definitions GLOBAL PROPERTY KESTREL_TOOL_DEFINITIONS)
+  get_property(all_names GLOBAL PROPERTY KESTREL_TOOL_NAMES)
+  foreach(name IN LISTS KESTREL_TOOLS)
+    if(NOT name IN_LIST all_names)
+      message(FATAL_ERROR "KESTREL_TOOLS: there is no tool '${name}' (the tools: ${all_names})")
+    endif()
+  endforeach()
+  set(selected ${KESTREL_TOOLS})
+  if(KESTREL_TOOLS_OF_TESTS)
+    get_property(tests GLOBAL PROPERTY KESTREL_TESTS_${KESTREL_TOOLS_OF_TESTS})
+    if(NOT tests)
+      message(FATAL_ERROR "KESTREL_TOOLS_OF_TESTS: no test has the label '${KESTREL_TOOLS_OF_TESTS}'")
+    endif()
+    foreach(test IN LISTS tests)
+      get_target_property(test_deps ${test} MANUALLY_ADDED_DEPENDENCIES)
+      foreach(dep IN LISTS test_deps)
+        if(dep STREQUAL "kestrel_tools")  # every tool
+          list(APPEND selected ${all_names})
+        elseif(dep MATCHES "^kestrel-(.+)$" AND CMAKE_MATCH_1 IN_LIST all_names)
+          list(APPEND selected ${CMAKE_MATCH_1})
+        endif()
+      endforeach()
+    endforeach()
+    if(NOT selected)
+      message(FATAL_ERROR "KESTREL_TOOLS_OF_TESTS: the tests labelled '${KESTREL_TOOLS_OF_TESTS}' need no tool")
+    endif()
+  endif()
+  set(subset OFF)
+  if(KESTREL_TOOLS OR KESTREL_TOOLS_OF_TESTS)
+    set(subset ON)
+  endif()
+  set(names "")
+  set(mains "")
+  set(extra "")
+  set(deps "")
+  set(definitions "")
+  foreach(name IN LISTS all_names)
+    if(subset AND NOT name IN_LIST selected)
+      continue()
+    endif()
+    list(APPEND names ${name})
+    foreach(property MAIN EXTRA DEPS DEFINITIONS)
+      get_target_property(value kestrel-${name} KESTREL_TOOL_${property})
+      if(value)
+        string(TOLOWER ${property} var)
+        if(var STREQUAL "main")
+          set(var mains)
+        endif()
+        list(APPEND ${var} ${value})
+      endif()
+    endforeach()
+  endforeach()
   set(dir ${CMAKE_BINARY_DIR}/tools_multicall)
   list(LENGTH names count)
   math(EXPR last "${count} - 1")
@@ -152,7 +204,7 @@ function(kestrel_add_tools_executable)
   add_executable(kestrel-tools ${PROJECT_SOURCE_DIR}/tools/multicall/main.cpp ${batches} ${extra})
   set_target_properties(kestrel-tools PROPERTIES UNITY_BUILD OFF)
   target_include_directories(kestrel-tools PRIVATE ${dir})
-  target_compile_definitions(kestrel-tools PRIVATE ${definitions})
+  target_compile_definitions(kestrel-tools PRIVATE ${definitions} $<$<BOOL:${subset}>:KESTREL_TOOLS_SUBSET>)
   list(REMOVE_DUPLICATES deps)
   target_link_libraries(kestrel-tools PRIVATE ${deps} kestrel_options)
   _kestrel_shared_pch(kestrel_tool_pch DEPS ${_KESTREL_TOOL_PCH_DEPS}
@@ -248,14 +300,47 @@ function(_kestrel_test_pch)
   set_target_properties(kestrel_test_pch PROPERTIES KESTREL_TEST_CODE ON)  # as its users
 endfunction()
 
-# kestrel_test(name SOURCES ... [DEPS ...] LABELS unit|integration|data [TIMEOUT s])
+# kestrel_test(name SOURCES ... [DEPS ...] LABELS unit|integration|data
+#              [SANITIZED [SANITIZED_CASES regex]] [THREADS] [TIMEOUT s])
 # A GoogleTest executable registered with ctest. Label `unit`: fast, in-process, no files
 # outside the repository. `integration`: several processes or tools, in a private network
 # namespace. `data`: needs ../shared/data and skips with a message without it.
+# SANITIZED (integration tests): its cases also get the label `sanitized`, and the executable
+# joins the target `sanitized_tests`: `./kestrel test` builds those in the sanitizer build
+# (build/asan), where test::tool() names the sanitized tools, and runs them there as well as on
+# Release. Chosen to run the processes on short inputs: under the sanitizers' -O1 they are 5-20x
+# slower (README.md, Tests). SANITIZED_CASES: only the cases ("Suite.Name") the regex matches.
+# THREADS: the test exercises code that runs on more than one thread; its cases also get the
+# label `threads`, and the executable joins `threads_tests`, which the ThreadSanitizer build
+# (build/tsan) builds and runs.
 function(kestrel_test name)
-  cmake_parse_arguments(ARG "" "TIMEOUT" "SOURCES;DEPS;LABELS" ${ARGN})
+  cmake_parse_arguments(ARG "SANITIZED;THREADS" "TIMEOUT;SANITIZED_CASES" "SOURCES;DEPS;LABELS" ${ARGN})
   if(NOT ARG_TIMEOUT)
     set(ARG_TIMEOUT 300)
+  endif()
+  list(LENGTH ARG_LABELS label_count)
+  if(NOT label_count EQUAL 1 OR NOT ARG_LABELS MATCHES "^(unit|integration|data)$")
+    message(FATAL_ERROR "kestrel_test(${name}): LABELS takes one of unit, integration, data (got '${ARG_LABELS}')")
+  endif()
+  set(labels ${ARG_LABELS})  # of every case
+  if(ARG_THREADS)
+    list(APPEND labels threads)
+    set_property(GLOBAL APPEND PROPERTY KESTREL_TESTS_threads ${name})
+  endif()
+  set(sanitized_labels "")  # of the cases that run sanitized
+  if(ARG_SANITIZED_CASES AND NOT ARG_SANITIZED)
+    message(FATAL_ERROR "kestrel_test(${name}): SANITIZED_CASES goes with SANITIZED")
+  endif()
+  if(ARG_SANITIZED)
+    if(NOT ARG_LABELS STREQUAL "integration")
+      message(FATAL_ERROR "kestrel_test(${name}): SANITIZED is for integration tests (the unit tests all run sanitized)")
+    endif()
+    set(sanitized_labels ${labels} sanitized)
+    if(NOT ARG_SANITIZED_CASES)
+      set(labels ${sanitized_labels})
+      set(ARG_SANITIZED_CASES ".")
+    endif()
+    set_property(GLOBAL APPEND PROPERTY KESTREL_TESTS_sanitized ${name})
   endif()
   add_executable(${name} ${ARG_SOURCES})
   target_link_libraries(${name} PRIVATE ${ARG_DEPS} GTest::gtest GTest::gtest_main GTest::gmock
@@ -266,8 +351,30 @@ function(kestrel_test name)
   set_target_properties(${name} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/test
                                            KESTREL_TEST_CODE ON)  # -O1 (KestrelWarnings.cmake)
   gtest_discover_tests(${name}
-    PROPERTIES LABELS "${ARG_LABELS}" TIMEOUT ${ARG_TIMEOUT}
+    PROPERTIES LABELS ${ARG_LABELS} TIMEOUT ${ARG_TIMEOUT}
     DISCOVERY_TIMEOUT 60)
+  if(NOT labels STREQUAL ARG_LABELS OR sanitized_labels)
+    # gtest_discover_tests takes one label (it spreads a list over the properties, escaped or
+    # not), so the full lists are set by a file ctest reads after the discovered tests, on the
+    # list of them that the discovery leaves in ${name}_TESTS.
+    set(labels_file ${CMAKE_CURRENT_BINARY_DIR}/${name}_labels.cmake)
+    if(sanitized_labels)
+      set(content "if(DEFINED ${name}_TESTS)
+  foreach(kestrel_case IN LISTS ${name}_TESTS)
+    if(kestrel_case MATCHES [=[${ARG_SANITIZED_CASES}]=])
+      set_tests_properties(\${kestrel_case} PROPERTIES LABELS \"${sanitized_labels}\")
+    else()
+      set_tests_properties(\${kestrel_case} PROPERTIES LABELS \"${labels}\")
+    endif()
+  endforeach()
+endif()
+")
+    else()
+      set(content "if(DEFINED ${name}_TESTS)\n  set_tests_properties(\${${name}_TESTS} PROPERTIES LABELS \"${labels}\")\nendif()\n")
+    endif()
+    file(CONFIGURE OUTPUT ${labels_file} CONTENT "${content}" @ONLY)
+    set_property(DIRECTORY APPEND PROPERTY TEST_INCLUDE_FILES ${labels_file})
+  endif()
   set_property(GLOBAL APPEND PROPERTY KESTREL_TESTS_${ARG_LABELS} ${name})
 endfunction()
 

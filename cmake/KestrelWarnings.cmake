@@ -49,6 +49,16 @@ if(KESTREL_SANITIZE)
   endif()
 endif()
 
+# The ThreadSanitizer build (`./kestrel test --tsan`, build/tsan): the tests of what runs on
+# more than one thread, on their own (README.md, Tests). -O1 and line tables as above.
+if(KESTREL_TSAN)
+  if(KESTREL_SANITIZE)
+    message(FATAL_ERROR "KESTREL_TSAN and KESTREL_SANITIZE exclude each other (ThreadSanitizer runs alone)")
+  endif()
+  target_compile_options(kestrel_options INTERFACE -fsanitize=thread -fno-omit-frame-pointer -O1 -g1)
+  target_link_options(kestrel_options INTERFACE -fsanitize=thread)
+endif()
+
 # The fuzz build (`./kestrel fuzz`, fuzz/README.md): every library is compiled with libFuzzer's
 # coverage instrumentation, on top of the sanitizers, so that the fuzzer sees which branches of
 # the decoders an input reached; kestrel-fuzz links libFuzzer's driver (fuzz/CMakeLists.txt).

@@ -22,6 +22,135 @@
 
 namespace kestrel::test {
 
+// ---- Sanitizer reports of child processes -------------------------------------------------
+//
+// In a sanitizer build the tools a test runs are sanitized too, and a report ends the child
+// with a signal (abort_on_error) or an exit code — which a test that expects a crash, kills the
+// child, or ignores a background child's status would not notice. So each test process sends its
+// children's reports to files of its own (log_path, in the options every child inherits) and
+// fails the test during which one appears, quoting it (ChildReports below). The test
+// process's own reports still go to stderr: its runtime read its options before this runs.
+#if defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer)
+#define KESTREL_TEST_SANITIZED 1
+#endif
+#endif
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+#define KESTREL_TEST_SANITIZED 1
+#endif
+
+namespace {
+
+#ifdef KESTREL_TEST_SANITIZED
+constexpr bool kSanitized = true;
+#else
+constexpr bool kSanitized = false;
+#endif
+
+std::string joined(const std::vector<std::string>& reports) {
+  std::string all;
+  for (const auto& r : reports) all += "\n" + r;
+  return all;
+}
+
+class ChildReports {
+ public:
+  static ChildReports& instance() {
+    static ChildReports reports;
+    return reports;
+  }
+
+  const std::filesystem::path& dir() const { return dir_; }
+
+  /// The reports written since the last call, each as "<file>:\n<text>".
+  std::vector<std::string> take_new() {
+    std::vector<std::string> found;
+    std::error_code ec;
+    if (dir_.empty() || !std::filesystem::is_directory(dir_, ec)) return found;
+    std::vector<std::filesystem::path> files;
+    for (const auto& entry : std::filesystem::directory_iterator(dir_, ec)) files.push_back(entry.path());
+    std::sort(files.begin(), files.end());
+    for (const auto& file : files) {
+      if (std::find(seen_.begin(), seen_.end(), file) != seen_.end()) continue;
+      seen_.push_back(file);
+      found.push_back(file.string() + ":\n" + read_file(file));
+    }
+    return found;
+  }
+
+  ~ChildReports() {
+    // At exit, in the process that made the folder (not in a forked child): a report no test
+    // saw (a child that outlived the tests) still fails the run. The reports were quoted by
+    // the failures they caused, so the folder goes.
+    if (dir_.empty() || ::getpid() != owner_) return;
+    const auto late = take_new();
+    std::error_code ec;
+    std::filesystem::remove_all(dir_, ec);
+    if (!late.empty()) {
+      std::fprintf(stderr, "test support: a child process wrote a sanitizer report after the tests ended:%s\n",
+                   joined(late).c_str());
+      std::_Exit(1);
+    }
+  }
+
+ private:
+  ChildReports() {
+    if (!kSanitized) return;
+    std::error_code ec;
+    const auto dir = std::filesystem::temp_directory_path(ec) /
+                     ("kestrel-sanitizer-reports-" + std::to_string(::getpid()));
+    if (ec || !(std::filesystem::create_directory(dir, ec) || std::filesystem::is_directory(dir, ec))) {
+      std::fprintf(stderr, "test support: cannot create %s: child processes' sanitizer reports go to stderr\n",
+                   dir.c_str());
+      return;
+    }
+    dir_ = dir;
+    owner_ = ::getpid();
+    // Later flags win: a child's reports go to <dir>/report.<its executable>.<its pid>.
+    const std::string where = ":log_path=" + (dir / "report").string() + ":log_exe_name=1";
+    for (const char* name : {"ASAN_OPTIONS", "UBSAN_OPTIONS", "LSAN_OPTIONS", "TSAN_OPTIONS"}) {
+      const char* old = std::getenv(name);
+      ::setenv(name, ((old != nullptr ? std::string(old) : std::string()) + where).c_str(), 1);
+    }
+  }
+
+  std::filesystem::path dir_;
+  pid_t owner_ = 0;
+  std::vector<std::filesystem::path> seen_;
+};
+
+// Fails the test during which a child's report appeared.
+class ChildReportListener : public ::testing::EmptyTestEventListener {
+  void OnTestEnd(const ::testing::TestInfo&) override {
+    const auto reports = ChildReports::instance().take_new();
+    EXPECT_TRUE(reports.empty()) << "a child process wrote a sanitizer report during this test:"
+                                 << joined(reports);
+  }
+};
+
+// Fails the run on a report that appeared after the last test ended (a child still exiting).
+class ChildReportEnvironment : public ::testing::Environment {
+  void TearDown() override {
+    const auto reports = ChildReports::instance().take_new();
+    EXPECT_TRUE(reports.empty()) << "a child process wrote a sanitizer report after the last test:"
+                                 << joined(reports);
+  }
+};
+
+// Before main: the options are set before any test starts a child (or a thread).
+[[maybe_unused]] const bool g_child_reports_watched = [] {
+  if (!kSanitized || ChildReports::instance().dir().empty()) return false;
+  ::testing::UnitTest::GetInstance()->listeners().Append(new ChildReportListener);
+  ::testing::AddGlobalTestEnvironment(new ChildReportEnvironment);
+  return true;
+}();
+
+}  // namespace
+
+std::filesystem::path child_sanitizer_report_dir() { return ChildReports::instance().dir(); }
+
+std::vector<std::string> take_child_sanitizer_reports() { return ChildReports::instance().take_new(); }
+
 std::string input_error_of(const std::function<void()>& f) {
   try {
     f();

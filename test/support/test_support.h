@@ -59,6 +59,14 @@ bool can_isolate_network();
 /// (kestrel-isolated, tools/launch/README.md), so the LCM traffic of the processes it starts stays there.
 RunResult run_isolated(const std::string& script, double timeout_s = 120.0);
 
+/// In a sanitizer build, where this test process's children write their sanitizer reports
+/// (ASAN_OPTIONS etc. carry log_path=<this>/report for them); empty in other builds. A report
+/// that appears there fails the test during which it appeared (test_support.cpp).
+std::filesystem::path child_sanitizer_report_dir();
+/// The children's reports that appeared since the last call (or since the last test ended),
+/// each as "<file>:\n<text>"; those taken here no longer fail the test.
+std::vector<std::string> take_child_sanitizer_reports();
+
 /// `s` in single quotes for sh.
 std::string quoted(const std::string& s);
 

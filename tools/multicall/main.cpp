@@ -35,6 +35,13 @@ const Tool* find(const std::string& name) {
   return nullptr;
 }
 
+// A build configured with KESTREL_TOOLS holds only the tools it names (cmake/KestrelTargets.cmake).
+#ifdef KESTREL_TOOLS_SUBSET
+constexpr const char* kMissing = " in this build (configured with KESTREL_TOOLS, a subset of the tools)";
+#else
+constexpr const char* kMissing = "";
+#endif
+
 int list(std::FILE* out) {
   std::fprintf(out, "usage: kestrel-tools TOOL [ARGS...], or run bin/kestrel-TOOL; the tools:\n");
   for (const Tool& t : kTools) std::fprintf(out, "  %s\n", t.name);
@@ -49,7 +56,7 @@ int main(int argc, char** argv) {
   const std::string prefix = "kestrel-";
   if (base.compare(0, prefix.size(), prefix) == 0 && base != "kestrel-tools") {
     if (const Tool* t = find(base.substr(prefix.size()))) return t->main(argc, argv);
-    std::fprintf(stderr, "kestrel-tools: error: no tool is called '%s'\n", base.c_str());
+    std::fprintf(stderr, "kestrel-tools: error: no tool is called '%s'%s\n", base.c_str(), kMissing);
     list(stderr);
     return 2;  // kExitUsage (common/error.h)
   }
@@ -57,7 +64,7 @@ int main(int argc, char** argv) {
     return list(argc < 2 ? stderr : stdout) + (argc < 2 ? 2 : 0);
   }
   if (const Tool* t = find(argv[1])) return t->main(argc - 1, argv + 1);
-  std::fprintf(stderr, "kestrel-tools: error: no tool is called '%s'\n", argv[1]);
+  std::fprintf(stderr, "kestrel-tools: error: no tool is called '%s'%s\n", argv[1], kMissing);
   list(stderr);
   return 2;
 }
