@@ -184,10 +184,12 @@ int serve(const Options& o, const SlamOptions& options, std::shared_ptr<const Vo
   spdlog::info("{}: {} + {} -> {}, {}", o.name, o.adapter.camera_channel, o.adapter.vo_channel,
                o.graph_channel, o.correction_channel);
   const int status = node->spin();
-  spdlog::info("{} keyframes, {} loop closures, {} frames re-anchored on a covering keyframe, {} VO restarts "
+  const auto& misses = adapter.slam().coverage_misses();
+  spdlog::info("{} keyframes, {} loop closures, {} frames re-anchored on a covering keyframe (keyframes instead: "
+               "{} with none near, {} none verified, {} located too far), {} VO restarts "
                "bridged by the estimator, {} estimator restarts, {} messages rejected",
                adapter.slam().keyframes().size(), adapter.slam().num_loop_closures(), adapter.slam().num_reanchors(),
-               adapter.bridges(),
+               misses.none_near, misses.not_verified, misses.too_far, adapter.bridges(),
                adapter.estimator_restarts(), node->counters().messages_rejected);
   return status;
 }

@@ -129,6 +129,7 @@ void Slam::reset() {
   reference_marginal_.reset();
   reference_ = OdometryReference{};
   reanchors_ = 0;
+  coverage_misses_ = CoverageMisses{};
 }
 
 void Slam::change_world(const Eigen::Isometry3d& T_new_world) {
@@ -282,6 +283,7 @@ bool Slam::reanchor(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_came
   }
   std::sort(covering.begin(), covering.end());
   if (static_cast<int>(covering.size()) > c.max_candidates) covering.resize(static_cast<size_t>(c.max_candidates));
+  if (covering.empty()) ++coverage_misses_.none_near;
   for (const auto& [distance, k] : covering) {
     const Keyframe& kf = keyframes_[k];
     // The seed depends on the pair only, so that a replay verifies identically.
@@ -296,6 +298,7 @@ bool Slam::reanchor(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_came
     if (T_expected_located.translation().norm() > c.max_correction_m ||
         so3::angle(T_expected_located.linear()) > c.max_correction_rad) {
       step.loop = located;
+      ++coverage_misses_.too_far;
       return false;
     }
     // The frame in keyframe k twice: predicted (the reference and the odometry since, with
@@ -321,6 +324,7 @@ bool Slam::reanchor(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_came
     ++reanchors_;
     return true;
   }
+  if (!covering.empty()) ++coverage_misses_.not_verified;
   return false;
 }
 

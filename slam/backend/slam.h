@@ -123,6 +123,12 @@ class Slam {
   int num_loop_closures() const { return loop_closures_; }
   /// Frames re-anchored on a covering keyframe instead of becoming keyframes.
   int num_reanchors() const { return reanchors_; }
+  /// Why frames tried for re-anchoring became keyframes instead: no keyframe near their
+  /// estimate, none verified, or located beyond the correction bound.
+  struct CoverageMisses {
+    int none_near = 0, not_verified = 0, too_far = 0;
+  };
+  const CoverageMisses& coverage_misses() const { return coverage_misses_; }
   const OdometryReference& reference() const { return reference_; }
   /// Verified loops refused because they disagreed with the odometry (loop_consistency.h).
   int num_inconsistent_loops() const { return inconsistent_loops_; }
@@ -171,6 +177,7 @@ class Slam {
   std::optional<Matrix6d> reference_marginal_;
   OdometryReference reference_;
   int reanchors_ = 0;
+  CoverageMisses coverage_misses_;
   bool gate_by_pose_ = true;  ///< off from an odometry break until a loop closure re-anchors
 };
 
