@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <iostream>
 
@@ -277,7 +278,11 @@ int run(const Options& o) {
   sampler.save_csv();
 
   std::string failure = flown.ok ? "" : flown.failure;
-  if (!sampler.died().empty()) {
+  if (interrupted) {  // which signal, and when: a soak stopped by someone else says so
+    const int sig = interrupt_signal();
+    failure = fmt::format("interrupted by signal {} ({}) at {:.1f} simulated minutes", sig,
+                          sig > 0 ? strsignal(sig) : "?", listener.sim_s() / 60.0);
+  } else if (!sampler.died().empty()) {
     failure.clear();
     for (const auto& [name, how] : sampler.died())
       failure += fmt::format("{}{} {} during the flight:\n{}", failure.empty() ? "" : "\n", name, how,
