@@ -22,4 +22,13 @@ inline double wrap_angle(double a) {
   return a <= -kPi ? a + kTwoPi : a;
 }
 
+/// An axis's grid step: 1, 2 or 5 times a power of ten giving about `count` steps over `span` (> 0).
+inline double nice_step(double span, int count) {
+  const double rough = span / count;
+  const double decade = std::pow(10.0, std::floor(std::log10(rough)));
+  for (double m : {1.0, 2.0, 5.0})
+    if (m * decade >= rough) return m * decade;
+  return 10.0 * decade;
+}
+
 }  // namespace kestrel

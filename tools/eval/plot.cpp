@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "common/error.h"
+#include "common/numbers.h"
 #include "common/time.h"
 
 namespace kestrel::eval {
@@ -23,16 +24,6 @@ const cv::Scalar kFailure(40, 40, 220);    // red
 constexpr int kFont = cv::FONT_HERSHEY_SIMPLEX;
 constexpr int kShift = 4;  // sub-pixel drawing: coordinates in 1/16 px
 constexpr int kWidth = 1000;
-
-// A grid step of 1, 2 or 5 times a power of ten giving about `ticks` intervals over `range`.
-double nice_step(double range, int ticks) {
-  const double raw = range / ticks;
-  const double magnitude = std::pow(10.0, std::floor(std::log10(raw)));
-  for (double m : {1.0, 2.0, 5.0}) {
-    if (m * magnitude >= raw) return m * magnitude;
-  }
-  return 10.0 * magnitude;
-}
 
 std::string tick_label(double v, double step) {
   const int decimals = std::max(0, -static_cast<int>(std::floor(std::log10(step) + 1e-9)));

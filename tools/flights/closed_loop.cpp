@@ -13,6 +13,7 @@
 #include "common/atomic_file.h"
 #include "common/error.h"
 #include "common/numbers.h"
+#include "tools/launch/isolation.h"
 #include "tools/launch/process_set.h"
 #include "tools/launch/supervisor.h"
 
@@ -120,6 +121,22 @@ FlightRun fly(const FlightSetup& s, const fs::path& tool_dir, const std::string&
   }
   run.ok = run.failure.empty();
   return run;
+}
+
+void enter_flight_network(const std::string& tool) {
+  try {
+    spdlog::info("private network: {}", launch::to_string(launch::enter_private_network()));
+  } catch (const launch::IsolationError& e) {
+    throw UnavailableError(std::string(e.what()) + " (kestrel " + tool + " runs its processes in a private network)");
+  }
+}
+
+fs::path make_output_folder(const std::string& folder) {
+  const fs::path out(folder);
+  std::error_code ec;
+  fs::create_directories(out, ec);
+  if (ec) throw InputError(folder + ": cannot make the folder: " + ec.message());
+  return out;
 }
 
 }  // namespace kestrel::flights

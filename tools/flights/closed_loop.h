@@ -54,6 +54,13 @@ using FlightWatch = std::function<void(const launch::Supervisor& processes, bool
 FlightRun fly(const FlightSetup& setup, const std::filesystem::path& tool_dir, const std::string& lcm_url,
               const std::function<bool()>& interrupted, const FlightWatch& watch = {});
 
+/// Puts this process (call it before any thread starts) in a private network that the flights'
+/// processes share and nothing leaves; UnavailableError naming `tool` when none can be made.
+void enter_flight_network(const std::string& tool);
+
+/// Makes `folder` (and its parents) for a tool's outputs; InputError naming it when it cannot.
+std::filesystem::path make_output_folder(const std::string& folder);
+
 /// The flight time a plan needs: its length at `speed_m_s`, a margin for the turns, the
 /// controller's lag and the start, and a hold at the goal.
 double flight_duration_s(const std::vector<Eigen::Vector4d>& waypoints, double speed_m_s);

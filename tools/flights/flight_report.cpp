@@ -7,6 +7,8 @@
 #include <map>
 #include <utility>
 
+#include "common/json_number.h"
+
 namespace kestrel::flights {
 namespace {
 
@@ -29,8 +31,6 @@ double max_of(const std::vector<double>& v) {
 std::string number(double v, const char* format = "{:.3f}") {
   return std::isfinite(v) ? fmt::format(fmt::runtime(format), v) : std::string("—");
 }
-
-nlohmann::json finite_or_null(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); }
 
 }  // namespace
 

@@ -28,7 +28,6 @@
 #include "tools/flights/flight_log.h"
 #include "tools/flights/flight_report.h"
 #include "drivers/sim/world_catalog.h"
-#include "tools/launch/isolation.h"
 
 #ifndef KESTREL_DEFAULT_STATA_MAP
 #define KESTREL_DEFAULT_STATA_MAP "../shared/data/maps/stata_basement.yaml"
@@ -113,18 +112,11 @@ int run(const Options& o) {
         throw CLI::ValidationError("--pairs", fmt::format("{} has pairs 1 to {}", name, worlds.back().pairs.size()));
   }
   // Before any thread: every flight's processes share this private network, and nothing leaves the host.
-  if (!o.plan_only) try {
-      spdlog::info("private network: {}", launch::to_string(launch::enter_private_network()));
-    } catch (const launch::IsolationError& e) {
-      throw UnavailableError(std::string(e.what()) + " (kestrel fly-plans runs its processes in a private network)");
-    }
+  if (!o.plan_only) flights::enter_flight_network("fly-plans");
   const auto& interrupted = catch_interrupts();
   const std::string url = transport::resolve_lcm_url(o.lcm_url);
   const fs::path tool_dir = fs::canonical("/proc/self/exe").parent_path();
-  const fs::path out(o.out);
-  std::error_code ec;
-  fs::create_directories(out, ec);
-  if (ec) throw InputError(o.out + ": cannot make the folder: " + ec.message());
+  const fs::path out = flights::make_output_folder(o.out);
 
   std::vector<flights::FlightRow> rows;
   std::string report = "# Closed-loop flights of PRM and BRM plans (kestrel fly-plans)\n\n";

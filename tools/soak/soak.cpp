@@ -7,10 +7,10 @@
 #include <iterator>
 #include <map>
 
+#include "common/json_number.h"
+
 namespace kestrel::soak {
 namespace {
-
-nlohmann::json finite_or_null(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); }
 
 std::string number(double v, int decimals) { return std::isfinite(v) ? fmt::format("{:.{}f}", v, decimals) : "—"; }
 std::string csv_number(double v, int decimals) { return std::isfinite(v) ? fmt::format("{:.{}f}", v, decimals) : ""; }

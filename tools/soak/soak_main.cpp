@@ -30,7 +30,6 @@
 #include "kestrel/slam_graph_t.hpp"
 #include "kestrel/vo_update_t.hpp"
 #include "tools/flights/closed_loop.h"
-#include "tools/launch/isolation.h"
 #include "tools/launch/supervisor.h"
 #include "tools/soak/proc_memory.h"
 #include "tools/soak/soak.h"
@@ -232,18 +231,12 @@ int run(const Options& o) {
   criteria.flat_mb_per_10min = o.flat_mb_per_10min;
 
   // Before any thread: the flight's processes and this listener share this private network.
-  try {
-    spdlog::info("private network: {}", launch::to_string(launch::enter_private_network()));
-  } catch (const launch::IsolationError& e) {
-    throw UnavailableError(std::string(e.what()) + " (kestrel soak runs its processes in a private network)");
-  }
+  flights::enter_flight_network("soak");
   const auto& interrupted = catch_interrupts();
   const std::string url = transport::resolve_lcm_url(o.lcm_url);
   const fs::path tool_dir = fs::canonical("/proc/self/exe").parent_path();
-  const fs::path out(o.out);
+  const fs::path out = flights::make_output_folder(o.out);
   std::error_code ec;
-  fs::create_directories(out, ec);
-  if (ec) throw InputError(o.out + ": cannot make the folder: " + ec.message());
   for (const char* stale : {"report.md", "soak.json", "soak.png", "samples.csv", "progress.csv"})
     fs::remove(out / stale, ec);  // an earlier soak's results must not pass for this one's
 

@@ -7,6 +7,8 @@
 #include <map>
 #include <opencv2/imgproc.hpp>
 
+#include "common/numbers.h"
+
 namespace kestrel::soak {
 namespace {
 
@@ -30,15 +32,6 @@ int label_width(const std::string& s, double scale = 0.45) {
   return cv::getTextSize(s, kFace, scale, 1, &base).width;
 }
 
-// 1, 2 or 5 times a power of ten, about `count` steps over `span`.
-double tick_step(double span, int count) {
-  const double rough = span / count;
-  const double decade = std::pow(10.0, std::floor(std::log10(rough)));
-  for (double m : {1.0, 2.0, 5.0})
-    if (m * decade >= rough) return m * decade;
-  return 10.0 * decade;
-}
-
 std::string tick_text(double v, double step) {
   const int decimals = std::max(0, -static_cast<int>(std::floor(std::log10(step) + 1e-9)));
   return fmt::format("{:.{}f}", std::abs(v) < 0.5 * step ? 0.0 : v, decimals);
@@ -58,7 +51,7 @@ struct Panel {
     cv::line(img, at(xa, ya), at(xb, yb), c, width, cv::LINE_AA, kSub);
   }
   void frame(cv::Mat& img, const std::string& x_title, const std::string& y_title) const {
-    const double xs = tick_step(x1 - x0, 10), ys = tick_step(y1 - y0, 5);
+    const double xs = nice_step(x1 - x0, 10), ys = nice_step(y1 - y0, 5);
     for (double x = std::ceil(x0 / xs) * xs; x <= x1 + 1e-9 * xs; x += xs) {
       segment(img, x, y0, x, y1, kRule, 1);
       const std::string s = tick_text(x, xs);
