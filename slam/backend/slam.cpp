@@ -57,18 +57,6 @@ Matrix6d odometry_information(const Eigen::Isometry3d& T_prev_cur, const Odometr
   return info;
 }
 
-// The same from the odometry's own covariance of a right perturbation [rho; phi] of T_prev_cur
-// (the measurement Z of the edge): the error of Z * Exp(xi) is [rho; phi / 2] to first order.
-Matrix6d reported_odometry_information(const Matrix6d& covariance, const OdometryNoise& n) {
-  Matrix6d cov = covariance;
-  cov.diagonal().head<3>().array() += n.reported_translation_floor_m * n.reported_translation_floor_m;
-  cov.diagonal().tail<3>().array() += n.reported_rotation_floor_rad * n.reported_rotation_floor_rad;
-  Matrix6d S = Matrix6d::Identity();
-  S.bottomRightCorner<3, 3>() *= 0.5;
-  const Matrix6d info = (S * cov * S).inverse();
-  return 0.5 * (info + info.transpose());
-}
-
 // The pose graph's error of a right perturbation [rho; phi] of a measurement is [rho; phi / 2]
 // (spaces.h): covariance <-> information of an edge.
 Matrix6d error_scale() {
@@ -85,6 +73,15 @@ Matrix6d information_of(const Matrix6d& right_covariance) {
   const Matrix6d S = error_scale();
   const Matrix6d info = (S * right_covariance * S).inverse();
   return 0.5 * (info + info.transpose());
+}
+
+// An odometry edge's information from the odometry's own covariance of a right perturbation [rho; phi] of T_prev_cur
+// (the measurement Z of the edge): the error of Z * Exp(xi) is [rho; phi / 2] to first order.
+Matrix6d reported_odometry_information(const Matrix6d& covariance, const OdometryNoise& n) {
+  Matrix6d cov = covariance;
+  cov.diagonal().head<3>().array() += n.reported_translation_floor_m * n.reported_translation_floor_m;
+  cov.diagonal().tail<3>().array() += n.reported_rotation_floor_rad * n.reported_rotation_floor_rad;
+  return information_of(cov);
 }
 
 // The information of Z = A * B from A's (right-perturbation covariance) and B's (an edge's
