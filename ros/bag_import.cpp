@@ -1,0 +1,399 @@
+#include "ros/bag_import.h"
+
+#include <algorithm>
+#include <map>
+#include <set>
+#include <utility>
+
+#include <geometry_msgs/PoseStamped.h>
+#include <rosbag/bag.h>
+#include <rosbag/exceptions.h>
+#include <rosbag/view.h>
+#include <tf2_msgs/TFMessage.h>
+
+#include "common/error.h"
+#include "common/rgbd_frame.h"
+#include "common/time.h"
+#include "common/transport/channels.h"
+#include "common/transport/convert.h"
+#include "common/transport/message.h"
+#include "drivers/tum/association.h"
+#include "kestrel/ground_truth_t.hpp"
+#include "kestrel/imu_t.hpp"
+#include "ros/ros_convert.h"
+
+namespace kestrel::ros1 {
+namespace {
+
+// "/camera/depth/image at 1305031104.659863 s", for an error about one message.
+std::string at(const std::string& topic, const ros::Time& stamp) {
+  return topic + " at " + format_seconds(to_utime(stamp)) + " s";
+}
+
+// The topics of the bag with their message types, for checks and error messages.
+struct Topics {
+  std::map<std::string, const rosbag::ConnectionInfo*> by_name;
+
+  bool has(const std::string& topic) const { return !topic.empty() && by_name.count(topic) > 0; }
+  std::string list() const {
+    std::string s;
+    for (const auto& [name, c] : by_name) s += (s.empty() ? "" : ", ") + name + " (" + c->datatype + ")";
+    return s.empty() ? "none" : s;
+  }
+  // Throws unless `topic` carries messages of type T (by MD5, as librosbag's instantiate does:
+  // tf/tfMessage of older bags and tf2_msgs/TFMessage are the same definition).
+  template <class T>
+  void require_type(const std::string& bag, const std::string& topic) const {
+    const rosbag::ConnectionInfo* c = by_name.at(topic);
+    const std::string expected = ros::message_traits::DataType<T>::value();
+    if (c->md5sum != ros::message_traits::MD5Sum<T>::value()) {
+      throw InputError(bag + ": " + topic + ": messages are " + c->datatype + " (md5 " + c->md5sum + "), not " +
+                       expected + (c->datatype == expected ? " as this ROS defines it (an older definition)" : ""));
+    }
+  }
+};
+
+// Message `index` of its topic, in bag order, with its stamp.
+struct Stamped {
+  int64_t utime = 0;
+  size_t order = 0;
+};
+
+// The stamps of one image topic sorted, repeated stamps dropped (counted).
+std::vector<Stamped> sorted_unique(std::vector<Stamped> stamps, size_t& repeated) {
+  std::stable_sort(stamps.begin(), stamps.end(), [](const Stamped& a, const Stamped& b) { return a.utime < b.utime; });
+  std::vector<Stamped> out;
+  out.reserve(stamps.size());
+  for (const Stamped& s : stamps) {
+    if (!out.empty() && out.back().utime == s.utime) {
+      ++repeated;
+      continue;
+    }
+    out.push_back(s);
+  }
+  return out;
+}
+
+enum class Kind { kImu = 0, kGroundTruth = 1, kFrame = 2 };
+struct Event {
+  int64_t utime = 0;
+  Kind kind = Kind::kFrame;
+  size_t index = 0;  // into the pairs, imu or poses
+};
+
+struct Pose {
+  int64_t utime = 0;
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+};
+
+// One edge of the tf tree: the child's transforms in its parent, sorted by time.
+struct Edge {
+  std::string parent;
+  std::vector<Pose> samples;
+};
+
+// The pose of `camera` in `world` along the tf tree, at each transform of the chain's busiest
+// edge; `why` says what was used or why nothing was.
+std::vector<Pose> poses_from_tf(std::map<std::string, Edge>& edges, const std::string& world,
+                                const std::string& camera, const std::string& topic, std::string& why) {
+  std::vector<const Edge*> chain;  // camera's edge first
+  std::string path = camera;
+  for (std::string frame = camera; frame != world;) {
+    const auto it = edges.find(frame);
+    if (it == edges.end() || chain.size() > 64) {
+      why = "none: no chain of transforms from '" + world + "' to '" + camera + "' on " + topic +
+            (edges.empty() ? " (no transforms)" : "");
+      return {};
+    }
+    chain.push_back(&it->second);
+    frame = it->second.parent;
+    path = frame + " -> " + path;
+  }
+  if (chain.empty()) {
+    why = "none: the world and camera frames are the same ('" + world + "')";
+    return {};
+  }
+  for (auto& [child, edge] : edges)
+    std::stable_sort(edge.samples.begin(), edge.samples.end(), [](const Pose& a, const Pose& b) { return a.utime < b.utime; });
+  const Edge* driving = *std::max_element(chain.begin(), chain.end(), [](const Edge* a, const Edge* b) {
+    return a->samples.size() < b->samples.size();
+  });
+  // The latest transform of `edge` at or before `utime`, or its first (a rigid mount published
+  // only after the motion started).
+  auto value_at = [](const Edge& edge, int64_t utime) -> const Eigen::Isometry3d& {
+    auto it = std::upper_bound(edge.samples.begin(), edge.samples.end(), utime,
+                               [](int64_t t, const Pose& p) { return t < p.utime; });
+    return it == edge.samples.begin() ? it->T : std::prev(it)->T;
+  };
+  std::vector<Pose> poses;
+  poses.reserve(driving->samples.size());
+  for (const Pose& s : driving->samples) {
+    if (!poses.empty() && poses.back().utime == s.utime) continue;
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    for (const Edge* e : chain) T = value_at(*e, s.utime) * T;
+    poses.push_back({s.utime, T});
+  }
+  why = topic + ": " + path;
+  return poses;
+}
+
+bool same_camera(const PinholeCamera& a, const PinholeCamera& b) {
+  return a.width == b.width && a.height == b.height && a.fx == b.fx && a.fy == b.fy && a.cx == b.cx &&
+         a.cy == b.cy && a.distortion == b.distortion;
+}
+
+BagImportStats import(rosbag::Bag& bag, const std::string& path, const BagImportOptions& o, const ImportSink& sink) {
+  BagImportStats stats;
+  Topics topics;
+  rosbag::View everything(bag);
+  for (const rosbag::ConnectionInfo* c : everything.getConnections()) topics.by_name.emplace(c->topic, c);
+
+  for (const std::string* t : {&o.colour_topic, &o.depth_topic}) {
+    if (!topics.has(*t))
+      throw InputError(path + ": " + *t + ": no such topic (" + (t == &o.colour_topic ? "colour" : "depth") +
+                       " images; the bag has: " + topics.list() + ")");
+    topics.require_type<sensor_msgs::Image>(path, *t);
+  }
+
+  // First pass: stamps, checks, calibration, IMU and poses; no pixels kept.
+  auto stamps_of = [&](const std::string& topic, bool depth, int& width, int& height) {
+    std::vector<Stamped> stamps;
+    rosbag::View view(bag, rosbag::TopicQuery(topic));
+    for (const rosbag::MessageInstance& m : view) {
+      const auto image = m.instantiate<sensor_msgs::Image>();
+      const std::string what = path + ": " + at(topic, image->header.stamp);
+      check_image(*image, depth, what);
+      if (stamps.empty()) {
+        width = static_cast<int>(image->width);
+        height = static_cast<int>(image->height);
+      } else if (width != static_cast<int>(image->width) || height != static_cast<int>(image->height)) {
+        throw InputError(what + ": image is " + std::to_string(image->width) + "x" + std::to_string(image->height) +
+                         ", the topic's first was " + std::to_string(width) + "x" + std::to_string(height));
+      }
+      stamps.push_back({to_utime(image->header.stamp), stamps.size()});
+    }
+    return stamps;
+  };
+  int colour_w = 0, colour_h = 0, depth_w = 0, depth_h = 0;
+  const std::vector<Stamped> colour_by_order = stamps_of(o.colour_topic, false, colour_w, colour_h);
+  const std::vector<Stamped> depth_by_order = stamps_of(o.depth_topic, true, depth_w, depth_h);
+  if (colour_w != depth_w || colour_h != depth_h)
+    throw InputError(path + ": " + o.depth_topic + ": depth images are " + std::to_string(depth_w) + "x" +
+                     std::to_string(depth_h) + ", the colour images on " + o.colour_topic + " " +
+                     std::to_string(colour_w) + "x" + std::to_string(colour_h) +
+                     " (kestrel needs depth registered to the colour camera)");
+
+  if (o.intrinsics) {
+    stats.camera = *o.intrinsics;
+    stats.camera.width = colour_w;
+    stats.camera.height = colour_h;
+    stats.camera.validate("--intrinsics");
+  } else {
+    if (!topics.has(o.camera_info_topic))
+      throw InputError(path + ": " + o.camera_info_topic + ": no such topic (the colour camera's CameraInfo; give "
+                       "the topic, or the intrinsics; the bag has: " + topics.list() + ")");
+    topics.require_type<sensor_msgs::CameraInfo>(path, o.camera_info_topic);
+    rosbag::View view(bag, rosbag::TopicQuery(o.camera_info_topic));
+    for (const rosbag::MessageInstance& m : view) {
+      const auto info = m.instantiate<sensor_msgs::CameraInfo>();
+      const PinholeCamera c = camera_from_info(*info, path + ": " + at(o.camera_info_topic, info->header.stamp));
+      if (stats.camera_infos++ == 0) {
+        stats.camera = c;
+      } else if (!same_camera(c, stats.camera)) {
+        ++stats.camera_info_changes;
+      }
+    }
+    if (stats.camera_infos == 0) throw InputError(path + ": " + o.camera_info_topic + ": no CameraInfo message");
+    if (stats.camera.width != colour_w || stats.camera.height != colour_h)
+      throw InputError(path + ": " + o.camera_info_topic + ": CameraInfo is " + std::to_string(stats.camera.width) +
+                       "x" + std::to_string(stats.camera.height) + ", the images on " + o.colour_topic + " " +
+                       std::to_string(colour_w) + "x" + std::to_string(colour_h));
+  }
+
+  std::vector<ImuReading> imu;
+  if (topics.has(o.imu_topic)) {
+    topics.require_type<sensor_msgs::Imu>(path, o.imu_topic);
+    rosbag::View view(bag, rosbag::TopicQuery(o.imu_topic));
+    for (const rosbag::MessageInstance& m : view) {
+      const auto msg = m.instantiate<sensor_msgs::Imu>();
+      ImuReading r = imu_from_message(*msg, path + ": " + at(o.imu_topic, msg->header.stamp));
+      if (!r.has_gyro && !r.has_accel) {
+        ++stats.imu_empty;
+        continue;
+      }
+      imu.push_back(r);
+    }
+    std::stable_sort(imu.begin(), imu.end(), [](const ImuReading& a, const ImuReading& b) { return a.utime < b.utime; });
+  }
+
+  std::vector<Pose> poses;
+  if (!o.pose_topic.empty()) {
+    if (!topics.has(o.pose_topic)) throw InputError(path + ": " + o.pose_topic + ": no such topic (ground-truth poses; the bag has: " + topics.list() + ")");
+    topics.require_type<geometry_msgs::PoseStamped>(path, o.pose_topic);
+    rosbag::View view(bag, rosbag::TopicQuery(o.pose_topic));
+    for (const rosbag::MessageInstance& m : view) {
+      const auto msg = m.instantiate<geometry_msgs::PoseStamped>();
+      poses.push_back({to_utime(msg->header.stamp), to_isometry(msg->pose, path + ": " + at(o.pose_topic, msg->header.stamp))});
+    }
+    std::stable_sort(poses.begin(), poses.end(), [](const Pose& a, const Pose& b) { return a.utime < b.utime; });
+    stats.ground_truth = o.pose_topic + " (geometry_msgs/PoseStamped)";
+  } else if (topics.has(o.tf_topic) || topics.has(o.tf_topic + "_static")) {
+    std::map<std::string, Edge> edges;
+    for (const std::string& topic : {o.tf_topic, o.tf_topic + "_static"}) {
+      if (!topics.has(topic)) continue;
+      topics.require_type<tf2_msgs::TFMessage>(path, topic);
+      rosbag::View view(bag, rosbag::TopicQuery(topic));
+      for (const rosbag::MessageInstance& m : view) {
+        const auto msg = m.instantiate<tf2_msgs::TFMessage>();
+        for (const geometry_msgs::TransformStamped& t : msg->transforms) {
+          const std::string child = frame_name(t.child_frame_id);
+          const std::string parent = frame_name(t.header.frame_id);
+          auto [it, added] = edges.try_emplace(child, Edge{parent, {}});
+          // A frame has one parent in a tf tree; a second parent is another tree's frame.
+          if (!added && it->second.parent != parent) continue;
+          it->second.samples.push_back(
+              {to_utime(t.header.stamp), to_isometry(t.transform, path + ": " + at(topic, t.header.stamp) + ": " +
+                                                                     parent + " -> " + child)});
+        }
+      }
+    }
+    poses = poses_from_tf(edges, frame_name(o.world_frame), frame_name(o.camera_frame), o.tf_topic, stats.ground_truth);
+  } else {
+    stats.ground_truth = "none: no " + o.tf_topic + (o.tf_topic.empty() ? "" : " topic");
+  }
+
+  // Pairing: the TUM reader's rule and code.
+  std::vector<Stamped> colour = sorted_unique(colour_by_order, stats.repeated_stamps);
+  std::vector<Stamped> depth = sorted_unique(depth_by_order, stats.repeated_stamps);
+  std::vector<int64_t> colour_times, depth_times;
+  for (const Stamped& s : colour) colour_times.push_back(s.utime);
+  for (const Stamped& s : depth) depth_times.push_back(s.utime);
+  const tum::Association association = tum::associate(colour_times, depth_times, o.max_difference_us);
+  stats.colour_images = colour.size();
+  stats.depth_images = depth.size();
+  stats.unmatched_colour = association.unmatched_a;
+  stats.unused_depth = association.unused_b;
+  stats.shared_depth = association.shared_b;
+  if (association.pairs.empty()) {
+    const auto span = [](const std::vector<int64_t>& t) {
+      return t.empty() ? std::string("none")
+                       : std::to_string(t.size()) + " from " + format_seconds(t.front()) + " to " + format_seconds(t.back()) + " s";
+    };
+    throw InputError(path + ": no image on " + o.colour_topic + " has one on " + o.depth_topic + " within " +
+                     format_seconds(o.max_difference_us) + " s (colour: " + span(colour_times) + "; depth: " +
+                     span(depth_times) + ")");
+  }
+
+  // What the second pass keeps: per message of each topic, in bag order, its pair (colour) or
+  // its place among the depth images and how many frames it serves.
+  const size_t none = static_cast<size_t>(-1);
+  std::vector<size_t> pair_of_colour_message(colour_by_order.size(), none);
+  std::vector<size_t> depth_index_of_message(depth_by_order.size(), none);
+  std::vector<int> depth_users(depth.size(), 0);
+  for (size_t p = 0; p < association.pairs.size(); ++p) {
+    pair_of_colour_message[colour[association.pairs[p].a].order] = p;
+    ++depth_users[association.pairs[p].b];
+  }
+  for (size_t d = 0; d < depth.size(); ++d) depth_index_of_message[depth[d].order] = d;
+
+  std::vector<Event> events;
+  events.reserve(association.pairs.size() + imu.size() + poses.size());
+  for (size_t p = 0; p < association.pairs.size(); ++p) events.push_back({colour[association.pairs[p].a].utime, Kind::kFrame, p});
+  for (size_t i = 0; i < imu.size(); ++i) events.push_back({imu[i].utime, Kind::kImu, i});
+  for (size_t i = 0; i < poses.size(); ++i) events.push_back({poses[i].utime, Kind::kGroundTruth, i});
+  std::stable_sort(events.begin(), events.end(), [](const Event& a, const Event& b) {
+    return a.utime != b.utime ? a.utime < b.utime : a.kind < b.kind;
+  });
+
+  // Second pass: pixels, written in event order as soon as a frame's two images are read.
+  std::map<size_t, cv::Mat> colour_ready;  // by pair
+  std::map<size_t, cv::Mat> depth_ready;   // by depth index
+  size_t next = 0;
+  int64_t imu_seq = 0;
+  auto flush = [&] {
+    for (; next < events.size(); ++next) {
+      const Event& e = events[next];
+      if (e.kind == Kind::kImu) {
+        const ImuReading& r = imu[e.index];
+        kestrel::imu_t m{};
+        m.utime = r.utime;
+        m.seq = imu_seq++;
+        m.fields = static_cast<int8_t>((r.has_gyro ? kestrel::imu_t::HAS_GYRO : 0) | (r.has_accel ? kestrel::imu_t::HAS_ACCEL : 0));
+        for (int k = 0; k < 3; ++k) {
+          m.angular_velocity[k] = r.angular_velocity[k];
+          m.linear_acceleration[k] = r.linear_acceleration[k];
+        }
+        sink.publish(channel::kImu, r.utime, transport::encode_message(m));
+        ++stats.imu_samples;
+        continue;
+      }
+      if (e.kind == Kind::kGroundTruth) {
+        kestrel::ground_truth_t m{};
+        m.utime = poses[e.index].utime;
+        // The import's body is the camera (T_body_camera = identity), so the camera's pose is
+        // also the body's; FRAME_CAMERA says which it is, as TUM's truth does.
+        m.frame = kestrel::ground_truth_t::FRAME_CAMERA;
+        m.T_world_frame = transport::to_message(poses[e.index].T);
+        m.fields = 0;
+        sink.publish(channel::kGroundTruth, m.utime, transport::encode_message(m));
+        ++stats.ground_truth_poses;
+        continue;
+      }
+      const tum::AssociatedPair& p = association.pairs[e.index];
+      const auto c = colour_ready.find(e.index);
+      const auto d = depth_ready.find(p.b);
+      if (c == colour_ready.end() || d == depth_ready.end()) return;  // not read yet
+      RgbdFrame f;
+      f.utime = colour[p.a].utime;
+      f.depth_utime = depth[p.b].utime;
+      f.seq = static_cast<int64_t>(p.a);
+      f.camera = stats.camera;
+      f.sensor = o.sensor;
+      f.rgb = c->second;
+      f.depth_mm = d->second;
+      sink.publish(channel::kCameraRgbd, f.utime, transport::encode_message(transport::encode_rgbd(f, o.encoding)));
+      ++stats.frames;
+      colour_ready.erase(c);
+      if (--depth_users[p.b] == 0) depth_ready.erase(d);
+    }
+  };
+  size_t colour_order = 0, depth_order = 0;
+  rosbag::View images(bag, rosbag::TopicQuery(std::vector<std::string>{o.colour_topic, o.depth_topic}));
+  for (const rosbag::MessageInstance& m : images) {
+    const bool is_colour = m.getTopic() == o.colour_topic;
+    const size_t order = is_colour ? colour_order++ : depth_order++;
+    const size_t slot = is_colour ? pair_of_colour_message.at(order) : depth_index_of_message.at(order);
+    if (slot == none || (!is_colour && depth_users[slot] == 0)) continue;
+    const auto image = m.instantiate<sensor_msgs::Image>();
+    const std::string what = path + ": " + at(m.getTopic(), image->header.stamp);
+    if (is_colour) {
+      colour_ready[slot] = colour_to_rgb(*image, what);
+    } else {
+      depth_ready[slot] = depth_to_mm(*image, what);
+    }
+    flush();
+  }
+  flush();
+  if (next != events.size())  // the bag changed between the passes, or librosbag skipped a message
+    throw InputError(path + ": the second reading of the images did not find every image the first found");
+  return stats;
+}
+
+}  // namespace
+
+BagImportStats import_bag(const std::string& bag_path, const BagImportOptions& options, const ImportSink& sink) {
+  try {
+    rosbag::Bag bag;
+    bag.open(bag_path, rosbag::bagmode::Read);
+    return import(bag, bag_path, options, sink);
+  } catch (const rosbag::BagUnindexedException& e) {
+    throw InputError(bag_path + ": the bag has no index (truncated, or its recording was cut short; `rosbag "
+                     "reindex` may recover it): " + e.what());
+  } catch (const ros::Exception& e) {
+    // rosbag::BagException (cannot open, bad header, a chunk cut short) and the message
+    // deserialiser's overruns.
+    throw InputError(bag_path + ": cannot read the bag: " + e.what());
+  }
+}
+
+}  // namespace kestrel::ros1

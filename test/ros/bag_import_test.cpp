@@ -1,0 +1,244 @@
+// ros/bag_import.h on small bags written with librosbag: pairing by the TUM reader's rule, the
+// order of the messages, IMU samples, ground truth from tf and from PoseStamped, the camera,
+// and the errors that name the topic.
+
+#include <gtest/gtest.h>
+
+#include <functional>
+
+#include <geometry_msgs/PoseStamped.h>
+#include <rosbag/bag.h>
+#include <tf2_msgs/TFMessage.h>
+
+#include "common/transport/channels.h"
+#include "common/transport/convert.h"
+#include "common/transport/message.h"
+#include "common/transport/rgbd_codec.h"
+#include "kestrel/ground_truth_t.hpp"
+#include "kestrel/imu_t.hpp"
+#include "ros/bag_import.h"
+#include "ros/ros_convert.h"
+#include "test/ros/bag_writer.h"
+#include "test/support/test_support.h"
+
+namespace kestrel {
+namespace {
+
+constexpr int kW = 4, kH = 3;
+
+struct Written {
+  std::vector<std::string> channels;
+  std::vector<RgbdFrame> frames;
+  std::vector<imu_t> imu;
+  std::vector<ground_truth_t> truth;
+};
+
+Written import(const std::string& bag, const ros1::BagImportOptions& o, ros1::BagImportStats* stats = nullptr) {
+  Written w;
+  ros1::ImportSink sink;
+  sink.publish = [&](const std::string& channel, int64_t, const std::vector<uint8_t>& bytes) {
+    w.channels.push_back(channel);
+    if (channel == channel::kCameraRgbd)
+      w.frames.push_back(transport::decode_rgbd(transport::decode_message<rgbd_frame_t>(bytes.data(), bytes.size(), "c"), "c"));
+    if (channel == channel::kImu) w.imu.push_back(transport::decode_message<imu_t>(bytes.data(), bytes.size(), "i"));
+    if (channel == channel::kGroundTruth)
+      w.truth.push_back(transport::decode_message<ground_truth_t>(bytes.data(), bytes.size(), "g"));
+  };
+  const ros1::BagImportStats s = ros1::import_bag(bag, o, sink);
+  if (stats) *stats = s;
+  return w;
+}
+
+void write_bag(const std::string& path, const std::function<void(rosbag::Bag&)>& fill) {
+  rosbag::Bag bag(path, rosbag::bagmode::Write);
+  fill(bag);
+  bag.close();
+}
+
+void put_colour(rosbag::Bag& bag, int64_t utime, const std::string& encoding = "rgb8") {
+  bag.write("/camera/rgb/image_color", ros1::to_ros_time(utime), test::colour_image(utime, kW, kH, encoding));
+  bag.write("/camera/rgb/camera_info", ros1::to_ros_time(utime), test::camera_info(utime, kW, kH, 5.0, 6.0));
+}
+void put_depth(rosbag::Bag& bag, int64_t utime, uint16_t mm) {
+  bag.write("/camera/depth/image", ros1::to_ros_time(utime), test::depth_image_mm(utime, kW, kH, mm));
+}
+
+geometry_msgs::TransformStamped tf(int64_t utime, const std::string& parent, const std::string& child,
+                                   const Eigen::Vector3d& t, double yaw) {
+  geometry_msgs::TransformStamped m;
+  m.header.stamp = ros1::to_ros_time(utime);
+  m.header.frame_id = parent;
+  m.child_frame_id = child;
+  m.transform.translation.x = t.x();
+  m.transform.translation.y = t.y();
+  m.transform.translation.z = t.z();
+  m.transform.rotation.z = std::sin(yaw / 2);
+  m.transform.rotation.w = std::cos(yaw / 2);
+  return m;
+}
+
+TEST(BagImport, PairsByTheTumRuleAndCountsWhatIsLeftOver) {
+  test::TempDir dir;
+  const std::string bag = (dir / "a.bag").string();
+  // Colour at 1.000, 1.033, 1.066, 1.200 s; depth at 1.010, 1.050, 1.500 s. By the rule (the
+  // nearest depth within 20 ms, a depth image may serve two): 1.000-1.010, 1.033-1.050
+  // (17 ms; 1.010 is 23 ms away), 1.066-1.050 (16 ms, shared); 1.200 has none (150 ms);
+  // 1.500 serves nothing.
+  write_bag(bag, [](rosbag::Bag& b) {
+    for (int64_t t : {1000000, 1033000, 1066000, 1200000}) put_colour(b, t);
+    put_depth(b, 1010000, 1000);
+    put_depth(b, 1050000, 2000);
+    put_depth(b, 1500000, 3000);
+  });
+  ros1::BagImportStats s;
+  const Written w = import(bag, {}, &s);
+  EXPECT_EQ(s.colour_images, 4u);
+  EXPECT_EQ(s.depth_images, 3u);
+  EXPECT_EQ(s.frames, 3u);
+  EXPECT_EQ(s.unmatched_colour, 1u);
+  EXPECT_EQ(s.unused_depth, 1u);
+  EXPECT_EQ(s.shared_depth, 1u);
+  ASSERT_EQ(w.frames.size(), 3u);
+  const int64_t colour_of[3] = {1000000, 1033000, 1066000};
+  const int64_t depth_of[3] = {1010000, 1050000, 1050000};
+  const uint16_t mm_of[3] = {1000, 2000, 2000};
+  for (size_t i = 0; i < 3; ++i) {
+    EXPECT_EQ(w.frames[i].utime, colour_of[i]);
+    EXPECT_EQ(w.frames[i].depth_utime, depth_of[i]);
+    EXPECT_EQ(w.frames[i].seq, static_cast<int64_t>(i));
+    EXPECT_EQ(w.frames[i].depth_mm.at<uint16_t>(2, 3), mm_of[i]);
+    EXPECT_EQ(w.frames[i].rgb.at<cv::Vec3b>(2, 3), cv::Vec3b(23, 102, 203));
+    EXPECT_EQ(w.frames[i].sensor, "kinect1");
+    EXPECT_EQ(w.frames[i].camera.fx, 5.0);
+    EXPECT_EQ(w.frames[i].camera.fy, 6.0);
+    EXPECT_EQ(w.frames[i].camera.cx, 1.5);
+    EXPECT_TRUE(w.frames[i].T_body_camera.isApprox(Eigen::Isometry3d::Identity()));
+  }
+  EXPECT_EQ(s.ground_truth, "none: no /tf topic");
+}
+
+TEST(BagImport, ImuAndGroundTruthComeBeforeAFrameOfTheSameTime) {
+  test::TempDir dir;
+  const std::string bag = (dir / "a.bag").string();
+  write_bag(bag, [](rosbag::Bag& b) {
+    put_colour(b, 2000000);
+    put_depth(b, 2000000, 500);
+    const sensor_msgs::Imu imu = test::accel_sample(2000000, {0.0, 9.81, 0.0});
+    b.write("/imu", imu.header.stamp, imu);
+    const sensor_msgs::Imu later = test::accel_sample(2005000, {0.0, 9.80, 0.1});
+    b.write("/imu", later.header.stamp, later);
+    sensor_msgs::Imu nothing = test::accel_sample(2006000, {0.0, 0.0, 0.0});
+    nothing.linear_acceleration_covariance[0] = -1.0;  // measures nothing: skipped, counted
+    b.write("/imu", nothing.header.stamp, nothing);
+    geometry_msgs::PoseStamped p;
+    p.header.stamp = ros1::to_ros_time(2000000);
+    p.pose.position.x = 0.5;
+    p.pose.orientation.w = 1.0;
+    b.write("/mocap/pose", p.header.stamp, p);
+  });
+  ros1::BagImportOptions o;
+  o.pose_topic = "/mocap/pose";
+  ros1::BagImportStats s;
+  const Written w = import(bag, o, &s);
+  EXPECT_EQ(w.channels, (std::vector<std::string>{"IMU", "GROUND_TRUTH", "CAMERA_RGBD", "IMU"}));
+  ASSERT_EQ(w.imu.size(), 2u);
+  EXPECT_EQ(s.imu_empty, 1u);
+  EXPECT_EQ(w.imu[1].utime, 2005000);
+  EXPECT_EQ(w.imu[1].seq, 1);
+  EXPECT_EQ(w.imu[1].fields, imu_t::HAS_ACCEL);
+  EXPECT_EQ(w.imu[1].linear_acceleration[1], 9.80);
+  EXPECT_EQ(w.imu[1].linear_acceleration[2], 0.1);
+  ASSERT_EQ(w.truth.size(), 1u);
+  EXPECT_EQ(w.truth[0].frame, ground_truth_t::FRAME_CAMERA);
+  EXPECT_EQ(w.truth[0].T_world_frame.position[0], 0.5);
+}
+
+TEST(BagImport, GroundTruthComposesTheTfChainAtTheMocapsStamps) {
+  test::TempDir dir;
+  const std::string bag = (dir / "a.bag").string();
+  write_bag(bag, [](rosbag::Bag& b) {
+    put_colour(b, 3000000);
+    put_depth(b, 3000000, 500);
+    // The body at (1, 0, 0) turned 90 degrees left, then at (2, 0, 0) unturned; the camera
+    // 1 m along the body's y, its mount published only after the first mocap pose (a mount is
+    // rigid: the first value serves before it) and from a frame of another tree (ignored).
+    for (const auto& [t, x, yaw] : {std::tuple{3000000, 1.0, M_PI / 2}, std::tuple{3010000, 2.0, 0.0}}) {
+      tf2_msgs::TFMessage m;
+      m.transforms.push_back(tf(t, "/world", "/body", {x, 0, 0}, yaw));
+      if (t == 3010000) {
+        m.transforms.push_back(tf(t, "/body", "/cam", {0, 1, 0}, 0.0));
+        m.transforms.push_back(tf(t, "/elsewhere", "/cam", {9, 9, 9}, 0.0));
+      }
+      b.write("/tf", ros1::to_ros_time(t), m);
+    }
+  });
+  ros1::BagImportOptions o;
+  o.camera_frame = "cam";
+  ros1::BagImportStats s;
+  const Written w = import(bag, o, &s);
+  EXPECT_EQ(s.ground_truth, "/tf: world -> body -> cam");
+  ASSERT_EQ(w.truth.size(), 2u);
+  // (1, 0, 0) + Rz(90)(0, 1, 0) = (0, 0, 0); then (2, 0, 0) + (0, 1, 0) = (2, 1, 0).
+  const Eigen::Isometry3d T0 = transport::from_message(w.truth[0].T_world_frame, "gt");
+  const Eigen::Isometry3d T1 = transport::from_message(w.truth[1].T_world_frame, "gt");
+  EXPECT_TRUE(T0.translation().isZero(1e-12)) << T0.translation().transpose();
+  EXPECT_TRUE(T1.translation().isApprox(Eigen::Vector3d(2, 1, 0), 1e-12)) << T1.translation().transpose();
+  EXPECT_NEAR(Eigen::AngleAxisd(T0.linear()).angle(), M_PI / 2, 1e-12);
+
+  // Frames that the tree does not join: no ground truth, and the summary says why.
+  o.camera_frame = "openni_rgb_optical_frame";
+  import(bag, o, &s);
+  EXPECT_EQ(s.ground_truth_poses, 0u);
+  EXPECT_NE(s.ground_truth.find("no chain of transforms from 'world' to 'openni_rgb_optical_frame'"), std::string::npos)
+      << s.ground_truth;
+}
+
+TEST(BagImport, IntrinsicsReplaceAMissingCameraInfo) {
+  test::TempDir dir;
+  const std::string bag = (dir / "a.bag").string();
+  write_bag(bag, [](rosbag::Bag& b) {
+    b.write("/camera/rgb/image_color", ros1::to_ros_time(1), test::colour_image(1, kW, kH, "bgr8"));
+    put_depth(b, 1, 500);
+  });
+  std::string e = test::input_error_of([&] { import(bag, {}); });
+  EXPECT_NE(e.find("/camera/rgb/camera_info: no such topic"), std::string::npos) << e;
+  ros1::BagImportOptions o;
+  o.intrinsics = PinholeCamera::vga(7, 8, 1, 1);
+  const Written w = import(bag, o);
+  ASSERT_EQ(w.frames.size(), 1u);
+  EXPECT_EQ(w.frames[0].camera.width, kW);
+  EXPECT_EQ(w.frames[0].camera.fx, 7.0);
+  EXPECT_EQ(w.frames[0].rgb.at<cv::Vec3b>(2, 3), cv::Vec3b(23, 102, 203));  // bgr8 read as such
+}
+
+TEST(BagImport, BadBagsAreErrorsNamingTheTopic) {
+  test::TempDir dir;
+  const std::string bag = (dir / "a.bag").string();
+  auto error_of = [&](const std::function<void(rosbag::Bag&)>& fill) {
+    write_bag(bag, fill);
+    return test::input_error_of([&] { import(bag, {}); });
+  };
+  std::string e = error_of([](rosbag::Bag& b) { put_colour(b, 1); });
+  EXPECT_NE(e.find("/camera/depth/image: no such topic"), std::string::npos) << e;
+  e = error_of([](rosbag::Bag& b) {
+    put_colour(b, 1);
+    b.write("/camera/depth/image", ros1::to_ros_time(1), test::accel_sample(1, {0, 0, 9.8}));
+  });
+  EXPECT_NE(e.find("/camera/depth/image: messages are sensor_msgs/Imu"), std::string::npos) << e;
+  e = error_of([](rosbag::Bag& b) {
+    b.write("/camera/rgb/image_color", ros1::to_ros_time(1), test::colour_image(1, kW, kH));
+    put_depth(b, 1, 500);
+    b.write("/camera/rgb/camera_info", ros1::to_ros_time(1), test::camera_info(1, kW + 1, kH, 5, 5));
+  });
+  EXPECT_NE(e.find("/camera/rgb/camera_info: CameraInfo is 5x3, the images on /camera/rgb/image_color 4x3"),
+            std::string::npos) << e;
+  e = error_of([](rosbag::Bag& b) {
+    put_colour(b, 1);
+    put_depth(b, 1000000, 500);  // 1 s later: nothing pairs
+  });
+  EXPECT_NE(e.find("no image on /camera/rgb/image_color has one on /camera/depth/image within 0.02"), std::string::npos) << e;
+  EXPECT_NE(test::input_error_of([&] { import((dir / "absent.bag").string(), {}); }).find("absent.bag"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace kestrel
