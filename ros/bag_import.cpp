@@ -160,6 +160,7 @@ BagImportStats import(rosbag::Bag& bag, const std::string& path, const BagImport
     std::vector<Stamped> stamps;
     rosbag::View view(bag, rosbag::TopicQuery(topic));
     for (const rosbag::MessageInstance& m : view) {
+      if (sink.stopping()) return stamps;
       const auto image = m.instantiate<sensor_msgs::Image>();
       const std::string what = path + ": " + at(topic, image->header.stamp);
       check_image(*image, depth, what);
@@ -177,6 +178,10 @@ BagImportStats import(rosbag::Bag& bag, const std::string& path, const BagImport
   int colour_w = 0, colour_h = 0, depth_w = 0, depth_h = 0;
   const std::vector<Stamped> colour_by_order = stamps_of(o.colour_topic, false, colour_w, colour_h);
   const std::vector<Stamped> depth_by_order = stamps_of(o.depth_topic, true, depth_w, depth_h);
+  if (sink.stopping()) {
+    stats.stopped = true;
+    return stats;
+  }
   if (colour_w != depth_w || colour_h != depth_h)
     throw InputError(path + ": " + o.depth_topic + ": depth images are " + std::to_string(depth_w) + "x" +
                      std::to_string(depth_h) + ", the colour images on " + o.colour_topic + " " +
@@ -360,6 +365,10 @@ BagImportStats import(rosbag::Bag& bag, const std::string& path, const BagImport
   size_t colour_order = 0, depth_order = 0;
   rosbag::View images(bag, rosbag::TopicQuery(std::vector<std::string>{o.colour_topic, o.depth_topic}));
   for (const rosbag::MessageInstance& m : images) {
+    if (sink.stopping()) {
+      stats.stopped = true;
+      return stats;
+    }
     const bool is_colour = m.getTopic() == o.colour_topic;
     const size_t order = is_colour ? colour_order++ : depth_order++;
     const size_t slot = is_colour ? pair_of_colour_message.at(order) : depth_index_of_message.at(order);
@@ -389,9 +398,15 @@ BagImportStats import_bag(const std::string& bag_path, const BagImportOptions& o
   } catch (const rosbag::BagUnindexedException& e) {
     throw InputError(bag_path + ": the bag has no index (truncated, or its recording was cut short; `rosbag "
                      "reindex` may recover it): " + e.what());
+  } catch (const rosbag::BagIOException& e) {
+    // A read past the end: the file was cut (a copy or a recording that stopped), or its
+    // records are damaged; librosbag's own words say how far it got.
+    throw InputError(bag_path + ": cannot read the bag: it ends early or is damaged (librosbag: " + e.what() + ")");
+  } catch (const rosbag::BagFormatException& e) {
+    throw InputError(bag_path + ": not a ROS 1 bag, or a damaged one (librosbag: " + std::string(e.what()) + ")");
   } catch (const ros::Exception& e) {
-    // rosbag::BagException (cannot open, bad header, a chunk cut short) and the message
-    // deserialiser's overruns.
+    // Any other rosbag::BagException (cannot open the file) and the message deserialiser's
+    // overruns.
     throw InputError(bag_path + ": cannot read the bag: " + e.what());
   }
 }

@@ -73,11 +73,14 @@ struct BagImportStats {
   size_t ground_truth_poses = 0;
   std::string ground_truth;     ///< where the poses came from, or why there are none
   PinholeCamera camera;         ///< the frames' camera
+  bool stopped = false;         ///< ended early by ImportSink::stopping (what was sent is a prefix)
 };
 
 struct ImportSink {
   /// Each message, in order: channel, utime, encoded bytes.
   std::function<void(const std::string& channel, int64_t utime, const std::vector<uint8_t>& bytes)> publish;
+  /// Polled between messages of the bag; true ends the import early (Ctrl-C).
+  std::function<bool()> stopping = [] { return false; };
 };
 
 BagImportStats import_bag(const std::string& bag_path, const BagImportOptions& options, const ImportSink& sink);

@@ -13,6 +13,7 @@
 #include "common/atomic_file.h"
 #include "common/cli.h"
 #include "common/error.h"
+#include "common/interrupt.h"
 #include "common/transport/log_file.h"
 #include "drivers/kinect/encoding_options.h"
 #include "ros/bag_import.h"
@@ -53,8 +54,16 @@ int run(Options& o) {
   sink.publish = [&](const std::string& channel, int64_t utime, const std::vector<uint8_t>& bytes) {
     log.write(channel, utime, bytes);
   };
+  catch_interrupts();
+  sink.stopping = [] { return interrupted(); };
   const ros1::BagImportStats s = ros1::import_bag(o.bag, o.import, sink);
   log.close();
+  if (s.stopped) {
+    // A log of the bag's first part would pass for the whole: nothing is written (the
+    // temporary goes with `out`).
+    std::cerr << "kestrel-bag-import: interrupted, no log written\n";
+    return kExitInterrupted;
+  }
   out.commit();
 
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -211,6 +211,25 @@ TEST(BagImport, IntrinsicsReplaceAMissingCameraInfo) {
   EXPECT_EQ(w.frames[0].rgb.at<cv::Vec3b>(2, 3), cv::Vec3b(23, 102, 203));  // bgr8 read as such
 }
 
+TEST(BagImport, StoppingEndsTheImportEarlyAndSaysSo) {
+  test::TempDir dir;
+  const std::string bag = (dir / "a.bag").string();
+  write_bag(bag, [](rosbag::Bag& b) {
+    for (int64_t t : {1000000, 1033000, 1066000}) {
+      put_colour(b, t);
+      put_depth(b, t, 1000);
+    }
+  });
+  int published = 0;
+  ros1::ImportSink sink;
+  sink.publish = [&](const std::string&, int64_t, const std::vector<uint8_t>&) { ++published; };
+  sink.stopping = [&] { return published >= 1; };  // Ctrl-C once the first frame is out
+  const ros1::BagImportStats s = ros1::import_bag(bag, {}, sink);
+  EXPECT_TRUE(s.stopped);
+  EXPECT_EQ(published, 1);
+  EXPECT_EQ(s.frames, 1u);
+}
+
 TEST(BagImport, BadBagsAreErrorsNamingTheTopic) {
   test::TempDir dir;
   const std::string bag = (dir / "a.bag").string();

@@ -118,7 +118,7 @@ TEST_F(BagImportTool, TruncatedBag) {
   ASSERT_GT(bytes.size(), 1000u);
   // Cut in the middle of the data: the index at the end is gone.
   std::ofstream(dir_ / "cut.bag", std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(bytes.size() / 2));
-  expect_refused_bag(dir_ / "cut.bag", (dir_ / "cut.bag").string() + ": ");
+  expect_refused_bag(dir_ / "cut.bag", (dir_ / "cut.bag").string() + ": cannot read the bag: it ends early or is damaged");
 }
 
 TEST_F(BagImportTool, CameraInfoWithZeroFocalLength) {
