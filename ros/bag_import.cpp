@@ -5,6 +5,7 @@
 #include <set>
 #include <utility>
 
+#include <boost/make_shared.hpp>
 #include <geometry_msgs/PoseStamped.h>
 #include <rosbag/bag.h>
 #include <rosbag/exceptions.h>
@@ -20,6 +21,7 @@
 #include "drivers/tum/association.h"
 #include "kestrel/ground_truth_t.hpp"
 #include "kestrel/imu_t.hpp"
+#include "ros/legacy_camera_info.h"
 #include "ros/ros_convert.h"
 
 namespace kestrel::ros1 {
@@ -43,12 +45,13 @@ struct Topics {
   // Throws unless `topic` carries messages of type T (by MD5, as librosbag's instantiate does:
   // tf/tfMessage of older bags and tf2_msgs/TFMessage are the same definition).
   template <class T>
-  void require_type(const std::string& bag, const std::string& topic) const {
+  void require_type(const std::string& bag, const std::string& topic, const std::string& hint = "") const {
     const rosbag::ConnectionInfo* c = by_name.at(topic);
     const std::string expected = ros::message_traits::DataType<T>::value();
     if (c->md5sum != ros::message_traits::MD5Sum<T>::value()) {
       throw InputError(bag + ": " + topic + ": messages are " + c->datatype + " (md5 " + c->md5sum + "), not " +
-                       expected + (c->datatype == expected ? " as this ROS defines it (an older definition)" : ""));
+                       expected + (c->datatype == expected ? " as this ROS defines it (another definition)" : "") +
+                       hint);
     }
   }
 };
@@ -197,10 +200,16 @@ BagImportStats import(rosbag::Bag& bag, const std::string& path, const BagImport
     if (!topics.has(o.camera_info_topic))
       throw InputError(path + ": " + o.camera_info_topic + ": no such topic (the colour camera's CameraInfo; give "
                        "the topic, or the intrinsics; the bag has: " + topics.list() + ")");
-    topics.require_type<sensor_msgs::CameraInfo>(path, o.camera_info_topic);
+    // Today's definition, or the one before ROS Electric that TUM's 2011 bags may hold.
+    const rosbag::ConnectionInfo* connection = topics.by_name.at(o.camera_info_topic);
+    const bool old_definition = connection->md5sum != ros::message_traits::MD5Sum<sensor_msgs::CameraInfo>::value() &&
+                                legacy::is_pre_electric_camera_info(connection->msg_def);
+    if (!old_definition) topics.require_type<sensor_msgs::CameraInfo>(path, o.camera_info_topic, "; give --intrinsics");
     rosbag::View view(bag, rosbag::TopicQuery(o.camera_info_topic));
     for (const rosbag::MessageInstance& m : view) {
-      const auto info = m.instantiate<sensor_msgs::CameraInfo>();
+      const auto info = old_definition ? boost::make_shared<sensor_msgs::CameraInfo>(
+                                             legacy::to_current(*m.instantiate<legacy::CameraInfo>()))
+                                       : m.instantiate<sensor_msgs::CameraInfo>();
       const PinholeCamera c = camera_from_info(*info, path + ": " + at(o.camera_info_topic, info->header.stamp));
       if (stats.camera_infos++ == 0) {
         stats.camera = c;

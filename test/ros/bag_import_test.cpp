@@ -17,9 +17,53 @@
 #include "kestrel/ground_truth_t.hpp"
 #include "kestrel/imu_t.hpp"
 #include "ros/bag_import.h"
+#include "ros/legacy_camera_info.h"
 #include "ros/ros_convert.h"
 #include "test/ros/bag_writer.h"
 #include "test/support/test_support.h"
+
+// A CameraInfo as ROS before Electric wrote it (TUM's 2011 bags may hold it), for the writer:
+// the old MD5 and definition, the layout of ros/legacy_camera_info.h.
+struct OldCameraInfoToWrite {
+  kestrel::ros1::legacy::CameraInfo m;
+};
+constexpr const char* kOldCameraInfoDefinition =
+    "# This message defines meta information for a camera.\n"
+    "Header header\nuint32 height\nuint32 width\nRegionOfInterest roi\n"
+    "float64[5]  D # The distortion parameters\nfloat64[9]  K\nfloat64[9]  R\nfloat64[12] P\n\n"
+    "================================================================================\n"
+    "MSG: std_msgs/Header\nuint32 seq\ntime stamp\nstring frame_id\n\n"
+    "================================================================================\n"
+    "MSG: sensor_msgs/RegionOfInterest\nuint32 x_offset\nuint32 y_offset\nuint32 height\nuint32 width\n";
+namespace ros {
+namespace message_traits {
+template <>
+struct MD5Sum<OldCameraInfoToWrite> {
+  static const char* value() { return "1b5cf7f984c229b6141ceb3a955aa18f"; }
+  static const char* value(const OldCameraInfoToWrite&) { return value(); }
+};
+template <>
+struct DataType<OldCameraInfoToWrite> {
+  static const char* value() { return "sensor_msgs/CameraInfo"; }
+  static const char* value(const OldCameraInfoToWrite&) { return value(); }
+};
+template <>
+struct Definition<OldCameraInfoToWrite> {
+  static const char* value() { return kOldCameraInfoDefinition; }
+  static const char* value(const OldCameraInfoToWrite&) { return value(); }
+};
+}  // namespace message_traits
+namespace serialization {
+template <>
+struct Serializer<OldCameraInfoToWrite> {
+  template <typename Stream, typename T>
+  inline static void allInOne(Stream& stream, T m) {
+    stream.next(m.m);
+  }
+  ROS_DECLARE_ALLINONE_SERIALIZER
+};
+}  // namespace serialization
+}  // namespace ros
 
 namespace kestrel {
 namespace {
@@ -209,6 +253,51 @@ TEST(BagImport, IntrinsicsReplaceAMissingCameraInfo) {
   EXPECT_EQ(w.frames[0].camera.width, kW);
   EXPECT_EQ(w.frames[0].camera.fx, 7.0);
   EXPECT_EQ(w.frames[0].rgb.at<cv::Vec3b>(2, 3), cv::Vec3b(23, 102, 203));  // bgr8 read as such
+}
+
+TEST(BagImport, ReadsTheCameraInfoOfRosBeforeElectric) {
+  test::TempDir dir;
+  const std::string bag = (dir / "a.bag").string();
+  write_bag(bag, [](rosbag::Bag& b) {
+    b.write("/camera/rgb/image_color", ros1::to_ros_time(1), test::colour_image(1, kW, kH));
+    put_depth(b, 1, 500);
+    OldCameraInfoToWrite info;
+    info.m.header.stamp = ros1::to_ros_time(1);
+    info.m.width = kW;
+    info.m.height = kH;
+    info.m.K = {525.0, 0, 1.5, 0, 520.0, 1.0, 0, 0, 1};
+    info.m.D = {0.25, -0.5, 0.001, 0.002, 0.75};
+    b.write("/camera/rgb/camera_info", ros1::to_ros_time(1), info);
+  });
+  ros1::BagImportStats s;
+  const Written w = import(bag, {}, &s);
+  ASSERT_EQ(w.frames.size(), 1u);
+  EXPECT_EQ(s.camera_infos, 1u);
+  EXPECT_EQ(w.frames[0].camera.fx, 525.0);
+  EXPECT_EQ(w.frames[0].camera.fy, 520.0);
+  EXPECT_EQ(w.frames[0].camera.cx, 1.5);
+  EXPECT_EQ(w.frames[0].camera.cy, 1.0);
+  EXPECT_EQ(w.frames[0].camera.distortion, (std::array<double, 5>{0.25, -0.5, 0.001, 0.002, 0.75}));
+}
+
+TEST(BagImport, OnlyTheExactOldCameraInfoDefinitionIsReadTheOldWay) {
+  const std::string old = kOldCameraInfoDefinition;
+  EXPECT_TRUE(ros1::legacy::is_pre_electric_camera_info(old));
+  // Absolute type names and a constant change nothing.
+  std::string absolute = old;
+  absolute.replace(absolute.find("Header header"), 13, "std_msgs/Header header\nuint8 SOME_CONSTANT=3");
+  EXPECT_TRUE(ros1::legacy::is_pre_electric_camera_info(absolute));
+  // Today's message, a field more or of another size, or a changed RegionOfInterest: no.
+  EXPECT_FALSE(ros1::legacy::is_pre_electric_camera_info(ros::message_traits::Definition<sensor_msgs::CameraInfo>::value()));
+  std::string more = old;
+  more.replace(more.find("float64[12] P"), 13, "float64[12] P\nuint32 binning_x");
+  EXPECT_FALSE(ros1::legacy::is_pre_electric_camera_info(more));
+  std::string sized = old;
+  sized.replace(sized.find("float64[5]"), 10, "float64[]");
+  EXPECT_FALSE(ros1::legacy::is_pre_electric_camera_info(sized));
+  std::string roi = old;
+  roi.replace(roi.find("uint32 width\n", roi.find("MSG: sensor_msgs")), 13, "uint32 width\nbool do_rectify\n");
+  EXPECT_FALSE(ros1::legacy::is_pre_electric_camera_info(roi));
 }
 
 TEST(BagImport, StoppingEndsTheImportEarlyAndSaysSo) {
