@@ -95,9 +95,31 @@ struct Edge {
   std::vector<Pose> samples;
 };
 
+// The latest transform of `edge` (samples sorted by time) at or before `utime`, or its first
+// (a rigid mount published only after the motion started).
+const Eigen::Isometry3d& value_at(const Edge& edge, int64_t utime) {
+  auto it = std::upper_bound(edge.samples.begin(), edge.samples.end(), utime,
+                             [](int64_t t, const Pose& p) { return t < p.utime; });
+  return it == edge.samples.begin() ? it->T : std::prev(it)->T;
+}
+
+// `frame` in the root of its tf tree at `utime`, and the root's name.
+std::pair<std::string, Eigen::Isometry3d> in_root(const std::map<std::string, Edge>& edges, const std::string& frame,
+                                                  int64_t utime) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  std::string f = frame;
+  for (size_t depth = 0; depth < 64; ++depth) {
+    const auto it = edges.find(f);
+    if (it == edges.end()) break;
+    T = value_at(it->second, utime) * T;
+    f = it->second.parent;
+  }
+  return {f, T};
+}
+
 // The pose of `camera` in `world` along the tf tree, at each transform of the chain's busiest
 // edge; `why` says what was used or why nothing was.
-std::vector<Pose> poses_from_tf(std::map<std::string, Edge>& edges, const std::string& world,
+std::vector<Pose> poses_from_tf(const std::map<std::string, Edge>& edges, const std::string& world,
                                 const std::string& camera, const std::string& topic, std::string& why) {
   std::vector<const Edge*> chain;  // camera's edge first
   std::string path = camera;
@@ -116,18 +138,9 @@ std::vector<Pose> poses_from_tf(std::map<std::string, Edge>& edges, const std::s
     why = "none: the world and camera frames are the same ('" + world + "')";
     return {};
   }
-  for (auto& [child, edge] : edges)
-    std::stable_sort(edge.samples.begin(), edge.samples.end(), [](const Pose& a, const Pose& b) { return a.utime < b.utime; });
   const Edge* driving = *std::max_element(chain.begin(), chain.end(), [](const Edge* a, const Edge* b) {
     return a->samples.size() < b->samples.size();
   });
-  // The latest transform of `edge` at or before `utime`, or its first (a rigid mount published
-  // only after the motion started).
-  auto value_at = [](const Edge& edge, int64_t utime) -> const Eigen::Isometry3d& {
-    auto it = std::upper_bound(edge.samples.begin(), edge.samples.end(), utime,
-                               [](int64_t t, const Pose& p) { return t < p.utime; });
-    return it == edge.samples.begin() ? it->T : std::prev(it)->T;
-  };
   std::vector<Pose> poses;
   poses.reserve(driving->samples.size());
   for (const Pose& s : driving->samples) {
@@ -159,6 +172,7 @@ BagImportStats import(rosbag::Bag& bag, const std::string& path, const BagImport
   }
 
   // First pass: stamps, checks, calibration, IMU and poses; no pixels kept.
+  std::string colour_frame;  // the colour images' frame_id: the camera's optical frame, the body
   auto stamps_of = [&](const std::string& topic, bool depth, int& width, int& height) {
     std::vector<Stamped> stamps;
     rosbag::View view(bag, rosbag::TopicQuery(topic));
@@ -168,6 +182,7 @@ BagImportStats import(rosbag::Bag& bag, const std::string& path, const BagImport
       const std::string what = path + ": " + at(topic, image->header.stamp);
       check_image(*image, depth, what);
       if (stamps.empty()) {
+        if (!depth) colour_frame = frame_name(image->header.frame_id);
         width = static_cast<int>(image->width);
         height = static_cast<int>(image->height);
       } else if (width != static_cast<int>(image->width) || height != static_cast<int>(image->height)) {
@@ -225,12 +240,14 @@ BagImportStats import(rosbag::Bag& bag, const std::string& path, const BagImport
   }
 
   std::vector<ImuReading> imu;
+  std::string imu_frame;
   if (topics.has(o.imu_topic)) {
     topics.require_type<sensor_msgs::Imu>(path, o.imu_topic);
     rosbag::View view(bag, rosbag::TopicQuery(o.imu_topic));
     for (const rosbag::MessageInstance& m : view) {
       const auto msg = m.instantiate<sensor_msgs::Imu>();
       ImuReading r = imu_from_message(*msg, path + ": " + at(o.imu_topic, msg->header.stamp));
+      if (imu.empty() && stats.imu_empty == 0) imu_frame = frame_name(msg->header.frame_id);
       if (!r.has_gyro && !r.has_accel) {
         ++stats.imu_empty;
         continue;
@@ -240,19 +257,10 @@ BagImportStats import(rosbag::Bag& bag, const std::string& path, const BagImport
     std::stable_sort(imu.begin(), imu.end(), [](const ImuReading& a, const ImuReading& b) { return a.utime < b.utime; });
   }
 
-  std::vector<Pose> poses;
-  if (!o.pose_topic.empty()) {
-    if (!topics.has(o.pose_topic)) throw InputError(path + ": " + o.pose_topic + ": no such topic (ground-truth poses; the bag has: " + topics.list() + ")");
-    topics.require_type<geometry_msgs::PoseStamped>(path, o.pose_topic);
-    rosbag::View view(bag, rosbag::TopicQuery(o.pose_topic));
-    for (const rosbag::MessageInstance& m : view) {
-      const auto msg = m.instantiate<geometry_msgs::PoseStamped>();
-      poses.push_back({to_utime(msg->header.stamp), to_isometry(msg->pose, path + ": " + at(o.pose_topic, msg->header.stamp))});
-    }
-    std::stable_sort(poses.begin(), poses.end(), [](const Pose& a, const Pose& b) { return a.utime < b.utime; });
-    stats.ground_truth = o.pose_topic + " (geometry_msgs/PoseStamped)";
-  } else if (topics.has(o.tf_topic) || topics.has(o.tf_topic + "_static")) {
-    std::map<std::string, Edge> edges;
+  // The tf tree (for the ground truth and the IMU's axes): each child's transforms in its parent.
+  std::map<std::string, Edge> edges;
+  const bool have_tf = !o.tf_topic.empty() && (topics.has(o.tf_topic) || topics.has(o.tf_topic + "_static"));
+  if (have_tf) {
     for (const std::string& topic : {o.tf_topic, o.tf_topic + "_static"}) {
       if (!topics.has(topic)) continue;
       topics.require_type<tf2_msgs::TFMessage>(path, topic);
@@ -271,6 +279,41 @@ BagImportStats import(rosbag::Bag& bag, const std::string& path, const BagImport
         }
       }
     }
+    for (auto& [child, edge] : edges)
+      std::stable_sort(edge.samples.begin(), edge.samples.end(), [](const Pose& a, const Pose& b) { return a.utime < b.utime; });
+  }
+
+  // The IMU in the body's axes (the camera's optical frame): rotated by the tf tree's mount when
+  // its frame is another one the tree joins to the camera's; the lever arm is not modelled.
+  stats.imu_axes = "as published";
+  if (!imu.empty() && !imu_frame.empty() && !colour_frame.empty() && imu_frame != colour_frame) {
+    const auto [imu_root, T_root_imu] = in_root(edges, imu_frame, imu.front().utime);
+    const auto [camera_root, T_root_camera] = in_root(edges, colour_frame, imu.front().utime);
+    if (imu_root == camera_root) {
+      const Eigen::Matrix3d R = (T_root_camera.inverse() * T_root_imu).linear();
+      for (ImuReading& r : imu) {
+        r.angular_velocity = R * r.angular_velocity;
+        r.linear_acceleration = R * r.linear_acceleration;
+      }
+      stats.imu_axes = "rotated from '" + imu_frame + "' to '" + colour_frame + "' by " + o.tf_topic;
+    } else {
+      stats.imu_axes = "as published: '" + imu_frame + "' is not joined to the images' '" + colour_frame + "' on " +
+                       (have_tf ? o.tf_topic : "tf (no tf topic)");
+    }
+  }
+
+  std::vector<Pose> poses;
+  if (!o.pose_topic.empty()) {
+    if (!topics.has(o.pose_topic)) throw InputError(path + ": " + o.pose_topic + ": no such topic (ground-truth poses; the bag has: " + topics.list() + ")");
+    topics.require_type<geometry_msgs::PoseStamped>(path, o.pose_topic);
+    rosbag::View view(bag, rosbag::TopicQuery(o.pose_topic));
+    for (const rosbag::MessageInstance& m : view) {
+      const auto msg = m.instantiate<geometry_msgs::PoseStamped>();
+      poses.push_back({to_utime(msg->header.stamp), to_isometry(msg->pose, path + ": " + at(o.pose_topic, msg->header.stamp))});
+    }
+    std::stable_sort(poses.begin(), poses.end(), [](const Pose& a, const Pose& b) { return a.utime < b.utime; });
+    stats.ground_truth = o.pose_topic + " (geometry_msgs/PoseStamped)";
+  } else if (have_tf) {
     poses = poses_from_tf(edges, frame_name(o.world_frame), frame_name(o.camera_frame), o.tf_topic, stats.ground_truth);
   } else {
     stats.ground_truth = "none: no " + o.tf_topic + (o.tf_topic.empty() ? "" : " topic");

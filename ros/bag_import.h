@@ -12,7 +12,9 @@
 //    stamp, seq = the colour image's index among the topic's images in stamp order (as the TUM
 //    reader's index in rgb.txt), camera = the first CameraInfo (or `intrinsics`), sensor as
 //    given, T_body_camera = identity (body = the camera's optical frame, as for TUM);
-//  * IMU: every Imu message that measures something, in its own axes (taken as the body's);
+//  * IMU: every Imu message that measures something, in the body's axes: rotated from its
+//    header's frame into the colour images' by the tf tree's mount when the tree joins the two
+//    (the mount at the first sample; no lever-arm term), else as published;
 //  * GROUND_TRUTH (FRAME_CAMERA): the pose of `camera_frame` in `world_frame`, either from a
 //    geometry_msgs/PoseStamped topic or composed along the tf tree (tf2_msgs/TFMessage on
 //    tf_topic and tf_topic + "_static"): one pose per transform of the chain's most frequent
@@ -70,6 +72,7 @@ struct BagImportStats {
   size_t camera_info_changes = 0;  ///< CameraInfo messages unlike the first (the first is used)
   size_t imu_samples = 0;       ///< written
   size_t imu_empty = 0;         ///< Imu messages that measure nothing (both covariances -1): skipped
+  std::string imu_axes;         ///< "as published", or the rotation applied from the IMU's frame
   size_t ground_truth_poses = 0;
   std::string ground_truth;     ///< where the poses came from, or why there are none
   PinholeCamera camera;         ///< the frames' camera

@@ -78,7 +78,8 @@ int run(Options& o) {
             << "depth images serving two colour images: " << s.shared_depth << "\n"
             << "images dropped for a repeated stamp: " << s.repeated_stamps << "\n"
             << "CameraInfo messages: " << s.camera_infos << " (" << s.camera_info_changes << " unlike the first)\n"
-            << "IMU samples written: " << s.imu_samples << " (" << s.imu_empty << " measuring nothing, skipped)\n"
+            << "IMU samples written: " << s.imu_samples << " (" << s.imu_empty << " measuring nothing, skipped; axes "
+            << s.imu_axes << ")\n"
             << "ground-truth poses written: " << s.ground_truth_poses << " (" << s.ground_truth << ")\n"
             << "time taken: " << seconds << " s\n";
   if (s.unmatched_colour > 0)

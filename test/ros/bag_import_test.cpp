@@ -237,6 +237,47 @@ TEST(BagImport, GroundTruthComposesTheTfChainAtTheMocapsStamps) {
       << s.ground_truth;
 }
 
+TEST(BagImport, ImuIsTurnedIntoTheCamerasAxesByTheTfMount) {
+  test::TempDir dir;
+  const std::string bag = (dir / "a.bag").string();
+  write_bag(bag, [](rosbag::Bag& b) {
+    sensor_msgs::Image colour = test::colour_image(1000, kW, kH);
+    colour.header.frame_id = "camera_color_optical_frame";
+    b.write("/camera/rgb/image_color", ros1::to_ros_time(1000), colour);
+    b.write("/camera/rgb/camera_info", ros1::to_ros_time(1000), test::camera_info(1000, kW, kH, 5, 5));
+    put_depth(b, 1000, 500);
+    sensor_msgs::Imu imu = test::accel_sample(1000, {1.0, 0.0, 0.0});
+    imu.header.frame_id = "camera_imu_optical_frame";
+    imu.angular_velocity_covariance[0] = 0.0;
+    imu.angular_velocity.z = 0.5;
+    b.write("/imu", ros1::to_ros_time(1000), imu);
+    // Both frames hang from camera_link (as a RealSense driver's /tf_static): the camera's
+    // optical frame is camera_link turned 90 degrees about z, the IMU's frame is camera_link.
+    tf2_msgs::TFMessage mounts;
+    mounts.transforms.push_back(tf(0, "camera_link", "camera_color_optical_frame", {0.01, 0, 0}, M_PI / 2));
+    mounts.transforms.push_back(tf(0, "camera_link", "camera_imu_optical_frame", {0, 0.02, 0}, 0.0));
+    b.write("/tf_static", ros1::to_ros_time(1), mounts);
+  });
+  ros1::BagImportStats s;
+  const Written w = import(bag, {}, &s);
+  EXPECT_EQ(s.imu_axes, "rotated from 'camera_imu_optical_frame' to 'camera_color_optical_frame' by /tf");
+  ASSERT_EQ(w.imu.size(), 1u);
+  // The IMU's x axis is the camera's -y (the camera is turned +90 degrees about the shared z).
+  EXPECT_NEAR(w.imu[0].linear_acceleration[0], 0.0, 1e-15);
+  EXPECT_NEAR(w.imu[0].linear_acceleration[1], -1.0, 1e-15);
+  EXPECT_NEAR(w.imu[0].angular_velocity[2], 0.5, 1e-15);
+  EXPECT_EQ(w.imu[0].fields, imu_t::HAS_ACCEL | imu_t::HAS_GYRO);
+
+  // Without the tf topic the frames are not joined: as published, and the summary says why.
+  ros1::BagImportOptions o;
+  o.tf_topic = "/no_tf";
+  const Written raw = import(bag, o, &s);
+  EXPECT_EQ(raw.imu[0].linear_acceleration[0], 1.0);
+  EXPECT_EQ(s.imu_axes,
+            "as published: 'camera_imu_optical_frame' is not joined to the images' 'camera_color_optical_frame' on "
+            "tf (no tf topic)");
+}
+
 TEST(BagImport, IntrinsicsReplaceAMissingCameraInfo) {
   test::TempDir dir;
   const std::string bag = (dir / "a.bag").string();
