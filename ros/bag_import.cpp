@@ -56,25 +56,14 @@ struct Topics {
   }
 };
 
-// Message `index` of its topic, in bag order, with its stamp.
-struct Stamped {
-  int64_t utime = 0;
-  size_t order = 0;
-};
-
-// The stamps of one image topic sorted, repeated stamps dropped (counted).
-std::vector<Stamped> sorted_unique(std::vector<Stamped> stamps, size_t& repeated) {
-  std::stable_sort(stamps.begin(), stamps.end(), [](const Stamped& a, const Stamped& b) { return a.utime < b.utime; });
-  std::vector<Stamped> out;
-  out.reserve(stamps.size());
-  for (const Stamped& s : stamps) {
-    if (!out.empty() && out.back().utime == s.utime) {
-      ++repeated;
-      continue;
-    }
-    out.push_back(s);
-  }
-  return out;
+// The stamps of one image topic sorted, repeated stamps dropped (counted): an image is known
+// by its stamp in both passes, whatever order librosbag gives them in.
+std::vector<int64_t> sorted_unique(std::vector<int64_t> stamps, size_t& repeated) {
+  std::sort(stamps.begin(), stamps.end());
+  const auto end = std::unique(stamps.begin(), stamps.end());
+  repeated += static_cast<size_t>(stamps.end() - end);
+  stamps.erase(end, stamps.end());
+  return stamps;
 }
 
 enum class Kind { kImu = 0, kGroundTruth = 1, kFrame = 2 };
@@ -174,7 +163,7 @@ BagImportStats import(rosbag::Bag& bag, const std::string& path, const BagImport
   // First pass: stamps, checks, calibration, IMU and poses; no pixels kept.
   std::string colour_frame;  // the colour images' frame_id: the camera's optical frame, the body
   auto stamps_of = [&](const std::string& topic, bool depth, int& width, int& height) {
-    std::vector<Stamped> stamps;
+    std::vector<int64_t> stamps;
     rosbag::View view(bag, rosbag::TopicQuery(topic));
     for (const rosbag::MessageInstance& m : view) {
       if (sink.stopping()) return stamps;
@@ -189,13 +178,13 @@ BagImportStats import(rosbag::Bag& bag, const std::string& path, const BagImport
         throw InputError(what + ": image is " + std::to_string(image->width) + "x" + std::to_string(image->height) +
                          ", the topic's first was " + std::to_string(width) + "x" + std::to_string(height));
       }
-      stamps.push_back({to_utime(image->header.stamp), stamps.size()});
+      stamps.push_back(to_utime(image->header.stamp));
     }
     return stamps;
   };
   int colour_w = 0, colour_h = 0, depth_w = 0, depth_h = 0;
-  const std::vector<Stamped> colour_by_order = stamps_of(o.colour_topic, false, colour_w, colour_h);
-  const std::vector<Stamped> depth_by_order = stamps_of(o.depth_topic, true, depth_w, depth_h);
+  const std::vector<int64_t> colour_by_order = stamps_of(o.colour_topic, false, colour_w, colour_h);
+  const std::vector<int64_t> depth_by_order = stamps_of(o.depth_topic, true, depth_w, depth_h);
   if (sink.stopping()) {
     stats.stopped = true;
     return stats;
@@ -214,7 +203,7 @@ BagImportStats import(rosbag::Bag& bag, const std::string& path, const BagImport
   } else {
     if (!topics.has(o.camera_info_topic))
       throw InputError(path + ": " + o.camera_info_topic + ": no such topic (the colour camera's CameraInfo; give "
-                       "the topic, or the intrinsics; the bag has: " + topics.list() + ")");
+                       "--camera-info-topic, or --intrinsics; the bag has: " + topics.list() + ")");
     // Today's definition, or the one before ROS Electric that TUM's 2011 bags may hold.
     const rosbag::ConnectionInfo* connection = topics.by_name.at(o.camera_info_topic);
     const bool old_definition = connection->md5sum != ros::message_traits::MD5Sum<sensor_msgs::CameraInfo>::value() &&
@@ -320,14 +309,11 @@ BagImportStats import(rosbag::Bag& bag, const std::string& path, const BagImport
   }
 
   // Pairing: the TUM reader's rule and code.
-  std::vector<Stamped> colour = sorted_unique(colour_by_order, stats.repeated_stamps);
-  std::vector<Stamped> depth = sorted_unique(depth_by_order, stats.repeated_stamps);
-  std::vector<int64_t> colour_times, depth_times;
-  for (const Stamped& s : colour) colour_times.push_back(s.utime);
-  for (const Stamped& s : depth) depth_times.push_back(s.utime);
+  const std::vector<int64_t> colour_times = sorted_unique(colour_by_order, stats.repeated_stamps);
+  const std::vector<int64_t> depth_times = sorted_unique(depth_by_order, stats.repeated_stamps);
   const tum::Association association = tum::associate(colour_times, depth_times, o.max_difference_us);
-  stats.colour_images = colour.size();
-  stats.depth_images = depth.size();
+  stats.colour_images = colour_times.size();
+  stats.depth_images = depth_times.size();
   stats.unmatched_colour = association.unmatched_a;
   stats.unused_depth = association.unused_b;
   stats.shared_depth = association.shared_b;
@@ -341,21 +327,20 @@ BagImportStats import(rosbag::Bag& bag, const std::string& path, const BagImport
                      span(depth_times) + ")");
   }
 
-  // What the second pass keeps: per message of each topic, in bag order, its pair (colour) or
-  // its place among the depth images and how many frames it serves.
-  const size_t none = static_cast<size_t>(-1);
-  std::vector<size_t> pair_of_colour_message(colour_by_order.size(), none);
-  std::vector<size_t> depth_index_of_message(depth_by_order.size(), none);
-  std::vector<int> depth_users(depth.size(), 0);
+  // What the second pass keeps, by stamp: the pair of each colour image that makes a frame,
+  // and each depth image's index and how many frames it still serves.
+  std::map<int64_t, size_t> pair_of_colour, index_of_depth;
+  std::vector<int> depth_users(depth_times.size(), 0);
   for (size_t p = 0; p < association.pairs.size(); ++p) {
-    pair_of_colour_message[colour[association.pairs[p].a].order] = p;
+    pair_of_colour.emplace(colour_times[association.pairs[p].a], p);
     ++depth_users[association.pairs[p].b];
   }
-  for (size_t d = 0; d < depth.size(); ++d) depth_index_of_message[depth[d].order] = d;
+  for (size_t d = 0; d < depth_times.size(); ++d)
+    if (depth_users[d] > 0) index_of_depth.emplace(depth_times[d], d);
 
   std::vector<Event> events;
   events.reserve(association.pairs.size() + imu.size() + poses.size());
-  for (size_t p = 0; p < association.pairs.size(); ++p) events.push_back({colour[association.pairs[p].a].utime, Kind::kFrame, p});
+  for (size_t p = 0; p < association.pairs.size(); ++p) events.push_back({colour_times[association.pairs[p].a], Kind::kFrame, p});
   for (size_t i = 0; i < imu.size(); ++i) events.push_back({imu[i].utime, Kind::kImu, i});
   for (size_t i = 0; i < poses.size(); ++i) events.push_back({poses[i].utime, Kind::kGroundTruth, i});
   std::stable_sort(events.begin(), events.end(), [](const Event& a, const Event& b) {
@@ -401,8 +386,8 @@ BagImportStats import(rosbag::Bag& bag, const std::string& path, const BagImport
       const auto d = depth_ready.find(p.b);
       if (c == colour_ready.end() || d == depth_ready.end()) return;  // not read yet
       RgbdFrame f;
-      f.utime = colour[p.a].utime;
-      f.depth_utime = depth[p.b].utime;
+      f.utime = colour_times[p.a];
+      f.depth_utime = depth_times[p.b];
       f.seq = static_cast<int64_t>(p.a);
       f.camera = stats.camera;
       f.sensor = o.sensor;
@@ -411,10 +396,10 @@ BagImportStats import(rosbag::Bag& bag, const std::string& path, const BagImport
       sink.publish(channel::kCameraRgbd, f.utime, transport::encode_message(transport::encode_rgbd(f, o.encoding)));
       ++stats.frames;
       colour_ready.erase(c);
+      pair_of_colour.erase(f.utime);  // a repeated stamp later is not read again
       if (--depth_users[p.b] == 0) depth_ready.erase(d);
     }
   };
-  size_t colour_order = 0, depth_order = 0;
   rosbag::View images(bag, rosbag::TopicQuery(std::vector<std::string>{o.colour_topic, o.depth_topic}));
   for (const rosbag::MessageInstance& m : images) {
     if (sink.stopping()) {
@@ -422,15 +407,18 @@ BagImportStats import(rosbag::Bag& bag, const std::string& path, const BagImport
       return stats;
     }
     const bool is_colour = m.getTopic() == o.colour_topic;
-    const size_t order = is_colour ? colour_order++ : depth_order++;
-    const size_t slot = is_colour ? pair_of_colour_message.at(order) : depth_index_of_message.at(order);
-    if (slot == none || (!is_colour && depth_users[slot] == 0)) continue;
     const auto image = m.instantiate<sensor_msgs::Image>();
+    const int64_t utime = to_utime(image->header.stamp);
     const std::string what = path + ": " + at(m.getTopic(), image->header.stamp);
     if (is_colour) {
-      colour_ready[slot] = colour_to_rgb(*image, what);
+      const auto it = pair_of_colour.find(utime);
+      // Not a frame's, or a repeated stamp whose first image is read already.
+      if (it == pair_of_colour.end() || colour_ready.count(it->second)) continue;
+      colour_ready[it->second] = colour_to_rgb(*image, what);
     } else {
-      depth_ready[slot] = depth_to_mm(*image, what);
+      const auto it = index_of_depth.find(utime);
+      if (it == index_of_depth.end() || depth_users[it->second] == 0 || depth_ready.count(it->second)) continue;
+      depth_ready[it->second] = depth_to_mm(*image, what);
     }
     flush();
   }

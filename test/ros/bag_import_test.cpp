@@ -161,6 +161,38 @@ TEST(BagImport, PairsByTheTumRuleAndCountsWhatIsLeftOver) {
   EXPECT_EQ(s.ground_truth, "none: no /tf topic");
 }
 
+TEST(BagImport, FramesFollowTheHeaderStampsNotTheBagOrderAndARepeatedStampIsDroppedOnce) {
+  test::TempDir dir;
+  const std::string bag = (dir / "a.bag").string();
+  // Received (bag time) in the order 1.066, 1.000, 1.033, 1.000 again (another picture), the
+  // depth images likewise late and out of order.
+  write_bag(bag, [](rosbag::Bag& b) {
+    int64_t received = 2000000;
+    for (const auto& [stamp, mm] : {std::pair{1066000, 3000}, std::pair{1000000, 1000}, std::pair{1033000, 2000},
+                                    std::pair{1000000, 4000}}) {
+      sensor_msgs::Image colour = test::colour_image(stamp, kW, kH);
+      colour.data[0] = static_cast<uint8_t>(mm / 1000);  // tells the two 1.000 pictures apart
+      b.write("/camera/rgb/image_color", ros1::to_ros_time(received), colour);
+      b.write("/camera/rgb/camera_info", ros1::to_ros_time(received), test::camera_info(stamp, kW, kH, 5, 5));
+      b.write("/camera/depth/image", ros1::to_ros_time(received + 1), test::depth_image_mm(stamp + 1000, kW, kH, mm));
+      received += 10000;
+    }
+  });
+  ros1::BagImportStats s;
+  const Written w = import(bag, {}, &s);
+  EXPECT_EQ(s.repeated_stamps, 2u);  // one colour, one depth
+  EXPECT_EQ(s.colour_images, 3u);
+  ASSERT_EQ(w.frames.size(), 3u);
+  for (size_t i = 0; i < 3; ++i) {
+    EXPECT_EQ(w.frames[i].utime, 1000000 + static_cast<int64_t>(i) * 33000) << i;
+    EXPECT_EQ(w.frames[i].seq, static_cast<int64_t>(i));
+  }
+  // The first image received with a repeated stamp is the one kept, colour and depth.
+  EXPECT_EQ(w.frames[0].rgb.at<cv::Vec3b>(0, 0)[0], 1);
+  EXPECT_EQ(w.frames[0].depth_mm.at<uint16_t>(0, 0), 1000);
+  EXPECT_EQ(w.frames[2].depth_mm.at<uint16_t>(0, 0), 3000);
+}
+
 TEST(BagImport, ImuAndGroundTruthComeBeforeAFrameOfTheSameTime) {
   test::TempDir dir;
   const std::string bag = (dir / "a.bag").string();
