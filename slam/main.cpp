@@ -128,7 +128,9 @@ int run_offline(const Options& o, const SlamOptions& options, std::shared_ptr<co
             << "keyframes: " << run.keyframes << ", loop closures: " << run.loop_closures
             << " (" << run.candidates_verified << " candidates verified, " << run.inconsistent_loops
             << " verified but refused by the odometry check), re-anchored on a covering keyframe: "
-            << run.reanchors << "\n";
+            << run.reanchors << " (keyframes instead: " << run.coverage_misses.none_near << " with none near, "
+            << run.coverage_misses.not_verified << " none verified, " << run.coverage_misses.too_far
+            << " located too far)\n";
   if (!ms.empty()) {
     std::cout << "ms per keyframe: median " << ms[ms.size() / 2] << ", p95 " << ms[ms.size() * 95 / 100]
               << ", max " << ms.back() << "\n";

@@ -105,6 +105,7 @@ SlamRun run_slam_sequence(size_t count, const std::function<RgbdFrame(size_t)>& 
   run.keyframes = static_cast<int>(slam.keyframes().size());
   run.loop_closures = slam.num_loop_closures();
   run.reanchors = slam.num_reanchors();
+  run.coverage_misses = slam.coverage_misses();
   run.inconsistent_loops = slam.num_inconsistent_loops();
   return run;
 }

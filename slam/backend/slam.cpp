@@ -285,8 +285,12 @@ bool Slam::reanchor(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_came
     const Keyframe& kf = keyframes_[k];
     // The seed depends on the pair only, so that a replay verifies identically.
     const uint64_t seed = static_cast<uint64_t>(kf.id) * 1000003u + static_cast<uint64_t>(frame.utime);
-    const LoopConstraint located =
-        verify_loop(features, kf.features, loop_verification(options_.verification, kf.sensor, sensor), seed);
+    // Located against a prediction it must match within max_correction: the inliers' precision
+    // (the rotation test) is what counts here, not their size, which refused close-up views of
+    // a wall (docs/decisions/2026-12-05-reanchoring-judged-by-precision.md).
+    VerificationOptions verification = loop_verification(options_.verification, kf.sensor, sensor);
+    verification.min_spread_m = 0.0;
+    const LoopConstraint located = verify_loop(features, kf.features, verification, seed);
     if (!located.accepted) continue;
     // The frame where the features put it, against where the map and the odometry expect it:
     // a small difference is the drift since the reference; a large one is a loop to close.

@@ -141,7 +141,9 @@ LoopConstraint verify_loop(const FrameFeatures& query, const FrameFeatures& cand
   if (c.inliers < o.min_inlier_fraction * c.matches) {
     return reject(c, std::to_string(c.inliers) + " of " + std::to_string(c.matches) + " matches agree");
   }
-  if (spread(query, matches, best) < o.min_spread_m) return reject(c, "inliers do not spread in space");
+  if (o.min_spread_m > 0.0 && spread(query, matches, best) < o.min_spread_m) {
+    return reject(c, "inliers do not spread in space");
+  }
 
   // Two-frame bundle adjustment of the relative pose.
   std::vector<TwoViewObservation> observations;
@@ -169,6 +171,16 @@ LoopConstraint verify_loop(const FrameFeatures& query, const FrameFeatures& cand
   }
   c.rms_px = std::sqrt(sum / c.inliers);
   if (c.rms_px > o.max_rms_px) return reject(c, "reprojection error " + std::to_string(c.rms_px) + " px");
+
+  // Inliers near one line (a row of features on an edge, a stripe of texture) leave the rotation
+  // about it to the noise; the adjustment's covariance says so whatever the range and the count.
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> rotation(ba.covariance.bottomRightCorner<3, 3>(),
+                                                               Eigen::EigenvaluesOnly);
+  const double rotation_sigma = std::sqrt(std::max(rotation.eigenvalues()(2), 0.0));
+  if (!(rotation_sigma <= o.max_rotation_sigma_rad)) {
+    return reject(c, "the inliers leave the rotation " + std::to_string(rotation_sigma * 180.0 / kPi) +
+                         " degrees uncertain about one axis");
+  }
 
   Matrix6d cov = ba.covariance;
   cov.topLeftCorner<3, 3>().diagonal().array() += o.translation_sigma_floor_m * o.translation_sigma_floor_m;

@@ -106,6 +106,48 @@ TEST(LoopVerifier, AKinectsLoopTakesTheKinectsRotationFloor) {
   EXPECT_GT(kinect_var.minCoeff(), 0.95 * floor_var) << kinect_var.transpose();
 }
 
+// A wall seen from half a metre: the inliers span 14 cm (standard deviation) across the image's
+// short side. A loop closure refuses that (no prior to check it against, min_spread_m), but there
+// are hundreds of inliers and they fix the pose: re-anchoring, which checks the location against
+// its prediction, judges them by their precision alone (min_spread_m = 0) and takes them.
+TEST(LoopVerifier, AcceptsAWallSeenFromCloseUpByItsPrecision) {
+  const SyntheticRoom room(3, 3.0, 2.5, 2.5);
+  const auto views = views_along(room, {test::level_camera({2.45, 0.0, 1.0}, 0.0),
+                                        test::level_camera({2.42, 0.04, 1.02}, 0.03)});
+  EXPECT_FALSE(verify_loop(views[1].features, views[0].features, VerificationOptions{}, 7).accepted);
+  VerificationOptions by_precision;
+  by_precision.min_spread_m = 0.0;
+  const LoopConstraint c = verify_loop(views[1].features, views[0].features, by_precision, 7);
+  ASSERT_TRUE(c.accepted) << c.reason;
+  EXPECT_GE(c.inliers, 50);
+  const Eigen::Isometry3d truth = views[0].T_world_camera.inverse() * views[1].T_world_camera;
+  expect_pose_near(c.T_candidate_query, truth, 0.01, 0.005);
+}
+
+// Inliers along one image row lie near one line on the wall: the rotation about that line is
+// left to the noise, so the candidate is refused by its precision, however many inliers.
+TEST(LoopVerifier, RejectsInliersAlongALine) {
+  const SyntheticRoom room(3, 3.0, 2.5, 2.5);
+  const auto views = views_along(room, {test::level_camera({0.0, 0.0, 1.0}, 0.0),
+                                        test::level_camera({0.1, 0.05, 1.0}, 0.05)});
+  constexpr double kBand = 4.0;  // pixels either side of the centre row: +-4 cm on the wall 3 m away
+  auto keep_one_row = [](FrameFeatures f) {
+    const double row = f.camera.cy;
+    for (size_t i = 0; i < f.size(); ++i)
+      if (std::abs(static_cast<double>(f.keypoints[i].pt.y) - row) > kBand) f.points[i].setConstant(std::nan(""));
+    return f;
+  };
+  VerificationOptions by_precision;
+  by_precision.min_spread_m = 0.0;
+  const LoopConstraint whole = verify_loop(views[1].features, views[0].features, by_precision, 7);
+  ASSERT_TRUE(whole.accepted) << whole.reason;
+  const LoopConstraint line =
+      verify_loop(keep_one_row(views[1].features), keep_one_row(views[0].features), by_precision, 7);
+  EXPECT_GE(line.matches, 10) << "the row must keep enough matches for the test to mean something";
+  EXPECT_FALSE(line.accepted) << line.inliers << " inliers";
+  EXPECT_NE(line.reason.find("rotation"), std::string::npos) << line.reason;
+}
+
 TEST(LoopVerifier, RejectsViewsOfDifferentPlaces) {
   const SyntheticRoom room(3, 3.0, 2.5, 2.5);
   const auto views = views_along(room, {test::level_camera({0.0, 0.0, 1.0}, 0.0),
