@@ -56,6 +56,25 @@ struct Topics {
   }
 };
 
+// The message as T. A message cut shorter than its type (the deserialiser's overrun) is an
+// error naming the topic, not a bare "Buffer Overrun"; one of another type (a bag file may hold
+// several connections on one topic, and only the first was checked; neither librosbag's nor
+// python3-rosbag's writer makes such a file) is an error, not a null pointer.
+template <class T>
+boost::shared_ptr<T> read_as(const rosbag::MessageInstance& m, const std::string& path) {
+  const std::string where = path + ": " + m.getTopic() + " at " + format_seconds(to_utime(m.getTime())) + " s (bag time)";
+  boost::shared_ptr<T> message;
+  try {
+    message = m.instantiate<T>();
+  } catch (const ros::serialization::StreamOverrunException&) {
+    throw InputError(where + ": a " + m.getDataType() + " message shorter than its type says (cut or damaged)");
+  }
+  if (!message)
+    throw InputError(where + ": a " + m.getDataType() + " message (md5 " + m.getMD5Sum() + ") among " +
+                     ros::message_traits::DataType<T>::value() + " ones");
+  return message;
+}
+
 // The stamps of one image topic sorted, repeated stamps dropped (counted): an image is known
 // by its stamp in both passes, whatever order librosbag gives them in.
 std::vector<int64_t> sorted_unique(std::vector<int64_t> stamps, size_t& repeated) {
@@ -167,7 +186,7 @@ BagImportStats import(rosbag::Bag& bag, const std::string& path, const BagImport
     rosbag::View view(bag, rosbag::TopicQuery(topic));
     for (const rosbag::MessageInstance& m : view) {
       if (sink.stopping()) return stamps;
-      const auto image = m.instantiate<sensor_msgs::Image>();
+      const auto image = read_as<sensor_msgs::Image>(m, path);
       const std::string what = path + ": " + at(topic, image->header.stamp);
       check_image(*image, depth, what);
       if (stamps.empty()) {
@@ -212,8 +231,8 @@ BagImportStats import(rosbag::Bag& bag, const std::string& path, const BagImport
     rosbag::View view(bag, rosbag::TopicQuery(o.camera_info_topic));
     for (const rosbag::MessageInstance& m : view) {
       const auto info = old_definition ? boost::make_shared<sensor_msgs::CameraInfo>(
-                                             legacy::to_current(*m.instantiate<legacy::CameraInfo>()))
-                                       : m.instantiate<sensor_msgs::CameraInfo>();
+                                             legacy::to_current(*read_as<legacy::CameraInfo>(m, path)))
+                                       : read_as<sensor_msgs::CameraInfo>(m, path);
       const PinholeCamera c = camera_from_info(*info, path + ": " + at(o.camera_info_topic, info->header.stamp));
       if (stats.camera_infos++ == 0) {
         stats.camera = c;
@@ -234,7 +253,7 @@ BagImportStats import(rosbag::Bag& bag, const std::string& path, const BagImport
     topics.require_type<sensor_msgs::Imu>(path, o.imu_topic);
     rosbag::View view(bag, rosbag::TopicQuery(o.imu_topic));
     for (const rosbag::MessageInstance& m : view) {
-      const auto msg = m.instantiate<sensor_msgs::Imu>();
+      const auto msg = read_as<sensor_msgs::Imu>(m, path);
       ImuReading r = imu_from_message(*msg, path + ": " + at(o.imu_topic, msg->header.stamp));
       if (imu.empty() && stats.imu_empty == 0) imu_frame = frame_name(msg->header.frame_id);
       if (!r.has_gyro && !r.has_accel) {
@@ -255,7 +274,7 @@ BagImportStats import(rosbag::Bag& bag, const std::string& path, const BagImport
       topics.require_type<tf2_msgs::TFMessage>(path, topic);
       rosbag::View view(bag, rosbag::TopicQuery(topic));
       for (const rosbag::MessageInstance& m : view) {
-        const auto msg = m.instantiate<tf2_msgs::TFMessage>();
+        const auto msg = read_as<tf2_msgs::TFMessage>(m, path);
         for (const geometry_msgs::TransformStamped& t : msg->transforms) {
           const std::string child = frame_name(t.child_frame_id);
           const std::string parent = frame_name(t.header.frame_id);
@@ -297,7 +316,7 @@ BagImportStats import(rosbag::Bag& bag, const std::string& path, const BagImport
     topics.require_type<geometry_msgs::PoseStamped>(path, o.pose_topic);
     rosbag::View view(bag, rosbag::TopicQuery(o.pose_topic));
     for (const rosbag::MessageInstance& m : view) {
-      const auto msg = m.instantiate<geometry_msgs::PoseStamped>();
+      const auto msg = read_as<geometry_msgs::PoseStamped>(m, path);
       poses.push_back({to_utime(msg->header.stamp), to_isometry(msg->pose, path + ": " + at(o.pose_topic, msg->header.stamp))});
     }
     std::stable_sort(poses.begin(), poses.end(), [](const Pose& a, const Pose& b) { return a.utime < b.utime; });
@@ -407,7 +426,7 @@ BagImportStats import(rosbag::Bag& bag, const std::string& path, const BagImport
       return stats;
     }
     const bool is_colour = m.getTopic() == o.colour_topic;
-    const auto image = m.instantiate<sensor_msgs::Image>();
+    const auto image = read_as<sensor_msgs::Image>(m, path);
     const int64_t utime = to_utime(image->header.stamp);
     const std::string what = path + ": " + at(m.getTopic(), image->header.stamp);
     if (is_colour) {

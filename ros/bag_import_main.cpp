@@ -3,6 +3,7 @@
 // and eval. The bag is read with librosbag (ros/bag_import.h); the log is written atomically:
 // a run that fails leaves no file. See ros/README.md.
 
+#include <console_bridge/console.h>
 #include <spdlog/spdlog.h>
 
 #include <chrono>
@@ -33,6 +34,10 @@ struct Options {
 
 int run(Options& o) {
   const auto t0 = std::chrono::steady_clock::now();
+  // ROS's own libraries print their complaints about a damaged bag ("Error: Received an
+  // invalid TCPROS header ...") through console_bridge; the exception they then throw ends in
+  // kestrel's one error line, which says the same, so they are silenced.
+  console_bridge::setLogLevel(console_bridge::CONSOLE_BRIDGE_LOG_NONE);
   o.import.max_difference_us = std::llround(o.max_dt_s * 1e6);
   if (!o.intrinsics.empty()) {
     PinholeCamera c;

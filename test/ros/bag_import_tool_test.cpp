@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <functional>
 
@@ -119,6 +120,21 @@ TEST_F(BagImportTool, TruncatedBag) {
   // Cut in the middle of the data: the index at the end is gone.
   std::ofstream(dir_ / "cut.bag", std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(bytes.size() / 2));
   expect_refused_bag(dir_ / "cut.bag", (dir_ / "cut.bag").string() + ": cannot read the bag: it ends early or is damaged");
+}
+
+TEST_F(BagImportTool, DamagedConnectionRecordIsOneErrorLine) {
+  write_bag(dir_ / "whole.bag", {});
+  std::string bytes = test::read_file(dir_ / "whole.bag");
+  // The connection records at the end of the file (the index librosbag reads) name each
+  // topic's type as "type=..."; without its '=' the record is damaged. librosbag reports that
+  // on its own console before it throws: kestrel's one line must be all the user sees.
+  const size_t at = bytes.rfind("type=sensor_msgs/Image");
+  ASSERT_NE(at, std::string::npos);
+  bytes[at + 4] = 'X';
+  std::ofstream(dir_ / "damaged.bag", std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  expect_refused_bag(dir_ / "damaged.bag", "not a ROS 1 bag, or a damaged one");
+  const test::RunResult r = import(dir_ / "damaged.bag");
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
 }
 
 TEST_F(BagImportTool, CameraInfoWithZeroFocalLength) {
