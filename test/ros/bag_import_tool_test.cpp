@@ -159,6 +159,25 @@ TEST_F(BagImportTool, AFailedImportKeepsTheFileItWouldHaveReplaced) {
   EXPECT_EQ(test::read_file(log()), "kept");
 }
 
+// What EveryTool.* (common_tools_cli_test) checks of the multi-call tools, for this one.
+TEST_F(BagImportTool, PrintedConfigReadsBackTheSameAndRunsTheSame) {
+  write_bag(dir_ / "good.bag", {});
+  const std::string tool = test::tool("bag-import").string();
+  const test::RunResult printed = test::run({tool, (dir_ / "good.bag").string(), "--log", log().string(), "--max-dt",
+                                             "0.01", "--imu-topic", "", "--intrinsics", "500,500,3.5,2.5", "--print-config"});
+  ASSERT_EQ(printed.exit_code, 0) << printed.err;
+  std::ofstream(dir_ / "a.ini") << printed.out;
+  const test::RunResult again = test::run({tool, "--config", (dir_ / "a.ini").string(), "--print-config"});
+  ASSERT_EQ(again.exit_code, 0) << again.err;
+  EXPECT_EQ(again.out, printed.out);
+  const test::RunResult run = test::run({tool, "--config", (dir_ / "a.ini").string()});
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(run.out.find("camera: 8x6, fx=500 fy=500 cx=3.5 cy=2.5, from --intrinsics\n"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("IMU samples written: 0 "), std::string::npos) << run.out;
+  std::ofstream(dir_ / "b.ini") << printed.out << "no-such-option = 1\n";
+  EXPECT_EQ(test::run({tool, "--config", (dir_ / "b.ini").string()}).exit_code, 2);
+}
+
 TEST_F(BagImportTool, MissingBagAndMissingLogOptionAreInputAndUsageErrors) {
   const test::RunResult missing = import(dir_ / "absent.bag");
   EXPECT_EQ(missing.exit_code, 3) << missing.err;
