@@ -119,6 +119,31 @@ TEST(ProcessSets, RunDirIsPutIntoTheArgumentsThatNameIt) {
   EXPECT_EQ(mapper->argv, (std::vector<std::string>{"mapper", "--journal", "/R/mapper.journal"}));
 }
 
+// restart_args only from the first restart on: the shipped estimator awaits SLAM's world
+// only when restarted (the first one of a launch defines it: issue 39, item 3).
+TEST(ProcessSets, RestartArgumentsAreAddedOnlyWhenRestarted) {
+  TempDir dir;
+  const ProcessSet set = read_process_sets(write(dir, R"(processes:
+  - {name: estimator, command: estimator -q, restart_args: "--await-world 1 --x={run_dir}", side: onboard}
+  - {name: vo, command: vo, side: onboard}
+)"));
+  ASSERT_EQ(set.size(), 2u);
+  EXPECT_EQ(command_of_start(set[0], 0), (std::vector<std::string>{"estimator", "-q"}));
+  EXPECT_EQ(command_of_start(set[0], 1), (std::vector<std::string>{"estimator", "-q", "--await-world", "1", "--x={run_dir}"}));
+  EXPECT_EQ(command_of_start(set[1], 3), (std::vector<std::string>{"vo"}));
+  EXPECT_TRUE(names_run_dir(set));
+  EXPECT_EQ(with_run_dir(set, "/R")[0].restart_args, (std::vector<std::string>{"--await-world", "1", "--x=/R"}));
+
+  const ProcessSet shipped = read_process_sets(KESTREL_DEFAULT_PROCESS_SETS);
+  const auto estimator = std::find_if(shipped.begin(), shipped.end(), [](const ProcessSpec& p) { return p.name == "estimator"; });
+  ASSERT_NE(estimator, shipped.end());
+  const auto first = command_of_start(*estimator, 0), again = command_of_start(*estimator, 1);
+  EXPECT_EQ(std::find(first.begin(), first.end(), "--await-world"), first.end())
+      << "the first estimator defines the world: nothing to await";
+  EXPECT_NE(std::find(again.begin(), again.end(), "--await-world"), again.end())
+      << "a restarted estimator awaits the map's world";
+}
+
 TEST(ResolveExecutable, PrefersKestrelToolsThenPath) {
   TempDir dir;
   const auto tool = dir / "kestrel-thing";

@@ -121,7 +121,10 @@ TEST(Supervisor, RestartsADeadChildUpToTheLimit) {
   o.restart = true;
   o.restart_delay_s = 0.01;
   o.max_restarts = 2;
-  Supervisor s({shell("flaky", "echo run >> " + (dir / "runs").string() + "; exit 1")}, {"/bin/sh"}, o);
+  // A restart adds restart_args: here the script's $0 (the first run's is the shell's path).
+  ProcessSpec flaky = shell("flaky", "echo \"run $0\" >> " + (dir / "runs").string() + "; exit 1");
+  flaky.restart_args = {"again"};
+  Supervisor s({flaky}, {"/bin/sh"}, o);
   s.start_all();
   const auto events = poll_until(s, ChildEvent::kGaveUp, 1);
   int ended = 0, restarting = 0, gave_up = 0;
@@ -135,9 +138,9 @@ TEST(Supervisor, RestartsADeadChildUpToTheLimit) {
   EXPECT_EQ(gave_up, 1);
   EXPECT_EQ(s.children()[0].restarts, 2);
   std::ifstream runs(dir / "runs");
-  int lines = 0;
-  for (std::string l; std::getline(runs, l);) ++lines;
-  EXPECT_EQ(lines, 3);
+  std::vector<std::string> lines;
+  for (std::string l; std::getline(runs, l);) lines.push_back(l);
+  EXPECT_EQ(lines, (std::vector<std::string>{"run /bin/sh", "run again", "run again"}));
 }
 
 TEST(Supervisor, StopEndsEveryChildEvenOneThatIgnoresSigterm) {

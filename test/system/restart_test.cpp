@@ -156,8 +156,8 @@ TEST(System, AnEstimatorKilledInFlightRestartsInTheMapsWorld) {
 
   // STATE against the truth: the dead filter's usable states and every one of the new
   // filter's (OK or DEGRADED: it publishes them once SLAM's correction has set its world,
-  // --await-world, as kestrel launch runs it), under one rigid fit. One world: a few
-  // millimetres; two worlds: metres.
+  // --await-world, as kestrel launch runs a restarted estimator), under one rigid fit. One
+  // world: a few millimetres; two worlds: metres.
   std::map<int64_t, Eigen::Vector3d> truth;
   std::vector<Sample> states;
   int64_t t0 = -1;
@@ -528,16 +528,20 @@ TEST(System, APlannerKilledWhileTheVehicleHoversPlansAgainOnceRestarted) {
 // goal (the closed-loop room of autonomy_test.cpp). The new estimator starts in a world of its
 // own (at the take-off pose its options give) and a hover makes no keyframe, so SLAM sends the
 // map's world for the next frame rather than the next keyframe (slam_adapter.h), and until it
-// comes the new filter's STATE is INITIALIZING (--await-world, as kestrel launch runs it), so
-// nobody flies on it. Before, the new filter stayed 1.5 m off for as long as the vehicle
-// hovered, and the next goal was planned and flown from where the vehicle was not.
+// comes the new filter's STATE is INITIALIZING (--await-world, as kestrel launch runs a
+// restarted estimator: processes.yaml's restart_args), so nobody flies on it. The first
+// estimator defines the world, as the launch's first one does: it awaits nothing. Before, the
+// new filter stayed 1.5 m off for as long as the vehicle hovered, and the next goal was
+// planned and flown from where the vehicle was not.
 TEST(System, AnEstimatorKilledWhileTheVehicleHoversTakesTheMapsWorldAtOnce) {
   if (const std::string why = test::LiveSystem::isolate(); !why.empty())
     KESTREL_SKIP_ENVIRONMENT() << "no network namespace available: " << why;
   test::TempDir dir;
   const auto bin = [](const char* name) { return test::tool(name).string(); };
-  const std::vector<std::string> estimator = {bin("estimator"), "--init-position", "8,3.5,1.3", "--await-world",
-                                              "1"};  // as launched
+  // As launched: the first with the command, the restarted one with its restart_args too.
+  const std::vector<std::string> estimator = {bin("estimator"), "--init-position", "8,3.5,1.3"};
+  std::vector<std::string> restarted_estimator = estimator;
+  restarted_estimator.insert(restarted_estimator.end(), {"--await-world", "1"});
   const auto go = [&](const char* x, const char* y) {
     return std::vector<std::string>{bin("goto"), "--wait", "--arrive-radius", "0.1", "--timeout", "60", "--goal",
                                     x, y, "1.3", "0"};
@@ -573,7 +577,7 @@ TEST(System, AnEstimatorKilledWhileTheVehicleHoversTakesTheMapsWorldAtOnce) {
         << live.output("sim");
     live.kill("estimator1", SIGKILL);
     live.exit_status("estimator1", 10.0);
-    const pid_t restarted = live.start("estimator2", estimator);
+    const pid_t restarted = live.start("estimator2", restarted_estimator);
     // The second goal once the new filter is in the map's world: its first usable STATE after
     // its first heartbeat (the dead filter's last states came before it).
     ASSERT_TRUE(live.wait_for<kestrel::process_status_t>(

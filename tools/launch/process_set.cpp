@@ -19,11 +19,12 @@ std::string where(const std::filesystem::path& file, const YAML::Node& node) {
 }
 
 ProcessSpec read_process(const std::filesystem::path& file, const YAML::Node& node) {
-  if (!node.IsMap()) throw InputError(where(file, node) + ": a process is a map (name, command, side)");
+  if (!node.IsMap())
+    throw InputError(where(file, node) + ": a process is a map (name, command, side, restart_args)");
   for (const auto& key : node) {
     const auto k = key.first.as<std::string>();
-    if (k != "name" && k != "command" && k != "side")
-      throw InputError(where(file, key.first) + ": unknown key '" + k + "' (name, command, side)");
+    if (k != "name" && k != "command" && k != "side" && k != "restart_args")
+      throw InputError(where(file, key.first) + ": unknown key '" + k + "' (name, command, side, restart_args)");
   }
   ProcessSpec p;
   if (!node["name"] || !node["command"] || !node["side"])
@@ -31,6 +32,7 @@ ProcessSpec read_process(const std::filesystem::path& file, const YAML::Node& no
   p.name = node["name"].as<std::string>();
   p.argv = split_command(node["command"].as<std::string>());
   p.side = node["side"].as<std::string>();
+  if (node["restart_args"]) p.restart_args = split_command(node["restart_args"].as<std::string>());
   if (p.name.empty() || p.name.find_first_of(" /\t") != std::string::npos)
     throw InputError(where(file, node["name"]) + ": a name is one word without '/'");
   if (p.argv.empty()) throw InputError(where(file, node["command"]) + ": empty command");
@@ -52,12 +54,20 @@ namespace {
 const std::string kRunDirKey = "{run_dir}";
 }  // namespace
 
+std::vector<std::string> command_of_start(const ProcessSpec& process, int run) {
+  std::vector<std::string> args = process.argv;
+  if (run > 0) args.insert(args.end(), process.restart_args.begin(), process.restart_args.end());
+  return args;
+}
+
 ProcessSet with_run_dir(ProcessSet set, const std::filesystem::path& run_dir) {
   for (ProcessSpec& p : set) {
-    for (std::string& arg : p.argv) {
-      for (size_t at = arg.find(kRunDirKey); at != std::string::npos;
-           at = arg.find(kRunDirKey, at + run_dir.string().size()))
-        arg.replace(at, kRunDirKey.size(), run_dir.string());
+    for (auto* args : {&p.argv, &p.restart_args}) {
+      for (std::string& arg : *args) {
+        for (size_t at = arg.find(kRunDirKey); at != std::string::npos;
+             at = arg.find(kRunDirKey, at + run_dir.string().size()))
+          arg.replace(at, kRunDirKey.size(), run_dir.string());
+      }
     }
   }
   return set;
@@ -65,8 +75,9 @@ ProcessSet with_run_dir(ProcessSet set, const std::filesystem::path& run_dir) {
 
 bool names_run_dir(const ProcessSet& set) {
   for (const ProcessSpec& p : set) {
-    for (const std::string& arg : p.argv)
-      if (arg.find(kRunDirKey) != std::string::npos) return true;
+    for (const auto* args : {&p.argv, &p.restart_args})
+      for (const std::string& arg : *args)
+        if (arg.find(kRunDirKey) != std::string::npos) return true;
   }
   return false;
 }

@@ -2,6 +2,10 @@
 // Process sets: which kestrel processes `kestrel launch SET` starts, read from a small YAML
 // file (tools/launch/processes.yaml is the default). Each process has a unique name, the
 // command that runs it and a side (onboard or offboard); the set `all` is every process.
+// Optionally `restart_args`: arguments added to the command when the launch starts the
+// process again (--restart), for what only a restarted process needs (the estimator's
+// --await-world: the first estimator of a launch defines the world, a restarted one must
+// await the world that SLAM's map keeps).
 //
 // Invariants: a ProcessSet never holds two processes with one name, nor an empty command; a
 // malformed file is an InputError naming the file (and line where yaml-cpp knows it).
@@ -16,7 +20,12 @@ struct ProcessSpec {
   std::string name;               ///< unique within a launch; also its log file's name
   std::vector<std::string> argv;  ///< argv[0] is a kestrel tool name ("vo") or a path
   std::string side;               ///< "onboard", "offboard" or "source"
+  std::vector<std::string> restart_args{};  ///< added to argv when restarted (--restart)
 };
+
+/// The command line of a process's `run`-th start (0: the first): argv, plus restart_args
+/// from the first restart on.
+std::vector<std::string> command_of_start(const ProcessSpec& process, int run);
 
 using ProcessSet = std::vector<ProcessSpec>;
 
@@ -33,9 +42,9 @@ ProcessSet select(const ProcessSet& all, const std::string& set,
 /// commands here are tool names and plain arguments.
 std::vector<std::string> split_command(const std::string& command);
 
-/// `{run_dir}` in an argument becomes `run_dir`: a folder the launch makes for itself, for
-/// files that must outlive a restarted process but not the launch (the mapper's journal: a
-/// restarted mapper gets its map back, a new launch starts a new map).
+/// `{run_dir}` in an argument (of restart_args too) becomes `run_dir`: a folder the launch
+/// makes for itself, for files that must outlive a restarted process but not the launch (the
+/// mapper's journal: a restarted mapper gets its map back, a new launch starts a new map).
 ProcessSet with_run_dir(ProcessSet set, const std::filesystem::path& run_dir);
 /// Whether an argument of `set` names `{run_dir}` (the launch makes the folder only then).
 bool names_run_dir(const ProcessSet& set);

@@ -81,7 +81,8 @@ Supervisor::~Supervisor() { stop_all(); }
 ChildEvent Supervisor::start(Child& child) {
   // Everything the child needs is prepared before fork(): after it, only async-signal-safe
   // calls are allowed (the launcher has an LCM thread).
-  std::vector<std::string> args = child.spec.argv;
+  // A restart adds the process's restart_args (process_set.h).
+  std::vector<std::string> args = command_of_start(child.spec, child.restarts);
   args[0] = child.executable.string();
   std::vector<char*> argv;
   for (auto& a : args) argv.push_back(a.data());
