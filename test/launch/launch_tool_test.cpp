@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <signal.h>
 
+#include <algorithm>
 #include <chrono>
 #include <fstream>
 #include <map>
@@ -72,6 +73,28 @@ TEST_F(LaunchTool, ShowsHealthReportsAKilledProcessAndRestartsIt) {
   EXPECT_EQ(*code, 0) << l->err();
   EXPECT_NE(l->out().find("ended: exited with status 0"), std::string::npos) << l->out();
   EXPECT_NE(::kill(second, 0), 0) << "codec-a outlived the launcher";
+}
+
+// restart_args at the first start only when one side is launched alone (the other may be
+// running with its state: process_set.h, joining_a_running_system), seen in the child's
+// command line.
+TEST_F(LaunchTool, ASideLaunchedAloneStartsItsProcessesAsRestartedOnes) {
+  std::ofstream(sets) << "processes:\n"
+                         "  - {name: codec-a, command: rgbd-codec --name codec-a --out A, restart_args: --max-rate 5, side: onboard}\n"
+                         "  - {name: codec-b, command: rgbd-codec --name codec-b --in A --out B, side: offboard}\n";
+  for (const std::string side : {"all", "onboard"}) {
+    Background l({tool("launch"), side, "--sets", sets.string(), "--isolated", "--status-period", "0.5", "--log-dir",
+                  (dir / ("logs-" + side)).string()},
+                 dir.path(), "launch-" + side);
+    ASSERT_TRUE(l.wait_for_output("all processes running", 20, true)) << l.err();
+    const pid_t a = started_pid(l, "codec-a");
+    ASSERT_GT(a, 0) << l.err();
+    std::string cmdline = read_file("/proc/" + std::to_string(a) + "/cmdline");
+    std::replace(cmdline.begin(), cmdline.end(), '\0', ' ');
+    EXPECT_EQ(cmdline.find("--max-rate 5") != std::string::npos, side == "onboard") << side << ": " << cmdline;
+    l.signal(SIGTERM);
+    ASSERT_TRUE(l.wait_exit(15).has_value()) << "the launcher did not stop";
+  }
 }
 
 TEST_F(LaunchTool, WithoutRestartADeadProcessIsAFailureAndCtrlCStopsTheRest) {

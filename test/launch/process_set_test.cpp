@@ -144,6 +144,16 @@ TEST(ProcessSets, RestartArgumentsAreAddedOnlyWhenRestarted) {
       << "a restarted estimator awaits the map's world";
 }
 
+// One side launched alone joins a system that may be running: its first start is a restart's.
+TEST(ProcessSets, ASideLaunchedAloneStartsAsARestartDoes) {
+  const ProcessSet set = joining_a_running_system(
+      {{"estimator", {"estimator", "-q"}, "onboard", {"--await-world", "1"}}, {"vo", {"vo"}, "onboard"}});
+  EXPECT_EQ(command_of_start(set[0], 0), (std::vector<std::string>{"estimator", "-q", "--await-world", "1"}));
+  EXPECT_EQ(command_of_start(set[0], 2), (std::vector<std::string>{"estimator", "-q", "--await-world", "1"}))
+      << "given once, not again at a restart";
+  EXPECT_EQ(command_of_start(set[1], 0), (std::vector<std::string>{"vo"}));
+}
+
 TEST(ResolveExecutable, PrefersKestrelToolsThenPath) {
   TempDir dir;
   const auto tool = dir / "kestrel-thing";

@@ -96,6 +96,9 @@ int launch(const Options& o) {
   } catch (const kestrel::InputError& e) {  // a name on the command line, not in the file: usage
     throw CLI::ValidationError("--only/--without", e.what());
   }
+  // One side alone: the other may have run for a while (a SLAM with a map), so every process
+  // starts as a restarted one would (its restart_args: the estimator awaits SLAM's world).
+  if (o.set != "all") set = joining_a_running_system(std::move(set));
   if (o.link) {
     // The link first, so that it hears the first messages; the codec onboard, so that frames
     // cross compressed (the link carries CAMERA_RGBD_Z up as CAMERA_RGBD).

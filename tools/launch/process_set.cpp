@@ -60,6 +60,14 @@ std::vector<std::string> command_of_start(const ProcessSpec& process, int run) {
   return args;
 }
 
+ProcessSet joining_a_running_system(ProcessSet set) {
+  for (ProcessSpec& p : set) {
+    p.argv = command_of_start(p, 1);
+    p.restart_args.clear();  // in argv now: a restart adds them no second time
+  }
+  return set;
+}
+
 ProcessSet with_run_dir(ProcessSet set, const std::filesystem::path& run_dir) {
   for (ProcessSpec& p : set) {
     for (auto* args : {&p.argv, &p.restart_args}) {

@@ -29,6 +29,12 @@ std::vector<std::string> command_of_start(const ProcessSpec& process, int run);
 
 using ProcessSet = std::vector<ProcessSpec>;
 
+/// `set` with each process's restart_args made part of its command, for a launch of one side
+/// alone (onboard or offboard): the other side may have run for a while already, so even a
+/// first start joins a running system as a restart does (the estimator then awaits the
+/// world of a SLAM that may have a map).
+ProcessSet joining_a_running_system(ProcessSet set);
+
 /// Every process the file declares, in file order. Throws InputError.
 ProcessSet read_process_sets(const std::filesystem::path& file);
 
