@@ -1,7 +1,5 @@
 #include "mapper/keyframe_store.h"
 
-#include "common/numbers.h"
-
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -22,58 +20,37 @@ size_t StoredKeyframe::bytes() const {
          frame.rgb.total() * frame.rgb.elemSize();
 }
 
-KeyframeStore::KeyframeStore(const KeyframeOptions& options) : options_(options) {
-  options_.validate();
+namespace {
+// The options' own messages name the command-line options; ViewBins' would not.
+const KeyframeOptions& validated(const KeyframeOptions& options) {
+  options.validate();
+  return options;
 }
+}  // namespace
 
-KeyframeStore::Bin KeyframeStore::bin_of(const Eigen::Isometry3d& T) const {
-  const Eigen::Vector3d p = T.translation() / options_.bin_size_m;
-  const Eigen::Vector3d axis = T.linear().col(2);
-  const double sector = options_.bin_angle_deg * kPi / 180.0;
-  const double azimuth = std::atan2(axis.y(), axis.x());
-  const double elevation = std::asin(std::clamp(axis.z(), -1.0, 1.0));
-  return {static_cast<int>(std::floor(p.x())), static_cast<int>(std::floor(p.y())),
-          static_cast<int>(std::floor(p.z())), static_cast<int>(std::floor(azimuth / sector)),
-          static_cast<int>(std::floor(elevation / sector))};
-}
-
-void KeyframeStore::unbin(int64_t id, const Bin& bin) {
-  auto it = bins_.find(bin);
-  if (it == bins_.end()) return;
-  auto& ids = it->second;
-  ids.erase(std::remove(ids.begin(), ids.end(), id), ids.end());
-  if (ids.empty()) bins_.erase(it);
-}
+KeyframeStore::KeyframeStore(const KeyframeOptions& options)
+    : options_(validated(options)), bins_(options.bin_size_m, options.bin_angle_deg) {}
 
 void KeyframeStore::add(StoredKeyframe keyframe) {
   const int64_t id = keyframe.id;
   if (auto old = keyframes_.find(id); old != keyframes_.end()) {
     bytes_ -= old->second.bytes();
-    unbin(id, bin_of_id_.at(id));
+    bins_.erase(id);  // a replaced keyframe is the newest of its bin
     keyframes_.erase(old);
   }
-  const Bin bin = bin_of(keyframe.T_world_camera);
+  bins_.insert(id, keyframe.T_world_camera);
   bytes_ += keyframe.bytes();
   keyframes_.emplace(id, std::move(keyframe));
-  bin_of_id_[id] = bin;
-  bins_[bin].push_back(id);
   const double budget = options_.max_megabytes * 1e6;
   while (static_cast<double>(bytes_) > budget && keyframes_.size() > 1) drop_one(id);
 }
 
 void KeyframeStore::drop_one(int64_t keep) {
-  // The fullest bin; its oldest keyframe other than `keep`.
-  const std::vector<int64_t>* fullest = nullptr;
-  for (const auto& [bin, ids] : bins_) {
-    const size_t candidates = ids.size() - (std::count(ids.begin(), ids.end(), keep) ? 1 : 0);
-    if (candidates > 0 && (fullest == nullptr || ids.size() > fullest->size())) fullest = &ids;
-  }
-  if (fullest == nullptr) return;
-  int64_t victim = fullest->front() == keep ? (*fullest)[1] : fullest->front();
-  auto it = keyframes_.find(victim);
+  const std::optional<int64_t> victim = bins_.first_to_thin(keep);
+  if (!victim) return;
+  auto it = keyframes_.find(*victim);
   bytes_ -= it->second.bytes();
-  unbin(victim, bin_of_id_.at(victim));
-  bin_of_id_.erase(victim);
+  bins_.erase(*victim);
   keyframes_.erase(it);
   ++dropped_;
 }
@@ -82,13 +59,7 @@ bool KeyframeStore::set_pose(int64_t id, const Eigen::Isometry3d& T_world_camera
   auto it = keyframes_.find(id);
   if (it == keyframes_.end()) return false;
   it->second.T_world_camera = T_world_camera;
-  const Bin bin = bin_of(T_world_camera);
-  Bin& old = bin_of_id_.at(id);
-  if (bin != old) {
-    unbin(id, old);
-    old = bin;
-    bins_[bin].push_back(id);
-  }
+  bins_.insert(id, T_world_camera);
   return true;
 }
 
@@ -108,7 +79,6 @@ std::vector<const StoredKeyframe*> KeyframeStore::in_time_order() const {
 
 void KeyframeStore::clear() {
   keyframes_.clear();
-  bin_of_id_.clear();
   bins_.clear();
   bytes_ = 0;
 }

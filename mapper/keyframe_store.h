@@ -6,17 +6,18 @@
 // resolution, colour for the point cloud), so a rebuild inserts exactly the same rays again;
 // at 128x96 that is about 61 kB a keyframe (0.5 GB holds about 8,500 of them).
 //
-// Policy when the budget is exceeded: keyframes are binned by position (bin_size_m cells) and
-// viewing direction (bin_angle_deg sectors of the optical axis); the oldest keyframe of the
-// fullest bin is dropped. So places seen from many nearby, similar viewpoints are thinned
-// first, and a place seen once keeps its only view. The newest keyframe is never dropped.
+// Policy when the budget is exceeded (common/geometry/view_bins.h): keyframes are binned by
+// position (bin_size_m cells) and viewing direction (bin_angle_deg sectors of the optical axis);
+// the oldest keyframe of the fullest bin is dropped. So places seen from many nearby, similar
+// viewpoints are thinned first, and a place seen once keeps its only view. The newest keyframe
+// is never dropped.
 
 #include <Eigen/Geometry>
 #include <cstdint>
 #include <map>
-#include <tuple>
 #include <vector>
 
+#include "common/geometry/view_bins.h"
 #include "common/rgbd_frame.h"
 
 namespace kestrel::mapper {
@@ -60,15 +61,11 @@ class KeyframeStore {
   void clear();
 
  private:
-  using Bin = std::tuple<int, int, int, int, int>;  // position cell, axis azimuth and elevation
-  Bin bin_of(const Eigen::Isometry3d& T) const;
-  void unbin(int64_t id, const Bin& bin);
   void drop_one(int64_t keep);
 
   KeyframeOptions options_;
   std::map<int64_t, StoredKeyframe> keyframes_;
-  std::map<int64_t, Bin> bin_of_id_;
-  std::map<Bin, std::vector<int64_t>> bins_;  // ids in insertion order
+  ViewBins bins_;
   size_t bytes_ = 0;
   size_t dropped_ = 0;
 };

@@ -62,6 +62,10 @@ void add_options(cli::App& app, Options& o, SlamOptions& s) {
   app.add_option("--reuse-max-correction", s.coverage.max_correction_m,
                  "A frame is located in a covering keyframe only within this of its estimate, m (more: a loop closure)")
       ->check(CLI::NonNegativeNumber)->capture_default_str();
+  app.add_option("--keyframe-megabytes", s.memory.max_megabytes,
+                 "Memory budget of the keyframes' features, MB: over it, keyframes of places seen from many similar "
+                 "views are thinned (kept in the graph, no longer matched)")
+      ->check(CLI::PositiveNumber)->capture_default_str();
   app.add_option("--loop-min-age", s.loops.min_age_s, "Loop candidates are at least this much older, s")
       ->check(CLI::NonNegativeNumber)->capture_default_str();
   app.add_option("--loop-max-distance", s.loops.max_distance_m,
@@ -187,10 +191,11 @@ int serve(const Options& o, const SlamOptions& options, std::shared_ptr<const Vo
                o.graph_channel, o.correction_channel);
   const int status = node->spin();
   const auto& misses = adapter.slam().coverage_misses();
-  spdlog::info("{} keyframes, {} loop closures, {} frames re-anchored on a covering keyframe (keyframes instead: "
-               "{} with none near, {} none verified, {} located too far), {} VO restarts "
+  spdlog::info("{} keyframes ({} thinned, features {:.1f} MB), {} loop closures, {} frames re-anchored on a "
+               "covering keyframe (keyframes instead: {} with none near, {} none verified, {} located too far), {} VO restarts "
                "bridged by the estimator, {} estimator restarts, {} messages rejected",
-               adapter.slam().keyframes().size(), adapter.slam().num_loop_closures(), adapter.slam().num_reanchors(),
+               adapter.slam().keyframes().size(), adapter.slam().num_thinned(), adapter.slam().feature_bytes() / 1e6,
+               adapter.slam().num_loop_closures(), adapter.slam().num_reanchors(),
                misses.none_near, misses.not_verified, misses.too_far, adapter.bridges(),
                adapter.estimator_restarts(), node->counters().messages_rejected);
   return status;

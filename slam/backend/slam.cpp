@@ -24,6 +24,10 @@ void check_options(const SlamOptions& o) {
   require(c.max_translation_m >= 0.0 && c.max_rotation_rad >= 0.0 && c.max_correction_m >= 0.0 &&
               c.max_correction_rad >= 0.0 && c.max_candidates >= 1,
           "coverage distances must be >= 0 and max_candidates >= 1");
+  const KeyframeMemoryOptions& m = o.memory;
+  require(std::isfinite(m.max_megabytes) && m.max_megabytes > 0.0, "memory.max_megabytes must be > 0");
+  require(std::isfinite(m.bin_size_m) && m.bin_size_m > 0.0, "memory.bin_size_m must be > 0");
+  require(m.bin_angle_deg > 0.0 && m.bin_angle_deg <= 180.0, "memory.bin_angle_deg must be in (0, 180]");
   require(o.loops.min_age_s >= 0.0, "loops.min_age_s must be >= 0");
   require(o.loops.max_candidates >= 1, "loops.max_candidates must be >= 1");
   const OdometryNoise& n = o.odometry;
@@ -34,6 +38,11 @@ void check_options(const SlamOptions& o) {
   require(n.bridge_translation_m > 0.0 && n.bridge_rotation_rad > 0.0, "odometry bridge noise must be > 0");
   require(n.reported_translation_floor_m > 0.0 && n.reported_rotation_floor_rad > 0.0,
           "odometry reported-covariance floors must be > 0");
+}
+
+const SlamOptions& checked(const SlamOptions& o) {
+  check_options(o);
+  return o;
 }
 
 // Information of an odometry edge in the pose graph's error convention (spaces.h): the
@@ -106,9 +115,16 @@ Matrix6d odometry_edge_information(const Eigen::Isometry3d& T_prev_cur, const Od
   return odometry_information(T_prev_cur, noise, link);
 }
 
+size_t memory_of(const FrameFeatures& f) {
+  return f.keypoints.capacity() * sizeof(cv::KeyPoint) + f.descriptors.total() * f.descriptors.elemSize() +
+         f.points.capacity() * sizeof(Eigen::Vector3d);
+}
+
 Slam::Slam(const SlamOptions& options, std::shared_ptr<const Vocabulary> vocabulary)
-    : options_(options), vocabulary_(std::move(vocabulary)), extractor_(options.features) {
-  check_options(options_);
+    : options_(checked(options)),
+      vocabulary_(std::move(vocabulary)),
+      extractor_(options.features),
+      matchable_(options.memory.bin_size_m, options.memory.bin_angle_deg) {
   reset();
 }
 
@@ -127,6 +143,24 @@ void Slam::reset() {
   reference_ = OdometryReference{};
   reanchors_ = 0;
   coverage_misses_ = CoverageMisses{};
+  matchable_.clear();
+  feature_bytes_ = 0;
+  thinned_ = 0;
+}
+
+void Slam::keep_within_budget(int64_t newest) {
+  const double budget = options_.memory.max_megabytes * 1e6;
+  while (static_cast<double>(feature_bytes_) > budget) {
+    const std::optional<int64_t> victim = matchable_.first_to_thin(newest);
+    if (!victim) return;
+    Keyframe& kf = keyframes_[static_cast<size_t>(*victim)];
+    feature_bytes_ -= memory_of(kf.features);
+    kf.features = FrameFeatures{};
+    kf.thinned = true;
+    places_->forget(static_cast<int>(kf.id));
+    matchable_.erase(kf.id);
+    ++thinned_;
+  }
 }
 
 void Slam::change_world(const Eigen::Isometry3d& T_new_world) {
@@ -212,7 +246,11 @@ SlamStep Slam::add(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camer
   step.keyframe = true;
   step.keyframe_id = keyframes_.back().id;
   step = close_loop(std::move(step));
-  places_->add(keyframes_.back().features.descriptors);
+  const Keyframe& added = keyframes_.back();
+  places_->add(added.features.descriptors);
+  matchable_.insert(added.id, graph_.poses.back());
+  feature_bytes_ += memory_of(added.features);
+  keep_within_budget(added.id);
   return step;
 }
 
@@ -275,7 +313,7 @@ bool Slam::reanchor(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_came
   for (size_t k = 0; k < keyframes_.size(); ++k) {
     const double d = se3::translation_distance(graph_.poses[k], T_world_frame);
     const double a = se3::rotation_distance(graph_.poses[k], T_world_frame);
-    if (d < c.max_translation_m && a < c.max_rotation_rad)
+    if (d < c.max_translation_m && a < c.max_rotation_rad && !keyframes_[k].thinned)
       covering.emplace_back(d / std::max(c.max_translation_m, 1e-9) + a / std::max(c.max_rotation_rad, 1e-9), k);
   }
   std::sort(covering.begin(), covering.end());

@@ -15,6 +15,9 @@
 // correction of its estimate, becomes the odometry's reference instead of a keyframe
 // (re-anchoring): later frames and the next keyframe's edge are measured from it.
 //
+// Bounded memory (KeyframeMemoryOptions): over a budget, the keyframes of places seen from many
+// similar views let their features go (thinned); they stay in the graph, unmatched.
+//
 // Frames: "world" is the odometry frame of the first keyframe, so before any loop closure the
 // optimised poses equal the odometry poses, until change_world() moves the whole graph into
 // another frame (the process puts it in the state estimator's world, slam_adapter.h).
@@ -28,6 +31,7 @@
 #include <optional>
 #include <vector>
 
+#include "common/geometry/view_bins.h"
 #include "common/rgbd_frame.h"
 #include "sensors/sensor_profile.h"
 #include "slam/backend/slam_options.h"
@@ -54,8 +58,12 @@ struct Keyframe {
   /// How its odometry pose relates to the previous keyframe's (the first's: kContinuous).
   OdometryLink link = OdometryLink::kContinuous;
   sensors::SensorProfile sensor;  ///< its camera's profile (its loops' noise); empty: none
-  FrameFeatures features;
+  FrameFeatures features;         ///< empty once thinned (KeyframeMemoryOptions)
+  bool thinned = false;           ///< its features went to keep within the memory budget
 };
+
+/// Bytes a keyframe's features take (what KeyframeMemoryOptions::max_megabytes bounds).
+size_t memory_of(const FrameFeatures& features);
 
 /// What the odometry since is measured from: the newest keyframe, or a later frame located in
 /// a covering keyframe (CoverageOptions).
@@ -129,6 +137,10 @@ class Slam {
     int none_near = 0, not_verified = 0, too_far = 0;
   };
   const CoverageMisses& coverage_misses() const { return coverage_misses_; }
+  /// Keyframes that let their features go to keep within the memory budget, and the bytes the
+  /// others' features take.
+  int num_thinned() const { return thinned_; }
+  size_t feature_bytes() const { return feature_bytes_; }
   const OdometryReference& reference() const { return reference_; }
   /// Verified loops refused because they disagreed with the odometry (loop_consistency.h).
   int num_inconsistent_loops() const { return inconsistent_loops_; }
@@ -162,6 +174,8 @@ class Slam {
                 const std::optional<Matrix6d>& odometry_covariance, const FrameFeatures& features,
                 const sensors::SensorProfile& sensor, SlamStep& step);
   Eigen::Isometry3d reference_world_pose() const;
+  /// Thins keyframes (never `newest`) while their features exceed the budget.
+  void keep_within_budget(int64_t newest);
 
   SlamOptions options_;
   std::shared_ptr<const Vocabulary> vocabulary_;
@@ -179,6 +193,9 @@ class Slam {
   int reanchors_ = 0;
   CoverageMisses coverage_misses_;
   bool gate_by_pose_ = true;  ///< off from an odometry break until a loop closure re-anchors
+  ViewBins matchable_;        ///< keyframes that still have their features, by view
+  size_t feature_bytes_ = 0;  ///< of those keyframes
+  int thinned_ = 0;
 };
 
 }  // namespace kestrel::slam

@@ -35,6 +35,18 @@ struct CoverageOptions {
   double max_correction_rad = 2.0 * kPi / 180.0;
 };
 
+/// The memory bound: keyframes keep their features (keypoints, descriptors, 3-D points: what
+/// loops and re-anchoring match against, ~40-80 kB each) within this budget. Over it, the
+/// oldest keyframe of the fullest bin of nearby, similar views (common/geometry/view_bins.h, the
+/// mapper's policy) lets its features go: it stays in the graph (its pose, its edges, the
+/// mapper's scan) but is no longer matched. A place seen once keeps its only view; the newest
+/// keyframe is never thinned. What remains per keyframe is the graph's vertex and edges.
+struct KeyframeMemoryOptions {
+  double max_megabytes = 256.0;  ///< features of all keyframes, MB (10^6 bytes)
+  double bin_size_m = 0.5;       ///< thinning bins: position cell
+  double bin_angle_deg = 30.0;   ///< thinning bins: optical-axis sector
+};
+
 struct LoopSearchOptions {
   double min_age_s = 4.0;       ///< candidates are keyframes at least this much older
   /// Candidates lie within this distance and angle of the current estimate; <= 0 disables the
@@ -73,6 +85,7 @@ struct OdometryNoise {
 struct SlamOptions {
   KeyframeOptions keyframes;
   CoverageOptions coverage;
+  KeyframeMemoryOptions memory;
   LoopSearchOptions loops;
   /// A verified loop must agree with the odometry between its keyframes (when the estimate is
   /// trustworthy): rejects perceptual aliasing (loop_consistency.h).

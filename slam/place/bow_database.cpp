@@ -37,6 +37,16 @@ std::vector<BowMatch> BowDatabase::query(const BowVector& query, int max_results
   return matches;
 }
 
+void BowDatabase::remove(int entry) {
+  if (entry < 0 || entry >= size()) return;
+  for (const auto& [word, weight] : vectors_[static_cast<size_t>(entry)]) {
+    auto& postings = inverted_[static_cast<size_t>(word)];
+    postings.erase(std::remove_if(postings.begin(), postings.end(), [entry](const Posting& p) { return p.entry == entry; }),
+                   postings.end());
+  }
+  vectors_[static_cast<size_t>(entry)] = BowVector{};
+}
+
 void BowDatabase::clear() {
   vectors_.clear();
   inverted_.clear();

@@ -25,6 +25,9 @@ class BowDatabase {
   /// those sharing at least one word with `query`.
   std::vector<BowMatch> query(const BowVector& query, int max_results,
                               const std::function<bool(int)>& allowed) const;
+  /// Takes `entry` out of every query's results; its number stays taken (entries are not
+  /// renumbered) and its vector becomes empty.
+  void remove(int entry);
   /// Forgets everything.
   void clear();
   int size() const { return static_cast<int>(vectors_.size()); }

@@ -25,8 +25,8 @@ int PlaceRecognizer::num_words() const {
 }
 
 int PlaceRecognizer::add(const cv::Mat& descriptors) {
-  descriptors_.push_back(descriptors.clone());
-  const int entry = size() - 1;
+  const int entry = entries_++;
+  if (online()) descriptors_.push_back(descriptors.clone());
   if (online() && size() >= next_training_) {
     retrain();  // indexes every keyframe, this one included
     next_training_ = 2 * size();
@@ -37,13 +37,18 @@ int PlaceRecognizer::add(const cv::Mat& descriptors) {
 }
 
 void PlaceRecognizer::retrain() {
-  // Training set: every descriptor, or a random subset of them when there are too many.
+  // Training set: every kept keyframe's descriptors (a forgotten one has none), or a random
+  // subset of them when there are too many.
+  std::vector<cv::Mat> kept;
   size_t total = 0;
-  for (const auto& d : descriptors_) total += static_cast<size_t>(d.rows);
+  for (const auto& d : descriptors_) {
+    if (d.empty()) continue;
+    kept.push_back(d);
+    total += static_cast<size_t>(d.rows);
+  }
   if (total == 0) return;  // nothing to learn words from yet (keyframes without texture)
   std::mt19937_64 rng(options_.seed + static_cast<uint64_t>(trainings_));
-  const std::vector<cv::Mat> images =
-      subsample_rows(descriptors_, static_cast<size_t>(options_.online_max_training), rng);
+  const std::vector<cv::Mat> images = subsample_rows(kept, static_cast<size_t>(options_.online_max_training), rng);
   total = 0;
   for (const auto& d : images) total += static_cast<size_t>(d.rows);
   VocabularyOptions vo = options_.online_vocabulary;
@@ -51,12 +56,13 @@ void PlaceRecognizer::retrain() {
   const double levels = std::log(std::max(static_cast<double>(total) / 10.0, 2.0)) / std::log(vo.branching);
   vo.depth = std::clamp(static_cast<int>(std::ceil(levels)), 1, options_.online_vocabulary.depth);
   online_ = Vocabulary::train(images, vo, rng());
-  // idf from every keyframe, not the subset.
+  // idf from every kept keyframe, not the subset.
   std::vector<std::vector<int>> documents;
-  for (const auto& d : descriptors_) documents.push_back(online_.words(d));
+  for (const auto& d : kept) documents.push_back(online_.words(d));
   online_.set_idf(documents);
+  // Every entry keeps its number; a forgotten one stays empty.
   database_.clear();
-  for (const auto& d : descriptors_) database_.add(online_.transform(d));
+  for (const auto& d : descriptors_) database_.add(d.empty() ? BowVector{} : online_.transform(d));
   ++trainings_;
 }
 
@@ -72,7 +78,14 @@ double PlaceRecognizer::score(int a, int b) const {
   return bow_score(database_.vector(a), database_.vector(b));
 }
 
+void PlaceRecognizer::forget(int entry) {
+  if (entry < 0 || entry >= entries_) return;
+  if (online()) descriptors_[static_cast<size_t>(entry)] = cv::Mat();  // later trainings skip it
+  database_.remove(entry);
+}
+
 void PlaceRecognizer::clear() {
+  entries_ = 0;
   descriptors_.clear();
   database_.clear();
   online_ = Vocabulary();

@@ -42,7 +42,9 @@ class PlaceRecognizer {
                               const std::function<bool(int)>& allowed) const;
   /// Similarity of two stored keyframes.
   double score(int a, int b) const;
-  int size() const { return static_cast<int>(descriptors_.size()); }
+  /// Stops returning `entry` (a keyframe that let its features go); its number stays taken.
+  void forget(int entry);
+  int size() const { return entries_; }
   /// Times the online vocabulary was (re)trained.
   int trainings() const { return trainings_; }
   /// Words of the vocabulary in use (0 before the first online training).
@@ -56,7 +58,10 @@ class PlaceRecognizer {
   PlaceOptions options_;
   std::shared_ptr<const Vocabulary> fixed_;
   Vocabulary online_;
-  std::vector<cv::Mat> descriptors_;  ///< per keyframe (kept to re-index after retraining)
+  int entries_ = 0;
+  /// Online vocabulary only: each keyframe's descriptors, to train on and re-index after each
+  /// training (a fixed vocabulary needs none: the keyframes' own are not copied).
+  std::vector<cv::Mat> descriptors_;
   BowDatabase database_;
   int next_training_ = 0;
   int trainings_ = 0;

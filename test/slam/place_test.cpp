@@ -199,6 +199,28 @@ TEST(PlaceRecognizer, FindsTheTrueRevisitOfALoop) {
   EXPECT_GE(places.trainings(), 3) << "the online vocabulary is retrained as keyframes double";
 }
 
+// A forgotten keyframe (SLAM thinned it) is never a candidate again, through later online
+// trainings too, and the others keep their numbers: entry i is still the i-th keyframe added.
+TEST(PlaceRecognizer, AForgottenKeyframeIsNeverACandidateAgain) {
+  const SyntheticRoom room(5, 3.0, 2.5, 2.5);
+  const auto views = views_along(room, test::circle_path(12, 1.0, 1.0));
+  PlaceRecognizer places;  // online: trained at 4 and 8 keyframes
+  for (int k = 0; k < 6; ++k) places.add(views[static_cast<size_t>(k)].features.descriptors);
+  auto best = [&](size_t view) {
+    const auto m = places.query(views[view].features.descriptors, 1, nullptr);
+    return m.empty() ? -1 : m.front().entry;
+  };
+  ASSERT_EQ(best(3), 3) << "a keyframe's own view finds it";
+  places.forget(3);
+  EXPECT_NE(best(3), 3);
+  for (int k = 6; k < 12; ++k) places.add(views[static_cast<size_t>(k)].features.descriptors);
+  EXPECT_GE(places.trainings(), 2);
+  EXPECT_EQ(places.size(), 12);
+  EXPECT_NE(best(3), 3) << "retraining brought a forgotten keyframe back";
+  EXPECT_EQ(best(10), 10) << "entries keep their numbers";
+  EXPECT_EQ(best(4), 4);
+}
+
 TEST(PlaceRecognizer, FindsNoLoopOnALoopFreePath) {
   // Along a 12 m wall, looking at it from 1.5 m: each stretch of wall is seen once.
   const SyntheticRoom room(5, 7.0, 1.5, 2.5);

@@ -60,6 +60,9 @@ struct LoopRun {
   std::vector<size_t> keyframes;             ///< keyframes made after each frame
   int reanchors = 0;
   int bad_reanchors = 0;                     ///< located more than 2 cm / 1 degree from the truth
+  std::vector<size_t> loop_frames;           ///< frames whose keyframe closed a loop
+  size_t peak_feature_bytes = 0;             ///< Slam::feature_bytes() at its largest
+  int thinned = 0;                           ///< keyframes thinned by the end
 };
 
 LoopRun run(const SyntheticRoom& room, const std::vector<Eigen::Isometry3d>& truth, double yaw_bias_rad,
@@ -72,8 +75,10 @@ LoopRun run(const SyntheticRoom& room, const std::vector<Eigen::Isometry3d>& tru
   for (size_t k = 0; k < truth.size(); ++k) {
     const RgbdFrame frame = room.render(truth[k], test::test_camera(), 1'000'000 + 200'000 * static_cast<int64_t>(k));
     const SlamStep step = slam.add(frame, r.odometry[k]);
+    r.peak_feature_bytes = std::max(r.peak_feature_bytes, slam.feature_bytes());
     if (step.loop_closed) {
       ++r.loop_closures;
+      r.loop_frames.push_back(k);
       r.last_loop_keyframe = step.keyframe_id;
       r.loop_covariance = slam.reference_marginal();
       // The closure's relative pose against the truth of the two keyframes' frames.
@@ -105,6 +110,7 @@ LoopRun run(const SyntheticRoom& room, const std::vector<Eigen::Isometry3d>& tru
   }
   for (const auto& [kf, T] : placed) r.optimised.push_back(slam.graph().poses[static_cast<size_t>(kf)] * T);
   r.graph = slam.graph();
+  r.thinned = slam.num_thinned();
   return r;
 }
 
@@ -160,6 +166,35 @@ TEST(Slam, LapsOverCoveredGroundAddNoKeyframes) {
   std::cout << "ATE: VO " << vo << " m, SLAM re-anchoring " << with_reuse << " m, every keyframe " << with_all << " m\n";
   EXPECT_LE(with_reuse, 0.3 * vo);
   EXPECT_LE(with_reuse, 1.5 * with_all + 0.01);
+}
+
+// Bounded memory (KeyframeMemoryOptions): three laps without re-anchoring, every lap making its
+// keyframes, under a budget for the features of about one lap's. The features stay within it;
+// the thinned keyframes stay in the graph; every place keeps a view, so the last lap still
+// closes loops and the trajectory stays as good as with every keyframe matchable.
+TEST(Slam, KeyframeFeaturesStayWithinTheirBudgetAndEveryPlaceKeepsAView) {
+  const SyntheticRoom room(5, 3.0, 2.5, 2.5);
+  const auto laps = test::circle_path(180, 1.0, 3.0);
+  SlamOptions unbounded;
+  unbounded.coverage.reuse_keyframes = false;
+  const LoopRun all = run(room, laps, 0.003, unbounded, builtin_vocabulary());
+  const size_t lap_keyframes = all.keyframes[59];
+  const double per_keyframe = static_cast<double>(all.peak_feature_bytes) / static_cast<double>(all.keyframes.back());
+  SlamOptions bounded = unbounded;
+  bounded.memory.max_megabytes = 1.2 * static_cast<double>(lap_keyframes) * per_keyframe / 1e6;
+  const LoopRun thin = run(room, laps, 0.003, bounded, builtin_vocabulary());
+  std::cout << all.keyframes.back() << " keyframes, " << per_keyframe / 1e3 << " kB of features each; budget "
+            << bounded.memory.max_megabytes << " MB: " << thin.thinned << " thinned, peak "
+            << thin.peak_feature_bytes / 1e6 << " MB, loops " << thin.loop_closures << " (" << all.loop_closures
+            << " unbounded)\n";
+  EXPECT_EQ(all.thinned, 0);
+  EXPECT_LE(static_cast<double>(thin.peak_feature_bytes), bounded.memory.max_megabytes * 1e6);
+  EXPECT_EQ(thin.keyframes.back(), all.keyframes.back()) << "thinned keyframes stay in the graph";
+  EXPECT_GE(thin.thinned, static_cast<int>(lap_keyframes));
+  ASSERT_FALSE(thin.loop_frames.empty());
+  EXPECT_GE(thin.loop_frames.back(), 150u) << "the last lap should still find views to close loops with";
+  EXPECT_EQ(thin.false_closures, 0);
+  EXPECT_LE(ate_rmse(thin.optimised, thin.truth), 1.5 * ate_rmse(all.optimised, all.truth) + 0.01);
 }
 
 // A VO restart the estimator bridged still knows where it is: over covered ground it is
