@@ -134,7 +134,7 @@ int run_offline(const Options& o, const SlamOptions& options, std::shared_ptr<co
             << " verified but refused by the odometry check), re-anchored on a covering keyframe: "
             << run.reanchors << " (keyframes instead: " << run.coverage_misses.none_near << " with none near, "
             << run.coverage_misses.not_verified << " none verified, " << run.coverage_misses.too_far
-            << " located too far)\n";
+            << " located too far; " << run.coverage_misses.featureless << " too featureless to locate, carried)\n";
   if (!ms.empty()) {
     std::cout << "ms per keyframe: median " << ms[ms.size() / 2] << ", p95 " << ms[ms.size() * 95 / 100]
               << ", max " << ms.back() << "\n";
@@ -192,11 +192,12 @@ int serve(const Options& o, const SlamOptions& options, std::shared_ptr<const Vo
   const int status = node->spin();
   const auto& misses = adapter.slam().coverage_misses();
   spdlog::info("{} keyframes ({} thinned, features {:.1f} MB), {} loop closures, {} frames re-anchored on a "
-               "covering keyframe (keyframes instead: {} with none near, {} none verified, {} located too far), {} VO restarts "
+               "covering keyframe (keyframes instead: {} with none near, {} none verified, {} located too far; {} too "
+               "featureless to locate, carried), {} VO restarts "
                "bridged by the estimator, {} estimator restarts, {} messages rejected",
                adapter.slam().keyframes().size(), adapter.slam().num_thinned(), adapter.slam().feature_bytes() / 1e6,
                adapter.slam().num_loop_closures(), adapter.slam().num_reanchors(),
-               misses.none_near, misses.not_verified, misses.too_far, adapter.bridges(),
+               misses.none_near, misses.not_verified, misses.too_far, misses.featureless, adapter.bridges(),
                adapter.estimator_restarts(), node->counters().messages_rejected);
   return status;
 }

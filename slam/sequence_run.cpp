@@ -76,7 +76,7 @@ SlamRun run_slam_sequence(size_t count, const std::function<RgbdFrame(size_t)>& 
         odometry_covariance = chain.relative_covariance(*reference_pose, *pose);
       }
       const SlamStep step = slam.add(frame, pose->T_odom_camera, link, odometry_covariance, motion, sensor);
-      if (step.keyframe || step.reanchored) {
+      if (step.new_reference()) {
         reference_pose = *pose;
         references.push_back({slam.reference(), !references.empty() && link == OdometryLink::kContinuous});
       }

@@ -236,7 +236,7 @@ AdapterOutputs SlamAdapter::process(const kestrel::rgbd_frame_t& message, const 
                              waiting.previous_utime, waiting.T_previous_current);
   }
   const SlamStep step = slam_.add(frame, pose.T_odom_camera, link, odometry_covariance, motion, sensor);
-  const bool new_reference = step.keyframe || step.reanchored;
+  const bool new_reference = step.new_reference();
   if (new_reference) reference_pose_ = chained;
   lost_break_ = false;
   remember(*last_pose_, new_reference);

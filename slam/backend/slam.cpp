@@ -318,14 +318,37 @@ bool Slam::reanchor(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_came
   }
   std::sort(covering.begin(), covering.end());
   if (static_cast<int>(covering.size()) > c.max_candidates) covering.resize(static_cast<size_t>(c.max_candidates));
-  if (covering.empty()) ++coverage_misses_.none_near;
+  if (covering.empty()) {
+    ++coverage_misses_.none_near;
+    return false;
+  }
+  // The frame in the reference's keyframe as the odometry predicts it, and that pose's
+  // covariance: the reference's, carried through the odometry since (adjoint), plus the
+  // odometry's own.
+  const Eigen::Isometry3d T_ref_frame = reference_.T_odom_camera.inverse() * T_odom_camera;
+  const Matrix6d Ad = se3::adjoint(T_ref_frame.inverse());
+  const Matrix6d predicted =
+      Ad * reference_.covariance * Ad.transpose() +
+      right_covariance(odometry_edge_information(T_ref_frame, options_.odometry, link, odometry_covariance));
+  if (static_cast<int>(features.num_points()) < options_.verification.min_inliers) {
+    // No verification can pass (it needs min_inliers points with depth): a keyframe here would
+    // never be matched, and the covering keyframes hold the view. The frame becomes the
+    // reference where the odometry puts it, so the next try comes after the keyframe spacing
+    // rather than at every frame of a blank stretch.
+    ++coverage_misses_.featureless;
+    reference_ = OdometryReference{reference_.keyframe_id,     frame.utime,
+                                   T_odom_camera,              frame.T_body_camera,
+                                   reference_.T_keyframe_camera * T_ref_frame, predicted};
+    step.carried = true;
+    return true;
+  }
   for (const auto& [distance, k] : covering) {
     const Keyframe& kf = keyframes_[k];
     // The seed depends on the pair only, so that a replay verifies identically.
     const uint64_t seed = static_cast<uint64_t>(kf.id) * 1000003u + static_cast<uint64_t>(frame.utime);
     // Located against a prediction it must match within max_correction: the inliers' precision
     // (the rotation test) is what counts here, not their size, which refused close-up views of
-    // a wall (docs/decisions/2026-12-05-reanchoring-judged-by-precision.md).
+    // a wall (docs/decisions/2026-12-05-reanchoring-judged-by-precision-and-a-feature-budget.md).
     VerificationOptions verification = loop_verification(options_.verification, kf.sensor, sensor);
     verification.min_spread_m = 0.0;
     const LoopConstraint located = verify_loop(features, kf.features, verification, seed);
@@ -343,12 +366,7 @@ bool Slam::reanchor(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_came
     // The frame in keyframe k twice: predicted (the reference and the odometry since, with
     // their covariances) and located (the features'); the reference becomes their fusion, so
     // a precise odometry is not replaced by a coarser location, and drift is still bounded.
-    const Eigen::Isometry3d T_ref_frame = reference_.T_odom_camera.inverse() * T_odom_camera;
     const Eigen::Isometry3d T_k_predicted = graph_.poses[k].inverse() * T_world_frame;
-    const Matrix6d Ad = se3::adjoint(T_ref_frame.inverse());
-    const Matrix6d odometry = right_covariance(
-        odometry_edge_information(T_ref_frame, options_.odometry, link, odometry_covariance));
-    const Matrix6d predicted = Ad * reference_.covariance * Ad.transpose() + odometry;
     const Matrix6d measured = right_covariance(located.information);
     const Matrix6d gain = predicted * (predicted + measured).inverse();
     const Eigen::Isometry3d T_k_frame = T_k_predicted * se3::exp(gain * se3::log(T_expected_located));
@@ -363,7 +381,7 @@ bool Slam::reanchor(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_came
     ++reanchors_;
     return true;
   }
-  if (!covering.empty()) ++coverage_misses_.not_verified;
+  ++coverage_misses_.not_verified;
   return false;
 }
 

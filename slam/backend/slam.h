@@ -13,7 +13,9 @@
 // Covered ground (CoverageOptions): a frame that would be a keyframe where an older keyframe
 // already sees the same view, and whose features place it in that keyframe within a small
 // correction of its estimate, becomes the odometry's reference instead of a keyframe
-// (re-anchoring): later frames and the next keyframe's edge are measured from it.
+// (re-anchoring): later frames and the next keyframe's edge are measured from it. One with too
+// few features ever to be located (a blank wall) becomes the reference at its predicted pose:
+// a keyframe there could never be matched, and the covering one holds the view.
 //
 // Bounded memory (KeyframeMemoryOptions): over a budget, the keyframes of places seen from many
 // similar views let their features go (thinned); they stay in the graph, unmatched.
@@ -84,12 +86,17 @@ struct SlamStep {
   int64_t keyframe_id = -1;
   bool reanchored = false;        ///< instead, it was located in a covering keyframe...
   int64_t reanchor_keyframe_id = -1;  ///< ...this one (`loop` holds the constraint)
+  /// Or, over covered ground but with too few features ever to be located, it became the
+  /// reference at its predicted pose (nothing measured: no correction to send).
+  bool carried = false;
   int candidates = 0;             ///< loop candidates verified
   int inconsistent = 0;           ///< of them, verified but refused as disagreeing with the odometry
   bool loop_closed = false;
   int64_t loop_keyframe_id = -1;  ///< the earlier keyframe it closed with
   LoopConstraint loop;            ///< the accepted constraint, or the last rejection
   std::optional<OptimizerSummary> optimisation;  ///< when the graph was optimised
+  /// Later frames are measured from this one (Slam::reference()).
+  bool new_reference() const { return keyframe || reanchored || carried; }
 };
 
 /// Information (pose-graph error convention, spaces.h) of the odometry edge previous -> current
@@ -135,6 +142,7 @@ class Slam {
   /// estimate, none verified, or located beyond the correction bound.
   struct CoverageMisses {
     int none_near = 0, not_verified = 0, too_far = 0;
+    int featureless = 0;  ///< covered, too few features to verify: carried, no keyframe either
   };
   const CoverageMisses& coverage_misses() const { return coverage_misses_; }
   /// Keyframes that let their features go to keep within the memory budget, and the bytes the
@@ -168,8 +176,9 @@ class Slam {
   std::vector<Matrix6d> gate_information_;
   void add_odometry_edge(const Keyframe& current, OdometryLink link, const std::optional<Matrix6d>& covariance);
   SlamStep close_loop(SlamStep step);
-  /// Locates the frame in a covering keyframe and makes it the reference; false (and nothing
-  /// changed) when no covering keyframe verifies within the correction bound.
+  /// Locates the frame in a covering keyframe and makes it the reference, or carries the
+  /// reference to it when it is covered but too featureless to locate; false (and nothing
+  /// changed) when no keyframe covers it or none verifies within the correction bound.
   bool reanchor(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera, OdometryLink link,
                 const std::optional<Matrix6d>& odometry_covariance, const FrameFeatures& features,
                 const sensors::SensorProfile& sensor, SlamStep& step);

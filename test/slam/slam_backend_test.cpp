@@ -218,6 +218,40 @@ TEST(Slam, ABridgedRestartOverCoveredGroundIsReanchoredAndABrokenOneIsAKeyframe)
   EXPECT_EQ(slam.keyframes().size(), keyframes + 1);
 }
 
+// A frame over covered ground with too few features ever to be located (a blank wall, the dark)
+// makes no keyframe: the reference is carried to it at its predicted pose, with no correction to
+// send. The same frame where nothing covers it still makes a keyframe (the map needs the pose).
+TEST(Slam, AFeaturelessFrameOverCoveredGroundIsCarriedNotAKeyframe) {
+  const SyntheticRoom room(5, 3.0, 2.5, 2.5);
+  const auto path = test::circle_path(30, 1.0, 0.5);
+  Slam slam(SlamOptions{}, builtin_vocabulary());
+  int64_t utime = 1'000'000;
+  for (const auto& T : path) slam.add(room.render(T, test::test_camera(), utime += 200'000), T);
+  const size_t keyframes = slam.keyframes().size();
+  const int64_t reference_keyframe = slam.reference().keyframe_id;
+  RgbdFrame blank;  // no image: no features
+  blank.camera = test::test_camera();
+  blank.utime = utime += 200'000;
+  const SlamStep carried = slam.add(blank, path.front());  // back over keyframe 0
+  EXPECT_TRUE(carried.carried);
+  EXPECT_TRUE(carried.new_reference());
+  EXPECT_FALSE(carried.keyframe || carried.reanchored);
+  EXPECT_EQ(slam.keyframes().size(), keyframes);
+  EXPECT_EQ(slam.reference().utime, blank.utime);
+  EXPECT_EQ(slam.reference().keyframe_id, reference_keyframe) << "carried, not located";
+  EXPECT_LT(se3::translation_distance(slam.world_pose(path.front()), path.front()), 1e-9);
+  EXPECT_GT(slam.reference().covariance.trace(), 0.0) << "the prediction's uncertainty goes with it";
+  EXPECT_EQ(slam.coverage_misses().featureless, 1);
+  EXPECT_FALSE(slam.wants_keyframe(path.front())) << "the next try waits for the keyframe spacing";
+
+  Eigen::Isometry3d uncovered = path.front();
+  uncovered.translation().z() += 0.8;
+  blank.utime = utime += 200'000;
+  const SlamStep made = slam.add(blank, uncovered);
+  EXPECT_TRUE(made.keyframe) << "nothing covers it";
+  EXPECT_EQ(slam.keyframes().size(), keyframes + 1);
+}
+
 TEST(Slam, ALoopFreeRunClosesNoLoop) {
   const SyntheticRoom room(5, 7.0, 1.5, 2.5);
   const LoopRun r = run(room, test::straight_path(40, 12.0), 0.004);
