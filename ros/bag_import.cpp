@@ -324,7 +324,7 @@ BagImportStats import(rosbag::Bag& bag, const std::string& path, const BagImport
   } else if (have_tf) {
     poses = poses_from_tf(edges, frame_name(o.world_frame), frame_name(o.camera_frame), o.tf_topic, stats.ground_truth);
   } else {
-    stats.ground_truth = "none: no " + o.tf_topic + (o.tf_topic.empty() ? "" : " topic");
+    stats.ground_truth = o.tf_topic.empty() ? "none: no tf topic given" : "none: no " + o.tf_topic + " topic";
   }
 
   // Pairing: the TUM reader's rule and code.
