@@ -1,0 +1,209 @@
+#include "ros/bag_export.h"
+
+#include <Eigen/Core>
+#include <cmath>
+
+#include <rosbag/bag.h>
+#include <tf2_msgs/TFMessage.h>
+
+#include "common/error.h"
+#include "common/transport/channels.h"
+#include "common/transport/convert.h"
+#include "common/transport/log_file.h"
+#include "common/transport/message.h"
+#include "kestrel/rgbd_frame_t.hpp"
+#include "ros/ros_convert.h"
+
+namespace kestrel::ros1 {
+
+namespace {
+
+using Matrix15d = Eigen::Matrix<double, 15, 15>;
+
+// state_t's error state (lcmtypes/state_t.lcm, docs/architecture.md "Covariances"):
+// [dp (world); dv (world); dtheta (body, R = R_est * Exp(dtheta)); d_gyro_bias; d_accel_bias].
+constexpr int kP = 0, kV = 3, kTheta = 6, kBg = 9, kNav = 15;
+
+Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
+  Eigen::Matrix3d S;
+  S << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
+  return S;
+}
+
+void to_msg(const Eigen::Isometry3d& T, geometry_msgs::Pose& p) {
+  const Eigen::Quaterniond q(T.linear());
+  p.position.x = T.translation().x();
+  p.position.y = T.translation().y();
+  p.position.z = T.translation().z();
+  p.orientation.x = q.x();
+  p.orientation.y = q.y();
+  p.orientation.z = q.z();
+  p.orientation.w = q.w();
+}
+
+void to_msg(const Eigen::Isometry3d& T, geometry_msgs::Transform& t) {
+  const Eigen::Quaterniond q(T.linear());
+  t.translation.x = T.translation().x();
+  t.translation.y = T.translation().y();
+  t.translation.z = T.translation().z();
+  t.rotation.x = q.x();
+  t.rotation.y = q.y();
+  t.rotation.z = q.z();
+  t.rotation.w = q.w();
+}
+
+ros::Time stamp_of(int64_t utime, const std::string& what) {
+  if (utime < 0) throw InputError(what + ": utime " + std::to_string(utime) + " is before 1970 (no ROS time)");
+  return to_ros_time(utime);
+}
+
+geometry_msgs::TransformStamped transform(const Eigen::Isometry3d& T, const ros::Time& stamp, const std::string& parent,
+                                          const std::string& child) {
+  geometry_msgs::TransformStamped t;
+  t.header.stamp = stamp;
+  t.header.frame_id = parent;
+  t.child_frame_id = child;
+  to_msg(T, t.transform);
+  return t;
+}
+
+}  // namespace
+
+nav_msgs::Odometry odometry_from_state(const kestrel::state_t& s, const std::string& world_frame,
+                                       const std::string& body_frame, const std::string& what) {
+  // from_message checks the pose (finite, a unit quaternion) and normalises a slightly
+  // non-unit one; the message keeps the normalised quaternion.
+  const Eigen::Isometry3d T = transport::from_message(s.T_world_body, what.c_str());
+  const Eigen::Matrix3d R = T.linear();
+  const Eigen::Vector3d v_world(s.velocity[0], s.velocity[1], s.velocity[2]);
+  const Eigen::Vector3d v_body = R.transpose() * v_world;
+  for (int i = 0; i < 3; ++i)
+    if (!std::isfinite(v_world[i]) || !std::isfinite(s.angular_velocity[i]))
+      throw InputError(what + ": a non-finite velocity");
+
+  nav_msgs::Odometry o;
+  o.header.stamp = stamp_of(s.utime, what);
+  o.header.seq = static_cast<uint32_t>(s.seq);
+  o.header.frame_id = world_frame;
+  o.child_frame_id = body_frame;
+  to_msg(T, o.pose.pose);
+  // nav_msgs/Odometry: the twist is in child_frame_id's axes (the body's).
+  o.twist.twist.linear.x = v_body.x();
+  o.twist.twist.linear.y = v_body.y();
+  o.twist.twist.linear.z = v_body.z();
+  o.twist.twist.angular.x = s.angular_velocity[0];
+  o.twist.twist.angular.y = s.angular_velocity[1];
+  o.twist.twist.angular.z = s.angular_velocity[2];
+
+  // Covariances. ROS's are row-major 6x6 over (x, y, z, rotation about x, y, z): the pose's in
+  // header.frame_id (the world; rotations about the world's axes, R = Exp(dphi) * R_est, as
+  // robot_localization and rviz's "fixed frame" orientation read them), the twist's in
+  // child_frame_id (the body). With the state's error x = [dp; dv; dtheta; d_bg; d_ba], to
+  // first order:
+  //   pose  [dp; dphi] = [dp; R * dtheta]                         (dp is already the world's)
+  //   twist [dv_body; domega] = [R^T dv + [v_body]x dtheta; -d_bg] (v_body = R^T v_world, and
+  //         R^T = Exp(-dtheta) R_est^T; omega = gyro - b_g)
+  // so each is J * P * J^T with J taking the blocks above. The twist's angular rows are the
+  // gyro bias's uncertainty only (the gyro's own noise is not in the state), and are left
+  // zero (ROS: unknown) for FILTER_VISUAL_ONLY, whose bias block is a constant prior and whose
+  // angular velocity is the VO's. The accelerometer bias block has no place in Odometry. A
+  // STATE with another cov_dim than 15 leaves both covariances zero.
+  if (s.cov_dim == kNav && s.covariance.size() == static_cast<size_t>(kNav)) {
+    Matrix15d P;
+    for (int r = 0; r < kNav; ++r) {
+      if (s.covariance[r].size() != static_cast<size_t>(kNav)) return o;
+      for (int c = 0; c < kNav; ++c) P(r, c) = s.covariance[r][c];
+    }
+    Eigen::Matrix<double, 6, 15> Jp = Eigen::Matrix<double, 6, 15>::Zero();
+    Jp.block<3, 3>(0, kP).setIdentity();
+    Jp.block<3, 3>(3, kTheta) = R;
+    Eigen::Matrix<double, 6, 15> Jt = Eigen::Matrix<double, 6, 15>::Zero();
+    Jt.block<3, 3>(0, kV) = R.transpose();
+    Jt.block<3, 3>(0, kTheta) = skew(v_body);
+    if (s.filter != kestrel::state_t::FILTER_VISUAL_ONLY) Jt.block<3, 3>(3, kBg) = -Eigen::Matrix3d::Identity();
+    const Eigen::Matrix<double, 6, 6> pose_cov = Jp * P * Jp.transpose();
+    const Eigen::Matrix<double, 6, 6> twist_cov = Jt * P * Jt.transpose();
+    for (int r = 0; r < 6; ++r)
+      for (int c = 0; c < 6; ++c) {
+        o.pose.covariance[static_cast<size_t>(r * 6 + c)] = pose_cov(r, c);
+        o.twist.covariance[static_cast<size_t>(r * 6 + c)] = twist_cov(r, c);
+      }
+  }
+  return o;
+}
+
+namespace {
+
+class Exporter {
+ public:
+  Exporter(const BagExportOptions& o, rosbag::Bag& bag, BagExportStats& stats) : o_(o), bag_(bag), stats_(stats) {}
+
+  template <class Msg>
+  void write(const std::string& topic, const ros::Time& t, const Msg& m) {
+    bag_.write(topic, t, m);
+    ++stats_.messages[topic];
+  }
+
+  void state(const kestrel::state_t& s, const std::string& what) {
+    const nav_msgs::Odometry odom = odometry_from_state(s, o_.world_frame, o_.body_frame, what);
+    write("/kestrel/odom", odom.header.stamp, odom);
+    tf2_msgs::TFMessage tf;
+    geometry_msgs::TransformStamped t;
+    t.header = odom.header;
+    t.child_frame_id = o_.body_frame;
+    t.transform.translation.x = odom.pose.pose.position.x;
+    t.transform.translation.y = odom.pose.pose.position.y;
+    t.transform.translation.z = odom.pose.pose.position.z;
+    t.transform.rotation = odom.pose.pose.orientation;
+    tf.transforms.push_back(t);
+    write("/tf", odom.header.stamp, tf);
+  }
+
+  // base_link -> camera, once, on /tf_static (latched by `rosbag play`, read by rviz as tf).
+  void camera(const kestrel::rgbd_frame_t& f, const std::string& what) {
+    if (camera_written_) return;
+    const Eigen::Isometry3d T_body_camera = transport::from_message(f.camera.T_body_camera, what.c_str());
+    tf2_msgs::TFMessage tf;
+    const ros::Time t = stamp_of(f.utime, what);
+    tf.transforms.push_back(transform(T_body_camera, t, o_.body_frame, o_.camera_frame));
+    write("/tf_static", t, tf);
+    camera_written_ = true;
+  }
+
+ private:
+  const BagExportOptions& o_;
+  rosbag::Bag& bag_;
+  BagExportStats& stats_;
+  bool camera_written_ = false;
+};
+
+}  // namespace
+
+BagExportStats export_log(const std::string& log_path, const BagExportOptions& options, rosbag::Bag& bag,
+                          const std::function<bool()>& stopping) {
+  BagExportStats stats;
+  Exporter ex(options, bag, stats);
+  transport::LogReader log(log_path);
+  int64_t exported_channels = 0;
+  while (auto e = log.next()) {
+    if (stopping && stopping()) {
+      stats.stopped = true;
+      return stats;
+    }
+    ++stats.log_events;
+    const std::string what = log_path + ": " + e->channel + " event " + std::to_string(e->event_number);
+    if (e->channel == channel::kState) {
+      ex.state(transport::decode_message<kestrel::state_t>(e->data.data(), e->data.size(), what), what);
+      ++exported_channels;
+    } else if (e->channel == channel::kCameraRgbd) {
+      ex.camera(transport::decode_message<kestrel::rgbd_frame_t>(e->data.data(), e->data.size(), what), what);
+    }
+  }
+  if (!log.damage_report().empty()) throw InputError(log.damage_report() + " (no bag written)");
+  if (exported_channels == 0)
+    throw InputError(log_path + ": none of the channels exported (STATE) is in the log (" +
+                     std::to_string(stats.log_events) + " events)");
+  return stats;
+}
+
+}  // namespace kestrel::ros1

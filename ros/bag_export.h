@@ -1,0 +1,56 @@
+#pragma once
+// kestrel's own output as ROS 1 messages in a bag (the other way from bag_import.h): a kestrel
+// LCM log read with transport::LogReader, written with librosbag's own writer. See
+// ros/README.md, "bag-export", for the topics and frames.
+//
+// Frames (REP-105 names, configurable): `world_frame` (default "map") is the estimator's world,
+// the frame STATE's T_world_body is in (SLAM's world once the estimator took it); `body_frame`
+// ("base_link") the vehicle body; `camera_frame` ("camera") the RGB camera's optical frame. The
+// map -> odom -> base_link split of REP-105 waits for an odometry frame of kestrel's own
+// (issue 39 item 1): today /tf holds map -> base_link directly.
+
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <string>
+
+#include <nav_msgs/Odometry.h>
+
+#include "kestrel/state_t.hpp"
+
+namespace rosbag {
+class Bag;
+}
+
+namespace kestrel::ros1 {
+
+struct BagExportOptions {
+  std::string world_frame = "map";
+  std::string body_frame = "base_link";
+  std::string camera_frame = "camera";
+};
+
+struct BagExportStats {
+  std::map<std::string, int64_t> messages;  ///< per topic, messages written
+  int64_t log_events = 0;                   ///< events read from the log
+  bool stopped = false;                     ///< `stopping` said so before the end
+  int64_t total() const {
+    int64_t n = 0;
+    for (const auto& [topic, count] : messages) n += count;
+    return n;
+  }
+};
+
+/// STATE as nav_msgs/Odometry: the pose of `body_frame` in `world_frame`, the twist in
+/// `body_frame`'s axes, both covariances from state_t's error state (bag_export.cpp says which
+/// blocks go where). Throws InputError naming `what` for a non-finite pose.
+nav_msgs::Odometry odometry_from_state(const kestrel::state_t& state, const std::string& world_frame,
+                                       const std::string& body_frame, const std::string& what);
+
+/// Writes the log's messages to `bag` (open for writing). Throws InputError (naming the log)
+/// for a log that cannot be read, is damaged (truncated, corrupt regions), holds a message that
+/// does not decode, or holds none of the channels exported.
+BagExportStats export_log(const std::string& log_path, const BagExportOptions& options, rosbag::Bag& bag,
+                          const std::function<bool()>& stopping = {});
+
+}  // namespace kestrel::ros1

@@ -1,0 +1,198 @@
+// ros/bag_export.h: STATE as nav_msgs/Odometry (pose, twist and both covariances on a case
+// worked by hand), and a log of hand-made messages exported and read back with librosbag.
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <filesystem>
+
+#include <rosbag/bag.h>
+#include <rosbag/view.h>
+#include <tf2_msgs/TFMessage.h>
+
+#include "common/error.h"
+#include "common/transport/channels.h"
+#include "common/transport/convert.h"
+#include "common/transport/log_file.h"
+#include "kestrel/rgbd_frame_t.hpp"
+#include "ros/bag_export.h"
+#include "ros/ros_convert.h"
+#include "test/ros/bag_export_logs.h"
+#include "test/support/test_support.h"
+
+namespace kestrel {
+namespace {
+
+namespace fs = std::filesystem;
+using test::make_state;
+
+double cov(const boost::array<double, 36>& c, int r, int k) { return c[static_cast<size_t>(r * 6 + k)]; }
+
+TEST(BagExport, OdometryPoseAndTwistAreStatesInRosFrames) {
+  // Yaw 90 degrees: the body's x is the world's y.
+  const Eigen::Isometry3d T = Eigen::Translation3d(1, 2, 3) * Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ());
+  kestrel::state_t s = make_state(1500000, T, {1, 0, 0}, {0.1, 0.2, 0.3});
+  s.seq = 7;
+  const nav_msgs::Odometry o = ros1::odometry_from_state(s, "map", "base_link", "test");
+  EXPECT_EQ(o.header.frame_id, "map");
+  EXPECT_EQ(o.child_frame_id, "base_link");
+  EXPECT_EQ(o.header.stamp, ros::Time(1, 500000000));
+  EXPECT_EQ(o.header.seq, 7u);
+  EXPECT_NEAR(o.pose.pose.position.x, 1, 1e-12);
+  EXPECT_NEAR(o.pose.pose.position.y, 2, 1e-12);
+  EXPECT_NEAR(o.pose.pose.position.z, 3, 1e-12);
+  EXPECT_NEAR(o.pose.pose.orientation.w, std::sqrt(0.5), 1e-12);
+  EXPECT_NEAR(o.pose.pose.orientation.z, std::sqrt(0.5), 1e-12);
+  // v_world = (1, 0, 0) is the body's -y.
+  EXPECT_NEAR(o.twist.twist.linear.x, 0, 1e-12);
+  EXPECT_NEAR(o.twist.twist.linear.y, -1, 1e-12);
+  EXPECT_NEAR(o.twist.twist.linear.z, 0, 1e-12);
+  EXPECT_EQ(o.twist.twist.angular.x, 0.1);
+  EXPECT_EQ(o.twist.twist.angular.z, 0.3);
+}
+
+// By hand, R = Rz(90 deg), v_world = (1, 0, 0) so v_body = (0, -1, 0), and diagonal blocks
+// P_pp = diag(1, 2, 3), P_vv = diag(d, e, f) = (4, 5, 6), P_thth = diag(a, b, c) = (7, 8, 9) (body),
+// P_bg = diag(10, 11, 12), P_ba = diag(13, 14, 15), plus P(dp_x, dtheta_x) = 0.5:
+//  pose:  position diag(1, 2, 3); rotation R diag(7, 8, 9) R^T = diag(8, 7, 9); the cross term
+//         dp_x with dtheta_x (body x = world y) lands at (x, rot y) = 0.5;
+//  twist: linear R^T P_vv R + [v_b]x P_thth [v_b]x^T = diag(e, d, f) + diag(c, 0, a)
+//         = diag(14, 4, 13); angular = P_bg = diag(10, 11, 12); no linear-angular term.
+TEST(BagExport, CovariancesMappedFromTheErrorStateOnAHandWorkedCase) {
+  const Eigen::Isometry3d T(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()));
+  kestrel::state_t s = make_state(1000000, T, {1, 0, 0}, {0, 0, 0});
+  for (int i = 0; i < 15; ++i) s.covariance[i][i] = i + 1;
+  s.covariance[0][6] = s.covariance[6][0] = 0.5;
+  const nav_msgs::Odometry o = ros1::odometry_from_state(s, "map", "base_link", "test");
+  const double pose_diag[6] = {1, 2, 3, 8, 7, 9};
+  const double twist_diag[6] = {14, 4, 13, 10, 11, 12};
+  for (int r = 0; r < 6; ++r)
+    for (int c = 0; c < 6; ++c) {
+      double want_pose = r == c ? pose_diag[r] : 0.0;
+      if ((r == 0 && c == 4) || (r == 4 && c == 0)) want_pose = 0.5;
+      EXPECT_NEAR(cov(o.pose.covariance, r, c), want_pose, 1e-12) << "pose (" << r << ", " << c << ")";
+      EXPECT_NEAR(cov(o.twist.covariance, r, c), r == c ? twist_diag[r] : 0.0, 1e-12) << "twist (" << r << ", " << c << ")";
+    }
+  // Visual-only: the angular velocity's covariance is not in the state (zero: unknown).
+  s.filter = kestrel::state_t::FILTER_VISUAL_ONLY;
+  const nav_msgs::Odometry v = ros1::odometry_from_state(s, "map", "base_link", "test");
+  for (int r = 3; r < 6; ++r) EXPECT_EQ(cov(v.twist.covariance, r, r), 0.0);
+  EXPECT_NEAR(cov(v.twist.covariance, 0, 0), 14, 1e-12);
+  // Another cov_dim: both covariances unknown (zero).
+  s.cov_dim = 0;
+  s.covariance.clear();
+  const nav_msgs::Odometry none = ros1::odometry_from_state(s, "map", "base_link", "test");
+  for (double x : none.pose.covariance) EXPECT_EQ(x, 0.0);
+  for (double x : none.twist.covariance) EXPECT_EQ(x, 0.0);
+}
+
+TEST(BagExport, ANonFinitePoseIsAnInputError) {
+  kestrel::state_t s = make_state(1000000, Eigen::Isometry3d::Identity(), {0, 0, 0}, {0, 0, 0});
+  s.T_world_body.position[1] = std::nan("");
+  EXPECT_THROW(ros1::odometry_from_state(s, "map", "base_link", "test"), InputError);
+}
+
+TEST(BagExport, EveryStateIsAnOdometryAndATransformAndTheCameraMountIsStatic) {
+  test::TempDir dir;
+  const fs::path log = dir / "in.lcmlog";
+  const auto states = test::write_state_log(log, 20, /*with_camera=*/true);
+  {
+    rosbag::Bag bag((dir / "out.bag").string(), rosbag::bagmode::Write);
+    const ros1::BagExportStats s = ros1::export_log(log.string(), {}, bag);
+    EXPECT_EQ(s.messages.at("/kestrel/odom"), 20);
+    EXPECT_EQ(s.messages.at("/tf"), 20);
+    EXPECT_EQ(s.messages.at("/tf_static"), 1);
+  }
+  rosbag::Bag bag((dir / "out.bag").string(), rosbag::bagmode::Read);
+  size_t i = 0;
+  for (const rosbag::MessageInstance& m : rosbag::View(bag, rosbag::TopicQuery("/kestrel/odom"))) {
+    const auto o = m.instantiate<nav_msgs::Odometry>();
+    ASSERT_TRUE(o);
+    ASSERT_LT(i, states.size());
+    const kestrel::state_t& s = states[i++];
+    EXPECT_EQ(m.getTime(), ros1::to_ros_time(s.utime));
+    EXPECT_EQ(o->header.stamp, m.getTime());
+    EXPECT_NEAR(o->pose.pose.position.x, s.T_world_body.position[0], 1e-9);
+    EXPECT_NEAR(o->pose.pose.position.y, s.T_world_body.position[1], 1e-9);
+    EXPECT_NEAR(o->pose.pose.position.z, s.T_world_body.position[2], 1e-9);
+    EXPECT_NEAR(o->pose.pose.orientation.w, s.T_world_body.orientation[0], 1e-9);
+    EXPECT_NEAR(o->pose.pose.orientation.x, s.T_world_body.orientation[1], 1e-9);
+    EXPECT_NEAR(o->pose.pose.orientation.y, s.T_world_body.orientation[2], 1e-9);
+    EXPECT_NEAR(o->pose.pose.orientation.z, s.T_world_body.orientation[3], 1e-9);
+  }
+  EXPECT_EQ(i, states.size());
+  size_t tf = 0;
+  for (const rosbag::MessageInstance& m : rosbag::View(bag, rosbag::TopicQuery("/tf"))) {
+    const auto t = m.instantiate<tf2_msgs::TFMessage>();
+    ASSERT_TRUE(t);
+    ASSERT_EQ(t->transforms.size(), 1u);
+    EXPECT_EQ(t->transforms[0].header.frame_id, "map");
+    EXPECT_EQ(t->transforms[0].child_frame_id, "base_link");
+    EXPECT_NEAR(t->transforms[0].transform.translation.x, states[tf].T_world_body.position[0], 1e-9);
+    ++tf;
+  }
+  EXPECT_EQ(tf, states.size());
+  size_t fixed = 0;
+  for (const rosbag::MessageInstance& m : rosbag::View(bag, rosbag::TopicQuery("/tf_static"))) {
+    const auto t = m.instantiate<tf2_msgs::TFMessage>();
+    ASSERT_TRUE(t);
+    ASSERT_EQ(t->transforms.size(), 1u);
+    EXPECT_EQ(t->transforms[0].header.frame_id, "base_link");
+    EXPECT_EQ(t->transforms[0].child_frame_id, "camera");
+    // test::kBodyCamera: the camera 10 cm ahead, looking along the body's x (optical z forward).
+    EXPECT_NEAR(t->transforms[0].transform.translation.x, 0.1, 1e-12);
+    const Eigen::Quaterniond q(t->transforms[0].transform.rotation.w, t->transforms[0].transform.rotation.x,
+                               t->transforms[0].transform.rotation.y, t->transforms[0].transform.rotation.z);
+    EXPECT_NEAR((q * Eigen::Vector3d::UnitZ() - Eigen::Vector3d::UnitX()).norm(), 0, 1e-12);
+    ++fixed;
+  }
+  EXPECT_EQ(fixed, 1u);
+}
+
+TEST(BagExport, FrameNamesAreOptions) {
+  test::TempDir dir;
+  test::write_state_log(dir / "in.lcmlog", 2, true);
+  ros1::BagExportOptions o;
+  o.world_frame = "odom";
+  o.body_frame = "body";
+  o.camera_frame = "rgb_optical";
+  {
+    rosbag::Bag bag((dir / "out.bag").string(), rosbag::bagmode::Write);
+    ros1::export_log((dir / "in.lcmlog").string(), o, bag);
+  }
+  rosbag::Bag bag((dir / "out.bag").string(), rosbag::bagmode::Read);
+  for (const rosbag::MessageInstance& m : rosbag::View(bag)) {
+    if (const auto odom = m.instantiate<nav_msgs::Odometry>()) {
+      EXPECT_EQ(odom->header.frame_id, "odom");
+      EXPECT_EQ(odom->child_frame_id, "body");
+    } else if (const auto tf = m.instantiate<tf2_msgs::TFMessage>()) {
+      const auto& t = tf->transforms.at(0);
+      EXPECT_TRUE((t.header.frame_id == "odom" && t.child_frame_id == "body") ||
+                  (t.header.frame_id == "body" && t.child_frame_id == "rgb_optical"))
+          << t.header.frame_id << " -> " << t.child_frame_id;
+    }
+  }
+}
+
+TEST(BagExport, ALogWithoutTheChannelsIsAnInputError) {
+  test::TempDir dir;
+  {
+    transport::LogWriter w((dir / "imu.lcmlog").string());
+    kestrel::rgbd_frame_t f{};
+    f.utime = 1000000;
+    f.camera.T_body_camera = transport::to_message(Eigen::Isometry3d::Identity());
+    w.write_message(channel::kCameraRgbd, f.utime, f);
+    w.close();
+  }
+  rosbag::Bag bag((dir / "out.bag").string(), rosbag::bagmode::Write);
+  try {
+    ros1::export_log((dir / "imu.lcmlog").string(), {}, bag);
+    FAIL() << "no InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("none of the channels exported"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace kestrel
