@@ -2,7 +2,9 @@
 
 #include <Eigen/Core>
 #include <cmath>
+#include <optional>
 
+#include <geometry_msgs/PoseStamped.h>
 #include <rosbag/bag.h>
 #include <tf2_msgs/TFMessage.h>
 
@@ -11,8 +13,11 @@
 #include "common/transport/convert.h"
 #include "common/transport/log_file.h"
 #include "common/transport/message.h"
+#include "kestrel/ground_truth_t.hpp"
 #include "kestrel/rgbd_frame_t.hpp"
+#include "kestrel/vo_update_t.hpp"
 #include "ros/ros_convert.h"
+#include "tools/eval/vo_chain.h"
 
 namespace kestrel::ros1 {
 
@@ -159,6 +164,49 @@ class Exporter {
     write("/tf", odom.header.stamp, tf);
   }
 
+  // The VO's motions chained into the camera's poses by eval's VoChain (tools/eval/vo_chain.h:
+  // its rules for a failed frame or an unknown reference), the step made from the message as
+  // eval's log reader makes it. Each frame the chain gives a pose is one Odometry of the
+  // camera in the VO's world; no covariance (the chain's is not accumulated) and no twist.
+  void vo(const kestrel::vo_update_t& m, const std::string& what) {
+    if (last_vo_utime_ && m.utime <= *last_vo_utime_) {
+      ++stats_.vo_out_of_order;
+      return;
+    }
+    last_vo_utime_ = m.utime;
+    eval::VoStep step;
+    step.utime = m.utime;
+    step.reference_utime = m.reference_utime;
+    step.no_reference = m.status == kestrel::vo_update_t::STATUS_NO_REFERENCE;
+    if (m.status == kestrel::vo_update_t::STATUS_OK) {
+      step.T_reference_current = transport::from_message(m.T_reference_current, what.c_str());
+      step.valid = true;
+    }
+    const size_t before = chain_.trajectory().size();
+    chain_.add(step);
+    stats_.vo_without_estimate = static_cast<int64_t>(chain_.without_estimate());
+    if (chain_.trajectory().size() == before) return;
+    nav_msgs::Odometry o;
+    o.header.stamp = stamp_of(m.utime, what);
+    o.header.seq = static_cast<uint32_t>(m.seq);
+    o.header.frame_id = o_.vo_frame;
+    o.child_frame_id = o_.camera_frame;
+    to_msg(chain_.trajectory().poses().back().T, o.pose.pose);
+    write("/kestrel/vo", o.header.stamp, o);
+  }
+
+  void truth(const kestrel::ground_truth_t& m, const std::string& what) {
+    geometry_msgs::PoseStamped p;
+    p.header.stamp = stamp_of(m.utime, what);
+    p.header.frame_id = o_.truth_frame;
+    to_msg(transport::from_message(m.T_world_frame, what.c_str()), p.pose);
+    write("/kestrel/ground_truth", p.header.stamp, p);
+    const std::string of = m.frame == kestrel::ground_truth_t::FRAME_CAMERA ? "camera" : "body";
+    if (!stats_.truth_of.empty() && stats_.truth_of != of)
+      throw InputError(what + ": the ground truth is of the " + of + " here, of the " + stats_.truth_of + " before");
+    stats_.truth_of = of;
+  }
+
   // base_link -> camera, once, on /tf_static (latched by `rosbag play`, read by rviz as tf).
   void camera(const kestrel::rgbd_frame_t& f, const std::string& what) {
     if (camera_written_) return;
@@ -175,6 +223,8 @@ class Exporter {
   rosbag::Bag& bag_;
   BagExportStats& stats_;
   bool camera_written_ = false;
+  eval::VoChain chain_;
+  std::optional<int64_t> last_vo_utime_;
 };
 
 }  // namespace
@@ -195,13 +245,19 @@ BagExportStats export_log(const std::string& log_path, const BagExportOptions& o
     if (e->channel == channel::kState) {
       ex.state(transport::decode_message<kestrel::state_t>(e->data.data(), e->data.size(), what), what);
       ++exported_channels;
+    } else if (e->channel == channel::kVoUpdate) {
+      ex.vo(transport::decode_message<kestrel::vo_update_t>(e->data.data(), e->data.size(), what), what);
+      ++exported_channels;
+    } else if (e->channel == channel::kGroundTruth) {
+      ex.truth(transport::decode_message<kestrel::ground_truth_t>(e->data.data(), e->data.size(), what), what);
+      ++exported_channels;
     } else if (e->channel == channel::kCameraRgbd) {
       ex.camera(transport::decode_message<kestrel::rgbd_frame_t>(e->data.data(), e->data.size(), what), what);
     }
   }
   if (!log.damage_report().empty()) throw InputError(log.damage_report() + " (no bag written)");
   if (exported_channels == 0)
-    throw InputError(log_path + ": none of the channels exported (STATE) is in the log (" +
+    throw InputError(log_path + ": none of the channels exported (STATE, VO_UPDATE, GROUND_TRUTH) is in the log (" +
                      std::to_string(stats.log_events) + " events)");
   return stats;
 }

@@ -28,12 +28,21 @@ struct BagExportOptions {
   std::string world_frame = "map";
   std::string body_frame = "base_link";
   std::string camera_frame = "camera";
+  /// VO_UPDATE's chained poses are the camera's in the VO's own world, the camera frame of the
+  /// VO's first frame: /kestrel/vo's header.frame_id (not joined to the others by tf).
+  std::string vo_frame = "vo";
+  /// GROUND_TRUTH's world (the sim's, the motion capture's): /kestrel/ground_truth's frame_id.
+  /// The estimator's world only where the run starts at the truth's pose (the sim does).
+  std::string truth_frame = "map";
 };
 
 struct BagExportStats {
   std::map<std::string, int64_t> messages;  ///< per topic, messages written
   int64_t log_events = 0;                   ///< events read from the log
   bool stopped = false;                     ///< `stopping` said so before the end
+  int64_t vo_without_estimate = 0;          ///< VO_UPDATEs the chain gives no pose (VoChain)
+  int64_t vo_out_of_order = 0;              ///< VO_UPDATEs not after the previous one, skipped
+  std::string truth_of;                     ///< "body", "camera" or "" (no GROUND_TRUTH)
   int64_t total() const {
     int64_t n = 0;
     for (const auto& [topic, count] : messages) n += count;
@@ -49,7 +58,7 @@ nav_msgs::Odometry odometry_from_state(const kestrel::state_t& state, const std:
 
 /// Writes the log's messages to `bag` (open for writing). Throws InputError (naming the log)
 /// for a log that cannot be read, is damaged (truncated, corrupt regions), holds a message that
-/// does not decode, or holds none of the channels exported.
+/// does not decode, or holds none of the channels exported (STATE, VO_UPDATE, GROUND_TRUTH).
 BagExportStats export_log(const std::string& log_path, const BagExportOptions& options, rosbag::Bag& bag,
                           const std::function<bool()>& stopping = {});
 

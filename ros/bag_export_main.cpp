@@ -53,6 +53,9 @@ int run(const Options& o) {
   for (const auto& [topic, n] : s.messages) std::cout << topic << ": " << n << " messages\n";
   std::cout << "messages written: " << s.total() << "\n"
             << "frames: " << o.exp.world_frame << " -> " << o.exp.body_frame << " -> " << o.exp.camera_frame << "\n"
+            << "VO frames without a pose: " << s.vo_without_estimate << " (out of order, skipped: " << s.vo_out_of_order
+            << ")\n"
+            << "ground truth of: " << (s.truth_of.empty() ? "none" : s.truth_of) << "\n"
             << "time taken: " << seconds << " s\n";
   return kExitOk;
 }
@@ -68,5 +71,9 @@ int main(int argc, char** argv) {
   app.add_option("--world-frame", e.world_frame, "tf frame of the estimator's world (STATE's)")->capture_default_str();
   app.add_option("--body-frame", e.body_frame, "tf frame of the vehicle body")->capture_default_str();
   app.add_option("--camera-frame", e.camera_frame, "tf frame of the RGB camera (optical)")->capture_default_str();
+  app.add_option("--vo-frame", e.vo_frame, "frame_id of /kestrel/vo (the VO's own world: its first camera frame)")
+      ->capture_default_str();
+  app.add_option("--truth-frame", e.truth_frame, "frame_id of /kestrel/ground_truth (the truth's world)")
+      ->capture_default_str();
   return app.run(argc, argv, [&] { return run(o); });
 }

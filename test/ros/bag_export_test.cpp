@@ -7,6 +7,7 @@
 #include <cmath>
 #include <filesystem>
 
+#include <geometry_msgs/PoseStamped.h>
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
 #include <tf2_msgs/TFMessage.h>
@@ -15,7 +16,9 @@
 #include "common/transport/channels.h"
 #include "common/transport/convert.h"
 #include "common/transport/log_file.h"
+#include "kestrel/ground_truth_t.hpp"
 #include "kestrel/rgbd_frame_t.hpp"
+#include "kestrel/vo_update_t.hpp"
 #include "ros/bag_export.h"
 #include "ros/ros_convert.h"
 #include "test/ros/bag_export_logs.h"
@@ -172,6 +175,83 @@ TEST(BagExport, FrameNamesAreOptions) {
                   (t.header.frame_id == "body" && t.child_frame_id == "rgb_optical"))
           << t.header.frame_id << " -> " << t.child_frame_id;
     }
+  }
+}
+
+kestrel::vo_update_t vo_update(int64_t utime, int64_t reference_utime, int8_t status, const Eigen::Isometry3d& T) {
+  kestrel::vo_update_t m{};
+  m.utime = utime;
+  m.seq = utime / 100000;
+  m.reference_utime = reference_utime;
+  m.status = status;
+  m.T_reference_current = transport::to_message(T);
+  m.T_body_camera = transport::to_message(Eigen::Isometry3d::Identity());
+  return m;
+}
+
+// The VO's chain by eval's rules, worked by hand: frame 1 is the first (identity), 2 and 3
+// are against keyframe 1, 4 fails (no pose), 5 is against keyframe 3, 6 against frame 4 (which
+// has no pose: chained on from the last pose, 5's).
+TEST(BagExport, VoUpdatesAreChainedAsEvalChainsThemAndTruthPassesThrough) {
+  test::TempDir dir;
+  const Eigen::Isometry3d A = Eigen::Translation3d(0.1, 0, 0) * Eigen::AngleAxisd(0.1, Eigen::Vector3d::UnitY());
+  const Eigen::Isometry3d B = Eigen::Translation3d(0, 0.2, 0.05) * Eigen::AngleAxisd(-0.2, Eigen::Vector3d::UnitX());
+  const Eigen::Isometry3d C = Eigen::Translation3d(0.3, 0, 0.1) * Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ());
+  using V = kestrel::vo_update_t;
+  {
+    transport::LogWriter w((dir / "vo.lcmlog").string());
+    w.write_message(channel::kVoUpdate, 100000, vo_update(100000, 0, V::STATUS_NO_REFERENCE, Eigen::Isometry3d::Identity()));
+    w.write_message(channel::kVoUpdate, 200000, vo_update(200000, 100000, V::STATUS_OK, A));
+    w.write_message(channel::kVoUpdate, 300000, vo_update(300000, 100000, V::STATUS_OK, B));
+    w.write_message(channel::kVoUpdate, 400000, vo_update(400000, 300000, V::STATUS_INSUFFICIENT_MATCHES, A));
+    w.write_message(channel::kVoUpdate, 500000, vo_update(500000, 300000, V::STATUS_OK, C));
+    w.write_message(channel::kVoUpdate, 500000, vo_update(500000, 300000, V::STATUS_OK, C));  // repeated: skipped
+    w.write_message(channel::kVoUpdate, 600000, vo_update(600000, 400000, V::STATUS_OK, A));
+    kestrel::ground_truth_t g{};
+    g.utime = 250000;
+    g.frame = kestrel::ground_truth_t::FRAME_CAMERA;
+    g.T_world_frame = transport::to_message(C);
+    w.write_message(channel::kGroundTruth, g.utime, g);
+    w.close();
+  }
+  ros1::BagExportStats stats;
+  {
+    rosbag::Bag bag((dir / "out.bag").string(), rosbag::bagmode::Write);
+    stats = ros1::export_log((dir / "vo.lcmlog").string(), {}, bag);
+  }
+  EXPECT_EQ(stats.messages.at("/kestrel/vo"), 5);
+  EXPECT_EQ(stats.messages.at("/kestrel/ground_truth"), 1);
+  EXPECT_EQ(stats.vo_without_estimate, 1);
+  EXPECT_EQ(stats.vo_out_of_order, 1);
+  EXPECT_EQ(stats.truth_of, "camera");
+  const std::vector<std::pair<int64_t, Eigen::Isometry3d>> want = {
+      {100000, Eigen::Isometry3d::Identity()}, {200000, A}, {300000, B}, {500000, B * C}, {600000, B * C * A}};
+  rosbag::Bag bag((dir / "out.bag").string(), rosbag::bagmode::Read);
+  size_t i = 0;
+  for (const rosbag::MessageInstance& m : rosbag::View(bag, rosbag::TopicQuery("/kestrel/vo"))) {
+    const auto o = m.instantiate<nav_msgs::Odometry>();
+    ASSERT_TRUE(o);
+    ASSERT_LT(i, want.size());
+    EXPECT_EQ(o->header.stamp, ros1::to_ros_time(want[i].first));
+    EXPECT_EQ(o->header.frame_id, "vo");
+    EXPECT_EQ(o->child_frame_id, "camera");
+    const Eigen::Isometry3d& T = want[i].second;
+    const Eigen::Quaterniond q(o->pose.pose.orientation.w, o->pose.pose.orientation.x, o->pose.pose.orientation.y,
+                               o->pose.pose.orientation.z);
+    EXPECT_NEAR((Eigen::Vector3d(o->pose.pose.position.x, o->pose.pose.position.y, o->pose.pose.position.z) -
+                 T.translation()).norm(), 0, 1e-9) << i;
+    EXPECT_NEAR(Eigen::AngleAxisd(q.toRotationMatrix().transpose() * T.linear()).angle(), 0, 1e-9) << i;
+    ++i;
+  }
+  EXPECT_EQ(i, want.size());
+  for (const rosbag::MessageInstance& m : rosbag::View(bag, rosbag::TopicQuery("/kestrel/ground_truth"))) {
+    const auto p = m.instantiate<geometry_msgs::PoseStamped>();
+    ASSERT_TRUE(p);
+    EXPECT_EQ(p->header.frame_id, "map");
+    EXPECT_EQ(p->header.stamp, ros1::to_ros_time(250000));
+    EXPECT_NEAR(p->pose.position.x, 0.3, 1e-12);
+    EXPECT_NEAR(p->pose.position.z, 0.1, 1e-12);
+    EXPECT_NEAR(p->pose.orientation.z, std::sin(0.15), 1e-12);
   }
 }
 
