@@ -1,10 +1,12 @@
 #include "ros/bag_export.h"
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <cmath>
 #include <optional>
 
 #include <geometry_msgs/PoseStamped.h>
+#include <nav_msgs/Path.h>
 #include <rosbag/bag.h>
 #include <tf2_msgs/TFMessage.h>
 
@@ -14,7 +16,9 @@
 #include "common/transport/log_file.h"
 #include "common/transport/message.h"
 #include "kestrel/ground_truth_t.hpp"
+#include "kestrel/plan_t.hpp"
 #include "kestrel/rgbd_frame_t.hpp"
+#include "kestrel/slam_graph_t.hpp"
 #include "kestrel/vo_update_t.hpp"
 #include "ros/ros_convert.h"
 #include "tools/eval/vo_chain.h"
@@ -207,6 +211,52 @@ class Exporter {
     stats_.truth_of = of;
   }
 
+  // Each revision of the graph as one Path of its keyframes' optimised camera poses, in time
+  // order, in the world frame (SLAM's world, which the estimator's STATE takes on); the
+  // message's stamp is the newest keyframe's utime. Loop edges are not exported.
+  void graph(const kestrel::slam_graph_t& g, const std::string& what) {
+    nav_msgs::Path path;
+    path.header.stamp = stamp_of(g.utime, what);
+    path.header.seq = static_cast<uint32_t>(g.revision);
+    path.header.frame_id = o_.world_frame;
+    std::vector<const kestrel::slam_keyframe_t*> keyframes;
+    for (const auto& k : g.keyframes) keyframes.push_back(&k);
+    std::stable_sort(keyframes.begin(), keyframes.end(), [](const auto* a, const auto* b) { return a->utime < b->utime; });
+    for (const auto* k : keyframes) {
+      geometry_msgs::PoseStamped p;
+      p.header.stamp = stamp_of(k->utime, what);
+      p.header.frame_id = o_.world_frame;
+      to_msg(transport::from_message(k->T_world_camera, what.c_str()), p.pose);
+      path.poses.push_back(p);
+    }
+    write("/kestrel/slam/keyframes", path.header.stamp, path);
+  }
+
+  // The planner's waypoints (x, y, z, yaw) as a Path in the world frame, the body level (roll
+  // and pitch zero); a plan without a path (no path, no map, ...) is an empty Path, which
+  // clears the last one in rviz.
+  void plan(const kestrel::plan_t& m, const std::string& what) {
+    nav_msgs::Path path;
+    path.header.stamp = stamp_of(m.utime, what);
+    path.header.seq = static_cast<uint32_t>(m.request_id);
+    path.header.frame_id = o_.world_frame;
+    if (m.status == kestrel::plan_t::STATUS_OK) {
+      for (const auto& w : m.waypoints) {
+        if (w.size() != 4 || !std::isfinite(w[0]) || !std::isfinite(w[1]) || !std::isfinite(w[2]) || !std::isfinite(w[3]))
+          throw InputError(what + ": a waypoint that is not four finite numbers");
+        geometry_msgs::PoseStamped p;
+        p.header = path.header;
+        p.pose.position.x = w[0];
+        p.pose.position.y = w[1];
+        p.pose.position.z = w[2];
+        p.pose.orientation.z = std::sin(w[3] / 2);
+        p.pose.orientation.w = std::cos(w[3] / 2);
+        path.poses.push_back(p);
+      }
+    }
+    write("/kestrel/plan", path.header.stamp, path);
+  }
+
   // base_link -> camera, once, on /tf_static (latched by `rosbag play`, read by rviz as tf).
   void camera(const kestrel::rgbd_frame_t& f, const std::string& what) {
     if (camera_written_) return;
@@ -251,13 +301,19 @@ BagExportStats export_log(const std::string& log_path, const BagExportOptions& o
     } else if (e->channel == channel::kGroundTruth) {
       ex.truth(transport::decode_message<kestrel::ground_truth_t>(e->data.data(), e->data.size(), what), what);
       ++exported_channels;
+    } else if (e->channel == channel::kSlamGraph) {
+      ex.graph(transport::decode_message<kestrel::slam_graph_t>(e->data.data(), e->data.size(), what), what);
+      ++exported_channels;
+    } else if (e->channel == channel::kPlan) {
+      ex.plan(transport::decode_message<kestrel::plan_t>(e->data.data(), e->data.size(), what), what);
+      ++exported_channels;
     } else if (e->channel == channel::kCameraRgbd) {
       ex.camera(transport::decode_message<kestrel::rgbd_frame_t>(e->data.data(), e->data.size(), what), what);
     }
   }
   if (!log.damage_report().empty()) throw InputError(log.damage_report() + " (no bag written)");
   if (exported_channels == 0)
-    throw InputError(log_path + ": none of the channels exported (STATE, VO_UPDATE, GROUND_TRUTH) is in the log (" +
+    throw InputError(log_path + ": none of the channels exported (STATE, VO_UPDATE, GROUND_TRUTH, SLAM_GRAPH, PLAN) is in the log (" +
                      std::to_string(stats.log_events) + " events)");
   return stats;
 }

@@ -58,7 +58,8 @@ nav_msgs::Odometry odometry_from_state(const kestrel::state_t& state, const std:
 
 /// Writes the log's messages to `bag` (open for writing). Throws InputError (naming the log)
 /// for a log that cannot be read, is damaged (truncated, corrupt regions), holds a message that
-/// does not decode, or holds none of the channels exported (STATE, VO_UPDATE, GROUND_TRUTH).
+/// does not decode, or holds none of the channels exported (STATE, VO_UPDATE, GROUND_TRUTH,
+/// SLAM_GRAPH, PLAN).
 BagExportStats export_log(const std::string& log_path, const BagExportOptions& options, rosbag::Bag& bag,
                           const std::function<bool()>& stopping = {});
 

@@ -8,6 +8,7 @@
 #include <filesystem>
 
 #include <geometry_msgs/PoseStamped.h>
+#include <nav_msgs/Path.h>
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
 #include <tf2_msgs/TFMessage.h>
@@ -17,7 +18,9 @@
 #include "common/transport/convert.h"
 #include "common/transport/log_file.h"
 #include "kestrel/ground_truth_t.hpp"
+#include "kestrel/plan_t.hpp"
 #include "kestrel/rgbd_frame_t.hpp"
+#include "kestrel/slam_graph_t.hpp"
 #include "kestrel/vo_update_t.hpp"
 #include "ros/bag_export.h"
 #include "ros/ros_convert.h"
@@ -253,6 +256,74 @@ TEST(BagExport, VoUpdatesAreChainedAsEvalChainsThemAndTruthPassesThrough) {
     EXPECT_NEAR(p->pose.position.z, 0.1, 1e-12);
     EXPECT_NEAR(p->pose.orientation.z, std::sin(0.15), 1e-12);
   }
+}
+
+// Every SLAM_GRAPH revision is a Path of its keyframes in time order; a PLAN is a Path of its
+// waypoints (yaw as a turn about z), an unsuccessful one an empty Path.
+TEST(BagExport, GraphsAndPlansArePaths) {
+  test::TempDir dir;
+  {
+    transport::LogWriter w((dir / "paths.lcmlog").string());
+    for (int revision = 1; revision <= 3; ++revision) {
+      kestrel::slam_graph_t g{};
+      g.revision = revision;
+      for (int k = revision; k >= 1; --k) {  // newest first: the Path puts them in time order
+        kestrel::slam_keyframe_t kf{};
+        kf.id = k;
+        kf.utime = 1000000 * k;
+        kf.T_world_camera = transport::to_message(Eigen::Isometry3d(Eigen::Translation3d(k + 0.01 * revision, 0, 0)));
+        kf.T_camera_depth = transport::to_message(Eigen::Isometry3d::Identity());
+        g.keyframes.push_back(kf);
+      }
+      g.num_keyframes = static_cast<int32_t>(g.keyframes.size());
+      g.utime = 1000000 * revision;
+      w.write_message(channel::kSlamGraph, g.utime, g);
+    }
+    kestrel::plan_t plan{};
+    plan.utime = 3500000;
+    plan.request_id = 9;
+    plan.status = kestrel::plan_t::STATUS_OK;
+    plan.waypoints = {{0, 0, 1, 0}, {1, 2, 1.5, M_PI / 2}};
+    plan.covariance_trace = {0.1, 0.2};
+    plan.num_waypoints = 2;
+    w.write_message(channel::kPlan, plan.utime, plan);
+    kestrel::plan_t none{};
+    none.utime = 3600000;
+    none.status = kestrel::plan_t::STATUS_NO_PATH;
+    w.write_message(channel::kPlan, none.utime, none);
+    w.close();
+  }
+  {
+    rosbag::Bag bag((dir / "out.bag").string(), rosbag::bagmode::Write);
+    const ros1::BagExportStats s = ros1::export_log((dir / "paths.lcmlog").string(), {}, bag);
+    EXPECT_EQ(s.messages.at("/kestrel/slam/keyframes"), 3);
+    EXPECT_EQ(s.messages.at("/kestrel/plan"), 2);
+  }
+  rosbag::Bag bag((dir / "out.bag").string(), rosbag::bagmode::Read);
+  int revision = 0;
+  for (const rosbag::MessageInstance& m : rosbag::View(bag, rosbag::TopicQuery("/kestrel/slam/keyframes"))) {
+    const auto p = m.instantiate<nav_msgs::Path>();
+    ASSERT_TRUE(p);
+    ++revision;
+    EXPECT_EQ(p->header.frame_id, "map");
+    EXPECT_EQ(p->header.stamp, ros1::to_ros_time(1000000 * revision));
+    ASSERT_EQ(p->poses.size(), static_cast<size_t>(revision));
+    for (int k = 1; k <= revision; ++k) {
+      EXPECT_EQ(p->poses[k - 1].header.stamp, ros1::to_ros_time(1000000 * k));
+      EXPECT_NEAR(p->poses[k - 1].pose.position.x, k + 0.01 * revision, 1e-12);
+    }
+  }
+  EXPECT_EQ(revision, 3);
+  std::vector<nav_msgs::Path> plans;
+  for (const rosbag::MessageInstance& m : rosbag::View(bag, rosbag::TopicQuery("/kestrel/plan")))
+    plans.push_back(*m.instantiate<nav_msgs::Path>());
+  ASSERT_EQ(plans.size(), 2u);
+  ASSERT_EQ(plans[0].poses.size(), 2u);
+  EXPECT_EQ(plans[0].poses[1].pose.position.y, 2);
+  EXPECT_EQ(plans[0].poses[1].pose.position.z, 1.5);
+  EXPECT_NEAR(plans[0].poses[1].pose.orientation.z, std::sqrt(0.5), 1e-12);
+  EXPECT_NEAR(plans[0].poses[1].pose.orientation.w, std::sqrt(0.5), 1e-12);
+  EXPECT_TRUE(plans[1].poses.empty());
 }
 
 TEST(BagExport, ALogWithoutTheChannelsIsAnInputError) {
