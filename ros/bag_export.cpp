@@ -8,6 +8,8 @@
 #include <geometry_msgs/PoseStamped.h>
 #include <nav_msgs/Path.h>
 #include <rosbag/bag.h>
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/Image.h>
 #include <tf2_msgs/TFMessage.h>
 
 #include "common/error.h"
@@ -15,6 +17,7 @@
 #include "common/transport/convert.h"
 #include "common/transport/log_file.h"
 #include "common/transport/message.h"
+#include "common/transport/rgbd_codec.h"
 #include "kestrel/ground_truth_t.hpp"
 #include "kestrel/plan_t.hpp"
 #include "kestrel/rgbd_frame_t.hpp"
@@ -257,6 +260,62 @@ class Exporter {
     write("/kestrel/plan", path.header.stamp, path);
   }
 
+  // A frame decoded by kestrel's RGB-D decoder (JPEG, zstd): the colour image as rgb8 at
+  // utime, the depth as 16UC1 millimetres (0 = no reading, the depth_image_proc convention)
+  // at depth_utime, both in the camera frame, and the CameraInfo at utime: K, plumb_bob D
+  // (k1 k2 p1 p2 k3), R = I, P = [K | 0] (the images are as the camera gave them, unrectified).
+  void images(const kestrel::rgbd_frame_t& m, const std::string& what) {
+    const RgbdFrame f = transport::decode_rgbd(m, what.c_str());
+    const ros::Time t = stamp_of(f.utime, what);
+    if (!f.rgb.empty()) {
+      sensor_msgs::Image image;
+      image.header.stamp = t;
+      image.header.seq = static_cast<uint32_t>(f.seq);
+      image.header.frame_id = o_.camera_frame;
+      image.width = static_cast<uint32_t>(f.rgb.cols);
+      image.height = static_cast<uint32_t>(f.rgb.rows);
+      image.encoding = "rgb8";
+      image.step = image.width * 3;
+      image.data.resize(static_cast<size_t>(image.step) * image.height);
+      for (int r = 0; r < f.rgb.rows; ++r)
+        std::copy_n(f.rgb.ptr<uint8_t>(r), image.step, image.data.data() + static_cast<size_t>(r) * image.step);
+      write("/kestrel/camera/rgb/image_raw", t, image);
+    }
+    if (!f.depth_mm.empty()) {
+      sensor_msgs::Image depth;
+      depth.header.stamp = stamp_of(f.depth_utime, what);
+      depth.header.seq = static_cast<uint32_t>(f.seq);
+      depth.header.frame_id = o_.camera_frame;
+      depth.width = static_cast<uint32_t>(f.depth_mm.cols);
+      depth.height = static_cast<uint32_t>(f.depth_mm.rows);
+      depth.encoding = "16UC1";
+      depth.is_bigendian = 0;
+      depth.step = depth.width * 2;
+      depth.data.resize(static_cast<size_t>(depth.step) * depth.height);
+      for (int r = 0; r < f.depth_mm.rows; ++r) {
+        const uint16_t* row = f.depth_mm.ptr<uint16_t>(r);
+        uint8_t* out = depth.data.data() + static_cast<size_t>(r) * depth.step;
+        for (int c = 0; c < f.depth_mm.cols; ++c) {  // little-endian, whatever the host
+          out[2 * c] = static_cast<uint8_t>(row[c] & 0xff);
+          out[2 * c + 1] = static_cast<uint8_t>(row[c] >> 8);
+        }
+      }
+      write("/kestrel/camera/depth/image_raw", depth.header.stamp, depth);
+    }
+    sensor_msgs::CameraInfo info;
+    info.header.stamp = t;
+    info.header.seq = static_cast<uint32_t>(f.seq);
+    info.header.frame_id = o_.camera_frame;
+    info.width = static_cast<uint32_t>(f.camera.width);
+    info.height = static_cast<uint32_t>(f.camera.height);
+    info.distortion_model = "plumb_bob";
+    info.D.assign(f.camera.distortion.begin(), f.camera.distortion.end());
+    info.K = {f.camera.fx, 0, f.camera.cx, 0, f.camera.fy, f.camera.cy, 0, 0, 1};
+    info.R = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+    info.P = {f.camera.fx, 0, f.camera.cx, 0, 0, f.camera.fy, f.camera.cy, 0, 0, 0, 1, 0};
+    write("/kestrel/camera/rgb/camera_info", t, info);
+  }
+
   // base_link -> camera, once, on /tf_static (latched by `rosbag play`, read by rviz as tf).
   void camera(const kestrel::rgbd_frame_t& f, const std::string& what) {
     if (camera_written_) return;
@@ -308,12 +367,18 @@ BagExportStats export_log(const std::string& log_path, const BagExportOptions& o
       ex.plan(transport::decode_message<kestrel::plan_t>(e->data.data(), e->data.size(), what), what);
       ++exported_channels;
     } else if (e->channel == channel::kCameraRgbd) {
-      ex.camera(transport::decode_message<kestrel::rgbd_frame_t>(e->data.data(), e->data.size(), what), what);
+      const auto frame = transport::decode_message<kestrel::rgbd_frame_t>(e->data.data(), e->data.size(), what);
+      ex.camera(frame, what);
+      if (options.images) {
+        ex.images(frame, what);
+        ++exported_channels;
+      }
     }
   }
   if (!log.damage_report().empty()) throw InputError(log.damage_report() + " (no bag written)");
   if (exported_channels == 0)
-    throw InputError(log_path + ": none of the channels exported (STATE, VO_UPDATE, GROUND_TRUTH, SLAM_GRAPH, PLAN) is in the log (" +
+    throw InputError(log_path + ": none of the channels exported (STATE, VO_UPDATE, GROUND_TRUTH, SLAM_GRAPH, PLAN" +
+                     std::string(options.images ? ", CAMERA_RGBD" : "; CAMERA_RGBD only with --images") + ") is in the log (" +
                      std::to_string(stats.log_events) + " events)");
   return stats;
 }

@@ -34,6 +34,8 @@ struct BagExportOptions {
   /// GROUND_TRUTH's world (the sim's, the motion capture's): /kestrel/ground_truth's frame_id.
   /// The estimator's world only where the run starts at the truth's pose (the sim does).
   std::string truth_frame = "map";
+  /// CAMERA_RGBD as sensor_msgs/Image (colour rgb8, depth 16UC1 mm) and CameraInfo (big).
+  bool images = false;
 };
 
 struct BagExportStats {
@@ -59,7 +61,7 @@ nav_msgs::Odometry odometry_from_state(const kestrel::state_t& state, const std:
 /// Writes the log's messages to `bag` (open for writing). Throws InputError (naming the log)
 /// for a log that cannot be read, is damaged (truncated, corrupt regions), holds a message that
 /// does not decode, or holds none of the channels exported (STATE, VO_UPDATE, GROUND_TRUTH,
-/// SLAM_GRAPH, PLAN).
+/// SLAM_GRAPH, PLAN; CAMERA_RGBD with `images`).
 BagExportStats export_log(const std::string& log_path, const BagExportOptions& options, rosbag::Bag& bag,
                           const std::function<bool()>& stopping = {});
 

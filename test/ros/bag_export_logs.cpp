@@ -51,7 +51,6 @@ std::vector<kestrel::state_t> write_state_log(const std::filesystem::path& path,
     if (with_camera && i % 3 == 0) {
       RgbdFrame f;
       f.utime = utime;
-      f.depth_utime = utime;
       f.seq = i / 3;
       f.camera.width = 4;
       f.camera.height = 3;
@@ -59,8 +58,16 @@ std::vector<kestrel::state_t> write_state_log(const std::filesystem::path& path,
       f.camera.cx = 1.5;
       f.camera.cy = 1;
       f.T_body_camera = body_camera();
-      f.rgb = cv::Mat(3, 4, CV_8UC3, cv::Scalar(10, 20, 30));
-      f.depth_mm = cv::Mat(3, 4, CV_16UC1, cv::Scalar(1500));
+      f.depth_utime = utime + 5000;
+      f.camera.distortion = {0.1, -0.05, 0.001, 0.002, 0.01};
+      f.rgb = cv::Mat(3, 4, CV_8UC3);
+      f.depth_mm = cv::Mat(3, 4, CV_16UC1);
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 4; ++c) {
+          f.rgb.at<cv::Vec3b>(r, c) = cv::Vec3b(static_cast<uint8_t>(10 * r + c + i), static_cast<uint8_t>(50 + r),
+                                                static_cast<uint8_t>(200 - c));
+          f.depth_mm.at<uint16_t>(r, c) = static_cast<uint16_t>(r == 1 && c == 2 ? 0 : 1000 + 300 * r + 7 * c + i);
+        }
       log.write_message(channel::kCameraRgbd, utime, transport::encode_rgbd(f));
     }
     log.write_message(channel::kState, utime, s);

@@ -22,7 +22,9 @@
 #include "kestrel/rgbd_frame_t.hpp"
 #include "kestrel/slam_graph_t.hpp"
 #include "kestrel/vo_update_t.hpp"
+#include "common/transport/rgbd_codec.h"
 #include "ros/bag_export.h"
+#include "ros/bag_import.h"
 #include "ros/ros_convert.h"
 #include "test/ros/bag_export_logs.h"
 #include "test/support/test_support.h"
@@ -324,6 +326,55 @@ TEST(BagExport, GraphsAndPlansArePaths) {
   EXPECT_NEAR(plans[0].poses[1].pose.orientation.z, std::sqrt(0.5), 1e-12);
   EXPECT_NEAR(plans[0].poses[1].pose.orientation.w, std::sqrt(0.5), 1e-12);
   EXPECT_TRUE(plans[1].poses.empty());
+}
+
+// With `images`, every CAMERA_RGBD is a colour and a depth Image and a CameraInfo; imported back
+// by bag-import from those topics, each frame is the one written (pixels, stamps, camera).
+TEST(BagExport, ImagesImportBackAsTheSameFrames) {
+  test::TempDir dir;
+  test::write_state_log(dir / "in.lcmlog", 30, true);
+  ros1::BagExportOptions o;
+  o.images = true;
+  {
+    rosbag::Bag bag((dir / "out.bag").string(), rosbag::bagmode::Write);
+    const ros1::BagExportStats s = ros1::export_log((dir / "in.lcmlog").string(), o, bag);
+    EXPECT_EQ(s.messages.at("/kestrel/camera/rgb/image_raw"), 10);
+    EXPECT_EQ(s.messages.at("/kestrel/camera/depth/image_raw"), 10);
+    EXPECT_EQ(s.messages.at("/kestrel/camera/rgb/camera_info"), 10);
+  }
+  std::vector<RgbdFrame> written;
+  {
+    transport::LogReader log((dir / "in.lcmlog").string());
+    while (auto e = log.next())
+      if (e->channel == channel::kCameraRgbd)
+        written.push_back(transport::decode_rgbd(
+            transport::decode_message<kestrel::rgbd_frame_t>(e->data.data(), e->data.size(), "test"), "test"));
+  }
+  ros1::BagImportOptions io;
+  io.colour_topic = "/kestrel/camera/rgb/image_raw";
+  io.depth_topic = "/kestrel/camera/depth/image_raw";
+  io.camera_info_topic = "/kestrel/camera/rgb/camera_info";
+  io.imu_topic = "";
+  io.tf_topic = "";
+  io.sensor = "";
+  std::vector<RgbdFrame> read;
+  ros1::ImportSink sink;
+  sink.publish = [&](const std::string& channel, int64_t, const std::vector<uint8_t>& bytes) {
+    if (channel == channel::kCameraRgbd)
+      read.push_back(transport::decode_rgbd(
+          transport::decode_message<kestrel::rgbd_frame_t>(bytes.data(), bytes.size(), "test"), "test"));
+  };
+  ros1::import_bag((dir / "out.bag").string(), io, sink);
+  ASSERT_EQ(read.size(), written.size());
+  for (size_t i = 0; i < read.size(); ++i) {
+    EXPECT_EQ(read[i].utime, written[i].utime);
+    EXPECT_EQ(read[i].depth_utime, written[i].depth_utime);
+    EXPECT_EQ(cv::norm(read[i].rgb, written[i].rgb, cv::NORM_INF), 0) << i;
+    EXPECT_EQ(cv::norm(read[i].depth_mm, written[i].depth_mm, cv::NORM_INF), 0) << i;
+    EXPECT_EQ(read[i].camera.fx, written[i].camera.fx);
+    EXPECT_EQ(read[i].camera.cy, written[i].camera.cy);
+    EXPECT_EQ(read[i].camera.distortion, written[i].camera.distortion);
+  }
 }
 
 TEST(BagExport, ALogWithoutTheChannelsIsAnInputError) {

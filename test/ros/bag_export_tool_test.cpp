@@ -92,6 +92,28 @@ TEST_F(BagExportTool, LogWithoutState) {
   expect_refused(dir_ / "other.lcmlog", "none of the channels exported");
 }
 
+// Images are exported only when asked: a log of camera frames alone is refused without
+// --images, and exported with it.
+TEST_F(BagExportTool, CameraFramesOnlyWithImages) {
+  {
+    transport::LogWriter w((dir_ / "camera.lcmlog").string());
+    transport::LogReader r([&] {
+      test::write_state_log(dir_ / "all.lcmlog", 9, true);
+      return (dir_ / "all.lcmlog").string();
+    }());
+    while (auto e = r.next())
+      if (e->channel == channel::kCameraRgbd) w.write(e->channel, e->timestamp, e->data);
+    w.close();
+  }
+  expect_refused(dir_ / "camera.lcmlog", "CAMERA_RGBD only with --images");
+  const test::RunResult r = run(dir_ / "camera.lcmlog", {"--images"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("/kestrel/camera/depth/image_raw: 3 messages\n"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("/kestrel/camera/rgb/camera_info: 3 messages\n"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("/kestrel/camera/rgb/image_raw: 3 messages\n"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("/tf_static: 1 messages\n"), std::string::npos) << r.out;
+}
+
 TEST_F(BagExportTool, AFailedExportKeepsTheFileItWouldHaveReplaced) {
   { std::ofstream(bag()) << "kept"; }
   const test::RunResult r = run(dir_ / "absent.lcmlog");
