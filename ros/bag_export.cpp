@@ -181,6 +181,7 @@ class Exporter {
       return;
     }
     last_vo_utime_ = m.utime;
+    mount(m.T_body_camera, m.utime, what);
     eval::VoStep step;
     step.utime = m.utime;
     step.reference_utime = m.reference_utime;
@@ -316,12 +317,15 @@ class Exporter {
     write("/kestrel/camera/rgb/camera_info", t, info);
   }
 
-  // base_link -> camera, once, on /tf_static (latched by `rosbag play`, read by rviz as tf).
-  void camera(const kestrel::rgbd_frame_t& f, const std::string& what) {
+  // base_link -> camera, once, on /tf_static (latched by `rosbag play`, read by rviz as tf),
+  // from the first CAMERA_RGBD's or VO_UPDATE's T_body_camera (the system's output logs hold
+  // no frames, and the VO copies the mounting into each update).
+  void camera(const kestrel::rgbd_frame_t& f, const std::string& what) { mount(f.camera.T_body_camera, f.utime, what); }
+  void mount(const kestrel::pose3_t& T_body_camera_message, int64_t utime, const std::string& what) {
     if (camera_written_) return;
-    const Eigen::Isometry3d T_body_camera = transport::from_message(f.camera.T_body_camera, what.c_str());
+    const Eigen::Isometry3d T_body_camera = transport::from_message(T_body_camera_message, what.c_str());
     tf2_msgs::TFMessage tf;
-    const ros::Time t = stamp_of(f.utime, what);
+    const ros::Time t = stamp_of(utime, what);
     tf.transforms.push_back(transform(T_body_camera, t, o_.body_frame, o_.camera_frame));
     write("/tf_static", t, tf);
     camera_written_ = true;

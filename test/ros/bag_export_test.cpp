@@ -226,6 +226,7 @@ TEST(BagExport, VoUpdatesAreChainedAsEvalChainsThemAndTruthPassesThrough) {
   }
   EXPECT_EQ(stats.messages.at("/kestrel/vo"), 5);
   EXPECT_EQ(stats.messages.at("/kestrel/ground_truth"), 1);
+  EXPECT_EQ(stats.messages.at("/tf_static"), 1);  // the mounting from the first VO_UPDATE
   EXPECT_EQ(stats.vo_without_estimate, 1);
   EXPECT_EQ(stats.vo_out_of_order, 1);
   EXPECT_EQ(stats.truth_of, "camera");

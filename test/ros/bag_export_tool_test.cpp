@@ -6,6 +6,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 
 #include <nav_msgs/Odometry.h>
 #include <rosbag/bag.h>
@@ -65,6 +66,41 @@ TEST_F(BagExportTool, ALogGivesABagAndASummary) {
     ++i;
   }
   EXPECT_EQ(i, states.size());
+}
+
+// The bag read by ROS's own Python reader (python3-rosbag, Debian's /usr/bin/python3): every
+// STATE is an Odometry there with the same stamp and pose.
+TEST_F(BagExportTool, PythonRosbagReadsTheSameOdometry) {
+  const char* python = "/usr/bin/python3";
+  if (test::run({python, "-c", "import rosbag"}, 30.0).exit_code != 0)
+    KESTREL_SKIP_ENVIRONMENT() << "python3-rosbag is not installed";
+  const auto states = test::write_state_log(dir_ / "in.lcmlog", 30, true);
+  ASSERT_EQ(run(dir_ / "in.lcmlog").exit_code, 0);
+  const test::RunResult r = test::run(
+      {python, "-c",
+       "import sys, rosbag\n"
+       "for _, m, t in rosbag.Bag(sys.argv[1]).read_messages(topics=['/kestrel/odom']):\n"
+       "    p = m.pose.pose\n"
+       "    print(m.header.stamp.to_nsec() // 1000, m.header.frame_id, m.child_frame_id, '%.17g %.17g %.17g %.17g %.17g %.17g %.17g' %"
+       " (p.position.x, p.position.y, p.position.z, p.orientation.w, p.orientation.x, p.orientation.y, p.orientation.z))\n",
+       bag().string()},
+      60.0);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::istringstream in(r.out);
+  size_t i = 0;
+  int64_t utime = 0;
+  std::string parent, child;
+  double v[7];
+  while (in >> utime >> parent >> child >> v[0] >> v[1] >> v[2] >> v[3] >> v[4] >> v[5] >> v[6]) {
+    ASSERT_LT(i, states.size());
+    const kestrel::state_t& s = states[i++];
+    EXPECT_EQ(utime, s.utime);
+    EXPECT_EQ(parent, "map");
+    EXPECT_EQ(child, "base_link");
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(v[k], s.T_world_body.position[k], 1e-9);
+    for (int k = 0; k < 4; ++k) EXPECT_NEAR(v[3 + k], s.T_world_body.orientation[k], 1e-9);
+  }
+  EXPECT_EQ(i, states.size()) << r.out;
 }
 
 TEST_F(BagExportTool, MissingLog) { expect_refused(dir_ / "absent.lcmlog", "absent.lcmlog"); }
