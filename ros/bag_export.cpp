@@ -64,8 +64,11 @@ void to_msg(const Eigen::Isometry3d& T, geometry_msgs::Transform& t) {
   t.rotation.w = q.w();
 }
 
+// A bag takes times from ros::TIME_MIN (1 ns) to 2^32 s (ros::Time's unsigned seconds).
 ros::Time stamp_of(int64_t utime, const std::string& what) {
-  if (utime < 0) throw InputError(what + ": utime " + std::to_string(utime) + " is before 1970 (no ROS time)");
+  constexpr int64_t kLast = (int64_t{1} << 32) * 1000000 - 1;
+  if (utime <= 0 || utime > kLast)
+    throw InputError(what + ": utime " + std::to_string(utime) + " is outside a ROS bag's times (1 us to 2^32 s)");
   return to_ros_time(utime);
 }
 

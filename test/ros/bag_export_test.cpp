@@ -6,6 +6,8 @@
 #include <Eigen/Geometry>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <iostream>
 
 #include <geometry_msgs/PoseStamped.h>
 #include <nav_msgs/Path.h>
@@ -376,6 +378,38 @@ TEST(BagExport, ImagesImportBackAsTheSameFrames) {
     EXPECT_EQ(read[i].camera.cy, written[i].camera.cy);
     EXPECT_EQ(read[i].camera.distortion, written[i].camera.distortion);
   }
+}
+
+// A log cut at 30 lengths or with a byte flipped at 150 places (states, VO, truth, frames with
+// --images) either exports or ends in InputError: nothing else escapes, nothing crashes.
+TEST(BagExport, CutAndFlippedLogsEndInInputErrorOrAnExport) {
+  test::TempDir dir;
+  test::write_state_log(dir / "whole.lcmlog", 12, true);
+  const std::string whole = test::read_file(dir / "whole.lcmlog");
+  ros1::BagExportOptions o;
+  o.images = true;
+  int exported = 0, refused = 0;
+  const auto attempt = [&](const std::string& bytes, const std::string& label) {
+    std::ofstream(dir / "bad.lcmlog", std::ios::binary | std::ios::trunc) << bytes;
+    rosbag::Bag bag((dir / "bad.bag").string(), rosbag::bagmode::Write);
+    try {
+      ros1::export_log((dir / "bad.lcmlog").string(), o, bag);
+      ++exported;
+    } catch (const InputError&) {
+      ++refused;
+    } catch (const std::exception& e) {
+      ADD_FAILURE() << label << ": " << e.what();
+    }
+  };
+  for (int i = 1; i <= 30; ++i) attempt(whole.substr(0, whole.size() * i / 31), "cut " + std::to_string(i));
+  for (int i = 0; i < 150; ++i) {
+    std::string bytes = whole;
+    const size_t at = (bytes.size() * static_cast<size_t>(i)) / 150 + static_cast<size_t>(i % 7);
+    bytes[at % bytes.size()] = static_cast<char>(bytes[at % bytes.size()] ^ (1 << (i % 8)));
+    attempt(bytes, "flip " + std::to_string(i));
+  }
+  EXPECT_GT(refused, 30);  // every cut log at least
+  std::cout << exported << " exported, " << refused << " refused\n";
 }
 
 TEST(BagExport, ALogWithoutTheChannelsIsAnInputError) {
