@@ -110,6 +110,12 @@ int serve(Options& o) {
   spdlog::info("{} frames ({} inserted, {} without pose), {} graphs, {} rebuilds, {} maps published ({} sent again), {} rejected",
                s.frames, s.frames_inserted, s.frames_without_pose, s.graphs, s.rebuilds, s.published, s.repeated,
                node->counters().messages_rejected);
+  // Where the memory is (the soak's question): the map, the keyframes kept for rebuilds and the
+  // rebuild checkpoints, each within its budget (--keyframe-megabytes, checkpoints' 128 MB).
+  const mapper::Mapper& m = map.mapper();
+  spdlog::info("memory: map {:.1f} MB; {} stored keyframes {:.1f} MB ({} dropped); {} checkpoints {:.1f} MB",
+               m.map().memory_bytes() / 1e6, m.keyframes().size(), m.keyframes().bytes() / 1e6,
+               m.keyframes().dropped(), m.checkpoints(), m.checkpoint_bytes() / 1e6);
   if (!o.save.empty()) {
     mapper::write_map_file(map.mapper().map(), o.save);
     spdlog::info("wrote {}", o.save);
