@@ -19,9 +19,11 @@ ViewBins::Bin ViewBins::bin_of(const Eigen::Isometry3d& T) const {
   const Eigen::Vector3d axis = T.linear().col(2);
   const double azimuth = std::atan2(axis.y(), axis.x());
   const double elevation = std::asin(std::clamp(axis.z(), -1.0, 1.0));
+  // Sectors centred on the axes (a level camera looking along x is mid-sector, not on the
+  // boundary where pitch jitter would split one place's views over two bins).
   return {static_cast<int>(std::floor(p.x())), static_cast<int>(std::floor(p.y())),
-          static_cast<int>(std::floor(p.z())), static_cast<int>(std::floor(azimuth / sector_rad_)),
-          static_cast<int>(std::floor(elevation / sector_rad_))};
+          static_cast<int>(std::floor(p.z())), static_cast<int>(std::floor(azimuth / sector_rad_ + 0.5)),
+          static_cast<int>(std::floor(elevation / sector_rad_ + 0.5))};
 }
 
 void ViewBins::insert(int64_t id, const Eigen::Isometry3d& T_world_camera) {
@@ -48,7 +50,11 @@ std::optional<int64_t> ViewBins::first_to_thin(std::optional<int64_t> keep) cons
   const std::vector<int64_t>* fullest = nullptr;
   for (const auto& [bin, ids] : bins_) {
     const bool only_keep = ids.size() == 1 && keep && ids.front() == *keep;
-    if (!only_keep && (fullest == nullptr || ids.size() > fullest->size())) fullest = &ids;
+    // The fullest bin; among equally full ones, the one holding the oldest view (ids grow with
+    // time), so that once every place is down to one view the oldest goes first.
+    if (only_keep) continue;
+    const bool older = fullest != nullptr && ids.size() == fullest->size() && ids.front() < fullest->front();
+    if (fullest == nullptr || ids.size() > fullest->size() || older) fullest = &ids;
   }
   if (fullest == nullptr) return std::nullopt;
   return keep && fullest->front() == *keep ? (*fullest)[1] : fullest->front();

@@ -2,11 +2,12 @@
 // Which stored views to let go first when a memory budget is exceeded: views (keyframes) are
 // binned by where the camera was (cells of cell_m) and where it looked (sectors of sector_deg
 // of the optical axis' azimuth and elevation), and the oldest view of the fullest bin goes
-// first. So places seen from many nearby, similar viewpoints are thinned first, and a place seen
-// once keeps its only view. The mapper's stored scans and SLAM's matchable keyframes share it.
+// first (among equally full bins, the oldest view). So places seen from many nearby, similar
+// viewpoints are thinned first, and a place seen once keeps its only view while any place has
+// more. The mapper's stored scans and SLAM's matchable keyframes share it.
 //
 // Invariants: an id is in at most one bin; "oldest" is the order of insertion into the bin (a
-// view that moves to another bin is the newest there).
+// view that moves to another bin is the newest there); ids grow with time.
 
 #include <Eigen/Geometry>
 #include <cstdint>

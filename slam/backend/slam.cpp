@@ -148,6 +148,13 @@ void Slam::reset() {
   thinned_ = 0;
 }
 
+void Slam::rebin() {
+  // The thinning bins follow the optimised poses, as the mapper's follow SLAM's graph: after a
+  // loop corrects drift, views of one place share a bin again.
+  for (const Keyframe& kf : keyframes_)
+    if (!kf.thinned) matchable_.insert(kf.id, graph_.poses[static_cast<size_t>(kf.id)]);
+}
+
 void Slam::keep_within_budget(int64_t newest) {
   const double budget = options_.memory.max_megabytes * 1e6;
   while (static_cast<double>(feature_bytes_) > budget) {
@@ -166,6 +173,7 @@ void Slam::keep_within_budget(int64_t newest) {
 void Slam::change_world(const Eigen::Isometry3d& T_new_world) {
   if (!se3::is_valid(T_new_world, 1e-6)) throw std::invalid_argument("slam: change_world needs a rigid transform");
   for (auto& T : graph_.poses) T = T_new_world * T;
+  rebin();
   ++revision_;
 }
 
@@ -187,6 +195,10 @@ Eigen::Isometry3d Slam::world_pose(const Eigen::Isometry3d& T_odom_camera) const
   return reference_world_pose() * reference_.T_odom_camera.inverse() * T_odom_camera;
 }
 
+namespace {
+OdometryLink weaker(OdometryLink a, OdometryLink b) { return static_cast<int>(a) >= static_cast<int>(b) ? a : b; }
+}  // namespace
+
 void Slam::add_odometry_edge(const Keyframe& current, OdometryLink link, const std::optional<Matrix6d>& covariance) {
   // After a break the odometry poses of the two are unrelated: assume no motion, weakly.
   const Eigen::Isometry3d T_ref_cur = link == OdometryLink::kBroken
@@ -198,8 +210,11 @@ void Slam::add_odometry_edge(const Keyframe& current, OdometryLink link, const s
       T_ref_cur, reference_.covariance, odometry_edge_information(T_ref_cur, options_.odometry, link, covariance));
   graph_.add_edge(static_cast<int>(reference_.keyframe_id), static_cast<int>(current.id), T_prev_cur, information,
                   EdgeKind::kOdometry);
+  // The loop gate's model of the whole edge: as weak as the weakest link since the keyframe
+  // (the reference's covariance already carries a bridge crossed before it, the information
+  // above does not need it twice).
   gate_information_.resize(graph_.edges.size() - 1, Matrix6d::Identity());
-  gate_information_.push_back(odometry_information(T_prev_cur, options_.odometry, link));
+  gate_information_.push_back(odometry_information(T_prev_cur, options_.odometry, current.link));
 }
 
 SlamStep Slam::add(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera, OdometryLink link,
@@ -233,7 +248,7 @@ SlamStep Slam::add(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camer
   kf.T_odom_camera = T_odom_camera;
   kf.T_body_camera = frame.T_body_camera;
   kf.T_camera_depth = motion.T_rgb_depth();
-  kf.link = keyframes_.empty() ? OdometryLink::kContinuous : link;
+  kf.link = keyframes_.empty() ? OdometryLink::kContinuous : weaker(link, reference_.link);
   kf.sensor = sensor;
   kf.features = std::move(features);
   const Eigen::Isometry3d T_world_camera =
@@ -242,6 +257,7 @@ SlamStep Slam::add(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camer
   graph_.add_vertex(kf.id, T_world_camera, keyframes_.empty());
   if (!keyframes_.empty()) add_odometry_edge(kf, link, odometry_covariance);
   reference_ = OdometryReference{kf.id, kf.utime, kf.T_odom_camera, kf.T_body_camera};
+  reference_marginal_.reset();  // the previous reference's: a loop closure below gives this one's
   keyframes_.push_back(std::move(kf));
   step.keyframe = true;
   step.keyframe_id = keyframes_.back().id;
@@ -294,6 +310,7 @@ SlamStep Slam::close_loop(SlamStep step) {
     step.loop_keyframe_id = earlier.id;
     ++loop_closures_;
     step.optimisation = optimize(graph_, options_.optimizer);
+    rebin();
     reference_marginal_ = marginal_covariance(graph_, static_cast<int>(query.id), options_.optimizer.kernel);
     ++revision_;
     gate_by_pose_ = true;
@@ -336,9 +353,13 @@ bool Slam::reanchor(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_came
     // reference where the odometry puts it, so the next try comes after the keyframe spacing
     // rather than at every frame of a blank stretch.
     ++coverage_misses_.featureless;
-    reference_ = OdometryReference{reference_.keyframe_id,     frame.utime,
-                                   T_odom_camera,              frame.T_body_camera,
-                                   reference_.T_keyframe_camera * T_ref_frame, predicted};
+    reference_ = OdometryReference{reference_.keyframe_id,
+                                   frame.utime,
+                                   T_odom_camera,
+                                   frame.T_body_camera,
+                                   reference_.T_keyframe_camera * T_ref_frame,
+                                   predicted,
+                                   weaker(reference_.link, link)};
     step.carried = true;
     return true;
   }

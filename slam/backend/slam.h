@@ -78,6 +78,9 @@ struct OdometryReference {
   /// perturbation [rho; phi]; zero for the keyframe itself).
   Eigen::Isometry3d T_keyframe_camera = Eigen::Isometry3d::Identity();
   Matrix6d covariance = Matrix6d::Zero();
+  /// The weakest link the odometry crossed from the keyframe to the frame (a carried
+  /// reference may have crossed a bridged restart): the next keyframe's edge is that weak.
+  OdometryLink link = OdometryLink::kContinuous;
 };
 
 /// What one call of Slam::add did.
@@ -183,6 +186,8 @@ class Slam {
                 const std::optional<Matrix6d>& odometry_covariance, const FrameFeatures& features,
                 const sensors::SensorProfile& sensor, SlamStep& step);
   Eigen::Isometry3d reference_world_pose() const;
+  /// Puts the keyframes that keep their features in the bins of their optimised poses.
+  void rebin();
   /// Thins keyframes (never `newest`) while their features exceed the budget.
   void keep_within_budget(int64_t newest);
 

@@ -36,7 +36,7 @@ struct CoverageOptions {
 };
 
 /// The memory bound: keyframes keep their features (keypoints, descriptors, 3-D points: what
-/// loops and re-anchoring match against, ~40-80 kB each) within this budget. Over it, the
+/// loops and re-anchoring match against, ~100 kB each on the simulator's 640x480) within this budget. Over it, the
 /// oldest keyframe of the fullest bin of nearby, similar views (common/geometry/view_bins.h, the
 /// mapper's policy) lets its features go: it stays in the graph (its pose, its edges, the
 /// mapper's scan) but is no longer matched. A place seen once keeps its only view; the newest

@@ -34,7 +34,9 @@ TEST(ViewBins, TheFullestBinGivesItsOldestViewFirst) {
   bins.erase(1);
   EXPECT_EQ(bins.first_to_thin(), 3);
   bins.erase(3);
-  // Each bin holds one view now; a second view of B makes B the fullest.
+  // Each bin holds one view now: equally full, the oldest view goes first.
+  EXPECT_EQ(bins.first_to_thin(), 2);
+  // A second view of B makes B the fullest.
   bins.insert(6, view(3.2, 0.2, 0.05));
   EXPECT_EQ(bins.first_to_thin(), 2) << "B is the fullest bin now";
   EXPECT_EQ(bins.first_to_thin(2), 6) << "the kept id is never chosen";

@@ -242,14 +242,40 @@ TEST(Slam, AFeaturelessFrameOverCoveredGroundIsCarriedNotAKeyframe) {
   EXPECT_LT(se3::translation_distance(slam.world_pose(path.front()), path.front()), 1e-9);
   EXPECT_GT(slam.reference().covariance.trace(), 0.0) << "the prediction's uncertainty goes with it";
   EXPECT_EQ(slam.coverage_misses().featureless, 1);
+  EXPECT_EQ(slam.reference().link, OdometryLink::kContinuous);
   EXPECT_FALSE(slam.wants_keyframe(path.front())) << "the next try waits for the keyframe spacing";
 
-  Eigen::Isometry3d uncovered = path.front();
+  // Carried again from the carried frame: the pose composes in the keyframe's frame and the
+  // covariance propagates through the adjoint (right perturbations) plus the odometry's own.
+  const OdometryReference first = slam.reference();
+  blank.utime = utime += 200'000;
+  ASSERT_TRUE(slam.add(blank, path[3]).carried);
+  const OdometryReference& second = slam.reference();
+  EXPECT_EQ(second.keyframe_id, reference_keyframe);
+  const Eigen::Isometry3d T_keyframe_truth =
+      slam.graph().poses[static_cast<size_t>(reference_keyframe)].inverse() * path[3];
+  EXPECT_LT(se3::translation_distance(second.T_keyframe_camera, T_keyframe_truth), 1e-9);
+  EXPECT_LT(se3::rotation_distance(second.T_keyframe_camera, T_keyframe_truth), 1e-9);
+  const Eigen::Isometry3d T_first_second = path.front().inverse() * path[3];
+  const Matrix6d Ad = se3::adjoint(T_first_second.inverse());
+  Matrix6d S_inv = Matrix6d::Identity();  // the graph's error of a right perturbation is [rho; phi / 2]
+  S_inv.bottomRightCorner<3, 3>() *= 2.0;
+  const Matrix6d odometry =
+      S_inv * odometry_edge_information(T_first_second, SlamOptions{}.odometry, OdometryLink::kContinuous).inverse() * S_inv;
+  const Matrix6d expected = Ad * first.covariance * Ad.transpose() + odometry;
+  EXPECT_LT((second.covariance - expected).norm(), 1e-9 * expected.norm()) << second.covariance << "\n" << expected;
+
+  // Carried across a VO restart the estimator bridged: the next keyframe's edge is a bridge's.
+  blank.utime = utime += 200'000;
+  ASSERT_TRUE(slam.add(blank, path[6], OdometryLink::kBridged).carried);
+  EXPECT_EQ(slam.reference().link, OdometryLink::kBridged);
+  Eigen::Isometry3d uncovered = path[6];
   uncovered.translation().z() += 0.8;
   blank.utime = utime += 200'000;
   const SlamStep made = slam.add(blank, uncovered);
   EXPECT_TRUE(made.keyframe) << "nothing covers it";
   EXPECT_EQ(slam.keyframes().size(), keyframes + 1);
+  EXPECT_EQ(slam.keyframes().back().link, OdometryLink::kBridged) << "as weak as the weakest link since";
 }
 
 TEST(Slam, ALoopFreeRunClosesNoLoop) {
