@@ -387,6 +387,14 @@ BagExportStats export_log(const std::string& log_path, const BagExportOptions& o
     throw InputError(log_path + ": none of the channels exported (STATE, VO_UPDATE, GROUND_TRUTH, SLAM_GRAPH, PLAN" +
                      std::string(options.images ? ", CAMERA_RGBD" : "; CAMERA_RGBD only with --images") + ") is in the log (" +
                      std::to_string(stats.log_events) + " events)");
+  // Channels present but nothing usable written (every VO_UPDATE without a pose, out of order):
+  // a bag of the camera's mounting alone is not a result.
+  int64_t written = stats.total();
+  if (const auto it = stats.messages.find("/tf_static"); it != stats.messages.end()) written -= it->second;
+  if (written == 0) {
+    throw InputError(log_path + ": nothing exportable in the log's messages (" + std::to_string(stats.vo_without_estimate) +
+                     " VO_UPDATEs without a pose, " + std::to_string(stats.vo_out_of_order) + " out of order)");
+  }
   return stats;
 }
 

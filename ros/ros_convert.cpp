@@ -73,6 +73,13 @@ void check_image(const sensor_msgs::Image& image, bool depth, const std::string&
     throw InputError(what + ": step " + std::to_string(image.step) + " is shorter than a row of " +
                      std::to_string(image.width) + " " + image.encoding + " pixels (" + std::to_string(row) + " bytes)");
   }
+  // Rows are read as cv::Mat rows of whole pixels: a step that is not a whole number of
+  // pixels' channels (2 bytes for 16UC1, 4 for 32FC1) is refused here, not by OpenCV.
+  const uint64_t element = depth ? static_cast<uint64_t>(bytes_per_pixel(image.encoding)) : 1;
+  if (image.step % element != 0) {
+    throw InputError(what + ": step " + std::to_string(image.step) + " is not a whole number of " + image.encoding +
+                     " pixels' " + std::to_string(element) + " bytes");
+  }
   const uint64_t needed = uint64_t{image.step} * image.height;
   if (image.data.size() < needed) {
     throw InputError(what + ": " + std::to_string(image.data.size()) + " bytes of pixels, " +

@@ -431,5 +431,25 @@ TEST(BagExport, ALogWithoutTheChannelsIsAnInputError) {
   }
 }
 
+// The channels are there but nothing in them can be exported (every VO_UPDATE failed): a bag of
+// the camera's mounting alone would read as a result, so it is an InputError.
+TEST(BagExport, ALogWhoseMessagesGiveNothingIsAnInputError) {
+  test::TempDir dir;
+  using V = kestrel::vo_update_t;
+  {
+    transport::LogWriter w((dir / "failed.lcmlog").string());
+    w.write_message(channel::kVoUpdate, 200000, vo_update(200000, 100000, V::STATUS_INSUFFICIENT_MATCHES, Eigen::Isometry3d::Identity()));
+    w.write_message(channel::kVoUpdate, 300000, vo_update(300000, 100000, V::STATUS_INSUFFICIENT_MATCHES, Eigen::Isometry3d::Identity()));
+    w.close();
+  }
+  rosbag::Bag bag((dir / "out.bag").string(), rosbag::bagmode::Write);
+  try {
+    const auto stats = ros1::export_log((dir / "failed.lcmlog").string(), {}, bag);
+    FAIL() << "no InputError; " << stats.total() << " messages written";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("nothing exportable"), std::string::npos) << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace kestrel

@@ -104,6 +104,13 @@ TEST(RosConvert, UnknownEncodingsAndShortImagesAreErrorsNamingTheTopic) {
   sensor_msgs::Image narrow = test::colour_image(0, 4, 3);
   narrow.step = 11;
   EXPECT_NE(test::input_error_of([&] { ros1::colour_to_rgb(narrow, "/c"); }).find("step 11"), std::string::npos);
+  // A depth row padded by an odd byte is not a whole number of 16-bit pixels: refused by name,
+  // not by OpenCV.
+  sensor_msgs::Image odd = test::depth_image_mm(0, 3, 2, 1);
+  odd.step = 7;
+  odd.data.resize(size_t{odd.step} * odd.height);
+  const std::string o = test::input_error_of([&] { ros1::depth_to_mm(odd, "/camera/depth/image"); });
+  EXPECT_NE(o.find("step 7 is not a whole number"), std::string::npos) << o;
 }
 
 TEST(RosConvert, CameraInfoGivesIntrinsicsAndPlumbBobDistortion) {
