@@ -20,7 +20,9 @@ struct ProcessSpec {
   std::string name;               ///< unique within a launch; also its log file's name
   std::vector<std::string> argv;  ///< argv[0] is a kestrel tool name ("vo") or a path
   std::string side;               ///< "onboard", "offboard" or "source"
-  std::vector<std::string> restart_args{};  ///< added to argv when restarted (--restart)
+  /// Added to argv when restarted (--restart), and at the first start when its side is launched
+  /// alone (the other side may already be running, with a map).
+  std::vector<std::string> restart_args{};
 };
 
 /// The command line of a process's `run`-th start (0: the first): argv, plus restart_args
