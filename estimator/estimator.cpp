@@ -257,7 +257,8 @@ bool Estimator::align_world(const PoseCorrection& c) {
   const FilterState& s = history_[snapshot_before(c.utime)].state;
   const Matrix6d noise = correction_noise(options_, c);
   const AbsolutePoseMeasurement m(c.T_world_body, noise);
-  if (innovation(m, s).mahalanobis2() <= options_.world_align_chi2) return false;
+  const bool awaited = options_.await_world_s > 0.0;  // options.h: the first correction is the world
+  if (!awaited && innovation(m, s).mahalanobis2() <= options_.world_align_chi2) return false;
   // The pose at the correction's time, between the IMU samples either side, is put on the
   // correction's position and yaw exactly: the correction is not fused afterwards (kAligned).
   const Eigen::Isometry3d change = world_change(pose_at(c.utime), c.T_world_body);

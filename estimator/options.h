@@ -127,7 +127,11 @@ struct EstimatorOptions {
   /// dof) says the filter's world is not SLAM's: the filter was restarted while SLAM's map,
   /// anchored to the filter that ran before, lived on. The filter then moves its world onto
   /// SLAM's (a turn about z and a shift) instead of fusing the correction; 0 = never. A filter
-  /// that started with SLAM shares its world and is within a few units of chi^2.
+  /// that started with SLAM shares its world and is within a few units of chi^2. A filter told
+  /// to await SLAM's world (await_world_s > 0) takes it from the first correction whatever its
+  /// chi^2: it was started to join a map, and a hover near its own origin can put SLAM's world
+  /// within the bound (a 1.5 m offset against SLAM's 5 cm is chi^2 ~900) where fusing the
+  /// correction into a millimetre-sure filter would leave it where it was.
   double world_align_chi2 = 1000.0;
   /// After the start, states are published as INITIALIZING (a pose in this filter's own world,
   /// not to be flown on) until a SLAM correction has been taken or this long (s, sensor time)

@@ -266,7 +266,7 @@ Verdict VisualOnlyEstimator::add_correction(const PoseCorrection& c) {
   if (!correction_since_start_) {
     correction_since_start_ = true;
     if (options_.world_align_chi2 > 0.0 &&
-        innovation.dot((P + Q).ldlt().solve(innovation)) > options_.world_align_chi2) {
+        (options_.await_world_s > 0.0 || innovation.dot((P + Q).ldlt().solve(innovation)) > options_.world_align_chi2)) {
       const Eigen::Isometry3d change = world_change(T, c.T_world_body);
       const Eigen::Matrix4d sigma = world_change_covariance(c.T_world_body, Q);
       for (Frame& f : frames_) {

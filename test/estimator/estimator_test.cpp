@@ -485,10 +485,11 @@ TEST(Estimator, ARestartedFilterMovesOntoSlamsWorldAtItsFirstCorrection) {
     const Eigen::Matrix3d P = step.output.covariance.block<3, 3>(idx::kP, idx::kP);
     return error.dot(P.ldlt().solve(error));
   };
-  const auto run = [&](FilterKind kind, const Eigen::Isometry3d& slam_world, double align_chi2) {
+  const auto run = [&](FilterKind kind, const Eigen::Isometry3d& slam_world, double align_chi2, double await_s = 0.0) {
     EstimatorOptions options;
     options.filter = kind;
     options.world_align_chi2 = align_chi2;
+    options.await_world_s = await_s;
     Estimator e(options);
     const ScenarioOptions o = scenario(4.0);
     // Corrections for 2.0 s and 3.0 s, each arriving 0.2 s later.
@@ -554,6 +555,19 @@ TEST(Estimator, ARestartedFilterMovesOntoSlamsWorldAtItsFirstCorrection) {
     EXPECT_EQ(shared.counters.corrections_applied, 2);
     EXPECT_EQ(fused.counters.world_alignments, 0);
     EXPECT_GT(fused.position_error, 0.5);
+
+    // A world 20 cm away is within the chi^2 bound (~400 against SLAM's 1 cm): fused, so a filter
+    // sure of itself to the millimetre stays near its own world. One told to await SLAM's world
+    // (--await-world, a restarted estimator) takes it from the first correction whatever.
+    const Eigen::Isometry3d near_world = se3::make(Eigen::Matrix3d::Identity(), Eigen::Vector3d(0.2, 0.0, 0.0));
+    const Outcome near_fused = run(kind, near_world, EstimatorOptions{}.world_align_chi2);
+    const Outcome near_awaited = run(kind, near_world, EstimatorOptions{}.world_align_chi2, 1.0);
+    std::printf("a world 0.2 m away: fused %.3f m off at the end, awaited and aligned %.3f m\n",
+                near_fused.position_error, near_awaited.position_error);
+    EXPECT_EQ(near_fused.counters.world_alignments, 0);
+    EXPECT_EQ(near_awaited.counters.world_alignments, 1);
+    EXPECT_LT(near_awaited.position_error, 0.034);
+    EXPECT_LT(near_awaited.position_nees, 14.2);
   }
 }
 
