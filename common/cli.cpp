@@ -218,4 +218,17 @@ int App::run(int argc, char** argv, const std::function<int()>& body) {
   }
 }
 
+std::optional<PinholeCamera> intrinsics_option(const std::vector<double>& values, const char* option) {
+  if (values.empty()) return std::nullopt;
+  if (values.size() != 4) throw CLI::ValidationError(option, "needs four values: fx,fy,cx,cy");
+  PinholeCamera c;
+  c.fx = values[0];
+  c.fy = values[1];
+  c.cx = values[2];
+  c.cy = values[3];
+  if (!(c.fx > 0 && c.fy > 0 && std::isfinite(c.fx) && std::isfinite(c.fy) && std::isfinite(c.cx) && std::isfinite(c.cy)))
+    throw CLI::ValidationError(option, "fx and fy must be > 0 and all values finite");
+  return c;
+}
+
 }  // namespace kestrel::cli

@@ -23,7 +23,10 @@
 #include <functional>
 #include <string>
 #include <string_view>
+#include <optional>
+#include <vector>
 
+#include "common/camera.h"
 #include "common/cli_config.h"
 
 namespace kestrel::cli {
@@ -50,6 +53,11 @@ class App : public CLI::App {
 extern const CLI::Validator Positive;
 /// Validator: a finite number (App::run adds it to every floating-point option).
 extern const CLI::Validator Finite;
+
+/// The camera an `--intrinsics fx,fy,cx,cy` option gives (the option declared with
+/// expected(4)): none when the option was not given. Throws CLI::ValidationError naming
+/// `option` unless fx, fy > 0 and every value is finite.
+std::optional<PinholeCamera> intrinsics_option(const std::vector<double>& values, const char* option = "--intrinsics");
 
 /// `text` fit for a terminal: newlines, control bytes and invalid UTF-8 escaped (\n, \xHH).
 std::string printable(std::string_view text);

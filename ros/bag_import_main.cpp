@@ -39,16 +39,7 @@ int run(Options& o) {
   // kestrel's one error line, which says the same, so they are silenced.
   console_bridge::setLogLevel(console_bridge::CONSOLE_BRIDGE_LOG_NONE);
   o.import.max_difference_us = std::llround(o.max_dt_s * 1e6);
-  if (!o.intrinsics.empty()) {
-    PinholeCamera c;
-    c.fx = o.intrinsics[0];
-    c.fy = o.intrinsics[1];
-    c.cx = o.intrinsics[2];
-    c.cy = o.intrinsics[3];
-    if (!(c.fx > 0 && c.fy > 0 && std::isfinite(c.fx) && std::isfinite(c.fy) && std::isfinite(c.cx) && std::isfinite(c.cy)))
-      throw CLI::ValidationError("--intrinsics", "fx and fy must be > 0 and all values finite");
-    o.import.intrinsics = c;
-  }
+  o.import.intrinsics = cli::intrinsics_option(o.intrinsics);
   o.import.encoding = o.encoding.encoding();
 
   // The log goes to a temporary beside its name and replaces it only once the whole bag was

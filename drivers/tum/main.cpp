@@ -76,17 +76,7 @@ tum::TumSequence open_sequence(const Options& o) {
   tum::SequenceOptions so;
   so.max_time_difference_us = std::llround(o.max_dt_s * 1e6);
   so.depth_scale_correction = o.depth_scale;
-  if (!o.intrinsics.empty()) {
-    PinholeCamera c;
-    c.fx = o.intrinsics[0];
-    c.fy = o.intrinsics[1];
-    c.cx = o.intrinsics[2];
-    c.cy = o.intrinsics[3];
-    if (!(c.fx > 0 && c.fy > 0 && std::isfinite(c.cx) && std::isfinite(c.cy) && std::isfinite(c.fx) &&
-          std::isfinite(c.fy)))
-      throw CLI::ValidationError("--intrinsics", "fx and fy must be > 0 and all values finite");
-    so.intrinsics = c;
-  }
+  so.intrinsics = cli::intrinsics_option(o.intrinsics);
   return tum::TumSequence(o.folder, so);
 }
 

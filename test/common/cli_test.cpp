@@ -339,5 +339,25 @@ TEST(CliErrors, AToolThatRunsACommandTakesNoUnknownOptionForIt) {
   EXPECT_EQ(command.back(), "-dash");
 }
 
+// --intrinsics, as tum-play and bag-import read it: absent is none; fx, fy > 0 and finite values.
+TEST(Cli, IntrinsicsOptionGivesACameraOrNamesTheOption) {
+  EXPECT_FALSE(intrinsics_option({}));
+  const auto c = intrinsics_option({500, 510, 319.5, 239.5});
+  ASSERT_TRUE(c);
+  EXPECT_EQ(c->fx, 500);
+  EXPECT_EQ(c->fy, 510);
+  EXPECT_EQ(c->cx, 319.5);
+  EXPECT_EQ(c->cy, 239.5);
+  for (const std::vector<double>& bad : std::vector<std::vector<double>>{
+           {0, 500, 1, 1}, {500, -1, 1, 1}, {500, 500, std::nan(""), 1}, {500, 500, 1, INFINITY}, {500, 500, 1}}) {
+    try {
+      intrinsics_option(bad);
+      ADD_FAILURE() << "accepted " << bad.size() << " values";
+    } catch (const CLI::ValidationError& e) {
+      EXPECT_NE(std::string(e.what()).find("--intrinsics"), std::string::npos) << e.what();
+    }
+  }
+}
+
 }  // namespace
 }  // namespace kestrel::cli
