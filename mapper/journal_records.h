@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "common/crc32.h"
 #include "mapper/keyframe_journal.h"
 
 namespace kestrel::mapper::journal {
@@ -29,8 +30,7 @@ constexpr size_t kRecordTail = 4;  // CRC
 constexpr uint32_t kMaxPayload = 64u << 20;
 constexpr size_t kFingerprint = 8;  // an LCM message starts with its type's hash
 
-/// CRC-32 (IEEE 802.3, reflected, as zlib and PNG compute it), continuing from `crc`.
-uint32_t crc32(const uint8_t* data, size_t size, uint32_t crc = 0);
+using kestrel::crc32;  // common/crc32.h
 void put_u32(std::vector<uint8_t>& out, uint32_t v);  ///< little-endian
 uint32_t get_u32(const uint8_t* p);                   ///< little-endian
 

@@ -7,7 +7,9 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <ctime>
 #include <iostream>
 #include <memory>
 
@@ -16,6 +18,7 @@
 #include "common/transport/channels.h"
 #include "common/transport/node.h"
 #include "slam/memory_policy.h"
+#include "slam/map/map_file.h"
 #include "slam/place/builtin_vocabulary.h"
 #include "slam/slam_adapter.h"
 #include "sensors/profile_file.h"
@@ -36,6 +39,7 @@ struct Options {
   std::string vocabulary = "builtin";
   std::string kernel = "dcs";
   std::string sensor;  // a sensor profile's name or file; empty: the TUM folder's, else each frame's
+  std::string map, save_map;  // folders of saved maps (slam/map/map_file.h)
   // Offline.
   std::string tum, out, vo_out;
   // Process.
@@ -92,6 +96,15 @@ void add_options(cli::App& app, Options& o, SlamOptions& s) {
                  "(sensors/README.md); by default the one each frame's sensor model names (with --tum the "
                  "folder's: kinect1 for freiburg1)")
       ->check(CLI::Validator([](std::string& name) { return sensors::check_sensor_profile_name(name); }, "PROFILE"));
+  app.add_option("--map", o.map,
+                 "Start from the SLAM map saved in this folder: frames are relocalised in it (no pose prior), then "
+                 "mapping goes on in its world (a new session); its vocabulary replaces --vocabulary");
+  app.add_option("--save-map", o.save_map,
+                 "Save the SLAM map (keyframes, features, graph, vocabulary) in this folder at the end (offline) or on "
+                 "exit (process), for a later --map");
+  app.add_option("--relocalisation-confirmations", s.relocalisation.confirmations,
+                 "With --map: verified placements from different frames that must agree before the camera is placed")
+      ->check(CLI::PositiveNumber)->capture_default_str();
   app.add_option("--tum", o.tum, "Offline: run VO + SLAM over this TUM RGB-D folder");
   app.add_option("--out", o.out, "Offline: write the optimised camera trajectory here (TUM format)");
   app.add_option("--vo-out", o.vo_out, "Offline: write the odometry-only trajectory here too");
@@ -107,6 +120,40 @@ void add_options(cli::App& app, Options& o, SlamOptions& s) {
       ->capture_default_str();
 }
 
+std::string utc_now() {
+  const std::time_t now = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
+  std::tm tm{};
+  gmtime_r(&now, &tm);
+  char text[32];
+  std::strftime(text, sizeof(text), "%Y-%m-%dT%H:%M:%SZ", &tm);
+  return text;
+}
+
+std::shared_ptr<const SlamMap> load_map(const std::string& dir) {
+  if (dir.empty()) return nullptr;
+  const auto t0 = std::chrono::steady_clock::now();
+  auto map = std::make_shared<const SlamMap>(read_map(dir));  // InputError: exit 3
+  spdlog::info("map {}: {} keyframes from {} session(s), read in {:.0f} ms", map_file_in(dir), map->keyframes.size(),
+               map->sessions, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+  return map;
+}
+
+void save_map(const std::string& dir, const SlamMap& map, const std::string& made_by) {
+  write_map(dir, map, MapProvenance{made_by, utc_now()});
+  spdlog::info("map saved: {} ({} keyframes, {} session(s))", map_file_in(dir), map.keyframes.size(), map.sessions);
+}
+
+void report_relocalisation(const std::optional<Relocalisation>& r, bool from_map) {
+  if (!from_map) return;
+  if (!r) {
+    spdlog::warn("never placed in the map: no frame verified consistently against it");
+    return;
+  }
+  const Eigen::Vector3d p = r->T_world_camera.translation();
+  spdlog::info("relocalised at frame {} of those tried (utime {}) in keyframe {}: camera at ({:.3f}, {:.3f}, {:.3f}) m",
+               r->frames_tried, r->utime, r->keyframe_id, p.x(), p.y(), p.z());
+}
+
 int run_offline(const Options& o, const SlamOptions& options, std::shared_ptr<const Vocabulary> vocabulary) {
   if (o.out.empty()) throw CLI::RequiredError("--out (with --tum)");
 #if !KESTREL_SLAM_OFFLINE
@@ -118,13 +165,20 @@ int run_offline(const Options& o, const SlamOptions& options, std::shared_ptr<co
   // The camera's profile: as told, else the folder's (as kestrel-vo --tum).
   const sensors::SensorProfile sensor = o.sensor.empty() ? vo::tum_sensor(o.tum) : sensors::load_sensor_profile(o.sensor);
   std::cout << "camera profile: " << sensor.name << "\n";
+  const std::shared_ptr<const SlamMap> map = load_map(o.map);
   const SlamRun run = run_slam_sequence(
       sequence.size(), [&sequence](size_t i) { return sequence.frame(i); }, sensor, vo::VoOptions{}, options,
-      std::move(vocabulary));
+      std::move(vocabulary), map);
   // Nothing is written for a run that estimated nothing, as by kestrel-vo --tum: a trajectory
   // of the first frame's identity pose alone, or of no pose, would read as a result.
   vo::require_usable(run.odometry, o.tum);  // InputError: exit 3
+  report_relocalisation(run.relocalisation, map != nullptr);
+  if (map && !run.relocalisation) {
+    std::cerr << "slam: no frame of " << o.tum << " was placed in the map " << o.map << ": nothing written\n";
+    return kExitFailure;
+  }
   write_tum_trajectory(o.out, run.slam);
+  if (!o.save_map.empty()) save_map(o.save_map, run.map, "kestrel-slam --tum " + o.tum);
   if (!o.vo_out.empty()) write_tum_trajectory(o.vo_out, run.vo);
   std::vector<double> ms = run.keyframe_ms;
   std::sort(ms.begin(), ms.end());
@@ -159,7 +213,9 @@ int serve(const Options& o, const SlamOptions& options, std::shared_ptr<const Vo
   AdapterOptions adapter_options = o.adapter;
   if (!o.sensor.empty()) adapter_options.sensor = sensors::load_sensor_profile(o.sensor);
   spdlog::info("camera profile: {}", o.sensor.empty() ? "each frame's sensor model" : o.sensor);
-  SlamAdapter adapter(options, std::move(vocabulary), adapter_options);
+  const std::shared_ptr<const SlamMap> map = load_map(o.map);
+  SlamAdapter adapter = map ? SlamAdapter(options, map, adapter_options)
+                            : SlamAdapter(options, std::move(vocabulary), adapter_options);
   std::unique_ptr<transport::Node> node;
   node = std::make_unique<transport::Node>(o.name, o.lcm_url);  // UnavailableError: exit 4
   node->advertise(o.graph_channel);
@@ -170,6 +226,7 @@ int serve(const Options& o, const SlamOptions& options, std::shared_ptr<const Vo
                                  published_id(adapter.slam(), adapter.slam().keyframes().back().id));
     if (out.graph) node->publish(o.graph_channel, *out.graph);
     if (out.correction) node->publish(o.correction_channel, *out.correction);
+    if (out.step && out.step->relocalised) report_relocalisation(adapter.slam().relocalisation(), true);
     if (out.step && out.step->loop_closed) {
       spdlog::info("keyframe {} closes a loop with keyframe {} ({} inliers, {:.2f} px); chi2 {:.4g} -> {:.4g}",
                    published_id(adapter.slam(), out.step->keyframe_id),
@@ -190,6 +247,8 @@ int serve(const Options& o, const SlamOptions& options, std::shared_ptr<const Vo
   spdlog::info("{}: {} + {} -> {}, {}", o.name, o.adapter.camera_channel, o.adapter.vo_channel,
                o.graph_channel, o.correction_channel);
   const int status = node->spin();
+  report_relocalisation(adapter.slam().relocalisation(), map != nullptr);
+  if (!o.save_map.empty()) save_map(o.save_map, adapter.slam().map(), "kestrel-slam (process " + o.name + ")");
   const auto& misses = adapter.slam().coverage_misses();
   spdlog::info("{} keyframes ({} thinned, features {:.1f} MB), {} loop closures, {} frames re-anchored on a "
                "covering keyframe (keyframes instead: {} with none near, {} none verified, {} located too far; {} too "

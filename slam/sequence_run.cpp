@@ -21,11 +21,11 @@ SlamRun run_slam_sequence(const std::vector<RgbdFrame>& frames, const sensors::S
 
 SlamRun run_slam_sequence(size_t count, const std::function<RgbdFrame(size_t)>& frame_at, const sensors::SensorProfile& sensor,
                           const vo::VoOptions& base_vo_options, const SlamOptions& options,
-                          std::shared_ptr<const Vocabulary> vocabulary) {
+                          std::shared_ptr<const Vocabulary> vocabulary, std::shared_ptr<const SlamMap> map) {
   const vo::VoOptions vo_options = vo::with_sensor(sensor, base_vo_options);
   vo::VisualOdometry odometry(vo_options);
   OdometryChain chain;
-  Slam slam(options, std::move(vocabulary));
+  Slam slam = map ? Slam(options, std::move(map)) : Slam(options, std::move(vocabulary));
   SlamRun run;
   // Each reference SLAM's odometry went from (a keyframe, or a frame re-anchored on one), and
   // each frame with the reference it came after.
@@ -107,6 +107,8 @@ SlamRun run_slam_sequence(size_t count, const std::function<RgbdFrame(size_t)>& 
   run.reanchors = slam.num_reanchors();
   run.coverage_misses = slam.coverage_misses();
   run.inconsistent_loops = slam.num_inconsistent_loops();
+  run.relocalisation = slam.relocalisation();
+  run.map = slam.map();
   return run;
 }
 

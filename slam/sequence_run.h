@@ -37,6 +37,10 @@ struct SlamRun {
   int inconsistent_loops = 0;      ///< verified loops refused as disagreeing with the odometry
   std::vector<double> keyframe_ms; ///< SLAM time per keyframe (features, loop search, optimisation)
   std::vector<LoopEdge> loops;     ///< every accepted loop closure, in the order found
+  /// Started from a saved map: where the camera was placed in it (none: never). Frames before
+  /// that have no SLAM pose (`slam` starts there); `slam` is in the map's world.
+  std::optional<Relocalisation> relocalisation;
+  SlamMap map;                     ///< the map at the end (what --save-map writes)
 };
 
 /// A loop closure's error against the ground truth: E = (T_from_to true)^-1 T_from_to measured.
@@ -75,9 +79,10 @@ SlamRun run_slam_sequence(const std::vector<RgbdFrame>& frames, const sensors::S
                           std::shared_ptr<const Vocabulary> vocabulary);
 
 /// The same over `count` frames decoded one at a time by `frame_at(i)` (a long sequence need
-/// not fit in memory: 1.5 MB a VGA frame).
+/// not fit in memory: 1.5 MB a VGA frame). With `map`, SLAM goes on from that saved map
+/// (Slam's constructor from a map: relocalisation first; `vocabulary` is then unused).
 SlamRun run_slam_sequence(size_t count, const std::function<RgbdFrame(size_t)>& frame_at, const sensors::SensorProfile& sensor,
                           const vo::VoOptions& vo_options, const SlamOptions& options,
-                          std::shared_ptr<const Vocabulary> vocabulary);
+                          std::shared_ptr<const Vocabulary> vocabulary, std::shared_ptr<const SlamMap> map = nullptr);
 
 }  // namespace kestrel::slam

@@ -18,6 +18,12 @@ SlamAdapter::SlamAdapter(const SlamOptions& options, std::shared_ptr<const Vocab
   if (adapter.buffer_frames < 1) throw std::invalid_argument("slam: buffer_frames must be >= 1");
 }
 
+SlamAdapter::SlamAdapter(const SlamOptions& options, std::shared_ptr<const SlamMap> map, const AdapterOptions& adapter)
+    : options_(adapter), slam_(options, std::move(map)), map_loaded_(true) {
+  if (adapter.buffer_frames < 1) throw std::invalid_argument("slam: buffer_frames must be >= 1");
+  anchored_ = true;
+}
+
 void SlamAdapter::reset() {
   slam_.reset();
   chain_.reset();
@@ -25,7 +31,7 @@ void SlamAdapter::reset() {
   poses_.clear();
   last_processed_utime_ = 0;
   lost_break_ = false;
-  anchored_ = false;
+  anchored_ = map_loaded_;
   states_.clear();
   recent_.clear();
   odometry_fix_ = Eigen::Isometry3d::Identity();
@@ -251,7 +257,7 @@ AdapterOutputs SlamAdapter::process(const kestrel::rgbd_frame_t& message, const 
   // (in SLAM's odometry frame it would pull the state by the frames' difference). A frame
   // re-anchored on the map is located in it: that is a correction too.
   const bool new_estimator_waits = restart_correction_due_ && message.utime >= restart_state_utime_;
-  if ((step.optimisation || step.reanchored || new_estimator_waits) && anchored_) {
+  if ((step.optimisation || step.reanchored || step.relocalised || new_estimator_waits) && anchored_) {
     out.correction = correction_message(slam_, options_.correction_sigma_m, options_.correction_sigma_rad);
     if (new_estimator_waits) restart_correction_due_ = false;
   }

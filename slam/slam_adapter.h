@@ -17,6 +17,9 @@
 // SLAM_CORRECTION is published until the graph is anchored: the estimator applies one as a
 // pose in its own world.
 //
+// A saved map (kestrel-slam --map): its world is the world from the start; nothing is
+// anchored, and the frame that relocalises the camera in it sends the first SLAM_CORRECTION.
+//
 // Estimator restarts: a restarted estimator (its STATE seq starts again) begins a world of its
 // own; SLAM keeps the map's, drops the old filter's states, and sends a SLAM_CORRECTION for the
 // next frame it processes that is not older than the new filter's first state (the pose of
@@ -88,6 +91,11 @@ class SlamAdapter {
  public:
   SlamAdapter(const SlamOptions& options, std::shared_ptr<const Vocabulary> vocabulary,
               const AdapterOptions& adapter = {});
+  /// Goes on from a saved map (Slam's constructor from a map): the map's world is the world
+  /// from the start (nothing is anchored on STATE), and the frame that relocalises the camera
+  /// in it sends a SLAM_CORRECTION, which an estimator told to await the map's world takes
+  /// as its world (estimator.h, --await-world).
+  SlamAdapter(const SlamOptions& options, std::shared_ptr<const SlamMap> map, const AdapterOptions& adapter = {});
 
   /// Throw InputError naming the channel for a message that cannot be used: the message is
   /// dropped (a corrupt keyframe is lost; the next frame that moved enough replaces it).
@@ -134,6 +142,7 @@ class SlamAdapter {
 
   AdapterOptions options_;
   Slam slam_;
+  bool map_loaded_ = false;  ///< started from a saved map: its world is the world
   OdometryChain chain_;
   std::map<int64_t, kestrel::rgbd_frame_t> frames_;  ///< utime -> waiting frame
   std::map<int64_t, ChainedPose> poses_;             ///< utime -> waiting pose

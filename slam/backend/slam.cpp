@@ -30,6 +30,10 @@ void check_options(const SlamOptions& o) {
   require(m.bin_angle_deg > 0.0 && m.bin_angle_deg <= 180.0, "memory.bin_angle_deg must be in (0, 180]");
   require(o.loops.min_age_s >= 0.0, "loops.min_age_s must be >= 0");
   require(o.loops.max_candidates >= 1, "loops.max_candidates must be >= 1");
+  const RelocalisationOptions& r = o.relocalisation;
+  require(r.max_candidates >= 1 && r.confirmations >= 1, "relocalisation: max_candidates and confirmations must be >= 1");
+  require(r.max_disagreement_m >= 0.0 && r.max_disagreement_rad >= 0.0 && r.max_span_s >= 0.0,
+          "relocalisation bounds must be >= 0");
   const OdometryNoise& n = o.odometry;
   require(n.translation_floor_m > 0.0 && n.rotation_floor_rad > 0.0, "odometry noise floors must be > 0");
   require(n.translation_per_m >= 0.0 && n.rotation_per_rad >= 0.0 && n.rotation_per_m >= 0.0,
@@ -128,6 +132,52 @@ Slam::Slam(const SlamOptions& options, std::shared_ptr<const Vocabulary> vocabul
   reset();
 }
 
+Slam::Slam(const SlamOptions& options, std::shared_ptr<const SlamMap> map)
+    : options_(checked(options)),
+      extractor_(options.features),
+      matchable_(options.memory.bin_size_m, options.memory.bin_angle_deg) {
+  if (!map) throw std::invalid_argument("slam: no map to start from");
+  check_map(*map, "slam map");
+  loaded_ = std::move(map);
+  // The map's vocabulary indexed its keyframes; an empty one (an online vocabulary never
+  // trained) is rebuilt online as the keyframes are added again.
+  if (loaded_->vocabulary && !loaded_->vocabulary->empty()) vocabulary_ = loaded_->vocabulary;
+  reset();
+}
+
+SlamMap Slam::map() const {
+  SlamMap map;
+  map.keyframes = keyframes_;
+  map.graph = graph_;
+  map.gate_information = gate_information_;
+  map.gate_information.resize(graph_.edges.size(), Matrix6d::Identity());
+  map.vocabulary = places_->vocabulary_in_use();
+  const bool added = std::any_of(keyframes_.begin(), keyframes_.end(),
+                                 [this](const Keyframe& k) { return k.session == session_; });
+  map.sessions = session_ + (added ? 1 : 0);
+  return map;
+}
+
+void Slam::restore(const SlamMap& map) {
+  keyframes_ = map.keyframes;
+  graph_ = map.graph;
+  gate_information_ = map.gate_information;
+  for (const Keyframe& kf : keyframes_) {
+    places_->add(kf.thinned ? cv::Mat() : kf.features.descriptors);
+    if (kf.thinned) {
+      places_->forget(static_cast<int>(kf.id));
+      ++thinned_;
+    } else {
+      feature_bytes_ += memory_of(kf.features);
+    }
+  }
+  rebin();
+  keep_within_budget(std::nullopt);
+  session_ = map.sessions;
+  // An empty map has nowhere to be placed in: the flight maps from nothing.
+  localized_ = keyframes_.empty();
+}
+
 void Slam::reset() {
   places_ = std::make_unique<PlaceRecognizer>(options_.place, vocabulary_);
   keyframes_.clear();
@@ -146,6 +196,12 @@ void Slam::reset() {
   matchable_.clear();
   feature_bytes_ = 0;
   thinned_ = 0;
+  session_ = 0;
+  localized_ = true;
+  relocalisation_.reset();
+  relocalisation_tries_ = 0;
+  placements_.clear();
+  if (loaded_) restore(*loaded_);
 }
 
 void Slam::rebin() {
@@ -155,7 +211,7 @@ void Slam::rebin() {
     if (!kf.thinned) matchable_.insert(kf.id, graph_.poses[static_cast<size_t>(kf.id)]);
 }
 
-void Slam::keep_within_budget(int64_t newest) {
+void Slam::keep_within_budget(std::optional<int64_t> newest) {
   const double budget = options_.memory.max_megabytes * 1e6;
   while (static_cast<double>(feature_bytes_) > budget) {
     const std::optional<int64_t> victim = matchable_.first_to_thin(newest);
@@ -179,6 +235,7 @@ void Slam::change_world(const Eigen::Isometry3d& T_new_world) {
 
 bool Slam::wants_keyframe(const Eigen::Isometry3d& T_odom_camera, OdometryLink link) const {
   if (!T_odom_camera.matrix().allFinite()) return false;
+  if (!localized_) return true;
   // After a restart the earlier keyframe's odometry ends: the edge must span only the gap.
   if (keyframes_.empty() || link != OdometryLink::kContinuous) return true;
   const Eigen::Isometry3d T_last_cur = reference_.T_odom_camera.inverse() * T_odom_camera;
@@ -231,6 +288,7 @@ SlamStep Slam::add(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camer
   have_frame_ = true;
   last_utime_ = frame.utime;
   if (odometry_broken) gate_by_pose_ = false;
+  if (!localized_) return relocalise(frame, T_odom_camera, link, motion, sensor);
   SlamStep step;
   if (!wants_keyframe(T_odom_camera, link)) return step;
 
@@ -245,6 +303,7 @@ SlamStep Slam::add(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camer
   Keyframe kf;
   kf.id = static_cast<int64_t>(keyframes_.size());
   kf.utime = frame.utime;
+  kf.session = session_;
   kf.T_odom_camera = T_odom_camera;
   kf.T_body_camera = frame.T_body_camera;
   kf.T_camera_depth = motion.T_rgb_depth();
@@ -278,7 +337,8 @@ SlamStep Slam::close_loop(SlamStep step) {
   const bool gate = gate_by_pose_ && lo.max_distance_m > 0.0;
   auto allowed = [&](int entry) {
     const Keyframe& k = keyframes_[static_cast<size_t>(entry)];
-    if (k.utime > query.utime - min_age_us) return false;
+    // Time orders keyframes within a flight only (slam_map.h).
+    if (k.session == query.session && k.utime > query.utime - min_age_us) return false;
     if (!gate) return true;
     const Eigen::Isometry3d& T_world_k = graph_.poses[static_cast<size_t>(entry)];
     return se3::translation_distance(T_world_k, T_world_query) <= lo.max_distance_m &&
@@ -315,6 +375,59 @@ SlamStep Slam::close_loop(SlamStep step) {
     ++revision_;
     gate_by_pose_ = true;
     break;  // the paper stops at the first success
+  }
+  return step;
+}
+
+SlamStep Slam::relocalise(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera, OdometryLink link,
+                          const sensors::FrameMotion& motion, const sensors::SensorProfile& sensor) {
+  const RelocalisationOptions& r = options_.relocalisation;
+  SlamStep step;
+  ++relocalisation_tries_;
+  // Hypotheses place the odometry frame: across a break of the odometry that frame changes.
+  if (link == OdometryLink::kBroken) placements_.clear();
+  const auto span_us = static_cast<int64_t>(std::llround(r.max_span_s * 1e6));
+  placements_.erase(std::remove_if(placements_.begin(), placements_.end(),
+                                   [&](const Placement& p) { return p.utime < frame.utime - span_us; }),
+                    placements_.end());
+  const FrameFeatures features = extractor_.extract(frame, motion);
+  if (static_cast<int>(features.num_points()) < options_.verification.min_inliers) return step;
+  const std::vector<BowMatch> candidates = places_->query(
+      features.descriptors, r.max_candidates, [this](int entry) { return !keyframes_[static_cast<size_t>(entry)].thinned; });
+  for (const BowMatch& candidate : candidates) {
+    ++step.candidates;
+    const Keyframe& kf = keyframes_[static_cast<size_t>(candidate.entry)];
+    const uint64_t seed = static_cast<uint64_t>(kf.id) * 1000003u + static_cast<uint64_t>(frame.utime);
+    const LoopConstraint located =
+        verify_loop(features, kf.features, loop_verification(options_.verification, kf.sensor, sensor), seed);
+    step.loop = located;
+    if (!located.accepted) continue;
+    const size_t k = static_cast<size_t>(kf.id);
+    const Eigen::Isometry3d T_world_odom =
+        graph_.poses[k] * located.T_candidate_query * T_odom_camera.inverse();
+    int agreeing = 1;  // this one
+    for (const Placement& p : placements_) {
+      const Eigen::Isometry3d D = p.T_world_odom.inverse() * T_world_odom;
+      if (D.translation().norm() <= r.max_disagreement_m && so3::angle(D.linear()) <= r.max_disagreement_rad) {
+        ++agreeing;
+      }
+    }
+    if (agreeing < r.confirmations) {
+      placements_.push_back({frame.utime, T_world_odom});
+      return step;  // one placement per frame: the best verified
+    }
+    // Placed: the odometry goes on from this frame, located in keyframe k, as after a
+    // re-anchoring; the next keyframe's edge joins the map there.
+    localized_ = true;
+    gate_by_pose_ = true;
+    placements_.clear();
+    reference_ = OdometryReference{kf.id,          frame.utime, T_odom_camera, frame.T_body_camera,
+                                   located.T_candidate_query, right_covariance(located.information)};
+    reference_marginal_ = marginal_covariance(graph_, static_cast<int>(k), options_.optimizer.kernel);
+    relocalisation_ = Relocalisation{frame.utime, relocalisation_tries_, kf.id, graph_.poses[k] * located.T_candidate_query};
+    step.relocalised = true;
+    step.reanchor_keyframe_id = kf.id;
+    return step;
   }
   return step;
 }

@@ -22,7 +22,9 @@
 //
 // Frames: "world" is the odometry frame of the first keyframe, so before any loop closure the
 // optimised poses equal the odometry poses, until change_world() moves the whole graph into
-// another frame (the process puts it in the state estimator's world, slam_adapter.h).
+// another frame (the process puts it in the state estimator's world, slam_adapter.h). Started
+// from a saved map (slam_map.h), "world" is the map's: the first frames are relocalised in it
+// (RelocalisationOptions), and the camera's odometry joins the map there, as at a re-anchoring.
 // Invariants: keyframe k is vertex k of graph(); vertex 0 is fixed; the edge into keyframe
 // k > 0 from its reference (the previous keyframe, or the keyframe re-anchored on before it)
 // is odometry; revision() grows by one with every change of the optimised poses other than
@@ -34,6 +36,7 @@
 #include <vector>
 
 #include "common/geometry/view_bins.h"
+#include "slam/backend/slam_map.h"
 #include "common/rgbd_frame.h"
 #include "sensors/sensor_profile.h"
 #include "slam/backend/slam_options.h"
@@ -41,31 +44,6 @@
 #include "sensors/frame_motion.h"
 
 namespace kestrel::slam {
-
-/// How a frame's odometry pose relates to the previous frame's.
-enum class OdometryLink {
-  kContinuous,  ///< the visual odometry carried on: the pose follows from the previous one
-  kBridged,     ///< the VO restarted and the state estimator (IMU) bridged the gap: related, less certain
-  kBroken,      ///< the VO restarted and nothing relates the poses
-};
-
-struct Keyframe {
-  int64_t id = 0;                 ///< = its index
-  int64_t utime = 0;
-  Eigen::Isometry3d T_odom_camera = Eigen::Isometry3d::Identity();
-  Eigen::Isometry3d T_body_camera = Eigen::Isometry3d::Identity();
-  /// The camera at the depth image's time, in the camera at utime's frame (the timing's
-  /// motion over the depth offset; identity when the motion is unknown).
-  Eigen::Isometry3d T_camera_depth = Eigen::Isometry3d::Identity();
-  /// How its odometry pose relates to the previous keyframe's (the first's: kContinuous).
-  OdometryLink link = OdometryLink::kContinuous;
-  sensors::SensorProfile sensor;  ///< its camera's profile (its loops' noise); empty: none
-  FrameFeatures features;         ///< empty once thinned (KeyframeMemoryOptions)
-  bool thinned = false;           ///< its features went to keep within the memory budget
-};
-
-/// Bytes a keyframe's features take (what KeyframeMemoryOptions::max_megabytes bounds).
-size_t memory_of(const FrameFeatures& features);
 
 /// What the odometry since is measured from: the newest keyframe, or a later frame located in
 /// a covering keyframe (CoverageOptions).
@@ -92,6 +70,9 @@ struct SlamStep {
   /// Or, over covered ground but with too few features ever to be located, it became the
   /// reference at its predicted pose (nothing measured: no correction to send).
   bool carried = false;
+  /// Or, started from a saved map, the frame placed the camera in it (Slam::relocalisation());
+  /// `reanchor_keyframe_id` and `loop` say where.
+  bool relocalised = false;
   int candidates = 0;             ///< loop candidates verified
   int inconsistent = 0;           ///< of them, verified but refused as disagreeing with the odometry
   bool loop_closed = false;
@@ -99,7 +80,7 @@ struct SlamStep {
   LoopConstraint loop;            ///< the accepted constraint, or the last rejection
   std::optional<OptimizerSummary> optimisation;  ///< when the graph was optimised
   /// Later frames are measured from this one (Slam::reference()).
-  bool new_reference() const { return keyframe || reanchored || carried; }
+  bool new_reference() const { return keyframe || reanchored || carried || relocalised; }
 };
 
 /// Information (pose-graph error convention, spaces.h) of the odometry edge previous -> current
@@ -109,14 +90,37 @@ struct SlamStep {
 Matrix6d odometry_edge_information(const Eigen::Isometry3d& T_prev_cur, const OdometryNoise& noise, OdometryLink link,
                                    const std::optional<Matrix6d>& reported_covariance = std::nullopt);
 
+/// Where a Slam started from a saved map found the camera.
+struct Relocalisation {
+  int64_t utime = 0;          ///< the frame that confirmed the place
+  int frames_tried = 0;       ///< frames compared with the map until then, that one included
+  int64_t keyframe_id = -1;   ///< the map's keyframe it was located in
+  Eigen::Isometry3d T_world_camera = Eigen::Isometry3d::Identity();
+};
+
 class Slam {
  public:
   /// With `vocabulary` null, place recognition builds its vocabulary online. Throws
   /// std::invalid_argument naming an unusable option.
   explicit Slam(const SlamOptions& options = {}, std::shared_ptr<const Vocabulary> vocabulary = nullptr);
+  /// Goes on from a saved map (map(), slam_map.h) in a new session: its world is the map's, its
+  /// vocabulary the map's (fixed from then on; an empty one is rebuilt online from the
+  /// keyframes). Frames are first relocalised (RelocalisationOptions): until one places the
+  /// camera in the map (localized()), nothing is added. Throws InputError for a map that breaks
+  /// its invariants, std::invalid_argument for an unusable option.
+  Slam(const SlamOptions& options, std::shared_ptr<const SlamMap> map);
 
-  /// Would a frame at this odometry pose become a keyframe, or be re-anchored? (false for a
-  /// frame whose pose is not finite; true after a restart of the odometry, bridged or not).
+  /// What a later flight needs to go on from here (slam_map.h): a copy.
+  SlamMap map() const;
+  /// False from the start on a saved map until a frame places the camera in it.
+  bool localized() const { return localized_; }
+  const std::optional<Relocalisation>& relocalisation() const { return relocalisation_; }
+  /// This flight's session number (keyframes it makes carry it).
+  int session() const { return session_; }
+
+  /// Would a frame at this odometry pose become a keyframe, be re-anchored or (not localized
+  /// yet) be relocalised? (false for a frame whose pose is not finite; true after a restart of
+  /// the odometry, bridged or not).
   bool wants_keyframe(const Eigen::Isometry3d& T_odom_camera, OdometryLink link = OdometryLink::kContinuous) const;
 
   /// Adds a frame seen at T_odom_camera; `link` says how that pose relates to the previous
@@ -170,7 +174,7 @@ class Slam {
   /// the revision grows by one. Throws std::invalid_argument for a non-rigid transform.
   void change_world(const Eigen::Isometry3d& T_new_world);
 
-  /// Forgets everything (as after construction).
+  /// Forgets this flight (as after construction: back to the saved map, if started from one).
   void reset();
 
  private:
@@ -186,12 +190,18 @@ class Slam {
                 const std::optional<Matrix6d>& odometry_covariance, const FrameFeatures& features,
                 const sensors::SensorProfile& sensor, SlamStep& step);
   Eigen::Isometry3d reference_world_pose() const;
+  /// Starts from the loaded map (reset()).
+  void restore(const SlamMap& map);
+  /// Not localized: places the frame in the map, or keeps it as a hypothesis (RelocalisationOptions).
+  SlamStep relocalise(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera, OdometryLink link,
+                      const sensors::FrameMotion& motion, const sensors::SensorProfile& sensor);
   /// Puts the keyframes that keep their features in the bins of their optimised poses.
   void rebin();
   /// Thins keyframes (never `newest`) while their features exceed the budget.
-  void keep_within_budget(int64_t newest);
+  void keep_within_budget(std::optional<int64_t> newest);
 
   SlamOptions options_;
+  std::shared_ptr<const SlamMap> loaded_;  ///< the saved map it started from, if any
   std::shared_ptr<const Vocabulary> vocabulary_;
   FeatureExtractor extractor_;
   std::unique_ptr<PlaceRecognizer> places_;
@@ -210,6 +220,15 @@ class Slam {
   ViewBins matchable_;        ///< keyframes that still have their features, by view
   size_t feature_bytes_ = 0;  ///< of those keyframes
   int thinned_ = 0;
+  int session_ = 0;
+  bool localized_ = true;
+  std::optional<Relocalisation> relocalisation_;
+  int relocalisation_tries_ = 0;
+  struct Placement {  ///< a verified relocalisation hypothesis
+    int64_t utime;
+    Eigen::Isometry3d T_world_odom;
+  };
+  std::vector<Placement> placements_;  ///< hypotheses within max_span_s, oldest first
 };
 
 }  // namespace kestrel::slam

@@ -47,6 +47,22 @@ struct KeyframeMemoryOptions {
   double bin_angle_deg = 30.0;   ///< thinning bins: optical-axis sector
 };
 
+/// A Slam started from a saved map (slam_map.h) knows nothing of where the camera is. Each frame
+/// is compared by appearance with the whole map and its best keyframes are verified
+/// geometrically, as a loop is (no gate by pose or age: there is no estimate yet). A false
+/// place is worse than none, so one verified placement is only a hypothesis: it is accepted
+/// when placements from other frames, each carried through the odometry since, put the
+/// odometry frame at the same place in the map. A wrong place verified by chance is not verified
+/// again, consistently, from other views; the bounds are re-anchoring's correction bounds
+/// (CoverageOptions), far above the odometry's drift over max_span_s.
+struct RelocalisationOptions {
+  int max_candidates = 5;          ///< keyframes verified per frame, best by appearance first
+  int confirmations = 2;           ///< agreeing placements from different frames (1: the first is taken)
+  double max_disagreement_m = 0.05;
+  double max_disagreement_rad = 2.0 * kPi / 180.0;
+  double max_span_s = 2.0;         ///< placements of frames at most this far apart agree
+};
+
 struct LoopSearchOptions {
   double min_age_s = 4.0;       ///< candidates are keyframes at least this much older
   /// Candidates lie within this distance and angle of the current estimate; <= 0 disables the
@@ -87,6 +103,7 @@ struct SlamOptions {
   CoverageOptions coverage;
   KeyframeMemoryOptions memory;
   LoopSearchOptions loops;
+  RelocalisationOptions relocalisation;
   /// A verified loop must agree with the odometry between its keyframes (when the estimate is
   /// trustworthy): rejects perceptual aliasing (loop_consistency.h).
   LoopConsistencyOptions loop_consistency;

@@ -24,6 +24,10 @@ int PlaceRecognizer::num_words() const {
   return v ? v->num_words() : 0;
 }
 
+std::shared_ptr<const Vocabulary> PlaceRecognizer::vocabulary_in_use() const {
+  return fixed_ ? fixed_ : std::make_shared<const Vocabulary>(online_);
+}
+
 int PlaceRecognizer::add(const cv::Mat& descriptors) {
   const int entry = entries_++;
   if (online()) descriptors_.push_back(descriptors.clone());

@@ -49,6 +49,9 @@ class PlaceRecognizer {
   int trainings() const { return trainings_; }
   /// Words of the vocabulary in use (0 before the first online training).
   int num_words() const;
+  /// The vocabulary in use (the fixed one, or a copy of the online one; empty before the first
+  /// online training): what indexes the keyframes, kept with a saved map.
+  std::shared_ptr<const Vocabulary> vocabulary_in_use() const;
   void clear();
 
  private:

@@ -216,7 +216,11 @@ void Vocabulary::set_idf(const std::vector<std::vector<int>>& documents) {
 
 void Vocabulary::save(const std::string& path) const {
   AtomicFile file(path);  // a failed run leaves no cut vocabulary that looks whole
-  std::ostream& out = file.stream();
+  write(file.stream());
+  file.commit();
+}
+
+void Vocabulary::write(std::ostream& out) const {
   out.write(kMagic, sizeof(kMagic) - 1);
   const int32_t header[4] = {branching_, depth_, static_cast<int32_t>(nodes_.size()),
                              static_cast<int32_t>(words_.size())};
@@ -227,7 +231,6 @@ void Vocabulary::save(const std::string& path) const {
     out.write(reinterpret_cast<const char*>(fields), sizeof(fields));
   }
   out.write(reinterpret_cast<const char*>(idf_.data()), static_cast<std::streamsize>(idf_.size() * sizeof(double)));
-  file.commit();
 }
 
 Vocabulary Vocabulary::load(const std::string& path) {

@@ -62,9 +62,12 @@ class Vocabulary {
   static Vocabulary load(const std::string& path);
   /// The same format from memory (e.g. a file built into the program); errors name `name`.
   static Vocabulary load_from_memory(const void* data, size_t size, const std::string& name);
+  /// The same format on a stream (a section of a saved SLAM map); read() takes the whole
+  /// rest of the stream, errors name `name`.
+  void write(std::ostream& out) const;
+  static Vocabulary read(std::istream& in, const std::string& name);
 
  private:
-  static Vocabulary read(std::istream& in, const std::string& name);
   struct Node {
     Descriptor centre{};
     int first_child = -1;  ///< children are consecutive nodes

@@ -1,0 +1,253 @@
+// Saved SLAM maps (issue 41): the file keeps a map bit for bit, every kind of damage is a clear
+// InputError, a camera started elsewhere in a mapped room is relocalised at its true pose, one
+// in another room never is, and the new session's keyframes join the old graph (loops across
+// sessions, although the new flight's clock starts again).
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+#include <vector>
+
+#include "common/error.h"
+#include "common/geometry/se3.h"
+#include "common/numbers.h"
+#include "slam/backend/slam.h"
+#include "slam/map/map_file.h"
+#include "slam/place/builtin_vocabulary.h"
+#include "test/slam/synthetic_room.h"
+#include "test/support/test_support.h"
+
+namespace kestrel::slam {
+namespace {
+
+namespace fs = std::filesystem;
+using test::SyntheticRoom;
+
+// A map of one lap of a room, its odometry the true poses (so its world is the room's).
+std::shared_ptr<const SlamMap> lap_map(const SyntheticRoom& room) {
+  Slam slam(SlamOptions{}, builtin_vocabulary());
+  int64_t utime = 1'000'000;
+  for (const auto& T : test::circle_path(48, 1.0, 1.0)) slam.add(room.render(T, test::test_camera(), utime += 200'000), T);
+  return std::make_shared<const SlamMap>(slam.map());
+}
+
+const SyntheticRoom& room() {
+  static const SyntheticRoom r(5, 3.0, 2.5, 2.5);
+  return r;
+}
+const SlamMap& saved() {
+  static const std::shared_ptr<const SlamMap> m = lap_map(room());
+  return *m;
+}
+
+struct TempDir {
+  fs::path path = fs::temp_directory_path() / ("kestrel_map_test_" + std::to_string(::getpid()) + "_" +
+                                               ::testing::UnitTest::GetInstance()->current_test_info()->name());
+  TempDir() { fs::remove_all(path); }
+  ~TempDir() { fs::remove_all(path); }
+};
+
+std::vector<char> bytes_of(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+void write_bytes(const fs::path& p, const std::vector<char>& b) {
+  std::ofstream out(p, std::ios::binary | std::ios::trunc);
+  out.write(b.data(), static_cast<std::streamsize>(b.size()));
+}
+
+TEST(SlamMapFile, KeepsAMapBitForBit) {
+  const TempDir dir;
+  const SlamMap& map = saved();
+  ASSERT_GE(map.keyframes.size(), 10u);
+  ASSERT_EQ(map.sessions, 1);
+  write_map(dir.path.string(), map, {"slam_map_test", "2026-12-05T00:00:00Z"});
+  std::string head;
+  const SlamMap back = read_map(dir.path.string(), &head);
+  EXPECT_NE(head.find("made_by: slam_map_test"), std::string::npos);
+  EXPECT_NE(head.find("keyframes: " + std::to_string(map.keyframes.size())), std::string::npos);
+  ASSERT_EQ(back.keyframes.size(), map.keyframes.size());
+  EXPECT_EQ(back.sessions, 1);
+  for (size_t k = 0; k < map.keyframes.size(); ++k) {
+    const Keyframe &a = map.keyframes[k], &b = back.keyframes[k];
+    EXPECT_EQ(a.utime, b.utime);
+    EXPECT_EQ(a.session, b.session);
+    EXPECT_TRUE(a.T_odom_camera.matrix() == b.T_odom_camera.matrix());
+    EXPECT_TRUE(map.graph.poses[k].matrix() == back.graph.poses[k].matrix());
+    EXPECT_EQ(a.sensor.name, b.sensor.name);
+    ASSERT_EQ(a.features.size(), b.features.size());
+    EXPECT_EQ(cv::norm(a.features.descriptors, b.features.descriptors, cv::NORM_HAMMING), 0.0);
+    for (size_t i = 0; i < a.features.size(); ++i) {
+      EXPECT_EQ(a.features.keypoints[i].pt, b.features.keypoints[i].pt);
+      EXPECT_TRUE(a.features.points[i].cwiseEqual(b.features.points[i]).all() ||
+                  (std::isnan(a.features.points[i].z()) && std::isnan(b.features.points[i].z())));
+    }
+  }
+  ASSERT_EQ(back.graph.edges.size(), map.graph.edges.size());
+  for (size_t e = 0; e < map.graph.edges.size(); ++e) {
+    EXPECT_TRUE(back.graph.edges[e].information == map.graph.edges[e].information);
+    EXPECT_TRUE(back.gate_information[e] == map.gate_information[e]);
+  }
+  // The vocabulary indexes the same words.
+  EXPECT_EQ(back.vocabulary->num_words(), map.vocabulary->num_words());
+  EXPECT_EQ(back.vocabulary->words(map.keyframes[3].features.descriptors),
+            map.vocabulary->words(map.keyframes[3].features.descriptors));
+}
+
+// Each kind of damage: an InputError naming the file, never a crash or a half-read map.
+TEST(SlamMapFile, RefusesEveryKindOfDamage) {
+  const TempDir dir;
+  write_map(dir.path.string(), saved(), {"slam_map_test", ""});
+  const fs::path file = map_file_in(dir.path.string());
+  const std::vector<char> good = bytes_of(file);
+  auto refused = [&](const std::vector<char>& b, const std::string& needle) {
+    write_bytes(file, b);
+    try {
+      read_map(dir.path.string());
+    } catch (const InputError& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find("slam.map"), std::string::npos) << what;
+      EXPECT_NE(what.find(needle), std::string::npos) << what;
+      return;
+    }
+    ADD_FAILURE() << "a damaged map was read (" << needle << ")";
+  };
+  // Cut at every 1/16 of its length and one byte short.
+  for (size_t cut : {size_t{0}, size_t{10}, size_t{20}, good.size() - 1}) {
+    refused(std::vector<char>(good.begin(), good.begin() + static_cast<std::ptrdiff_t>(cut)),
+            cut < 20 ? "not a kestrel SLAM map" : "cut short");
+  }
+  for (int i = 1; i < 16; ++i) {
+    const size_t cut = good.size() * static_cast<size_t>(i) / 16;
+    write_bytes(file, std::vector<char>(good.begin(), good.begin() + static_cast<std::ptrdiff_t>(cut)));
+    EXPECT_THROW(read_map(dir.path.string()), InputError) << "cut at " << cut;
+  }
+  // One flipped bit anywhere after the magic and version: the checksum (or a size check) says so.
+  for (int i = 0; i < 64; ++i) {
+    std::vector<char> b = good;
+    const size_t at = 20 + (b.size() - 20) * static_cast<size_t>(i) / 64;
+    b[at] = static_cast<char>(b[at] ^ 0x10);
+    write_bytes(file, b);
+    EXPECT_THROW(read_map(dir.path.string()), InputError) << "bit flipped at " << at;
+  }
+  // Another format, a newer version, trailing bytes.
+  std::vector<char> foreign = good;
+  foreign[0] = 'X';
+  refused(foreign, "not a kestrel SLAM map");
+  std::vector<char> newer = good;
+  newer[16] = 2;
+  refused(newer, "made by a newer kestrel");
+  std::vector<char> longer = good;
+  longer.push_back(0);
+  refused(longer, "after its end");
+  // A file of another kind under the name, and a folder with no map.
+  write_bytes(file, std::vector<char>(4096, 'a'));
+  EXPECT_THROW(read_map(dir.path.string()), InputError);
+  fs::remove(file);
+  refused({}, "");  // write_bytes made an empty file: not a map
+  fs::remove(file);
+  EXPECT_THROW(read_map(dir.path.string()), InputError);
+  EXPECT_THROW(read_map((dir.path / "absent").string()), InputError);
+}
+
+TEST(SlamMapFile, ASaveThatFailsLeavesTheOldMapWhole) {
+  const TempDir dir;
+  write_map(dir.path.string(), saved(), {"first", ""});
+  SlamMap broken = saved();
+  broken.gate_information.pop_back();  // breaks an invariant: refused before anything is written
+  EXPECT_THROW(write_map(dir.path.string(), broken, {"second", ""}), InputError);
+  std::string head;
+  EXPECT_EQ(read_map(dir.path.string(), &head).keyframes.size(), saved().keyframes.size());
+  EXPECT_NE(head.find("made_by: first"), std::string::npos);
+}
+
+// A camera started at an unknown pose in the mapped room, its odometry in a frame of its own
+// and its clock started again.
+struct Flight {
+  std::vector<Eigen::Isometry3d> truth;
+  Eigen::Isometry3d T_odom_world = se3::exp((Vector6d() << 4.0, -7.0, 1.0, 0.3, -0.2, 2.0).finished());
+};
+
+TEST(Relocalisation, PlacesACameraStartedElsewhereAtItsTruePoseAndItsKeyframesJoinTheMap) {
+  Slam slam(SlamOptions{}, std::make_shared<const SlamMap>(saved()));
+  EXPECT_FALSE(slam.localized());
+  EXPECT_EQ(slam.session(), 1);
+  // Half a lap the other way round from another radius, starting at utime 0 (before the map's).
+  Flight f;
+  for (int i = 0; i < 30; ++i) {
+    const double yaw = 2.5 - 0.11 * i;
+    f.truth.push_back(test::level_camera({0.6 * std::cos(yaw), 0.6 * std::sin(yaw), 1.1}, yaw));
+  }
+  int64_t utime = 0;
+  std::optional<size_t> placed_at;
+  for (size_t i = 0; i < f.truth.size(); ++i) {
+    const SlamStep step =
+        slam.add(room().render(f.truth[i], test::test_camera(), utime += 100'000), f.T_odom_world * f.truth[i]);
+    if (step.relocalised) placed_at = i;
+  }
+  ASSERT_TRUE(placed_at) << "never relocalised";
+  ASSERT_TRUE(slam.relocalisation());
+  EXPECT_EQ(slam.relocalisation()->frames_tried, static_cast<int>(*placed_at) + 1);
+  EXPECT_LE(*placed_at, 3u) << "two agreeing frames should come within the first few";
+  const Eigen::Isometry3d E = f.truth[*placed_at].inverse() * slam.relocalisation()->T_world_camera;
+  EXPECT_LT(E.translation().norm(), 0.02);
+  EXPECT_LT(so3::angle(E.linear()), 1.0 * kPi / 180.0);
+  // From there the odometry is in the map's world, and new keyframes join the old graph.
+  const Eigen::Isometry3d last = slam.world_pose(f.T_odom_world * f.truth.back());
+  EXPECT_LT((last.translation() - f.truth.back().translation()).norm(), 0.05);
+  const SlamMap joined = slam.map();
+  EXPECT_EQ(joined.sessions, 2);
+  EXPECT_GT(joined.keyframes.size(), saved().keyframes.size());
+  EXPECT_EQ(joined.keyframes.back().session, 1);
+  EXPECT_TRUE(unanchored_components(joined.graph).empty()) << "the new session hangs on its own";
+}
+
+TEST(Relocalisation, NeverPlacesACameraInARoomTheMapHasNotSeen) {
+  Slam slam(SlamOptions{}, std::make_shared<const SlamMap>(saved()));
+  const SyntheticRoom other(77, 3.0, 2.5, 2.5);  // same shape and texture scales, other cells
+  int64_t utime = 0;
+  int candidates = 0;
+  for (const auto& T : test::circle_path(48, 1.0, 1.0)) {
+    const SlamStep step = slam.add(other.render(T, test::test_camera(), utime += 100'000), T);
+    EXPECT_FALSE(step.relocalised);
+    candidates += step.candidates;
+  }
+  EXPECT_GT(candidates, 0) << "nothing was even compared: the test would pass without relocalisation";
+  EXPECT_FALSE(slam.localized());
+  EXPECT_FALSE(slam.relocalisation());
+  EXPECT_EQ(slam.map().keyframes.size(), saved().keyframes.size()) << "a lost camera adds nothing";
+}
+
+TEST(Relocalisation, OnePlacementIsNotEnoughAndABrokenOdometryForgetsTheHypotheses) {
+  Slam slam(SlamOptions{}, std::make_shared<const SlamMap>(saved()));
+  const auto path = test::circle_path(48, 1.0, 1.0);
+  const Flight f;
+  const SlamStep first = slam.add(room().render(path[5], test::test_camera(), 100'000), f.T_odom_world * path[5]);
+  EXPECT_FALSE(first.relocalised);
+  // The next frame agrees with it, but the odometry broke in between: it is a first placement again.
+  const SlamStep after_break = slam.add(room().render(path[6], test::test_camera(), 200'000),
+                                        Eigen::Isometry3d::Identity(), OdometryLink::kBroken);
+  EXPECT_FALSE(after_break.relocalised);
+  const SlamStep confirmed = slam.add(room().render(path[7], test::test_camera(), 300'000),
+                                      path[6].inverse() * path[7]);  // the odometry since the break
+  EXPECT_TRUE(confirmed.relocalised);
+  // reset() goes back to the saved map, not to nothing.
+  slam.reset();
+  EXPECT_FALSE(slam.localized());
+  EXPECT_EQ(slam.keyframes().size(), saved().keyframes.size());
+}
+
+TEST(Relocalisation, AMapOfNothingMapsFromTheStart) {
+  Slam empty_run(SlamOptions{}, builtin_vocabulary());
+  Slam slam(SlamOptions{}, std::make_shared<const SlamMap>(empty_run.map()));
+  EXPECT_TRUE(slam.localized());
+  EXPECT_TRUE(slam.add(room().render(test::circle_path(4, 1.0, 1.0)[0], test::test_camera(), 1), Eigen::Isometry3d::Identity())
+                  .keyframe);
+}
+
+}  // namespace
+}  // namespace kestrel::slam
