@@ -212,9 +212,9 @@ int serve(const Options& o, const SlamOptions& options, std::shared_ptr<const Vo
   if (!o.out.empty() || !o.vo_out.empty()) throw CLI::ValidationError("--out/--vo-out", "only with --tum");
   AdapterOptions adapter_options = o.adapter;
   if (!o.sensor.empty()) adapter_options.sensor = sensors::load_sensor_profile(o.sensor);
-  spdlog::info("camera profile: {}", o.sensor.empty() ? "each frame's sensor model" : o.sensor);
   const std::shared_ptr<const SlamMap> map = load_map(o.map);
-  SlamAdapter adapter = map ? SlamAdapter(options, map, adapter_options)
+  spdlog::info("camera profile: {}", o.sensor.empty() ? "each frame's sensor model" : o.sensor);
+  SlamAdapter adapter = map ? SlamAdapter(map, options, adapter_options)
                             : SlamAdapter(options, std::move(vocabulary), adapter_options);
   std::unique_ptr<transport::Node> node;
   node = std::make_unique<transport::Node>(o.name, o.lcm_url);  // UnavailableError: exit 4

@@ -25,7 +25,7 @@ SlamRun run_slam_sequence(size_t count, const std::function<RgbdFrame(size_t)>& 
   const vo::VoOptions vo_options = vo::with_sensor(sensor, base_vo_options);
   vo::VisualOdometry odometry(vo_options);
   OdometryChain chain;
-  Slam slam = map ? Slam(options, std::move(map)) : Slam(options, std::move(vocabulary));
+  Slam slam = map ? Slam(std::move(map), options) : Slam(options, std::move(vocabulary));
   SlamRun run;
   // Each reference SLAM's odometry went from (a keyframe, or a frame re-anchored on one), and
   // each frame with the reference it came after.

@@ -18,8 +18,8 @@ SlamAdapter::SlamAdapter(const SlamOptions& options, std::shared_ptr<const Vocab
   if (adapter.buffer_frames < 1) throw std::invalid_argument("slam: buffer_frames must be >= 1");
 }
 
-SlamAdapter::SlamAdapter(const SlamOptions& options, std::shared_ptr<const SlamMap> map, const AdapterOptions& adapter)
-    : options_(adapter), slam_(options, std::move(map)), map_loaded_(true) {
+SlamAdapter::SlamAdapter(std::shared_ptr<const SlamMap> map, const SlamOptions& options, const AdapterOptions& adapter)
+    : options_(adapter), slam_(std::move(map), options), map_loaded_(true) {
   if (adapter.buffer_frames < 1) throw std::invalid_argument("slam: buffer_frames must be >= 1");
   anchored_ = true;
 }

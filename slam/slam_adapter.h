@@ -95,7 +95,7 @@ class SlamAdapter {
   /// from the start (nothing is anchored on STATE), and the frame that relocalises the camera
   /// in it sends a SLAM_CORRECTION, which an estimator told to await the map's world takes
   /// as its world (estimator.h, --await-world).
-  SlamAdapter(const SlamOptions& options, std::shared_ptr<const SlamMap> map, const AdapterOptions& adapter = {});
+  SlamAdapter(std::shared_ptr<const SlamMap> map, const SlamOptions& options, const AdapterOptions& adapter = {});
 
   /// Throw InputError naming the channel for a message that cannot be used: the message is
   /// dropped (a corrupt keyframe is lost; the next frame that moved enough replaces it).

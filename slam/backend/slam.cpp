@@ -132,7 +132,7 @@ Slam::Slam(const SlamOptions& options, std::shared_ptr<const Vocabulary> vocabul
   reset();
 }
 
-Slam::Slam(const SlamOptions& options, std::shared_ptr<const SlamMap> map)
+Slam::Slam(std::shared_ptr<const SlamMap> map, const SlamOptions& options)
     : options_(checked(options)),
       extractor_(options.features),
       matchable_(options.memory.bin_size_m, options.memory.bin_angle_deg) {

@@ -108,7 +108,7 @@ class Slam {
   /// keyframes). Frames are first relocalised (RelocalisationOptions): until one places the
   /// camera in the map (localized()), nothing is added. Throws InputError for a map that breaks
   /// its invariants, std::invalid_argument for an unusable option.
-  Slam(const SlamOptions& options, std::shared_ptr<const SlamMap> map);
+  Slam(std::shared_ptr<const SlamMap> map, const SlamOptions& options);
 
   /// What a later flight needs to go on from here (slam_map.h): a copy.
   SlamMap map() const;

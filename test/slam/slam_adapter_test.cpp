@@ -498,6 +498,35 @@ TEST_F(AdapterTest, ResetForgetsEverything) {
   EXPECT_TRUE(adapter_.on_vo_update(update(0)).graph);
 }
 
+// Started from a saved map (issue 41): the map's world is the world, no STATE moves it, and the
+// frame that places the camera in the map sends the first correction, a pose in the map's world.
+TEST_F(AdapterTest, OnASavedMapTheRelocalisingFrameSendsTheFirstCorrectionInTheMapsWorld) {
+  // The map: the same straight path, mapped with the true poses as odometry.
+  Slam mapping(SlamOptions{}, std::shared_ptr<const Vocabulary>{});
+  for (int k = 0; k < 12; ++k) mapping.add(room_.render(pose(k), test::test_camera(), utime(k)), pose(k));
+  SlamAdapter adapter(std::make_shared<const SlamMap>(mapping.map()), SlamOptions{});
+  EXPECT_TRUE(adapter.anchored());
+  std::optional<kestrel::slam_correction_t> correction;
+  int k = 0;
+  for (; k < 12 && !correction; ++k) {
+    adapter.on_state(state(k, estimator_world()));  // another world: never anchored on
+    adapter.on_frame(frame(k));
+    const AdapterOutputs out = adapter.on_vo_update(update(k));
+    EXPECT_FALSE(out.anchored);
+    correction = out.correction;
+    if (correction) EXPECT_TRUE(out.step && out.step->relocalised);
+  }
+  ASSERT_TRUE(correction) << "never relocalised";
+  EXPECT_LE(k, 3);
+  const Eigen::Isometry3d T = transport::from_message(correction->T_world_body, "test");
+  EXPECT_LT((T.translation() - pose(k - 1).translation()).norm(), 0.02);
+  EXPECT_LT(so3::angle(T.linear().transpose() * pose(k - 1).linear()), 1.0 * kPi / 180.0);
+  // reset() goes back to the map, still its world.
+  adapter.reset();
+  EXPECT_TRUE(adapter.anchored());
+  EXPECT_FALSE(adapter.slam().localized());
+}
+
 TEST(CorrectionCovariance, CarriesTheCameraMarginalToTheBody) {
   // The camera sits 10 cm ahead of the body; its yaw uncertainty swings the body sideways.
   Eigen::Isometry3d T_body_camera = Eigen::Isometry3d::Identity();

@@ -173,7 +173,7 @@ struct Flight {
 };
 
 TEST(Relocalisation, PlacesACameraStartedElsewhereAtItsTruePoseAndItsKeyframesJoinTheMap) {
-  Slam slam(SlamOptions{}, std::make_shared<const SlamMap>(saved()));
+  Slam slam(std::make_shared<const SlamMap>(saved()), SlamOptions{});
   EXPECT_FALSE(slam.localized());
   EXPECT_EQ(slam.session(), 1);
   // Half a lap the other way round from another radius, starting at utime 0 (before the map's).
@@ -207,7 +207,7 @@ TEST(Relocalisation, PlacesACameraStartedElsewhereAtItsTruePoseAndItsKeyframesJo
 }
 
 TEST(Relocalisation, NeverPlacesACameraInARoomTheMapHasNotSeen) {
-  Slam slam(SlamOptions{}, std::make_shared<const SlamMap>(saved()));
+  Slam slam(std::make_shared<const SlamMap>(saved()), SlamOptions{});
   const SyntheticRoom other(77, 3.0, 2.5, 2.5);  // same shape and texture scales, other cells
   int64_t utime = 0;
   int candidates = 0;
@@ -223,7 +223,7 @@ TEST(Relocalisation, NeverPlacesACameraInARoomTheMapHasNotSeen) {
 }
 
 TEST(Relocalisation, OnePlacementIsNotEnoughAndABrokenOdometryForgetsTheHypotheses) {
-  Slam slam(SlamOptions{}, std::make_shared<const SlamMap>(saved()));
+  Slam slam(std::make_shared<const SlamMap>(saved()), SlamOptions{});
   const auto path = test::circle_path(48, 1.0, 1.0);
   const Flight f;
   const SlamStep first = slam.add(room().render(path[5], test::test_camera(), 100'000), f.T_odom_world * path[5]);
@@ -243,7 +243,7 @@ TEST(Relocalisation, OnePlacementIsNotEnoughAndABrokenOdometryForgetsTheHypothes
 
 TEST(Relocalisation, AMapOfNothingMapsFromTheStart) {
   Slam empty_run(SlamOptions{}, builtin_vocabulary());
-  Slam slam(SlamOptions{}, std::make_shared<const SlamMap>(empty_run.map()));
+  Slam slam(std::make_shared<const SlamMap>(empty_run.map()), SlamOptions{});
   EXPECT_TRUE(slam.localized());
   EXPECT_TRUE(slam.add(room().render(test::circle_path(4, 1.0, 1.0)[0], test::test_camera(), 1), Eigen::Isometry3d::Identity())
                   .keyframe);

@@ -54,6 +54,18 @@ TEST(SlamTool, AMissingVocabularyFileIsExitCode3) {
   EXPECT_NE(r.err.find("none.voc: cannot open"), std::string::npos) << r.err;
 }
 
+TEST(SlamTool, ADamagedOrMissingMapIsExitCode3NamingItBeforeAnythingRuns) {
+  TempDir dir;
+  std::filesystem::create_directories(dir / "map");
+  std::ofstream(dir / "map" / "slam.map") << "KESTREL-SLAM-MAP but not one\n";
+  for (const auto& folder : {dir / "map", dir / "none"}) {
+    const auto r = run({tool("slam"), "--map", folder.string()});  // the process: refused before it joins LCM
+    EXPECT_EQ(r.exit_code, kExitBadInput) << r.err;
+    EXPECT_NE(r.err.find((folder / "slam.map").string()), std::string::npos) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  }
+}
+
 #if KESTREL_SLAM_OFFLINE
 namespace fs = std::filesystem;
 using ::kestrel::test::RunResult;
@@ -112,6 +124,36 @@ TEST(SlamTool, AUsableTumFolderWritesBothTrajectoriesWithEveryFrame) {
   EXPECT_NE(r.out.find("frames: 4, with a pose: 4\n"), std::string::npos) << r.out;
   EXPECT_EQ(read_tum_trajectory((dir / "slam.txt").string()).size(), 4u);
   EXPECT_EQ(read_tum_trajectory((dir / "vo.txt").string()).size(), 4u);
+}
+
+// A map saved by one run is where the next starts: placed in it by relocalisation, its
+// trajectory in the map's world (here the same room from the same start: the same poses).
+TEST(SlamTool, ASavedMapIsWhereTheNextRunIsPlaced) {
+  TempDir dir;
+  vo::test::TumFolderSpec spec;
+  spec.frames = 12;
+  const fs::path folder = vo::test::write_tum_folder(dir.path(), spec);
+  const RunResult first = run({tool("slam"), "--tum", folder.string(), "--out", (dir / "first.txt").string(),
+                               "--save-map", (dir / "map").string()});
+  ASSERT_EQ(first.exit_code, kExitOk) << first.out << first.err;
+  ASSERT_TRUE(fs::is_regular_file(dir / "map" / "slam.map"));
+  const RunResult second = run({tool("slam"), "--tum", folder.string(), "--out", (dir / "second.txt").string(),
+                                "--map", (dir / "map").string(), "--save-map", (dir / "map").string()});
+  ASSERT_EQ(second.exit_code, kExitOk) << second.out << second.err;
+  EXPECT_NE(second.err.find("relocalised at frame 2 of those tried"), std::string::npos) << second.err;
+  const Trajectory a = read_tum_trajectory((dir / "first.txt").string());
+  const Trajectory b = read_tum_trajectory((dir / "second.txt").string());
+  ASSERT_GE(b.size(), 8u);
+  for (const StampedPose& p : b.poses()) {
+    const auto q = a.at(p.utime, 0);
+    ASSERT_TRUE(q);
+    EXPECT_LT((q->translation() - p.T.translation()).norm(), 0.01) << p.utime;
+  }
+  // Saved again over the map it read (atomically): the second run added no keyframe over the
+  // ground the first covered, so the map is still one session's.
+  EXPECT_NE(second.err.find("map saved: " + (dir / "map" / "slam.map").string() + " (1 keyframes, 1 session(s))"),
+            std::string::npos)
+      << second.err;
 }
 #endif
 
