@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <iterator>
 #include <string>
 #include <vector>
@@ -194,6 +195,8 @@ TEST(Relocalisation, PlacesACameraStartedElsewhereAtItsTruePoseAndItsKeyframesJo
   EXPECT_EQ(slam.relocalisation()->frames_tried, static_cast<int>(*placed_at) + 1);
   EXPECT_LE(*placed_at, 3u) << "two agreeing frames should come within the first few";
   const Eigen::Isometry3d E = f.truth[*placed_at].inverse() * slam.relocalisation()->T_world_camera;
+  std::cout << "relocalised at frame " << *placed_at + 1 << ": " << E.translation().norm() * 100.0 << " cm, "
+            << so3::angle(E.linear()) * 180.0 / kPi << " deg off the truth\n";
   EXPECT_LT(E.translation().norm(), 0.02);
   EXPECT_LT(so3::angle(E.linear()), 1.0 * kPi / 180.0);
   // From there the odometry is in the map's world, and new keyframes join the old graph.
