@@ -102,6 +102,10 @@ void add_options(cli::App& app, Options& o, SlamOptions& s) {
   app.add_option("--save-map", o.save_map,
                  "Save the SLAM map (keyframes, features, graph, vocabulary) in this folder at the end (offline) or on "
                  "exit (process), for a later --map");
+  app.add_flag("--localize-only", s.localize_only,
+               "With --map: add no keyframe over the map (frames are located in it, relocalised again when lost); "
+               "keyframes only where the vehicle leaves it")
+      ->capture_default_str();
   app.add_option("--relocalisation-confirmations", s.relocalisation.confirmations,
                  "With --map: verified placements from different frames that must agree before the camera is placed")
       ->check(CLI::PositiveNumber)->capture_default_str();

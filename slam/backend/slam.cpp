@@ -30,6 +30,7 @@ void check_options(const SlamOptions& o) {
   require(m.bin_angle_deg > 0.0 && m.bin_angle_deg <= 180.0, "memory.bin_angle_deg must be in (0, 180]");
   require(o.loops.min_age_s >= 0.0, "loops.min_age_s must be >= 0");
   require(o.loops.max_candidates >= 1, "loops.max_candidates must be >= 1");
+  require(!o.localize_only || c.reuse_keyframes, "localize_only needs coverage.reuse_keyframes");
   const RelocalisationOptions& r = o.relocalisation;
   require(r.max_candidates >= 1 && r.confirmations >= 1, "relocalisation: max_candidates and confirmations must be >= 1");
   require(r.max_disagreement_m >= 0.0 && r.max_disagreement_rad >= 0.0 && r.max_span_s >= 0.0,
@@ -155,6 +156,7 @@ SlamMap Slam::map() const {
   const bool added = std::any_of(keyframes_.begin(), keyframes_.end(),
                                  [this](const Keyframe& k) { return k.session == session_; });
   map.sessions = session_ + (added ? 1 : 0);
+  map.revision = revision_;
   return map;
 }
 
@@ -174,6 +176,7 @@ void Slam::restore(const SlamMap& map) {
   rebin();
   keep_within_budget(std::nullopt);
   session_ = map.sessions;
+  revision_ = map.revision + 1;  // the loaded graph is a change after the one saved
   // An empty map has nowhere to be placed in: the flight maps from nothing.
   localized_ = keyframes_.empty();
 }
@@ -288,6 +291,8 @@ SlamStep Slam::add(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camer
   have_frame_ = true;
   last_utime_ = frame.utime;
   if (odometry_broken) gate_by_pose_ = false;
+  // Localisation only: after a break of the odometry the camera is placed in the map again.
+  if (odometry_broken && options_.localize_only && !keyframes_.empty()) localized_ = false;
   if (!localized_) return relocalise(frame, T_odom_camera, link, motion, sensor);
   SlamStep step;
   if (!wants_keyframe(T_odom_camera, link)) return step;
@@ -466,14 +471,7 @@ bool Slam::reanchor(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_came
     // reference where the odometry puts it, so the next try comes after the keyframe spacing
     // rather than at every frame of a blank stretch.
     ++coverage_misses_.featureless;
-    reference_ = OdometryReference{reference_.keyframe_id,
-                                   frame.utime,
-                                   T_odom_camera,
-                                   frame.T_body_camera,
-                                   reference_.T_keyframe_camera * T_ref_frame,
-                                   predicted,
-                                   weaker(reference_.link, link)};
-    step.carried = true;
+    carry_reference(frame, T_odom_camera, link, predicted, step);
     return true;
   }
   for (const auto& [distance, k] : covering) {
@@ -495,7 +493,13 @@ bool Slam::reanchor(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_came
         so3::angle(T_expected_located.linear()) > c.max_correction_rad) {
       step.loop = located;
       ++coverage_misses_.too_far;
-      return false;
+      if (!options_.localize_only) return false;  // a loop to close, through a new keyframe
+      // Localisation only: the map stays as it is, so the frame is placed in it again, with
+      // relocalisation's confirmation (a large correction from one view may be a wrong place).
+      localized_ = false;
+      placements_.clear();
+      step.lost = true;
+      return true;
     }
     // The frame in keyframe k twice: predicted (the reference and the odometry since, with
     // their covariances) and located (the features'); the reference becomes their fusion, so
@@ -516,7 +520,23 @@ bool Slam::reanchor(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_came
     return true;
   }
   ++coverage_misses_.not_verified;
-  return false;
+  if (!options_.localize_only) return false;
+  // Localisation only: a view of the map that does not verify adds no keyframe either.
+  carry_reference(frame, T_odom_camera, link, predicted, step);
+  return true;
+}
+
+void Slam::carry_reference(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera, OdometryLink link,
+                           const Matrix6d& predicted, SlamStep& step) {
+  const Eigen::Isometry3d T_ref_frame = reference_.T_odom_camera.inverse() * T_odom_camera;
+  reference_ = OdometryReference{reference_.keyframe_id,
+                                 frame.utime,
+                                 T_odom_camera,
+                                 frame.T_body_camera,
+                                 reference_.T_keyframe_camera * T_ref_frame,
+                                 predicted,
+                                 weaker(reference_.link, link)};
+  step.carried = true;
 }
 
 }  // namespace kestrel::slam

@@ -73,6 +73,9 @@ struct SlamStep {
   /// Or, started from a saved map, the frame placed the camera in it (Slam::relocalisation());
   /// `reanchor_keyframe_id` and `loop` say where.
   bool relocalised = false;
+  /// Localisation only: located too far from its estimate (or the odometry broke): the camera
+  /// is relocalised again from the next frame (SlamOptions::localize_only).
+  bool lost = false;
   int candidates = 0;             ///< loop candidates verified
   int inconsistent = 0;           ///< of them, verified but refused as disagreeing with the odometry
   bool loop_closed = false;
@@ -190,6 +193,9 @@ class Slam {
                 const std::optional<Matrix6d>& odometry_covariance, const FrameFeatures& features,
                 const sensors::SensorProfile& sensor, SlamStep& step);
   Eigen::Isometry3d reference_world_pose() const;
+  /// Makes the frame the reference at its predicted pose, in the reference's keyframe.
+  void carry_reference(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera, OdometryLink link,
+                       const Matrix6d& predicted, SlamStep& step);
   /// Starts from the loaded map (reset()).
   void restore(const SlamMap& map);
   /// Not localized: places the frame in the map, or keeps it as a hypothesis (RelocalisationOptions).

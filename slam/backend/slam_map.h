@@ -59,6 +59,9 @@ struct SlamMap {
   std::vector<Matrix6d> gate_information;  ///< per edge: the loop-consistency gate's model
   std::shared_ptr<const Vocabulary> vocabulary;
   int sessions = 0;                     ///< flights that made it
+  /// The graph's revision when it was taken (Slam::revision()): a Slam going on from the map
+  /// continues from it, so the published revisions never go back (slam_messages.h).
+  int64_t revision = 0;
 };
 
 /// Throws InputError naming `what` and the first broken invariant (see the top).

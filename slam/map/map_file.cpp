@@ -170,6 +170,7 @@ std::vector<uint8_t> graph_section(const SlamMap& map) {
     w.put_matrix6(edge.information);
     w.put_matrix6(map.gate_information[e]);
   }
+  w.put(map.revision);
   return w.bytes;
 }
 
@@ -257,6 +258,8 @@ void read_graph(Reader& r, SlamMap& map) {
     g.add_edge(from, to, measurement, information, static_cast<EdgeKind>(kind));
     map.gate_information.push_back(r.get_matrix6());
   }
+  map.revision = r.get<int64_t>();
+  if (map.revision < 0) r.fail("has a negative revision");
 }
 
 }  // namespace

@@ -8,7 +8,7 @@
 //           for errors; nothing is read back from it but the counts it is checked against)
 //     VOCB  the vocabulary (slam/place/vocabulary.h's format; empty: none trained)
 //     KEYF  the keyframes: poses, session, link, sensor, camera, features
-//     GRPH  the pose graph's vertices and edges, and the loop gate's model per edge
+//     GRPH  the pose graph's vertices and edges, the loop gate's model per edge, the revision
 //     END.  nothing: the file is whole
 // Numbers are little-endian (the reader refuses a big-endian host rather than misread).
 //
