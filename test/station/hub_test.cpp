@@ -1,0 +1,106 @@
+// The browsers' mailboxes: newest per kind, bounded, map differences per client.
+#include <gtest/gtest.h>
+
+#include "station/hub.h"
+#include "station/station.h"
+#include "station/wire.h"
+
+namespace kestrel::station {
+namespace {
+
+std::shared_ptr<const CellSet> cells(std::vector<uint64_t> ids) {
+  auto s = std::make_shared<CellSet>();
+  s->resolution_m = 0.1;
+  for (uint64_t id : ids) {
+    s->ids.push_back(id);
+    s->cells.push_back({static_cast<float>(id), 0.f, 0.f, 0.1f});
+  }
+  return s;
+}
+
+TEST(StationHub, ASlowClientGetsTheNewestOfEachKindOnly) {
+  UpdateHub hub;
+  int wakes = 0;
+  const auto id = hub.add_client([&] { ++wakes; });
+  ASSERT_TRUE(id.has_value());
+  for (int i = 0; i < 1000; ++i) hub.post("state", {false, "s" + std::to_string(i)});
+  hub.post("plan", {false, "p"});
+  const auto out = hub.take(*id);
+  ASSERT_EQ(out.size(), 2u);  // bounded by the kinds, not by what was posted
+  EXPECT_EQ(out[1].bytes, "s999");
+  EXPECT_EQ(hub.stats().dropped, 999);
+  EXPECT_GE(wakes, 1001);
+  EXPECT_TRUE(hub.take(*id).empty());
+}
+
+TEST(StationHub, ALateClientStartsFromTheNewestOfEveryKindAndTheWholeMap) {
+  UpdateHub hub;
+  hub.post("graph", {false, "g"});
+  hub.post_map(cells({1, 2, 3}));
+  const auto id = hub.add_client({});
+  const auto out = hub.take(*id);
+  ASSERT_EQ(out.size(), 2u);
+  EXPECT_EQ(out[0].bytes, "g");
+  size_t after = 0;
+  const CellDiff d = decode_map_diff(out[1].bytes, &after);
+  EXPECT_TRUE(d.reset);
+  EXPECT_EQ(d.added.size(), 3u);
+  EXPECT_EQ(after, 3u);
+}
+
+TEST(StationHub, EachClientGetsTheDifferenceFromWhatItHas) {
+  UpdateHub hub;
+  const auto fast = hub.add_client({}), slow = hub.add_client({});
+  hub.post_map(cells({1, 2, 3}));
+  hub.take(*fast);
+  hub.take(*slow);
+  hub.post_map(cells({2, 3, 4}));
+  const CellDiff f = decode_map_diff(hub.take(*fast).at(0).bytes);
+  EXPECT_EQ(f.added.size(), 1u);
+  EXPECT_EQ(f.removed.size(), 1u);
+  hub.post_map(cells({3, 4, 5, 6}));
+  EXPECT_EQ(decode_map_diff(hub.take(*fast).at(0).bytes).added.size(), 2u);
+  // The slow client skipped a map: one difference from {1,2,3} to {3,4,5,6}.
+  const CellDiff s = decode_map_diff(hub.take(*slow).at(0).bytes);
+  EXPECT_FALSE(s.reset);
+  EXPECT_EQ(s.added.size(), 3u);
+  EXPECT_EQ(s.removed.size(), 2u);
+  hub.post_map(nullptr);
+  size_t after = 99;
+  EXPECT_TRUE(decode_map_diff(hub.take(*fast).at(0).bytes, &after).reset);
+  EXPECT_EQ(after, 0u);
+}
+
+TEST(StationHub, ClientsBeyondTheLimitAreRefused) {
+  UpdateHub hub(2);
+  EXPECT_TRUE(hub.add_client({}).has_value());
+  const auto b = hub.add_client({});
+  EXPECT_TRUE(b.has_value());
+  EXPECT_FALSE(hub.add_client({}).has_value());
+  hub.remove_client(*b);
+  EXPECT_TRUE(hub.add_client({}).has_value());
+}
+
+TEST(StationStation, ACommandIsAnsweredOnItsOwnSocketAndYieldsOneMessage) {
+  UpdateHub hub;
+  const auto a = hub.add_client({}), b = hub.add_client({});
+  Station st({}, hub, 1000);
+  hub.take(*a);
+  hub.take(*b);
+  CommandResult r = st.on_command(*a, R"({"cmd":"goal","goal":[0,0,1,0]})");
+  EXPECT_FALSE(r.ok);  // no map yet
+  EXPECT_FALSE(r.request.has_value());
+  ASSERT_EQ(hub.take(*a).size(), 1u);
+  EXPECT_TRUE(hub.take(*b).empty());
+  r = st.on_command(*a, R"({"cmd":"hold"})");
+  EXPECT_TRUE(r.ok);
+  ASSERT_TRUE(r.hold.has_value());
+  EXPECT_EQ(r.hold->request_id, 1000);
+  EXPECT_EQ(r.hold->status, kestrel::plan_t::STATUS_NO_PATH);
+  r = st.on_command(*b, "garbage");
+  EXPECT_FALSE(r.ok);
+  EXPECT_NE(hub.take(*b).at(0).bytes.find("not a JSON object"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace kestrel::station
