@@ -9,7 +9,7 @@
 
   // --- the scene -------------------------------------------------------------------------
   const view = document.getElementById('view');
-  const renderer = new THREE.WebGLRenderer({ antialias: false, preserveDrawingBuffer: true });
+  const renderer = new THREE.WebGLRenderer({ antialias: false });
   renderer.setPixelRatio(1);
   renderer.setClearColor(0x15181c);
   view.appendChild(renderer.domElement);
@@ -320,6 +320,7 @@
 
   // --- the socket ------------------------------------------------------------------------
   let socket = null;
+  const received = { total: 0 };
   function connect() {
     const url = `ws://${location.host}/ws` + (token ? `?token=${encodeURIComponent(token)}` : '');
     socket = new WebSocket(url);
@@ -330,6 +331,11 @@
       setTimeout(connect, 1000);
     };
     socket.onmessage = (e) => {
+      // Payload bytes received, per kind: the socket's traffic figure (station/README.md).
+      const n = typeof e.data === 'string' ? e.data.length : e.data.byteLength;
+      const kind = typeof e.data === 'string' ? 'json' : (['', 'map', 'colour', 'depth'][new DataView(e.data).getUint8(0)] || 'other');
+      received[kind] = (received[kind] || 0) + n;
+      received.total += n;
       if (typeof e.data === 'string') {
         try { onJson(JSON.parse(e.data)); } catch (err) { console.warn('bad update', err); }
       } else {
@@ -394,6 +400,7 @@
   // What tests and measurements read (test/station/browser/check.js).
   window.station = {
     cellCount: () => map.count,
+    received: () => Object.assign({}, received),
     vehiclePosition: () => (vehicle.visible ? [vehicle.position.x, vehicle.position.y, vehicle.position.z] : null),
     healthNames: () => state.health.map((p) => p.name),
     lastNotice: () => state.notice,
@@ -403,6 +410,24 @@
     worldToClient,
     // Frames the map's message path (applyMap) exactly as the socket does; for measurements.
     applyMapMessage: (buffer) => applyMap(buffer),
+    // Renders a frame and reads it back at once (the drawing buffer is not kept between
+    // frames, which software GL would pay for on every frame): how much of the canvas is not
+    // the background, and how many colours it holds.
+    canvasStats: () => {
+      renderer.render(scene, camera);
+      const gl = renderer.getContext();
+      const w = gl.drawingBufferWidth, h = gl.drawingBufferHeight;
+      const d = new Uint8Array(w * h * 4);
+      gl.readPixels(0, 0, w, h, gl.RGBA, gl.UNSIGNED_BYTE, d);
+      const bg = [d[0], d[1], d[2]];
+      let other = 0;
+      const colours = new Set();
+      for (let i = 0; i < d.length; i += 4) {
+        if (Math.abs(d[i] - bg[0]) + Math.abs(d[i + 1] - bg[1]) + Math.abs(d[i + 2] - bg[2]) > 24) other += 1;
+        if (colours.size < 5000) colours.add((d[i] << 16) | (d[i + 1] << 8) | d[i + 2]);
+      }
+      return { width: w, height: h, non_background: other / (w * h), colours: colours.size };
+    },
     lookAt: (x, y, z, fromX, fromY, fromZ) => {
       controls.target.set(x, y, z); camera.position.set(fromX, fromY, fromZ); controls.update();
     },

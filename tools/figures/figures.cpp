@@ -46,6 +46,7 @@ const std::vector<std::pair<std::string, std::string>> kReadmes = {
     {"replay", "tools/replay/README.md"},
     {"launch", "tools/launch/README.md"},
     {"fuzz", "fuzz/README.md"},
+    {"station", "station/README.md"},
 };
 
 const std::set<std::string> kKeys = {"id",   "component", "table", "figure", "data",  "value",   "unit",

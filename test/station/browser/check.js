@@ -3,8 +3,9 @@
 // writes what it saw as JSON for the test to judge (test/station/browser_test.cpp). It judges
 // nothing itself: a timeout only ends the wait, and the test then finds the values wrong.
 //
-//   node check.js --url URL --out RESULT.json --screenshot PNG --cells N --vehicle x,y,z
+//   node check.js --url URL [--size 1280x800] --out RESULT.json --screenshot PNG --cells N --vehicle x,y,z
 //                 --processes a,b --goal x,y,z --refused-goal x,y,z [--chromium PATH]
+// Also --watch S: instead, stay connected S seconds and report the bytes received per kind.
 // Also --fps N: instead, load N synthetic cells through the page's map path and measure the
 // frame rate for 5 s (the performance figure; station/README.md).
 'use strict';
@@ -29,24 +30,10 @@ async function waitUntil(page, fn, arg, timeoutMs) {
   }
 }
 
-// How much of the canvas is not the background, and how many colours it holds.
+// How much of the canvas is not the background, and how many colours it holds (the page
+// renders a frame and reads it back: station.canvasStats).
 async function canvasContent(page) {
-  return page.evaluate(() => {
-    const src = document.querySelector('#view canvas');
-    const c = document.createElement('canvas');
-    c.width = src.width; c.height = src.height;
-    const ctx = c.getContext('2d');
-    ctx.drawImage(src, 0, 0);
-    const d = ctx.getImageData(0, 0, c.width, c.height).data;
-    const bg = [d[0], d[1], d[2]];
-    let other = 0;
-    const colours = new Set();
-    for (let i = 0; i < d.length; i += 4) {
-      if (Math.abs(d[i] - bg[0]) + Math.abs(d[i + 1] - bg[1]) + Math.abs(d[i + 2] - bg[2]) > 24) other += 1;
-      if (colours.size < 5000) colours.add((d[i] << 16) | (d[i + 1] << 8) | d[i + 2]);
-    }
-    return { width: c.width, height: c.height, non_background: other / (d.length / 4), colours: colours.size };
-  });
+  return page.evaluate(() => window.station.canvasStats());
 }
 
 async function measureFps(page, cells) {
@@ -90,11 +77,21 @@ async function measureFps(page, cells) {
   const result = { console: [] };
   try {
     const page = await browser.newPage();
-    await page.setViewport({ width: 1280, height: 800 });
+    const [width, height] = (a.size || '1280x800').split('x').map(Number);
+    await page.setViewport({ width, height });
     page.on('console', (m) => result.console.push(m.type() + ': ' + m.text()));
     page.on('pageerror', (e) => result.console.push('pageerror: ' + e.message));
     await page.goto(a.url, { waitUntil: 'load', timeout: 15000 });
     result.webgl = await page.evaluate(() => !!document.querySelector('#view canvas').getContext('webgl'));
+    if (a.watch) {
+      // Stay connected for --watch seconds and say what crossed the socket.
+      await sleep(1000 * Number(a.watch));
+      result.received = await page.evaluate(() => window.station.received());
+      result.cells = await page.evaluate(() => window.station.cellCount());
+      result.map_info = await page.evaluate(() => window.station.mapInfo());
+      if (a.screenshot) await page.screenshot({ path: a.screenshot });
+      return;
+    }
     if (a.fps) {
       Object.assign(result, await measureFps(page, Number(a.fps)));
       if (a.screenshot) await page.screenshot({ path: a.screenshot });
