@@ -75,6 +75,7 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--truth-frame", e.truth_frame, "frame_id of /kestrel/ground_truth (the truth's world)")
       ->capture_default_str();
+  app.add_flag("--map-free", e.map_free, "Also MAP_OCTOMAP's free cells, as /kestrel/map/free (many points)");
   app.add_flag("--images", e.images, "Also CAMERA_RGBD: colour (rgb8), depth (16UC1 mm), CameraInfo (big)");
   return app.run(argc, argv, [&] { return run(o); });
 }

@@ -12,14 +12,10 @@
 #include <tf2_msgs/TFMessage.h>
 
 #include "common/error.h"
-#include "common/rgbd_frame.h"
 #include "common/time.h"
 #include "common/transport/channels.h"
-#include "common/transport/convert.h"
-#include "common/transport/message.h"
 #include "drivers/tum/association.h"
-#include "kestrel/ground_truth_t.hpp"
-#include "kestrel/imu_t.hpp"
+#include "ros/camera_source.h"
 #include "ros/legacy_camera_info.h"
 #include "ros/ros_convert.h"
 
@@ -160,11 +156,6 @@ std::vector<Pose> poses_from_tf(const std::map<std::string, Edge>& edges, const 
   return poses;
 }
 
-bool same_camera(const PinholeCamera& a, const PinholeCamera& b) {
-  return a.width == b.width && a.height == b.height && a.fx == b.fx && a.fy == b.fy && a.cx == b.cx &&
-         a.cy == b.cy && a.distortion == b.distortion;
-}
-
 BagImportStats import(rosbag::Bag& bag, const std::string& path, const BagImportOptions& o, const ImportSink& sink) {
   BagImportStats stats;
   Topics topics;
@@ -207,17 +198,10 @@ BagImportStats import(rosbag::Bag& bag, const std::string& path, const BagImport
     stats.stopped = true;
     return stats;
   }
-  if (colour_w != depth_w || colour_h != depth_h)
-    throw InputError(path + ": " + o.depth_topic + ": depth images are " + std::to_string(depth_w) + "x" +
-                     std::to_string(depth_h) + ", the colour images on " + o.colour_topic + " " +
-                     std::to_string(colour_w) + "x" + std::to_string(colour_h) +
-                     " (kestrel needs depth registered to the colour camera)");
+  check_depth_size(colour_w, colour_h, depth_w, depth_h, o, path);
 
   if (o.intrinsics) {
-    stats.camera = *o.intrinsics;
-    stats.camera.width = colour_w;
-    stats.camera.height = colour_h;
-    stats.camera.validate("--intrinsics");
+    stats.camera = intrinsics_camera(*o.intrinsics, colour_w, colour_h);
   } else {
     if (!topics.has(o.camera_info_topic))
       throw InputError(path + ": " + o.camera_info_topic + ": no such topic (the colour camera's CameraInfo; give "
@@ -240,10 +224,7 @@ BagImportStats import(rosbag::Bag& bag, const std::string& path, const BagImport
       }
     }
     if (stats.camera_infos == 0) throw InputError(path + ": " + o.camera_info_topic + ": no CameraInfo message");
-    if (stats.camera.width != colour_w || stats.camera.height != colour_h)
-      throw InputError(path + ": " + o.camera_info_topic + ": CameraInfo is " + std::to_string(stats.camera.width) +
-                       "x" + std::to_string(stats.camera.height) + ", the images on " + o.colour_topic + " " +
-                       std::to_string(colour_w) + "x" + std::to_string(colour_h));
+    check_camera_size(stats.camera, colour_w, colour_h, o, path);
   }
 
   std::vector<ImuReading> imu;
@@ -375,27 +356,12 @@ BagImportStats import(rosbag::Bag& bag, const std::string& path, const BagImport
       const Event& e = events[next];
       if (e.kind == Kind::kImu) {
         const ImuReading& r = imu[e.index];
-        kestrel::imu_t m{};
-        m.utime = r.utime;
-        m.seq = imu_seq++;
-        m.fields = static_cast<int8_t>((r.has_gyro ? kestrel::imu_t::HAS_GYRO : 0) | (r.has_accel ? kestrel::imu_t::HAS_ACCEL : 0));
-        for (int k = 0; k < 3; ++k) {
-          m.angular_velocity[k] = r.angular_velocity[k];
-          m.linear_acceleration[k] = r.linear_acceleration[k];
-        }
-        sink.publish(channel::kImu, r.utime, transport::encode_message(m));
+        sink.publish(channel::kImu, r.utime, imu_message(r, imu_seq++));
         ++stats.imu_samples;
         continue;
       }
       if (e.kind == Kind::kGroundTruth) {
-        kestrel::ground_truth_t m{};
-        m.utime = poses[e.index].utime;
-        // The import's body is the camera (T_body_camera = identity), so the camera's pose is
-        // also the body's; FRAME_CAMERA says which it is, as TUM's truth does.
-        m.frame = kestrel::ground_truth_t::FRAME_CAMERA;
-        m.T_world_frame = transport::to_message(poses[e.index].T);
-        m.fields = 0;
-        sink.publish(channel::kGroundTruth, m.utime, transport::encode_message(m));
+        sink.publish(channel::kGroundTruth, poses[e.index].utime, ground_truth_message(poses[e.index].utime, poses[e.index].T));
         ++stats.ground_truth_poses;
         continue;
       }
@@ -403,18 +369,13 @@ BagImportStats import(rosbag::Bag& bag, const std::string& path, const BagImport
       const auto c = colour_ready.find(e.index);
       const auto d = depth_ready.find(p.b);
       if (c == colour_ready.end() || d == depth_ready.end()) return;  // not read yet
-      RgbdFrame f;
-      f.utime = colour_times[p.a];
-      f.depth_utime = depth_times[p.b];
-      f.seq = static_cast<int64_t>(p.a);
-      f.camera = stats.camera;
-      f.sensor = o.sensor;
-      f.rgb = c->second;
-      f.depth_mm = d->second;
-      sink.publish(channel::kCameraRgbd, f.utime, transport::encode_message(transport::encode_rgbd(f, o.encoding)));
+      const int64_t colour_utime = colour_times[p.a];
+      sink.publish(channel::kCameraRgbd, colour_utime,
+                   frame_message(colour_utime, depth_times[p.b], static_cast<int64_t>(p.a), stats.camera, c->second,
+                                 d->second, o));
       ++stats.frames;
       colour_ready.erase(c);
-      pair_of_colour.erase(f.utime);  // a repeated stamp later is not read again
+      pair_of_colour.erase(colour_utime);  // a repeated stamp later is not read again
       if (--depth_users[p.b] == 0) depth_ready.erase(d);
     }
   };

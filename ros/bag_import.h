@@ -39,25 +39,17 @@
 #include <vector>
 
 #include "common/camera.h"
-#include "common/transport/rgbd_codec.h"
+#include "ros/camera_source.h"
 
 namespace kestrel::ros1 {
 
-/// Defaults read TUM RGB-D's own bags (rgbd_dataset_freiburg*_*.bag, recorded with a Kinect
-/// through openni_camera; https://vision.in.tum.de/data/datasets/rgbd-dataset/file_formats).
-struct BagImportOptions {
-  std::string colour_topic = "/camera/rgb/image_color";
-  std::string depth_topic = "/camera/depth/image";
-  std::string camera_info_topic = "/camera/rgb/camera_info";
-  std::string imu_topic = "/imu";       ///< "" = none
+/// The camera's topics and what the frames say (camera_source.h; the defaults read TUM RGB-D's
+/// own bags), and where the ground truth is.
+struct BagImportOptions : CameraTopicOptions {
   std::string tf_topic = "/tf";         ///< "" = none
   std::string pose_topic;               ///< geometry_msgs/PoseStamped ground truth; "" = from tf
   std::string world_frame = "world";    ///< the ground truth's world (TUM: the mocap's)
   std::string camera_frame = "openni_rgb_optical_frame";  ///< the frame whose pose is the truth
-  std::string sensor = "kinect1";       ///< RgbdFrame::sensor (the VO's camera profile)
-  int64_t max_difference_us = 20000;    ///< largest |t_colour - t_depth| of a frame (TUM's 20 ms)
-  std::optional<PinholeCamera> intrinsics;  ///< instead of the CameraInfo (size from the images)
-  transport::RgbdEncoding encoding;
 };
 
 struct BagImportStats {

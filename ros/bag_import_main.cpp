@@ -16,8 +16,8 @@
 #include "common/error.h"
 #include "common/interrupt.h"
 #include "common/transport/log_file.h"
-#include "drivers/kinect/encoding_options.h"
 #include "ros/bag_import.h"
+#include "ros/camera_cli.h"
 
 namespace {
 
@@ -26,10 +26,8 @@ using namespace kestrel;
 struct Options {
   std::string bag;
   std::string log;
-  double max_dt_s = 0.02;
-  std::vector<double> intrinsics;
   ros1::BagImportOptions import;
-  kinect::EncodingOptions encoding;
+  ros1::CameraTopicCli camera;
 };
 
 int run(Options& o) {
@@ -38,9 +36,7 @@ int run(Options& o) {
   // invalid TCPROS header ...") through console_bridge; the exception they then throw ends in
   // kestrel's one error line, which says the same, so they are silenced.
   console_bridge::setLogLevel(console_bridge::CONSOLE_BRIDGE_LOG_NONE);
-  o.import.max_difference_us = std::llround(o.max_dt_s * 1e6);
-  o.import.intrinsics = cli::intrinsics_option(o.intrinsics);
-  o.import.encoding = o.encoding.encoding();
+  o.camera.apply(o.import);
 
   // The log goes to a temporary beside its name and replaces it only once the whole bag was
   // read: a bad bag found half-way (its index, a message) leaves no log that looks whole.
@@ -69,7 +65,7 @@ int run(Options& o) {
             << (o.import.intrinsics ? "--intrinsics" : o.import.camera_info_topic) << "\n"
             << "frames written: " << s.frames << " (colour images " << s.colour_images << ", depth images "
             << s.depth_images << ")\n"
-            << "colour images without a depth image within " << o.max_dt_s << " s: " << s.unmatched_colour << "\n"
+            << "colour images without a depth image within " << o.camera.max_dt_s() << " s: " << s.unmatched_colour << "\n"
             << "unused depth images: " << s.unused_depth << "\n"
             << "depth images serving two colour images: " << s.shared_depth << "\n"
             << "images dropped for a repeated stamp: " << s.repeated_stamps << "\n"
@@ -79,7 +75,7 @@ int run(Options& o) {
             << "ground-truth poses written: " << s.ground_truth_poses << " (" << s.ground_truth << ")\n"
             << "time taken: " << seconds << " s\n";
   if (s.unmatched_colour > 0)
-    spdlog::warn("{}: {} colour images have no depth image within {} s and were skipped", o.bag, s.unmatched_colour, o.max_dt_s);
+    spdlog::warn("{}: {} colour images have no depth image within {} s and were skipped", o.bag, s.unmatched_colour, o.camera.max_dt_s());
   if (s.camera_info_changes > 0)
     spdlog::warn("{}: {} CameraInfo messages differ from the first, which every frame uses", o.bag, s.camera_info_changes);
   return kExitOk;
@@ -94,26 +90,12 @@ int main(int argc, char** argv) {
   auto& i = o.import;
   app.add_option("bag", o.bag, "ROS 1 bag file (.bag)")->required();
   app.add_option("--log", o.log, "Write the LCM log here (atomically)")->required();
-  app.add_option("--colour-topic", i.colour_topic, "sensor_msgs/Image, rgb8, bgr8 or mono8")->capture_default_str();
-  app.add_option("--depth-topic", i.depth_topic, "sensor_msgs/Image registered to colour, 16UC1 mm or 32FC1 m")
-      ->capture_default_str();
-  app.add_option("--camera-info-topic", i.camera_info_topic, "sensor_msgs/CameraInfo of the colour camera")
-      ->capture_default_str();
-  app.add_option("--imu-topic", i.imu_topic, "sensor_msgs/Imu (\"\" or an absent topic: no IMU)")->capture_default_str();
+  o.camera.add_to(app, i);
   app.add_option("--tf-topic", i.tf_topic, "tf2_msgs/TFMessage for the ground truth (and <topic>_static)")
       ->capture_default_str();
   app.add_option("--pose-topic", i.pose_topic, "geometry_msgs/PoseStamped ground truth instead of tf");
   app.add_option("--world-frame", i.world_frame, "Ground truth: the world frame (tf)")->capture_default_str();
   app.add_option("--camera-frame", i.camera_frame, "Ground truth: the frame whose pose is the truth (tf)")
       ->capture_default_str();
-  app.add_option("--sensor", i.sensor, "Sensor model the frames name (kinect1, simulator, \"\" = unknown)")
-      ->capture_default_str();
-  app.add_option("--max-dt", o.max_dt_s, "Largest colour-depth time difference of a frame, seconds")
-      ->check(CLI::Range(0.0, 1.0))
-      ->capture_default_str();
-  app.add_option("--intrinsics", o.intrinsics, "fx,fy,cx,cy instead of the CameraInfo (no distortion)")
-      ->expected(4)
-      ->delimiter(',');
-  o.encoding.add_to(app);
   return app.run(argc, argv, [&] { return run(o); });
 }

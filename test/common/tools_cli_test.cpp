@@ -1,5 +1,5 @@
 // Every tool the multi-call executable lists (kestrel-tools --help), and those that are
-// executables of their own (bag-import, bag-export) where built, as a user runs it: its
+// executables of their own (bag-import, bag-export, ros-bridge) where built, as a user runs it: its
 // --print-config read back with --config prints the same text, also with every default it
 // shows uncommented; --print-config, --config and --help are never in that file; a non-finite
 // value for any floating-point option and an unknown option are usage errors (exit 2). Each run
@@ -62,7 +62,7 @@ class EveryTool : public ::testing::Test {
       if (line.rfind("  ", 0) == 0) tools_.push_back(line.substr(2));
     ASSERT_GE(tools_.size(), 20u) << list.out;
     // The tools that are executables of their own (ros/: ROS's libraries), where built.
-    for (const char* own : {"bag-import", "bag-export"})
+    for (const char* own : {"bag-import", "bag-export", "ros-bridge"})
       if (fs::exists(test::tool(own))) tools_.push_back(own);
     fs::create_directory(dir_ / "seq");
     std::ofstream(dir_ / "empty.file").flush();
