@@ -102,6 +102,13 @@ AdapterOutputs SlamAdapter::on_state(const kestrel::state_t& state) {
     throw InputError(options_.state_channel + ": state " + std::to_string(state.utime) +
                      " is not newer than the previous one");
   }
+  if (last_state_seq_ < 0 && map_loaded_) {
+    // On a saved map every estimator is new to the map's world: like a restarted one, it gets
+    // a correction at the first frame not older than its first state once the camera is placed
+    // (the relocalising frame may come before the filter has started, which then drops it).
+    restart_correction_due_ = true;
+    restart_state_utime_ = state.utime;
+  }
   if (last_state_seq_ >= 0 && state.seq < last_state_seq_) {
     // A new estimator (its seq starts again): its world is its own until SLAM's first
     // correction moves it onto the map's (estimator.h), so the map's world stays, the old
@@ -250,13 +257,16 @@ AdapterOutputs SlamAdapter::process(const kestrel::rgbd_frame_t& message, const 
     try_anchor(out);
     return out;
   }
-  if (step.keyframe) out.graph = graph_message(slam_);
+  // Placed in a saved map: the map's graph goes out too, so that the mapper (restored from its
+  // journal) publishes the map the planner flies in before this flight makes a keyframe.
+  if (step.keyframe || step.relocalised) out.graph = graph_message(slam_);
   out.step = step;
   try_anchor(out);
   // A correction is a pose in the estimator's world: none before the graph is anchored in it
   // (in SLAM's odometry frame it would pull the state by the frames' difference). A frame
   // re-anchored on the map is located in it: that is a correction too.
-  const bool new_estimator_waits = restart_correction_due_ && message.utime >= restart_state_utime_;
+  // Strictly after: the filter takes a correction only after its oldest state (estimator.cpp).
+  const bool new_estimator_waits = restart_correction_due_ && message.utime > restart_state_utime_;
   if ((step.optimisation || step.reanchored || step.relocalised || new_estimator_waits) && anchored_) {
     out.correction = correction_message(slam_, options_.correction_sigma_m, options_.correction_sigma_rad);
     if (new_estimator_waits) restart_correction_due_ = false;
@@ -266,7 +276,7 @@ AdapterOutputs SlamAdapter::process(const kestrel::rgbd_frame_t& message, const 
 
 void SlamAdapter::correct_new_estimator(int64_t utime, const ChainedPose& chained, OdometryLink link,
                                         AdapterOutputs& out) {
-  if (!restart_correction_due_ || !anchored_ || utime < restart_state_utime_) return;
+  if (!restart_correction_due_ || !anchored_ || !slam_.localized() || utime <= restart_state_utime_) return;
   if (link != OdometryLink::kContinuous || !reference_pose_ || !last_pose_) return;
   const std::optional<Matrix6d> odometry = chain_.relative_covariance(*reference_pose_, chained.pose);
   if (!odometry) return;

@@ -19,6 +19,8 @@
 //
 // A saved map (kestrel-slam --map): its world is the world from the start; nothing is
 // anchored, and the frame that relocalises the camera in it sends the first SLAM_CORRECTION.
+// The estimator is new to that world, as a restarted one (below): once the camera is placed,
+// the first frame not older than its first state gets a correction too.
 //
 // Estimator restarts: a restarted estimator (its STATE seq starts again) begins a world of its
 // own; SLAM keeps the map's, drops the old filter's states, and sends a SLAM_CORRECTION for the
