@@ -57,6 +57,19 @@ class RosRejections {
   std::chrono::steady_clock::time_point last_log_{};
 };
 
+// A publisher of another type on a topic the bridge reads: roscpp refuses it connection by
+// connection, in its own log, and the bridge would wait for frames that never come. The
+// master's list of topics names the type: that is a stream that can give no frame.
+void check_topic_types(const std::vector<ros::Subscriber>& subscribers, const std::vector<std::string>& types) {
+  ros::master::V_TopicInfo topics;
+  if (!ros::master::getTopics(topics)) return;  // the master is gone: the caller reports that
+  for (const ros::master::TopicInfo& t : topics)
+    for (size_t i = 0; i < subscribers.size(); ++i)
+      if (t.name == subscribers[i].getTopic() && t.datatype != types[i])
+        throw StreamError("ros-bridge: " + t.name + ": published as " + t.datatype + ", not " + types[i] +
+                          " (another topic? see `rostopic list -v`)");
+}
+
 // How long the camera is silent before its waiting colour images are decided: several frame
 // periods of a 30 Hz camera, far longer than a depth image arrives behind its colour image.
 constexpr std::chrono::milliseconds kQuietCamera{250};
@@ -82,6 +95,7 @@ BridgeSummary run_bridge(const BridgeOptions& o) {
     node.publish_bytes(channel, bytes);
   });
   std::vector<ros::Subscriber> subscribers;
+  std::vector<std::string> types;  // of each subscriber's messages
   // Each callback: a bad message is dropped and counted; a stream that cannot give a frame ends
   // the bridge (after the callback, from the loop).
   auto guarded = [&](auto handle) {
@@ -111,6 +125,10 @@ BridgeSummary run_bridge(const BridgeOptions& o) {
     if (!c.imu_topic.empty())
       subscribers.push_back(nh.subscribe<sensor_msgs::Imu>(
           c.imu_topic, 400, guarded([&](const sensor_msgs::Imu& m) { camera.imu(m); }), ros::VoidConstPtr(), hints));
+    types = {ros::message_traits::DataType<sensor_msgs::Image>::value(),
+             ros::message_traits::DataType<sensor_msgs::Image>::value()};
+    if (!c.intrinsics) types.push_back(ros::message_traits::DataType<sensor_msgs::CameraInfo>::value());
+    if (!c.imu_topic.empty()) types.push_back(ros::message_traits::DataType<sensor_msgs::Imu>::value());
     node.advertise(channel::kCameraRgbd);
     node.advertise(channel::kImu);
   }
@@ -147,6 +165,13 @@ BridgeSummary run_bridge(const BridgeOptions& o) {
     if (const auto now = std::chrono::steady_clock::now(); now >= next_master_check) {
       next_master_check = now + std::chrono::milliseconds(static_cast<int64_t>(o.master_check_period_s * 1000));
       const bool lost = !ros::master::check();
+      if (!lost) {
+        try {
+          check_topic_types(subscribers, types);
+        } catch (const StreamError& e) {
+          fatal = e.what();
+        }
+      }
       if (lost != master_lost) {
         master_lost = lost;
         if (lost) spdlog::warn("the ROS master at {} is not reachable; waiting for it", ros::master::getURI());

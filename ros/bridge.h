@@ -12,7 +12,8 @@
 //
 // Errors: no ROS master at start is UnavailableError (exit 4) naming ROS_MASTER_URI; a camera
 // stream that can never give a frame (StreamError: an unknown encoding, an unusable
-// CameraInfo) ends the bridge with InputError naming the topic (exit 3); one bad ROS message
+// CameraInfo, a topic published with another message type) ends the bridge with InputError
+// naming the topic (exit 3); one bad ROS message
 // is dropped, counted and logged (rate-limited); a bad LCM message is counted by the Node.
 
 #include <string>
@@ -29,7 +30,7 @@ struct BridgeOptions {
   bool to_ros = true;                     ///< the LCM -> ROS side
   std::string ros_name = "kestrel_bridge";  ///< the ROS node's name
   std::string lcm_url;                    ///< "" = $LCM_DEFAULT_URL or kestrel's
-  double master_check_period_s = 2.0;     ///< how often a lost master is looked for
+  double master_check_period_s = 1.0;     ///< how often the master (and the topics' types) is looked at
 };
 
 struct BridgeSummary {

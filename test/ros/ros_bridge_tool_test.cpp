@@ -1,7 +1,8 @@
 // kestrel-ros-bridge against a real ROS master (Debian's roscore in the test's private network
 // namespace) fed by `rosbag play`: what it does with input it cannot use. No master: exit 4
 // naming the master's URI. A depth encoding it does not read, a CameraInfo with a zero focal
-// length: exit 3, one line naming the topic, and no CAMERA_RGBD published.
+// length, a topic of another message type: exit 3, one line naming the topic, and no
+// CAMERA_RGBD published.
 
 #include <gtest/gtest.h>
 
@@ -106,6 +107,32 @@ TEST(RosBridge, ACameraInfoWithZeroFocalLengthEndsItNamingTheTopic) {
       << r.log;
   EXPECT_NE(r.log.find("focal length fx=0"), std::string::npos) << r.log;
   EXPECT_EQ(r.frames, 0u);
+}
+
+TEST(RosBridge, ATopicOfAnotherMessageTypeEndsItNamingTheTopic) {
+  KESTREL_REQUIRE_ROS();
+  test::TempDir dir;
+  {
+    // CameraInfo's topic carrying Images: roscpp would refuse each connection in its own log.
+    rosbag::Bag bag((dir / "typed.bag").string(), rosbag::bagmode::Write);
+    for (int i = 0; i < 30; ++i) {
+      const int64_t t = kT0 + i * 33333;
+      const auto stamp = ros::Time(static_cast<uint32_t>(t / 1000000), static_cast<uint32_t>(t % 1000000 * 1000));
+      bag.write("/camera/rgb/camera_info", stamp, test::colour_image(t, 4, 3));
+    }
+  }
+  test::use_ros_master(dir.path());
+  test::LiveSystem system(dir.path(), frames_only());
+  ASSERT_TRUE(test::start_roscore(system));
+  system.start("bridge", {test::tool("ros-bridge").string()});
+  ASSERT_NE(system.wait_running("ros-bridge"), 0);
+  // Not --wait-for-subscribers: the bridge's subscription of another type never connects.
+  system.start("play", {"rosbag", "play", "-q", "-l", (dir / "typed.bag").string()});
+  EXPECT_EQ(system.exit_status("bridge", 30.0), 3) << system.output("bridge");
+  EXPECT_NE(system.output("bridge").find("kestrel-ros-bridge: error: ros-bridge: /camera/rgb/camera_info: published as "
+                                         "sensor_msgs/Image, not sensor_msgs/CameraInfo"),
+            std::string::npos)
+      << system.output("bridge");
 }
 
 // The control: the same bag with a usable depth encoding and calibration gives its frames.
