@@ -18,6 +18,9 @@ const std::vector<Target>& targets() {
     for (auto group : {message_targets, text_targets, image_targets, journal_targets, estimator_targets}) {
       for (Target& t : group()) v.push_back(t);
     }
+#if KESTREL_FUZZ_STATION
+    for (Target& t : station_targets()) v.push_back(t);  // built only with station/
+#endif
     return v;
   }();
   return all;
