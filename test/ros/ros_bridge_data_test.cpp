@@ -9,6 +9,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <chrono>
 #include <mutex>
 
 #include <nav_msgs/Odometry.h>
@@ -79,11 +81,15 @@ TEST(RosBridgeData, Fr1XyzPlayedIntoTheBridgeGivesImportsFramesAndTheStateOnBoth
   ros::init(ros::M_string{}, "kestrel_bridge_test", ros::init_options::NoSigintHandler | ros::init_options::AnonymousName);
   std::mutex mutex;
   std::vector<nav_msgs::Odometry> odom;
+  std::vector<int64_t> odom_received_us;  // wall clock, as LiveSystem stamps what it hears
   {
     ros::NodeHandle nh;
     ros::Subscriber sub = nh.subscribe<nav_msgs::Odometry>("/kestrel/odom", 10000, [&](const nav_msgs::Odometry::ConstPtr& m) {
       std::lock_guard<std::mutex> lock(mutex);
       odom.push_back(*m);
+      odom_received_us.push_back(std::chrono::duration_cast<std::chrono::microseconds>(
+                                     std::chrono::system_clock::now().time_since_epoch())
+                                     .count());
     });
     ros::AsyncSpinner spinner(1);
     spinner.start();
@@ -149,6 +155,13 @@ TEST(RosBridgeData, Fr1XyzPlayedIntoTheBridgeGivesImportsFramesAndTheStateOnBoth
                               last.T_world_body.position[1] - first.T_world_body.position[1],
                               last.T_world_body.position[2] - first.T_world_body.position[2]);
   EXPECT_GT(moved.norm(), 0.02);
+  // For the record, not a check: how long a STATE took from LCM to /kestrel/odom here (both
+  // heard by this process, on one clock; the bridge and this test share 2 cores with the rest).
+  std::vector<int64_t> latency_us;
+  for (size_t i = 0; i < odom.size(); ++i) latency_us.push_back(odom_received_us[i] - state_messages[i].received_utime);
+  std::sort(latency_us.begin(), latency_us.end());
+  std::cout << "STATE -> /kestrel/odom: median " << latency_us[latency_us.size() / 2] << " us, max " << latency_us.back()
+            << " us over " << latency_us.size() << "\n";
   EXPECT_EQ(system.stop("bridge"), 0) << system.output("bridge");
   std::cout << system.output("bridge");
 }
