@@ -20,6 +20,16 @@
   const controls = new THREE.OrbitControls(camera, renderer.domElement);
   controls.target.set(0, 0, 1);
   controls.update();
+  // The view follows the map's bounds until the operator turns or moves it.
+  let userMoved = false;
+  controls.addEventListener('start', () => { userMoved = true; });
+  function frameBounds(b) {
+    const c = new THREE.Vector3((b[0] + b[3]) / 2, (b[1] + b[4]) / 2, (b[2] + b[5]) / 2);
+    const r = Math.max(b[3] - b[0], b[4] - b[1], b[5] - b[2], 2);
+    controls.target.copy(c);
+    camera.position.set(c.x - 0.9 * r, c.y - 0.6 * r, c.z + 0.8 * r);  // behind and above, as the camera sees it
+    controls.update();
+  }
   const grid = new THREE.GridHelper(20, 20, 0x445566, 0x2a3038);
   grid.rotation.x = Math.PI / 2;  // GridHelper lies in x-z; the world's floor is x-y
   scene.add(grid);
@@ -272,6 +282,7 @@
         if (u.bounds) {
           cellMaterial.uniforms.zMin.value = u.bounds[2];
           cellMaterial.uniforms.zMax.value = u.bounds[5];
+          if (!userMoved) frameBounds(u.bounds);
         }
         $('mapinfo').textContent = `map: revision ${u.revision}, ${u.cells} occupied cells at ${fmt(100 * u.resolution, 0)} cm`;
         break;
@@ -407,6 +418,7 @@
     notices: () => state.notices,
     frames: () => state.frames,
     mapInfo: () => state.mapInfo,
+    plan: () => state.plan,
     worldToClient,
     // Frames the map's message path (applyMap) exactly as the socket does; for measurements.
     applyMapMessage: (buffer) => applyMap(buffer),
@@ -429,6 +441,7 @@
       return { width: w, height: h, non_background: other / (w * h), colours: colours.size };
     },
     lookAt: (x, y, z, fromX, fromY, fromZ) => {
+      userMoved = true;
       controls.target.set(x, y, z); camera.position.set(fromX, fromY, fromZ); controls.update();
     },
   };

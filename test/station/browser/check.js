@@ -5,7 +5,8 @@
 //
 //   node check.js --url URL [--size 1280x800] --out RESULT.json --screenshot PNG --cells N --vehicle x,y,z
 //                 --processes a,b --goal x,y,z --refused-goal x,y,z [--chromium PATH]
-// Also --watch S: instead, stay connected S seconds and report the bytes received per kind.
+// Also --watch S [--until-plan 1 --after A]: instead, stay connected S seconds (or until a plan
+// with a path shows, then A seconds more) and report the bytes received per kind.
 // Also --fps N: instead, load N synthetic cells through the page's map path and measure the
 // frame rate for 5 s (the performance figure; station/README.md).
 'use strict';
@@ -84,8 +85,17 @@ async function measureFps(page, cells) {
     await page.goto(a.url, { waitUntil: 'load', timeout: 15000 });
     result.webgl = await page.evaluate(() => !!document.querySelector('#view canvas').getContext('webgl'));
     if (a.watch) {
-      // Stay connected for --watch seconds and say what crossed the socket.
-      await sleep(1000 * Number(a.watch));
+      // Stay connected for --watch seconds (with --until-plan: until a plan with a path is
+      // shown, at most that long, then --after seconds more) and say what crossed the socket.
+      if (a['until-plan']) {
+        result.plan_shown = await waitUntil(page, () => {
+          const p = window.station.plan();
+          return p && p.status_name === 'OK';
+        }, null, 1000 * Number(a.watch));
+        await sleep(1000 * Number(a.after || 0));
+      } else {
+        await sleep(1000 * Number(a.watch));
+      }
       result.received = await page.evaluate(() => window.station.received());
       result.cells = await page.evaluate(() => window.station.cellCount());
       result.map_info = await page.evaluate(() => window.station.mapInfo());
