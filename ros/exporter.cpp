@@ -205,7 +205,10 @@ void Exporter::truth(const kestrel::ground_truth_t& m, const std::string& what) 
 
 // Each revision of the graph as one Path of its keyframes' optimised camera poses, in time
 // order, in the world frame (SLAM's world, which the estimator's STATE takes on); the
-// message's stamp is the newest keyframe's utime. Loop edges are not exported.
+// message's stamp is the newest keyframe's utime. Its loop closures go to /kestrel/slam/loops
+// as one LINE_LIST marker, a segment between the two keyframes' cameras per edge (an edge whose
+// keyframe the graph no longer holds is left out); a graph without one sends DELETEALL, so that
+// rviz drops the loops of a graph SLAM restarted.
 void Exporter::graph(const kestrel::slam_graph_t& g, const std::string& what) {
   nav_msgs::Path path;
   path.header.stamp = stamp_of(g.utime, what);
@@ -222,6 +225,30 @@ void Exporter::graph(const kestrel::slam_graph_t& g, const std::string& what) {
     path.poses.push_back(p);
   }
   write(topic::kKeyframes, path.header.stamp, path, /*latched=*/true);
+
+  std::map<int64_t, geometry_msgs::Point> camera_of;
+  for (size_t i = 0; i < keyframes.size(); ++i) camera_of[keyframes[i]->id] = path.poses[i].pose.position;
+  visualization_msgs::Marker loops;
+  loops.header = path.header;
+  loops.ns = "loops";
+  loops.id = 0;
+  loops.pose.orientation.w = 1.0;
+  loops.type = visualization_msgs::Marker::LINE_LIST;
+  loops.scale.x = 0.02;  // line width, metres
+  loops.color.r = 1.0f;
+  loops.color.g = 0.8f;
+  loops.color.a = 1.0f;
+  for (const kestrel::slam_edge_t& e : g.edges) {
+    if (e.kind != kestrel::slam_edge_t::KIND_LOOP_CLOSURE) continue;
+    const auto from = camera_of.find(e.from_id), to = camera_of.find(e.to_id);
+    if (from == camera_of.end() || to == camera_of.end()) continue;
+    loops.points.push_back(from->second);
+    loops.points.push_back(to->second);
+  }
+  loops.action = loops.points.empty() ? visualization_msgs::Marker::DELETEALL : visualization_msgs::Marker::ADD;
+  visualization_msgs::MarkerArray a;
+  a.markers.push_back(loops);
+  write(topic::kLoops, path.header.stamp, a, /*latched=*/true);
 }
 
 // The planner's waypoints (x, y, z, yaw) as a Path in the world frame, the body level (roll

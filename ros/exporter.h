@@ -49,6 +49,7 @@ inline constexpr const char* kTf = "/tf";
 inline constexpr const char* kVo = "/kestrel/vo";
 inline constexpr const char* kGroundTruth = "/kestrel/ground_truth";
 inline constexpr const char* kKeyframes = "/kestrel/slam/keyframes";
+inline constexpr const char* kLoops = "/kestrel/slam/loops";
 inline constexpr const char* kPlan = "/kestrel/plan";
 inline constexpr const char* kColour = "/kestrel/camera/rgb/image_raw";
 inline constexpr const char* kDepth = "/kestrel/camera/depth/image_raw";
@@ -146,7 +147,8 @@ class Exporter {
   void vo(const kestrel::vo_update_t& m, const std::string& what);
   /// /kestrel/ground_truth.
   void truth(const kestrel::ground_truth_t& m, const std::string& what);
-  /// /kestrel/slam/keyframes: each revision's keyframes as a Path.
+  /// /kestrel/slam/keyframes: each revision's keyframes as a Path; /kestrel/slam/loops: its loop
+  /// closures as line segments between keyframes.
   void graph(const kestrel::slam_graph_t& g, const std::string& what);
   /// /kestrel/plan.
   void plan(const kestrel::plan_t& m, const std::string& what);

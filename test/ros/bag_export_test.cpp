@@ -8,12 +8,14 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <tuple>
 
 #include <geometry_msgs/PoseStamped.h>
 #include <nav_msgs/Path.h>
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
 #include <tf2_msgs/TFMessage.h>
+#include <visualization_msgs/MarkerArray.h>
 
 #include "common/error.h"
 #include "common/transport/channels.h"
@@ -263,7 +265,8 @@ TEST(BagExport, VoUpdatesAreChainedAsEvalChainsThemAndTruthPassesThrough) {
   }
 }
 
-// Every SLAM_GRAPH revision is a Path of its keyframes in time order; a PLAN is a Path of its
+// Every SLAM_GRAPH revision is a Path of its keyframes in time order and a LINE_LIST of its loop
+// closures; a PLAN is a Path of its
 // waypoints (yaw as a turn about z), an unsuccessful one an empty Path.
 TEST(BagExport, GraphsAndPlansArePaths) {
   test::TempDir dir;
@@ -281,6 +284,20 @@ TEST(BagExport, GraphsAndPlansArePaths) {
         g.keyframes.push_back(kf);
       }
       g.num_keyframes = static_cast<int32_t>(g.keyframes.size());
+      // Revision 3 closes a loop from keyframe 3 to 1, and has one to a keyframe it lacks (9).
+      if (revision == 3) {
+        for (const auto& [from, to, kind] : {std::tuple{3, 1, kestrel::slam_edge_t::KIND_LOOP_CLOSURE},
+                                            std::tuple{2, 3, kestrel::slam_edge_t::KIND_ODOMETRY},
+                                            std::tuple{9, 1, kestrel::slam_edge_t::KIND_LOOP_CLOSURE}}) {
+          kestrel::slam_edge_t e{};
+          e.from_id = from;
+          e.to_id = to;
+          e.kind = kind;
+          e.T_from_to = transport::to_message(Eigen::Isometry3d::Identity());
+          g.edges.push_back(e);
+        }
+        g.num_edges = static_cast<int32_t>(g.edges.size());
+      }
       g.utime = 1000000 * revision;
       w.write_message(channel::kSlamGraph, g.utime, g);
     }
@@ -319,6 +336,19 @@ TEST(BagExport, GraphsAndPlansArePaths) {
     }
   }
   EXPECT_EQ(revision, 3);
+  // Loops: none in revisions 1 and 2 (DELETEALL), then the segment from keyframe 3 to 1.
+  std::vector<visualization_msgs::MarkerArray> loops;
+  for (const rosbag::MessageInstance& m : rosbag::View(bag, rosbag::TopicQuery("/kestrel/slam/loops")))
+    loops.push_back(*m.instantiate<visualization_msgs::MarkerArray>());
+  ASSERT_EQ(loops.size(), 3u);
+  EXPECT_EQ(loops[0].markers.at(0).action, visualization_msgs::Marker::DELETEALL);
+  const visualization_msgs::Marker& loop = loops[2].markers.at(0);
+  EXPECT_EQ(loop.action, visualization_msgs::Marker::ADD);
+  EXPECT_EQ(loop.type, visualization_msgs::Marker::LINE_LIST);
+  EXPECT_EQ(loop.header.frame_id, "map");
+  ASSERT_EQ(loop.points.size(), 2u);
+  EXPECT_NEAR(loop.points[0].x, 3.03, 1e-12);
+  EXPECT_NEAR(loop.points[1].x, 1.03, 1e-12);
   std::vector<nav_msgs::Path> plans;
   for (const rosbag::MessageInstance& m : rosbag::View(bag, rosbag::TopicQuery("/kestrel/plan")))
     plans.push_back(*m.instantiate<nav_msgs::Path>());
