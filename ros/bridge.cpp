@@ -152,6 +152,8 @@ BridgeSummary run_bridge(const BridgeOptions& o) {
         channel::kMapOctomap, [&](const kestrel::octomap_t& m) { exporter.map(m, "MAP_OCTOMAP"); }, 2);
   }
 
+  // A replay that restarts the system restarts the VO: its chain starts again here too.
+  node.on_reset([&] { exporter.reset(); });
   node.set_health(kestrel::process_status_t::STATE_RUNNING, "");
   spdlog::info("bridging ROS master {} and LCM", ros::master::getURI());
   auto next_master_check = std::chrono::steady_clock::now();

@@ -134,6 +134,12 @@ nav_msgs::Odometry odometry_from_state(const kestrel::state_t& s, const std::str
 Exporter::Exporter(ExportOptions options, RosSink& sink, ExportStats& stats)
     : o_(std::move(options)), sink_(sink), stats_(stats) {}
 
+void Exporter::reset() {
+  chain_ = eval::VoChain{};
+  last_vo_utime_.reset();
+  camera_written_ = false;
+}
+
 // The map's occupied cells (and free ones with map_free) as clouds and the occupied as cubes,
 // in the world frame at the map's utime; latched: rviz started later still shows the map.
 void Exporter::map(const kestrel::octomap_t& m, const std::string& what) {

@@ -157,6 +157,10 @@ class Exporter {
   /// The camera's mount on /tf_static (once); with `images`, the frame's images and CameraInfo.
   void camera(const kestrel::rgbd_frame_t& f, const std::string& what);
 
+  /// Forgets the VO's chain and the camera's mount, as for a new run (lock-step replay's RESET):
+  /// the VO's first frame after it starts a new chain instead of being out of order.
+  void reset();
+
   const ExportOptions& options() const { return o_; }
 
  private:

@@ -8,7 +8,9 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <tuple>
+#include <type_traits>
 
 #include <geometry_msgs/PoseStamped.h>
 #include <nav_msgs/Path.h>
@@ -479,6 +481,45 @@ TEST(BagExport, ALogWhoseMessagesGiveNothingIsAnInputError) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("nothing exportable"), std::string::npos) << e.what();
   }
+}
+
+}  // namespace
+}  // namespace kestrel
+
+namespace kestrel {
+namespace {
+
+// The Exporter forgets the VO's chain on reset() (the bridge's lock-step RESET): the VO's first
+// frame after it starts a new chain at the identity instead of being dropped as out of order,
+// and the camera's mount is sent again.
+TEST(Exporter, ResetStartsANewVoChain) {
+  std::map<std::string, int> written;
+  std::vector<double> vo_x;
+  ros1::RosSinkOf sink([&](const std::string& topic, const ros::Time&, const auto& m, bool) {
+    ++written[topic];
+    if constexpr (std::is_same_v<std::decay_t<decltype(m)>, nav_msgs::Odometry>) vo_x.push_back(m.pose.pose.position.x);
+  });
+  ros1::ExportStats stats;
+  ros1::Exporter exporter({}, sink, stats);
+  auto update = [](int64_t utime, int64_t reference, int8_t status, double x) {
+    kestrel::vo_update_t m{};
+    m.utime = utime;
+    m.reference_utime = reference;
+    m.status = status;
+    m.T_reference_current = transport::to_message(Eigen::Isometry3d(Eigen::Translation3d(x, 0, 0)));
+    m.T_body_camera = transport::to_message(Eigen::Isometry3d::Identity());
+    return m;
+  };
+  exporter.vo(update(1000000, 0, kestrel::vo_update_t::STATUS_NO_REFERENCE, 0), "VO_UPDATE");
+  exporter.vo(update(2000000, 1000000, kestrel::vo_update_t::STATUS_OK, 0.5), "VO_UPDATE");
+  exporter.vo(update(1000000, 0, kestrel::vo_update_t::STATUS_NO_REFERENCE, 0), "VO_UPDATE");  // old: dropped
+  EXPECT_EQ(stats.vo_out_of_order, 1);
+  exporter.reset();
+  exporter.vo(update(1000000, 0, kestrel::vo_update_t::STATUS_NO_REFERENCE, 0), "VO_UPDATE");
+  exporter.vo(update(2000000, 1000000, kestrel::vo_update_t::STATUS_OK, 0.25), "VO_UPDATE");
+  EXPECT_EQ(stats.vo_out_of_order, 1);
+  EXPECT_EQ(vo_x, (std::vector<double>{0, 0.5, 0, 0.25}));
+  EXPECT_EQ(written["/tf_static"], 2);
 }
 
 }  // namespace
