@@ -98,9 +98,9 @@ visualization_msgs::MarkerArray voxel_markers(const MapCells& cells, const std::
     m.colors.reserve(cells.occupied.size());
     for (const auto& p : cells.occupied) {
       geometry_msgs::Point q;
-      q.x = p.x();
-      q.y = p.y();
-      q.z = p.z();
+      q.x = static_cast<double>(p.x());
+      q.y = static_cast<double>(p.y());
+      q.z = static_cast<double>(p.z());
       m.points.push_back(q);
       // Blue (low) to red (high): the cubes' height reads at a glance.
       const float h = z_max > z_min ? (p.z() - z_min) / (z_max - z_min) : 0.5f;
