@@ -123,14 +123,54 @@
     pointGeometry.setAttribute('cell', map.pointAttr);
     pointGeometry.setAttribute('position', map.pointAttr);  // sets the draw count; the shader reads `cell`
   }
-  // Cubes or squares, whichever suits the count; only the one drawn is uploaded.
+  // Above kPointBudget cells, each square stands for a block of 2^L x 2^L x 2^L cells, the
+  // smallest L that keeps the squares within the budget (OctoMap's levels up, as octovis draws
+  // a map at a chosen depth): software GL's cost is per primitive, and a map's surfaces have
+  // about 4^L times fewer blocks than cells. The page still holds every cell (cellCount); only
+  // the drawing is coarser.
+  const kPointBudget = 25000;
+  const coarse = { geometry: new THREE.BufferGeometry(), data: null, pending: false, blocks: 0, level: 0 };
+  const coarsePoints = new THREE.Points(coarse.geometry, pointMaterial);
+  coarsePoints.frustumCulled = false;
+  coarsePoints.visible = false;
+  scene.add(coarsePoints);
+  function blocksAt(level) {
+    const seen = new Set();
+    const out = [];
+    const e = map.data[3] * (1 << level);
+    for (let i = 0; i < map.count; ++i) {
+      const ix = Math.floor(map.data[4 * i] / e), iy = Math.floor(map.data[4 * i + 1] / e), iz = Math.floor(map.data[4 * i + 2] / e);
+      const key = (ix + 32768) + 65536 * ((iy + 32768) + 65536 * (iz + 512));
+      if (seen.has(key)) continue;
+      seen.add(key);
+      out.push((ix + 0.5) * e, (iy + 0.5) * e, (iz + 0.5) * e, e);
+    }
+    return out;
+  }
+  function buildCoarse() {
+    coarse.pending = false;
+    let level = 1, out = blocksAt(level);
+    while (out.length / 4 > kPointBudget && level < 4) out = blocksAt(++level);
+    coarse.data = new Float32Array(out);
+    coarse.geometry.setAttribute('cell', new THREE.BufferAttribute(coarse.data, 4));
+    coarse.geometry.setAttribute('position', coarse.geometry.getAttribute('cell'));
+    coarse.blocks = out.length / 4;
+    coarse.level = level;
+  }
+  // Cubes, squares or blocks, whichever suits the count; only what is drawn is uploaded.
   function showCells() {
-    const cubes = map.count <= kCubesUpTo;
+    const cubes = map.count <= kCubesUpTo, blocks = map.count > kPointBudget;
     cellMesh.visible = cubes;
-    cellPoints.visible = !cubes;
+    cellPoints.visible = !cubes && !blocks;
+    coarsePoints.visible = blocks;
     cellGeometry.maxInstancedCount = cubes ? map.count : 0;
-    pointGeometry.setDrawRange(0, cubes ? 0 : map.count);
-    (cubes ? map.attr : map.pointAttr).needsUpdate = true;
+    pointGeometry.setDrawRange(0, cubes || blocks ? 0 : map.count);
+    if (cubes) map.attr.needsUpdate = true;
+    else if (!blocks) map.pointAttr.needsUpdate = true;
+    else if (!coarse.pending) {  // at most one rebuild a half second, off the socket's handler
+      coarse.pending = true;
+      setTimeout(buildCoarse, coarse.data ? 500 : 0);
+    }
   }
   reserve(1024);
   function cellKey(w, i) { return w[i] + ',' + w[i + 1] + ',' + w[i + 2] + ',' + w[i + 3]; }
@@ -411,6 +451,7 @@
   // What tests and measurements read (test/station/browser/check.js).
   window.station = {
     cellCount: () => map.count,
+    drawn: () => (coarsePoints.visible ? { blocks: coarse.blocks, level: coarse.level } : null),
     received: () => Object.assign({}, received),
     vehiclePosition: () => (vehicle.visible ? [vehicle.position.x, vehicle.position.y, vehicle.position.z] : null),
     healthNames: () => state.health.map((p) => p.name),

@@ -63,7 +63,8 @@ async function measureFps(page, cells) {
   const t0 = Date.now();
   await sleep(5000);
   const f1 = await page.evaluate(() => window.station.frames());
-  return { cells: await page.evaluate(() => window.station.cellCount()), fps: (f1 - f0) / ((Date.now() - t0) / 1000) };
+  return { cells: await page.evaluate(() => window.station.cellCount()), drawn: await page.evaluate(() => window.station.drawn()),
+           fps: (f1 - f0) / ((Date.now() - t0) / 1000) };
 }
 
 (async () => {
