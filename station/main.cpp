@@ -96,7 +96,9 @@ int serve(Options& o) {
     }
   } counter{&st};
   lcm::Subscription* all = node.lcm().subscribeFunction(".*", &Counter::on, &counter);
-  if (all) all->setQueueCapacity(1000);
+  // Every message waits here too, camera frames included (1.5 MB raw): a short queue bounds
+  // what a stalled station holds; a rate counted short then is the price.
+  if (all) all->setQueueCapacity(64);
 
   station::WebServer server(o.web, hub);
   const std::string url = "http://" + (o.web.bind.find(':') != std::string::npos ? "[" + o.web.bind + "]" : o.web.bind) +
