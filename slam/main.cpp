@@ -251,7 +251,7 @@ int serve(const Options& o, const SlamOptions& options, std::shared_ptr<const Vo
   spdlog::info("{}: {} + {} -> {}, {}", o.name, o.adapter.camera_channel, o.adapter.vo_channel,
                o.graph_channel, o.correction_channel);
   const int status = node->spin();
-  report_relocalisation(adapter.slam().relocalisation(), map != nullptr);
+  if (map && !adapter.slam().relocalisation()) report_relocalisation(std::nullopt, true);  // placed: said when it was
   if (!o.save_map.empty()) save_map(o.save_map, adapter.slam().map(), "kestrel-slam (process " + o.name + ")");
   const auto& misses = adapter.slam().coverage_misses();
   spdlog::info("{} keyframes ({} thinned, features {:.1f} MB), {} loop closures, {} frames re-anchored on a "

@@ -154,6 +154,30 @@ TEST(ProcessSets, ASideLaunchedAloneStartsAsARestartDoes) {
   EXPECT_EQ(command_of_start(set[1], 0), (std::vector<std::string>{"vo"}));
 }
 
+// kestrel launch --map DIR: SLAM saves (and, with a map there, loads) it, the mapper journals in
+// it, and on an existing map every estimator awaits the map's world, its first start too.
+TEST(ProcessSets, ASavedMapIsWiredIntoSlamTheMapperAndTheEstimator) {
+  const ProcessSet shipped = read_process_sets(KESTREL_DEFAULT_PROCESS_SETS);
+  auto args_of = [](const ProcessSet& set, const std::string& name) {
+    for (const auto& p : set)
+      if (p.name == name) return p;
+    ADD_FAILURE() << name;
+    return ProcessSpec{};
+  };
+  const ProcessSet first = with_saved_map(shipped, "/maps/b1", false, 30.0);
+  EXPECT_EQ(args_of(first, "slam").argv, (std::vector<std::string>{"slam", "--save-map", "/maps/b1"}));
+  EXPECT_EQ(args_of(first, "mapper").argv, (std::vector<std::string>{"mapper", "--journal", "/maps/b1/mapper.journal"}));
+  EXPECT_EQ(args_of(first, "estimator").argv, args_of(shipped, "estimator").argv) << "the first flight defines the world";
+  const ProcessSet again = with_saved_map(shipped, "/maps/b1", true, 30.0);
+  EXPECT_EQ(args_of(again, "slam").argv,
+            (std::vector<std::string>{"slam", "--map", "/maps/b1", "--save-map", "/maps/b1"}));
+  const ProcessSpec estimator = args_of(again, "estimator");
+  EXPECT_EQ(estimator.argv, (std::vector<std::string>{"estimator", "--await-world", "30"}));
+  EXPECT_TRUE(estimator.restart_args.empty()) << "a restart awaits the map's world as long, once";
+  EXPECT_EQ(command_of_start(estimator, 2), estimator.argv);
+  EXPECT_EQ(args_of(again, "vo").argv, args_of(shipped, "vo").argv);
+}
+
 TEST(ResolveExecutable, PrefersKestrelToolsThenPath) {
   TempDir dir;
   const auto tool = dir / "kestrel-thing";

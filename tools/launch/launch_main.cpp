@@ -60,6 +60,8 @@ struct Options {
   std::string log_dir;
   double status_period_s = 10.0;
   bool list = false;
+  std::string map;  // a building's saved map (slam.map, mapper.journal)
+  double await_map_s = 30.0;
 };
 
 // LCM 1.3 takes member functions, not lambdas.
@@ -106,6 +108,15 @@ int launch(const Options& o) {
     std::vector<std::string> link_argv = {"link", "--offboard-netns", kOffboardNetns, "--stats", "{log_dir}/link.json"};
     for (auto& a : split_command(o.link_options)) link_argv.push_back(std::move(a));
     set.insert(set.begin(), {{"link", link_argv, "link"}, {"rgbd-codec", {"rgbd-codec", "--max-rate", fmt::format("{:g}", o.link_frame_rate)}, "onboard"}});
+  }
+  if (!o.map.empty()) {
+    const bool exists = fs::is_regular_file(fs::path(o.map) / "slam.map");
+    std::error_code ec;
+    fs::create_directories(o.map, ec);  // the mapper's journal goes there from the start
+    if (ec) throw kestrel::InputError(o.map + ": cannot make the map's folder (" + ec.message() + ")");
+    set = with_saved_map(std::move(set), o.map, exists, o.await_map_s);
+    spdlog::info("{}: {}", o.map, exists ? "flying in its saved map (SLAM relocalises the vehicle in it), saved again on exit"
+                                         : "no map yet: this flight's is saved there on exit");
   }
   if (!o.source.empty()) {
     set.push_back({"source", split_command(o.source), "source"});
@@ -330,6 +341,14 @@ int main(int argc, char** argv) {
   app.add_option("--status-period", o.status_period_s, "Seconds between health tables (0: none)")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
+  app.add_option("--map", o.map,
+                 "A building's map folder: SLAM starts from the map saved there (relocalising the vehicle; the "
+                 "estimator awaits the map's world) and saves it there on exit; the mapper journals its keyframes "
+                 "there, so the occupancy map follows. An empty or new folder: this flight's map is saved there");
+  app.add_option("--await-map", o.await_map_s,
+                 "--map: seconds the estimator's STATE waits for the map's world before flying on its own")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
   app.add_flag("--list", o.list, "Print the processes the command would start, and exit");
   return app.run(argc, argv, [&] { return launch(o); });
 }

@@ -4,6 +4,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <cstdlib>
 #include <set>
 #include <sstream>
@@ -88,6 +89,42 @@ bool names_run_dir(const ProcessSet& set) {
         if (arg.find(kRunDirKey) != std::string::npos) return true;
   }
   return false;
+}
+
+namespace {
+// Removes `option` and its value from `args`.
+void drop_option(std::vector<std::string>& args, const std::string& option) {
+  for (auto it = args.begin(); it != args.end();) {
+    if (*it == option) {
+      it = args.erase(it);
+      if (it != args.end()) it = args.erase(it);
+    } else {
+      ++it;
+    }
+  }
+}
+}  // namespace
+
+ProcessSet with_saved_map(ProcessSet set, const std::filesystem::path& map_dir, bool map_exists,
+                          double await_world_s) {
+  for (ProcessSpec& p : set) {
+    const std::string& tool = p.argv.front();
+    if (tool == "slam") {
+      if (map_exists) p.argv.insert(p.argv.end(), {"--map", map_dir.string()});
+      p.argv.insert(p.argv.end(), {"--save-map", map_dir.string()});
+    } else if (tool == "mapper") {
+      drop_option(p.argv, "--journal");
+      p.argv.insert(p.argv.end(), {"--journal", (map_dir / "mapper.journal").string()});
+    } else if (tool == "estimator" && map_exists) {
+      // Every start awaits the map's world, the first one too (and for as long).
+      drop_option(p.argv, "--await-world");
+      drop_option(p.restart_args, "--await-world");
+      char seconds[32];
+      std::snprintf(seconds, sizeof(seconds), "%g", await_world_s);
+      p.argv.insert(p.argv.end(), {"--await-world", seconds});
+    }
+  }
+  return set;
 }
 
 ProcessSet read_process_sets(const std::filesystem::path& file) {
