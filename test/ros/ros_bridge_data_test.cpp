@@ -11,9 +11,11 @@
 
 #include <algorithm>
 #include <chrono>
+#include <map>
 #include <mutex>
 
 #include <nav_msgs/Odometry.h>
+#include <sensor_msgs/Image.h>
 #include <ros/ros.h>
 
 #include "common/transport/channels.h"
@@ -91,6 +93,15 @@ TEST(RosBridgeData, Fr1XyzPlayedIntoTheBridgeGivesImportsFramesAndTheStateOnBoth
                                      std::chrono::system_clock::now().time_since_epoch())
                                      .count());
     });
+    // The colour images too, when this node hears them: a frame's latency through the bridge
+    // is from its colour image on ROS to its CAMERA_RGBD on LCM (pairing's wait included).
+    std::map<int64_t, int64_t> colour_received_us;  // by stamp
+    ros::Subscriber colour = nh.subscribe<sensor_msgs::Image>("/camera/rgb/image_color", 100, [&](const sensor_msgs::Image::ConstPtr& m) {
+      std::lock_guard<std::mutex> lock(mutex);
+      colour_received_us[ros1::to_utime(m->header.stamp)] = std::chrono::duration_cast<std::chrono::microseconds>(
+                                                                std::chrono::system_clock::now().time_since_epoch())
+                                                                .count();
+    });
     ros::AsyncSpinner spinner(1);
     spinner.start();
     for (int i = 0; i < 400 && sub.getNumPublishers() == 0; ++i) ros::WallDuration(0.05).sleep();
@@ -118,6 +129,16 @@ TEST(RosBridgeData, Fr1XyzPlayedIntoTheBridgeGivesImportsFramesAndTheStateOnBoth
       ros::WallDuration(0.025).sleep();
     }
     spinner.stop();
+    std::vector<int64_t> frame_latency_us;
+    for (const auto& f : system.messages(channel::kCameraRgbd)) {
+      const auto frame = transport::decode_message<kestrel::rgbd_frame_t>(f.data.data(), f.data.size(), "frame");
+      if (const auto it = colour_received_us.find(frame.utime); it != colour_received_us.end())
+        frame_latency_us.push_back(f.received_utime - it->second);
+    }
+    std::sort(frame_latency_us.begin(), frame_latency_us.end());
+    if (!frame_latency_us.empty())
+      std::cout << "colour image on ROS -> CAMERA_RGBD on LCM: median " << frame_latency_us[frame_latency_us.size() / 2]
+                << " us, max " << frame_latency_us.back() << " us over " << frame_latency_us.size() << "\n";
   }
   ros::shutdown();
 
