@@ -15,14 +15,14 @@ std::string CameraStream::at(const std::string& topic, const ros::Time& stamp) c
 
 // The checks bag-import makes over the whole bag, made as the first images come.
 void CameraStream::check_size(const sensor_msgs::Image& image, bool depth, const std::string& what) {
-  if (depth ? !is_depth_encoding(image.encoding) : !is_colour_encoding(image.encoding)) {
-    try {
-      check_image(image, depth, what);
-    } catch (const InputError& e) {
-      throw StreamError(e.what());
-    }
+  // An encoding it does not read fails every image of the topic; a cut image is one message.
+  const bool known = depth ? is_depth_encoding(image.encoding) : is_colour_encoding(image.encoding);
+  try {
+    check_image(image, depth, what);
+  } catch (const InputError& e) {
+    if (!known) throw StreamError(e.what());
+    throw;
   }
-  check_image(image, depth, what);
   const std::pair<int, int> size{static_cast<int>(image.width), static_cast<int>(image.height)};
   auto& first = depth ? depth_size_ : colour_size_;
   if (!first) {
