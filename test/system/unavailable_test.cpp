@@ -19,6 +19,7 @@ TEST(Unavailable, EveryProcessExitsFourNamingLcmWhenThereIsNoNetwork) {
   };
   const Case cases[] = {{"vo", {}},      {"estimator", {}}, {"slam", {}},       {"mapper", {}},
                         {"planner", {}}, {"follow", {}},    {"rgbd-codec", {}}, {"monitor", {}},
+                        {"station", {}},
                         {"sim", {"--world", "room", "--duration", "1"}}};
   int ran = 0;
   for (const Case& c : cases) {
