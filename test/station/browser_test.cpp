@@ -4,6 +4,7 @@
 //  * the page's map holds exactly the occupied cells of the mapper's last MAP_OCTOMAP;
 //  * the vehicle marker is at the pose of the STATE the test published;
 //  * the health table lists every process heard on PROCESS_STATUS;
+//  * the colour and depth images arrive and decode at the camera's size;
 //  * a goal outside the map is refused with a message in the page, and nothing is sent;
 //  * a click on the map sends a PLAN_REQUEST that appears on LCM with the clicked point;
 //  * the screenshot's canvas is not blank.
@@ -127,6 +128,8 @@ TEST(StationBrowser, ThePageShowsTheFlightAndAClickSendsAPlanRequest) {
     EXPECT_NE(std::find(listed.begin(), listed.end(), n), listed.end()) << n << " is not in the health table";
   }
   EXPECT_GE(r["health_rows"].get<size_t>(), processes.size());
+  // The camera's images, decoded by the browser at the simulator's 640 x 480.
+  EXPECT_EQ(r["images"], nlohmann::json::parse("[[640,480],[640,480]]")) << r["images"].dump();
 
   ASSERT_TRUE(r["refused_notice"].is_object()) << r.dump(1);
   EXPECT_FALSE(r["refused_notice"]["ok"].get<bool>());

@@ -120,6 +120,11 @@ async function measureFps(page, cells) {
     const names = a.processes.split(',');
     result.processes_reached = await waitUntil(page, (n) => n.every((x) => window.station.healthNames().includes(x)), names, 10000);
     result.health_names = await page.evaluate(() => window.station.healthNames());
+    await waitUntil(page, () => document.getElementById('depth').naturalWidth > 0, null, 5000);
+    result.images = await page.evaluate(() => ['colour', 'depth'].map((id) => {
+      const img = document.getElementById(id);
+      return [img.naturalWidth, img.naturalHeight];
+    }));
     result.health_rows = await page.evaluate(() => document.querySelectorAll('#health tbody tr').length);
 
     // A goal outside the map, typed: refused in the page.
