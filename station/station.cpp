@@ -59,9 +59,10 @@ void Station::on_state(const kestrel::state_t& m, const char* channel) {
     post_json("state", u);
     last_state_utime_ = m.utime;
   }
-  if (due(last_path_utime_, m.utime, options_.slow_period_s)) {
+  if (due(last_path_utime_, m.utime, options_.slow_period_s) && path_.added() != path_posted_) {
     post_json("path", path_.to_json("path"));
     last_path_utime_ = m.utime;
+    path_posted_ = path_.added();
   }
 }
 
@@ -71,7 +72,8 @@ void Station::on_truth(const kestrel::ground_truth_t& m, const char* channel) {
   truth_path_.add(Eigen::Vector3d(u["p"][0].get<double>(), u["p"][1].get<double>(), u["p"][2].get<double>()));
   if (due(last_truth_utime_, m.utime, options_.slow_period_s)) {
     post_json("truth_pose", u);
-    post_json("truth_path", truth_path_.to_json("truth_path"));
+    if (truth_path_.added() != truth_path_posted_) post_json("truth_path", truth_path_.to_json("truth_path"));
+    truth_path_posted_ = truth_path_.added();
     last_truth_utime_ = m.utime;
   }
 }
@@ -159,6 +161,7 @@ void Station::reset() {
   last_state_utime_.reset();
   last_path_utime_.reset();
   last_truth_utime_.reset();
+  path_posted_ = truth_path_posted_ = -1;
   latest_utime_ = 0;
   post_json("path", path_.to_json("path"));
   post_json("truth_path", truth_path_.to_json("truth_path"));

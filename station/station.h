@@ -5,8 +5,8 @@
 //
 // Invariants:
 //  * Only the LCM thread calls it (the hub carries everything across threads).
-//  * STATE is forwarded at most once per state_period_s of its utime, the paths and the
-//    health table at most once per slow_period_s; every MAP_OCTOMAP becomes a new snapshot (a
+//  * STATE is forwarded at most once per state_period_s of its utime, the paths at most once
+//    per slow_period_s and only when they grew; every MAP_OCTOMAP becomes a new snapshot (a
 //    map the mapper sent again unchanged is not posted twice).
 //  * A command is answered on its own socket with a "notice" (what was sent, or why not), and
 //    yields at most one message to publish: a PLAN_REQUEST for an accepted goal, a PLAN
@@ -92,6 +92,7 @@ class Station {
   ChannelRates rates_;
   PreviewThinner previews_;
   std::optional<int64_t> last_state_utime_, last_path_utime_, last_truth_utime_;
+  int64_t path_posted_ = -1, truth_path_posted_ = -1;  ///< added() when last posted: unchanged paths are not sent again
   int64_t latest_utime_ = 0;  ///< newest sensor time seen, stamps what the station sends
 };
 

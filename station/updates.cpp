@@ -15,6 +15,10 @@ namespace {
 using nlohmann::json;
 
 json vec3(const Eigen::Vector3d& v) { return json::array({v.x(), v.y(), v.z()}); }
+// Millimetres: what a drawn path or keyframe needs; JSON of a long path is then about a third
+// of full precision's size.
+double mm(double v) { return std::round(v * 1e3) / 1e3; }
+json vec3_mm(const Eigen::Vector3d& v) { return json::array({mm(v.x()), mm(v.y()), mm(v.z())}); }
 json quat(const Eigen::Quaterniond& q) { return json::array({q.w(), q.x(), q.y(), q.z()}); }
 
 // The 1-sigma ellipsoid of a 3x3 covariance: its semi-axes and the rotation whose columns are
@@ -71,7 +75,7 @@ json graph_update(const kestrel::slam_graph_t& m, const char* channel) {
   for (const auto& kf : m.keyframes) {
     const Eigen::Isometry3d T_world_camera = transport::from_message(kf.T_world_camera, channel);
     index.emplace(kf.id, keyframes.size());
-    keyframes.push_back(vec3(T_world_camera.translation()));
+    keyframes.push_back(vec3_mm(T_world_camera.translation()));
   }
   for (const auto& e : m.edges) {
     const auto a = index.find(e.from_id), b = index.find(e.to_id);
@@ -112,6 +116,7 @@ bool PathTrace::add(const Eigen::Vector3d& p) {
   if (!p.allFinite()) return false;
   if (!points_.empty() && (p - points_.back()).norm() < min_step_m_) return false;
   points_.push_back(p);
+  ++added_;
   if (points_.size() > max_points_) {
     // Halve the resolution: keep every second point, and always the newest.
     std::vector<Eigen::Vector3d> kept;
@@ -125,7 +130,7 @@ bool PathTrace::add(const Eigen::Vector3d& p) {
 
 json PathTrace::to_json(const std::string& kind) const {
   json pts = json::array();
-  for (const auto& p : points_) pts.push_back(vec3(p));
+  for (const auto& p : points_) pts.push_back(vec3_mm(p));
   return json{{"kind", kind}, {"points", std::move(pts)}};
 }
 

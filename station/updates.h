@@ -35,7 +35,7 @@ nlohmann::json state_update(const kestrel::state_t& m, const char* channel);
 /// {"kind":"truth_pose", utime, frame:"body"|"camera", p, q}
 nlohmann::json truth_update(const kestrel::ground_truth_t& m, const char* channel);
 
-/// {"kind":"graph", revision, keyframes:[[x,y,z]...], odometry:[[i,j]...], loops:[[i,j]...]}:
+/// {"kind":"graph", revision, keyframes:[[x,y,z]...] (mm), odometry:[[i,j]...], loops:[[i,j]...]}:
 /// the keyframes' camera positions and the edges as indices into them (an edge naming an
 /// unknown keyframe is left out).
 nlohmann::json graph_update(const kestrel::slam_graph_t& m, const char* channel);
@@ -55,13 +55,16 @@ class PathTrace {
   bool add(const Eigen::Vector3d& p_in_world);
   void clear() { points_.clear(); }
   const std::vector<Eigen::Vector3d>& points() const { return points_; }
-  /// {"kind": kind, "points":[[x,y,z]...]}
+  /// How many points were ever kept (grows when the path does; thinning does not lower it).
+  int64_t added() const { return added_; }
+  /// {"kind": kind, "points":[[x,y,z]...]}, millimetres
   nlohmann::json to_json(const std::string& kind) const;
 
  private:
   double min_step_m_;
   size_t max_points_;
   std::vector<Eigen::Vector3d> points_;
+  int64_t added_ = 0;
 };
 
 /// The latest heartbeat of every process, by name.

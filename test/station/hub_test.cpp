@@ -104,3 +104,39 @@ TEST(StationStation, ACommandIsAnsweredOnItsOwnSocketAndYieldsOneMessage) {
 
 }  // namespace
 }  // namespace kestrel::station
+
+namespace kestrel::station {
+namespace {
+
+bool has_kind(const std::vector<Outgoing>& out, const std::string& kind) {
+  for (const Outgoing& m : out)
+    if (!m.binary && m.bytes.find("\"kind\":\"" + kind + "\"") != std::string::npos) return true;
+  return false;
+}
+
+TEST(StationStation, APathThatDidNotGrowIsNotSentAgain) {
+  UpdateHub hub;
+  const auto id = hub.add_client({});
+  Station st({}, hub, 1);
+  kestrel::state_t s{};
+  s.utime = 1'000'000;
+  s.status = kestrel::state_t::STATUS_OK;
+  s.T_world_body.orientation[0] = 1.0;
+  s.T_world_body.position[2] = 1.0;
+  st.on_state(s, "STATE");
+  auto out = hub.take(*id);
+  EXPECT_TRUE(has_kind(out, "state"));
+  EXPECT_TRUE(has_kind(out, "path"));
+  s.utime += 1'000'000;  // a second later, hovering where it was
+  st.on_state(s, "STATE");
+  out = hub.take(*id);
+  EXPECT_TRUE(has_kind(out, "state"));
+  EXPECT_FALSE(has_kind(out, "path"));
+  s.utime += 1'000'000;
+  s.T_world_body.position[0] = 0.5;  // moved: the path grew
+  st.on_state(s, "STATE");
+  EXPECT_TRUE(has_kind(hub.take(*id), "path"));
+}
+
+}  // namespace
+}  // namespace kestrel::station

@@ -170,3 +170,18 @@ TEST(StationUpdates, TheHealthTableListsEveryProcessOnceByName) {
 
 }  // namespace
 }  // namespace kestrel::station
+
+namespace kestrel::station {
+namespace {
+
+TEST(StationUpdates, APathIsSentInMillimetres) {
+  PathTrace path(0.01, 10);
+  path.add({1.23456, -0.25049, 2.0});
+  const nlohmann::json u = path.to_json("path");
+  EXPECT_DOUBLE_EQ(u["points"][0][0].get<double>(), 1.235);
+  EXPECT_DOUBLE_EQ(u["points"][0][1].get<double>(), -0.25);
+  EXPECT_EQ(path.added(), 1);
+}
+
+}  // namespace
+}  // namespace kestrel::station
