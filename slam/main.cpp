@@ -17,6 +17,7 @@
 #include "common/error.h"
 #include "common/transport/channels.h"
 #include "common/transport/node.h"
+#include "kestrel/map_save_request_t.hpp"
 #include "slam/memory_policy.h"
 #include "slam/map/map_file.h"
 #include "slam/place/builtin_vocabulary.h"
@@ -247,6 +248,23 @@ int serve(const Options& o, const SlamOptions& options, std::shared_ptr<const Vo
       spdlog::warn("{}: a new estimator (its seq started again): the next keyframe's {} gives it the map's world",
                    o.adapter.state_channel, o.correction_channel);
   });
+  if (!o.save_map.empty()) {
+    // Saving on request: the answer is the heartbeat's message, which `kestrel save-map` waits
+    // for. A failed save (a full disk) leaves the process running and says why.
+    node->subscribe<map_save_request_t>(channel::kSlamSaveMap, [&](const map_save_request_t& m) {
+      try {
+        const SlamMap map = adapter.slam().map();
+        save_map(o.save_map, map, "kestrel-slam (process " + o.name + ", on request)");
+        node->set_health(process_status_t::STATE_RUNNING,
+                         fmt::format("map saved for request {}: {} keyframes in {}", m.request_id,
+                                     map.keyframes.size(), map_file_in(o.save_map)));
+      } catch (const InputError& e) {
+        spdlog::error("map not saved: {}", e.what());
+        node->set_health(process_status_t::STATE_DEGRADED,
+                         fmt::format("map not saved for request {}: {}", m.request_id, e.what()));
+      }
+    });
+  }
   node->set_health(process_status_t::STATE_RUNNING, "");
   spdlog::info("{}: {} + {} -> {}, {}", o.name, o.adapter.camera_channel, o.adapter.vo_channel,
                o.graph_channel, o.correction_channel);

@@ -66,6 +66,24 @@ TEST(SlamTool, ADamagedOrMissingMapIsExitCode3NamingItBeforeAnythingRuns) {
   }
 }
 
+// `kestrel save-map` asks a running kestrel-slam to save now; one without --save-map says it
+// cannot, and save-map says so (exit 1) rather than waiting for ever.
+TEST(SlamTool, SaveMapAsksARunningSlamToSaveItsMapNow) {
+  if (!::kestrel::test::can_isolate_network()) KESTREL_SKIP_ENVIRONMENT() << "no network namespace available";
+  TempDir dir;
+  const std::string slam = tool("slam").string(), save = tool("save-map").string(), map = (dir / "m").string();
+  const auto saved = ::kestrel::test::run_isolated(
+      "'" + slam + "' -q --save-map '" + map + "' & S=$!; '" + save + "' --timeout 20; R=$?; kill -INT $S; wait $S; exit $R",
+      60.0);
+  EXPECT_EQ(saved.exit_code, kExitOk) << saved.out << saved.err;
+  EXPECT_NE(saved.out.find("map saved for request"), std::string::npos) << saved.out;
+  EXPECT_TRUE(std::filesystem::is_regular_file(dir / "m" / "slam.map"));
+  const auto refused = ::kestrel::test::run_isolated(
+      "'" + slam + "' -q & S=$!; '" + save + "' --timeout 4; R=$?; kill -INT $S; wait $S; exit $R", 60.0);
+  EXPECT_EQ(refused.exit_code, kExitFailure) << refused.out << refused.err;
+  EXPECT_NE(refused.err.find("was it started with --save-map?"), std::string::npos) << refused.err;
+}
+
 #if KESTREL_SLAM_OFFLINE
 namespace fs = std::filesystem;
 using ::kestrel::test::RunResult;
