@@ -1,7 +1,10 @@
 #include "metrics/alignment.h"
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/SVD>
 #include <stdexcept>
+#include <utility>
+#include <vector>
 
 #include "common/geometry/align.h"
 
@@ -12,6 +15,29 @@ namespace {
 constexpr double kCoincident_m = 1e-9;
 
 }  // namespace
+
+Alignment align_poses(const Trajectory& est, const Trajectory& gt, int64_t max_gap_us) {
+  Eigen::Matrix3d sum = Eigen::Matrix3d::Zero();
+  std::vector<std::pair<Eigen::Isometry3d, Eigen::Isometry3d>> pairs;  // (est, gt)
+  for (const StampedPose& p : est.poses()) {
+    if (const auto t = gt.at(p.utime, max_gap_us)) {
+      pairs.emplace_back(p.T, *t);
+      sum += t->linear() * p.T.linear().transpose();
+    }
+  }
+  if (pairs.empty()) throw std::invalid_argument("align_poses: the ground truth covers no pose of the estimate");
+  // The rotation nearest (Frobenius) to the sum: U diag(1, 1, det) V^T of its SVD.
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(sum, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d D = Eigen::Matrix3d::Identity();
+  D(2, 2) = (svd.matrixU() * svd.matrixV().transpose()).determinant() < 0.0 ? -1.0 : 1.0;
+  Alignment a;
+  a.kind = AlignmentKind::kRigid;
+  a.T_gt_est.linear() = svd.matrixU() * D * svd.matrixV().transpose();
+  Eigen::Vector3d t = Eigen::Vector3d::Zero();
+  for (const auto& [T_est, T_gt] : pairs) t += T_gt.translation() - a.T_gt_est.linear() * T_est.translation();
+  a.T_gt_est.translation() = t / static_cast<double>(pairs.size());
+  return a;
+}
 
 Alignment align_positions(const Eigen::Matrix3Xd& p_est, const Eigen::Matrix3Xd& p_gt) {
   if (p_est.cols() == 0 || p_est.cols() != p_gt.cols())

@@ -12,6 +12,9 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <cstdint>
+
+#include "common/trajectory.h"
 
 namespace kestrel::metrics {
 
@@ -30,6 +33,13 @@ struct Alignment {
 /// Aligns corresponding columns of `p_est` onto `p_gt` (same size, at least one column;
 /// std::invalid_argument otherwise).
 Alignment align_positions(const Eigen::Matrix3Xd& p_est, const Eigen::Matrix3Xd& p_gt);
+
+/// Aligns whole poses: the rotation is the chordal mean of R_gt R_est^T over the estimate's
+/// poses that `gt` covers (within `max_gap_us`, Trajectory::at), the translation the mean of
+/// p_gt - R p_est. For expressing one world in another once (a saved map's world in the
+/// truth's: `kestrel eval --world-from`), where the positions alone may leave the rotation
+/// loose (a camera turning on the spot). Throws std::invalid_argument when no pose is covered.
+Alignment align_poses(const Trajectory& est, const Trajectory& gt, int64_t max_gap_us);
 
 const char* to_string(AlignmentKind kind);
 

@@ -112,6 +112,37 @@ TEST(EvalCli, JsonParsesAndHoldsTheFigures) {
   EXPECT_EQ(j["rpe"]["delta_s"], 1.0);
 }
 
+// --world-from: a second run (frames 45..89) in the world of a first (0..44), whose estimate is
+// the truth seen from another frame X: the first run's whole poses give X once, and the second,
+// in X too, scores 0 with no alignment of its own; without it, not aligned, it is X's offset.
+TEST(EvalCli, WorldFromScoresASecondRunInTheFirstRunsWorld) {
+  TempDir dir;
+  const auto times = test::frame_times(90);
+  const Eigen::Isometry3d X = Eigen::Translation3d(1.0, -2.0, 0.5) * Eigen::AngleAxisd(0.7, Eigen::Vector3d::UnitZ());
+  Trajectory gt0, est0, gt1, est1;
+  for (size_t i = 0; i < times.size(); ++i) {
+    const Eigen::Isometry3d T = test::helix_pose(times[i]);
+    (i < 45 ? gt0 : gt1).push_back(times[i], T);
+    (i < 45 ? est0 : est1).push_back(times[i], X.inverse() * T);
+  }
+  for (const auto& [name, t] : {std::pair<const char*, const Trajectory*>{"gt0", &gt0}, {"est0", &est0}, {"gt1", &gt1}, {"est1", &est1}})
+    write_tum_trajectory((dir / name).string(), *t);
+  const RunResult r = eval({"--gt", (dir / "gt1").string(), "--est", (dir / "est1").string(), "--world-from",
+                            (dir / "gt0").string(), (dir / "est0").string(), "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_FALSE(j["ate_m"]["aligned"].get<bool>());
+  EXPECT_LT(j["ate_m"]["rmse"].get<double>(), 1e-6);
+  const RunResult plain = eval({"--gt", (dir / "gt1").string(), "--est", (dir / "est1").string(), "--no-align", "--json"});
+  ASSERT_EQ(plain.exit_code, 0) << plain.err;
+  EXPECT_GT(nlohmann::json::parse(plain.out)["ate_m"]["rmse"].get<double>(), 0.5);
+  // A first run the truth does not cover gives no world: exit 3 naming it.
+  const RunResult none = eval({"--gt", (dir / "gt1").string(), "--est", (dir / "est1").string(), "--world-from",
+                               (dir / "gt1").string(), (dir / "est0").string()});
+  EXPECT_EQ(none.exit_code, 3) << none.err;
+  EXPECT_NE(none.err.find("covers no pose"), std::string::npos) << none.err;
+}
+
 TEST(EvalCli, TextReportNamesWhatWasCompared) {
   const TumPair p;
   const RunResult r = eval({"--gt", p.gt, "--est", p.est, "--no-align"});

@@ -7,7 +7,8 @@
 // Aligning the mapped run to its own truth once gives T_truth_map; the second run, placed in
 // the map's world by relocalisation alone, is then compared in that frame with no alignment
 // of its own (issue 41 item 5: relocalised within 3 cm / 2 degrees of the truth). The alignment
-// uses whole poses: the positions alone leave its rotation loose on fr1_rpy.
+// uses whole poses (metrics::align_poses): the positions alone leave its rotation loose on
+// fr1_rpy, which turns on the spot.
 
 #include <gtest/gtest.h>
 
@@ -17,6 +18,7 @@
 
 #include "common/geometry/se3.h"
 #include "common/numbers.h"
+#include "metrics/alignment.h"
 #include "metrics/evaluate.h"
 #include "slam/map/map_file.h"
 #include "slam/place/builtin_vocabulary.h"
@@ -28,27 +30,6 @@ namespace kestrel::slam {
 namespace {
 
 namespace fs = std::filesystem;
-
-// The map's world in the truth's from whole poses: rotation the chordal mean of R_truth R_est^T,
-// then the mean translation. (kestrel eval aligns positions only, which leaves the rotation
-// loose on fr1_rpy, where the camera turns on the spot over a few centimetres.)
-Eigen::Isometry3d align_poses(const Trajectory& estimate, const Trajectory& truth) {
-  Eigen::Matrix3d sum = Eigen::Matrix3d::Zero();
-  std::vector<std::pair<Eigen::Isometry3d, Eigen::Isometry3d>> pairs;
-  for (const StampedPose& p : estimate.poses()) {
-    if (const auto t = truth.at(p.utime, 20000)) pairs.emplace_back(p.T, *t);
-  }
-  for (const auto& [est, gt] : pairs) sum += gt.linear() * est.linear().transpose();
-  Eigen::JacobiSVD<Eigen::Matrix3d> svd(sum, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  Eigen::Matrix3d D = Eigen::Matrix3d::Identity();
-  D(2, 2) = (svd.matrixU() * svd.matrixV().transpose()).determinant() < 0 ? -1.0 : 1.0;
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = svd.matrixU() * D * svd.matrixV().transpose();
-  Eigen::Vector3d t = Eigen::Vector3d::Zero();
-  for (const auto& [est, gt] : pairs) t += gt.translation() - T.linear() * est.translation();
-  T.translation() = t / static_cast<double>(std::max<size_t>(pairs.size(), 1));
-  return T;
-}
 
 class CrossSession : public ::testing::TestWithParam<std::pair<const char*, const char*>> {};
 
@@ -74,7 +55,7 @@ TEST_P(CrossSession, TheSecondClipIsPlacedInTheFirstClipsMapAtItsTruePose) {
   metrics::EvalOptions aligned;
   const metrics::Evaluation e1 =
       metrics::evaluate(metrics::frame_times(first.slam), first.slam, mapped.ground_truth, aligned);
-  const Eigen::Isometry3d T_truth_map = align_poses(first.slam, mapped.ground_truth);
+  const Eigen::Isometry3d T_truth_map = metrics::align_poses(first.slam, mapped.ground_truth, 20000).T_gt_est;
 
   // The second clip on the map, no prior.
   const SlamRun second = run_slam_sequence(

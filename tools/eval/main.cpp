@@ -7,11 +7,14 @@
 #include <cmath>
 #include <filesystem>
 #include <iostream>
+#include <string>
+#include <vector>
 
 #include "common/cli.h"
 #include "common/error.h"
 #include "common/image/image_io.h"
 #include "common/transport/channels.h"
+#include "metrics/alignment.h"
 #include "metrics/evaluate.h"
 #include "tools/eval/log_input.h"
 #include "tools/eval/plot.h"
@@ -78,6 +81,7 @@ int main(int argc, char** argv) {
   std::string gt_channel = channel::kGroundTruth;
   std::string est_channel = kAuto;
   bool json = false, no_align = false, no_gap_failures = false;
+  std::vector<std::string> world_from;  // GT EST of the session that made a saved map
   double gt_max_gap_s = 0.02, est_max_gap_s = 0.0, rpe_delta_s = 1.0, rpe_tolerance_s = 0.1,
          gross_velocity_mps = 1.0;
 
@@ -96,6 +100,11 @@ int main(int argc, char** argv) {
                  "Write the estimated trajectory (as read, e.g. VO chained) as a TUM file; "
                  "without --gt, do only that");
   app.add_flag("--no-align", no_align, "Compute the ATE without the rigid alignment");
+  app.add_option("--world-from", world_from,
+                 "GT EST of another run in the same world (the flight that made a saved map): its whole poses "
+                 "aligned to its truth once put this estimate in the truth's world, which is then scored with no "
+                 "alignment of its own (a flight relocalised in that map)")
+      ->expected(2);
   app.add_option("--gt-max-gap", gt_max_gap_s,
                  "Interpolate ground truth only between samples within this of the frame (s)")
       ->check(CLI::NonNegativeNumber);
@@ -124,6 +133,23 @@ int main(int argc, char** argv) {
     }
     TrajectoryInput gt = read_input("--gt", gt_spec, gt_channel, {channel::kGroundTruth});
     const std::string compared = reconcile_frames(gt, est);
+    if (!world_from.empty()) {
+      TrajectoryInput gt0 = read_input("--world-from", world_from[0], gt_channel, {channel::kGroundTruth});
+      TrajectoryInput est0 = read_input("--world-from", world_from[1], est_channel, {channel::kState, channel::kVoUpdate});
+      reconcile_frames(gt0, est0);
+      metrics::Alignment world;
+      try {
+        world = metrics::align_poses(est0.trajectory, gt0.trajectory, to_utime(gt_max_gap_s));
+      } catch (const std::invalid_argument&) {
+        throw InputError(world_from[0] + " covers no pose of " + world_from[1] + ": no world to take");
+      }
+      std::vector<StampedPose> moved;
+      for (const StampedPose& p : est.trajectory.poses()) moved.push_back({p.utime, world.T_gt_est * p.T});
+      est.trajectory = Trajectory(std::move(moved));
+      no_align = true;
+      spdlog::info("the estimate put in the truth's world by {} against {} (whole poses), not aligned itself",
+                   world_from[1], world_from[0]);
+    }
 
     metrics::EvalOptions options;
     options.gt_max_gap_us = to_utime(gt_max_gap_s);
