@@ -149,6 +149,9 @@ int main(int argc, char** argv) {
   app.add_option("--journal", o.node.journal_path,
                  "slam: journal the keyframes to this file and, if it exists, restore the map from it "
                  "first (a mapper restarted in flight; kestrel launch gives each launch its own)");
+  app.add_flag("--journal-is-map", o.node.journal_is_map,
+               "The journal is a building's saved map (kestrel launch --map): a lock-step RESET before any input "
+               "keeps the map restored from it (by default a RESET forgets it: a replay of its own flight)");
   app.add_option("--journal-keep", o.node.journal_keep,
                  "Journals set aside kept of each kind (FILE.reset-*, FILE.damaged-*): the newest; each older one "
                  "is deleted, and logged, when another is set aside")

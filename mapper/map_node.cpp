@@ -84,6 +84,8 @@ void MapNode::write_journal(const kestrel::slam_graph_t& msg, const GraphResult&
 }
 
 void MapNode::reset() {
+  if (options_.journal_is_map && !input_since_start_) return;  // the saved map is where this flight begins
+  input_since_start_ = false;
   mapper_.reset();
   journal_kept_aside_.clear();
   journal_pruned_ = {};
@@ -149,6 +151,7 @@ std::optional<kestrel::octomap_t> MapNode::repeat_map(int64_t frame_utime) {
 }
 
 std::optional<kestrel::octomap_t> MapNode::on_frame(const kestrel::rgbd_frame_t& msg, const char* channel) {
+  input_since_start_ = true;
   RgbdFrame frame = transport::decode_rgbd(msg, channel);
   if (frame.depth_mm.empty()) throw InputError(std::string(channel) + ": frame has no depth image");
   if (stats_.frames > 0 && frame.utime <= last_frame_utime_) {
@@ -190,6 +193,7 @@ void MapNode::insert_pending() {
 
 std::optional<kestrel::octomap_t> MapNode::on_ground_truth(const kestrel::ground_truth_t& msg,
                                                            const char* channel) {
+  input_since_start_ = true;
   if (options_.pose_source != PoseSource::kGroundTruth) return std::nullopt;
   Eigen::Isometry3d T = transport::from_message(msg.T_world_frame, channel);
   // Frames are placed by T_world_body * T_body_camera; camera-frame truth (TUM) is turned into a
@@ -211,6 +215,7 @@ std::optional<kestrel::octomap_t> MapNode::on_ground_truth(const kestrel::ground
 }
 
 std::optional<kestrel::octomap_t> MapNode::on_graph(const kestrel::slam_graph_t& msg, const char* channel) {
+  input_since_start_ = true;
   if (options_.pose_source != PoseSource::kSlamGraph) return std::nullopt;
   if (msg.revision < last_graph_revision_) {
     throw InputError(std::string(channel) + ": revision " + std::to_string(msg.revision) +

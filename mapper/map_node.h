@@ -57,6 +57,11 @@ struct NodeOptions {
   double max_pose_gap_s = 0.1;      ///< kGroundTruth: largest gap to interpolate across
   int max_pending_frames = 90;      ///< kGroundTruth: frames waiting for a pose after theirs
   std::string journal_path;         ///< kSlamGraph: journal here, restore from it ("" = none)
+  /// The journal is a building's saved map (kestrel launch --map): a RESET before any input
+  /// since the start (a lock-step session's first) leaves the map it restored, where the new
+  /// flight begins. Without it a RESET forgets that map (a replay of the flight that wrote the
+  /// journal feeds the same keyframes again).
+  bool journal_is_map = false;
   /// Journals set aside kept of each kind (reset, damaged), the newest; >= 1.
   int journal_keep = kDefaultKeptJournals;
   void validate() const;
@@ -134,6 +139,7 @@ class MapNode {
   std::string journal_damage_;
   std::string journal_kept_aside_;
   std::string journal_error_;
+  bool input_since_start_ = false;  ///< a frame, graph or pose handled since the start or reset()
   PrunedJournals journal_pruned_;
 };
 

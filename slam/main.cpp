@@ -12,6 +12,7 @@
 #include <ctime>
 #include <iostream>
 #include <memory>
+#include <set>
 
 #include "common/cli.h"
 #include "common/error.h"
@@ -248,16 +249,23 @@ int serve(const Options& o, const SlamOptions& options, std::shared_ptr<const Vo
       spdlog::warn("{}: a new estimator (its seq started again): the next keyframe's {} gives it the map's world",
                    o.adapter.state_channel, o.correction_channel);
   });
+  std::set<int64_t> answered;  // save requests answered (save-map asks again until answered)
   if (!o.save_map.empty()) {
     // Saving on request: the answer is the heartbeat's message, which `kestrel save-map` waits
     // for. A failed save (a full disk) leaves the process running and says why.
     node->subscribe<map_save_request_t>(channel::kSlamSaveMap, [&](const map_save_request_t& m) {
+      if (!answered.insert(m.request_id).second) return;
       try {
-        const SlamMap map = adapter.slam().map();
-        save_map(o.save_map, map, "kestrel-slam (process " + o.name + ", on request)");
+        const SlamMap now = adapter.slam().map();
+        if (now.keyframes.empty()) {
+          node->set_health(process_status_t::STATE_RUNNING,
+                           fmt::format("map not saved for request {}: no keyframe yet", m.request_id));
+          return;
+        }
+        save_map(o.save_map, now, "kestrel-slam (process " + o.name + ", on request)");
         node->set_health(process_status_t::STATE_RUNNING,
                          fmt::format("map saved for request {}: {} keyframes in {}", m.request_id,
-                                     map.keyframes.size(), map_file_in(o.save_map)));
+                                     now.keyframes.size(), map_file_in(o.save_map)));
       } catch (const InputError& e) {
         spdlog::error("map not saved: {}", e.what());
         node->set_health(process_status_t::STATE_DEGRADED,
@@ -270,7 +278,9 @@ int serve(const Options& o, const SlamOptions& options, std::shared_ptr<const Vo
                o.graph_channel, o.correction_channel);
   const int status = node->spin();
   if (map && !adapter.slam().relocalisation()) report_relocalisation(std::nullopt, true);  // placed: said when it was
-  if (!o.save_map.empty()) save_map(o.save_map, adapter.slam().map(), "kestrel-slam (process " + o.name + ")");
+  // A map of nothing is not saved: the next flight would take it for a building's map.
+  if (!o.save_map.empty() && !adapter.slam().keyframes().empty())
+    save_map(o.save_map, adapter.slam().map(), "kestrel-slam (process " + o.name + ")");
   const auto& misses = adapter.slam().coverage_misses();
   spdlog::info("{} keyframes ({} thinned, features {:.1f} MB), {} loop closures, {} frames re-anchored on a "
                "covering keyframe (keyframes instead: {} with none near, {} none verified, {} located too far; {} too "

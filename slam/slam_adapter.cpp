@@ -19,9 +19,10 @@ SlamAdapter::SlamAdapter(const SlamOptions& options, std::shared_ptr<const Vocab
 }
 
 SlamAdapter::SlamAdapter(std::shared_ptr<const SlamMap> map, const SlamOptions& options, const AdapterOptions& adapter)
-    : options_(adapter), slam_(std::move(map), options), map_loaded_(true) {
+    : options_(adapter), slam_(std::move(map), options), map_loaded_(!slam_.keyframes().empty()) {
   if (adapter.buffer_frames < 1) throw std::invalid_argument("slam: buffer_frames must be >= 1");
-  anchored_ = true;
+  // A map of nothing has no world to bring: the graph is anchored on STATE as without one.
+  anchored_ = map_loaded_;
 }
 
 void SlamAdapter::reset() {

@@ -144,7 +144,7 @@ class SlamAdapter {
 
   AdapterOptions options_;
   Slam slam_;
-  bool map_loaded_ = false;  ///< started from a saved map: its world is the world
+  bool map_loaded_ = false;  ///< started from a saved map with keyframes: its world is the world
   OdometryChain chain_;
   std::map<int64_t, kestrel::rgbd_frame_t> frames_;  ///< utime -> waiting frame
   std::map<int64_t, ChainedPose> poses_;             ///< utime -> waiting pose

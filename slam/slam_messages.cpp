@@ -1,5 +1,7 @@
 #include "slam/slam_messages.h"
 
+#include <algorithm>
+
 #include "common/geometry/se3.h"
 #include "common/transport/convert.h"
 
@@ -21,15 +23,18 @@ VoMotion motion_from_message(const kestrel::vo_update_t& m, const char* channel)
   return motion;
 }
 
-namespace {
-int64_t session_base(const Slam& slam) {
-  return slam.keyframes().empty() ? 0 : slam.keyframes().front().utime;
+int64_t published_id(const Slam& slam, int64_t keyframe_index) {
+  const int session = slam.keyframes().at(static_cast<size_t>(keyframe_index)).session;
+  return slam.session_start_utime(session) + keyframe_index;
 }
-}  // namespace
 
-int64_t published_id(const Slam& slam, int64_t keyframe_index) { return session_base(slam) + keyframe_index; }
-
-int64_t published_revision(const Slam& slam) { return session_base(slam) + slam.revision(); }
+int64_t published_revision(const Slam& slam) {
+  // The newest session with a keyframe, or this process's first frame when it has none yet (on
+  // a saved map: after the map's revisions, which the flight that made it published).
+  int64_t base = slam.first_frame_utime();
+  if (!slam.keyframes().empty()) base = std::max(base, slam.session_start_utime(slam.keyframes().back().session));
+  return base + slam.revision();
+}
 
 kestrel::slam_graph_t graph_message(const Slam& slam) {
   kestrel::slam_graph_t m{};

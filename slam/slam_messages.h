@@ -8,7 +8,11 @@
 // keyframe (odometry_chain.h).
 //
 // Published keyframe ids and graph revisions count from the session's first keyframe: its
-// utime (µs) plus the library's own index or revision. A SLAM process restarted in flight
+// utime (µs) plus the library's own index or revision. A keyframe keeps its own session's base
+// (a saved map's keyframes keep the ids the flight that made them published); the revision
+// counts from the newest session's base, or from this process's first frame while that session
+// has no keyframe yet, so a process started on a saved map publishes after everything the
+// flights before it did, even one that ended without saving. A SLAM process restarted in flight
 // (a new session) therefore never reuses an id of the one before and never goes back in
 // revision, so the mapper keeps the old session's keyframes where they were and adds the new
 // ones (the library's indices restart at 0; a session has fewer keyframes and revisions than

@@ -146,6 +146,10 @@ Slam::Slam(std::shared_ptr<const SlamMap> map, const SlamOptions& options)
   reset();
 }
 
+int64_t Slam::session_start_utime(int s) const {
+  return s >= 0 && static_cast<size_t>(s) < session_start_utime_.size() ? session_start_utime_[static_cast<size_t>(s)] : 0;
+}
+
 SlamMap Slam::map() const {
   SlamMap map;
   map.keyframes = keyframes_;
@@ -162,6 +166,11 @@ SlamMap Slam::map() const {
 
 void Slam::restore(const SlamMap& map) {
   keyframes_ = map.keyframes;
+  for (const Keyframe& kf : keyframes_) {
+    if (static_cast<size_t>(kf.session) >= session_start_utime_.size())
+      session_start_utime_.resize(static_cast<size_t>(kf.session) + 1, 0);
+    if (session_start_utime_[static_cast<size_t>(kf.session)] == 0) session_start_utime_[static_cast<size_t>(kf.session)] = kf.utime;
+  }
   graph_ = map.graph;
   gate_information_ = map.gate_information;
   for (const Keyframe& kf : keyframes_) {
@@ -200,7 +209,10 @@ void Slam::reset() {
   feature_bytes_ = 0;
   thinned_ = 0;
   session_ = 0;
+  session_start_utime_.clear();
+  first_frame_utime_ = 0;
   localized_ = true;
+  lost_since_utime_ = -1;
   relocalisation_.reset();
   relocalisation_tries_ = 0;
   placements_.clear();
@@ -288,11 +300,18 @@ SlamStep Slam::add(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camer
   if (!se3::is_valid(T_odom_camera, 1e-6)) {
     throw InputError("slam: odometry pose of frame " + std::to_string(frame.utime) + " is not a rigid transform");
   }
+  if (!have_frame_) first_frame_utime_ = frame.utime;
   have_frame_ = true;
   last_utime_ = frame.utime;
   if (odometry_broken) gate_by_pose_ = false;
-  // Localisation only: after a break of the odometry the camera is placed in the map again.
-  if (odometry_broken && options_.localize_only && !keyframes_.empty()) localized_ = false;
+  // Placement hypotheses place the odometry frame: across a break that frame changes.
+  if (odometry_broken) placements_.clear();
+  if (!localized_ && lost_since_utime_ >= 0 &&
+      frame.utime - lost_since_utime_ > static_cast<int64_t>(std::llround(options_.relocalisation.max_span_s * 1e6))) {
+    // Localisation only, not confirmed elsewhere in time: the estimate carries on from where it was.
+    localized_ = true;
+    lost_since_utime_ = -1;
+  }
   if (!localized_) return relocalise(frame, T_odom_camera, link, motion, sensor);
   SlamStep step;
   if (!wants_keyframe(T_odom_camera, link)) return step;
@@ -309,6 +328,8 @@ SlamStep Slam::add(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camer
   kf.id = static_cast<int64_t>(keyframes_.size());
   kf.utime = frame.utime;
   kf.session = session_;
+  if (session_start_utime_.size() <= static_cast<size_t>(session_)) session_start_utime_.resize(static_cast<size_t>(session_) + 1, 0);
+  if (session_start_utime_[static_cast<size_t>(session_)] == 0) session_start_utime_[static_cast<size_t>(session_)] = frame.utime;
   kf.T_odom_camera = T_odom_camera;
   kf.T_body_camera = frame.T_body_camera;
   kf.T_camera_depth = motion.T_rgb_depth();
@@ -384,17 +405,39 @@ SlamStep Slam::close_loop(SlamStep step) {
   return step;
 }
 
+bool Slam::accept_placement(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera, const Keyframe& kf,
+                            const LoopConstraint& located) {
+  const RelocalisationOptions& r = options_.relocalisation;
+  const auto span_us = static_cast<int64_t>(std::llround(r.max_span_s * 1e6));
+  placements_.erase(std::remove_if(placements_.begin(), placements_.end(),
+                                   [&](const Placement& p) { return p.utime < frame.utime - span_us; }),
+                    placements_.end());
+  const size_t k = static_cast<size_t>(kf.id);
+  const Eigen::Isometry3d T_world_odom = graph_.poses[k] * located.T_candidate_query * T_odom_camera.inverse();
+  int agreeing = 1;  // this one
+  for (const Placement& p : placements_) {
+    const Eigen::Isometry3d D = p.T_world_odom.inverse() * T_world_odom;
+    if (D.translation().norm() <= r.max_disagreement_m && so3::angle(D.linear()) <= r.max_disagreement_rad) ++agreeing;
+  }
+  if (agreeing < r.confirmations) {
+    placements_.push_back({frame.utime, T_world_odom});
+    return false;
+  }
+  // Placed: the odometry goes on from this frame, located in keyframe k, as after a
+  // re-anchoring; the next keyframe's edge joins the map there.
+  placements_.clear();
+  reference_ = OdometryReference{kf.id,          frame.utime, T_odom_camera, frame.T_body_camera,
+                                 located.T_candidate_query, right_covariance(located.information)};
+  reference_marginal_ = marginal_covariance(graph_, static_cast<int>(k), options_.optimizer.kernel);
+  return true;
+}
+
 SlamStep Slam::relocalise(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera, OdometryLink link,
                           const sensors::FrameMotion& motion, const sensors::SensorProfile& sensor) {
   const RelocalisationOptions& r = options_.relocalisation;
   SlamStep step;
   ++relocalisation_tries_;
-  // Hypotheses place the odometry frame: across a break of the odometry that frame changes.
-  if (link == OdometryLink::kBroken) placements_.clear();
-  const auto span_us = static_cast<int64_t>(std::llround(r.max_span_s * 1e6));
-  placements_.erase(std::remove_if(placements_.begin(), placements_.end(),
-                                   [&](const Placement& p) { return p.utime < frame.utime - span_us; }),
-                    placements_.end());
+  (void)link;  // a break cleared the hypotheses already (add())
   const FrameFeatures features = extractor_.extract(frame, motion);
   if (static_cast<int>(features.num_points()) < options_.verification.min_inliers) return step;
   const std::vector<BowMatch> candidates = places_->query(
@@ -407,29 +450,12 @@ SlamStep Slam::relocalise(const RgbdFrame& frame, const Eigen::Isometry3d& T_odo
         verify_loop(features, kf.features, loop_verification(options_.verification, kf.sensor, sensor), seed);
     step.loop = located;
     if (!located.accepted) continue;
-    const size_t k = static_cast<size_t>(kf.id);
-    const Eigen::Isometry3d T_world_odom =
-        graph_.poses[k] * located.T_candidate_query * T_odom_camera.inverse();
-    int agreeing = 1;  // this one
-    for (const Placement& p : placements_) {
-      const Eigen::Isometry3d D = p.T_world_odom.inverse() * T_world_odom;
-      if (D.translation().norm() <= r.max_disagreement_m && so3::angle(D.linear()) <= r.max_disagreement_rad) {
-        ++agreeing;
-      }
-    }
-    if (agreeing < r.confirmations) {
-      placements_.push_back({frame.utime, T_world_odom});
-      return step;  // one placement per frame: the best verified
-    }
-    // Placed: the odometry goes on from this frame, located in keyframe k, as after a
-    // re-anchoring; the next keyframe's edge joins the map there.
+    if (!accept_placement(frame, T_odom_camera, kf, located)) return step;  // one placement per frame: the best verified
     localized_ = true;
+    lost_since_utime_ = -1;
     gate_by_pose_ = true;
-    placements_.clear();
-    reference_ = OdometryReference{kf.id,          frame.utime, T_odom_camera, frame.T_body_camera,
-                                   located.T_candidate_query, right_covariance(located.information)};
-    reference_marginal_ = marginal_covariance(graph_, static_cast<int>(k), options_.optimizer.kernel);
-    relocalisation_ = Relocalisation{frame.utime, relocalisation_tries_, kf.id, graph_.poses[k] * located.T_candidate_query};
+    relocalisation_ = Relocalisation{frame.utime, relocalisation_tries_, kf.id, reference_world_pose()};
+    relocalisation_tries_ = 0;
     step.relocalised = true;
     step.reanchor_keyframe_id = kf.id;
     return step;
@@ -448,7 +474,8 @@ bool Slam::reanchor(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_came
   for (size_t k = 0; k < keyframes_.size(); ++k) {
     const double d = se3::translation_distance(graph_.poses[k], T_world_frame);
     const double a = se3::rotation_distance(graph_.poses[k], T_world_frame);
-    if (d < c.max_translation_m && a < c.max_rotation_rad && !keyframes_[k].thinned)
+    // Localisation only: a thinned keyframe still covers its view (the map is not to grow there).
+    if (d < c.max_translation_m && a < c.max_rotation_rad && (!keyframes_[k].thinned || options_.localize_only))
       covering.emplace_back(d / std::max(c.max_translation_m, 1e-9) + a / std::max(c.max_rotation_rad, 1e-9), k);
   }
   std::sort(covering.begin(), covering.end());
@@ -476,6 +503,7 @@ bool Slam::reanchor(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_came
   }
   for (const auto& [distance, k] : covering) {
     const Keyframe& kf = keyframes_[k];
+    if (kf.thinned) continue;
     // The seed depends on the pair only, so that a replay verifies identically.
     const uint64_t seed = static_cast<uint64_t>(kf.id) * 1000003u + static_cast<uint64_t>(frame.utime);
     // Located against a prediction it must match within max_correction: the inliers' precision
@@ -494,11 +522,14 @@ bool Slam::reanchor(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_came
       step.loop = located;
       ++coverage_misses_.too_far;
       if (!options_.localize_only) return false;  // a loop to close, through a new keyframe
-      // Localisation only: the map stays as it is, so the frame is placed in it again, with
-      // relocalisation's confirmation (a large correction from one view may be a wrong place).
+      // Localisation only: the map stays as it is. One view placing the frame far from its
+      // estimate may be a wrong place, so the frame is carried at its prediction and the next
+      // frames are relocalised (with confirmation; this placement is the first hypothesis) for
+      // at most max_span_s, after which the estimate carries on (the vehicle may have left).
+      carry_reference(frame, T_odom_camera, link, predicted, step);
+      accept_placement(frame, T_odom_camera, kf, located);  // at most one: never enough alone
       localized_ = false;
-      placements_.clear();
-      step.lost = true;
+      lost_since_utime_ = frame.utime;
       return true;
     }
     // The frame in keyframe k twice: predicted (the reference and the odometry since, with

@@ -71,11 +71,9 @@ struct SlamStep {
   /// reference at its predicted pose (nothing measured: no correction to send).
   bool carried = false;
   /// Or, started from a saved map, the frame placed the camera in it (Slam::relocalisation());
+  /// or, localising only, a confirmed placement moved it beyond the correction bound.
   /// `reanchor_keyframe_id` and `loop` say where.
   bool relocalised = false;
-  /// Localisation only: located too far from its estimate (or the odometry broke): the camera
-  /// is relocalised again from the next frame (SlamOptions::localize_only).
-  bool lost = false;
   int candidates = 0;             ///< loop candidates verified
   int inconsistent = 0;           ///< of them, verified but refused as disagreeing with the odometry
   bool loop_closed = false;
@@ -120,6 +118,11 @@ class Slam {
   const std::optional<Relocalisation>& relocalisation() const { return relocalisation_; }
   /// This flight's session number (keyframes it makes carry it).
   int session() const { return session_; }
+  /// The utime of session `s`'s first keyframe (0: it has none yet), and of the first frame this
+  /// Slam was given since its start or reset (0: none): what published ids and revisions count
+  /// from (slam_messages.h).
+  int64_t session_start_utime(int s) const;
+  int64_t first_frame_utime() const { return first_frame_utime_; }
 
   /// Would a frame at this odometry pose become a keyframe, be re-anchored or (not localized
   /// yet) be relocalised? (false for a frame whose pose is not finite; true after a restart of
@@ -193,6 +196,11 @@ class Slam {
                 const std::optional<Matrix6d>& odometry_covariance, const FrameFeatures& features,
                 const sensors::SensorProfile& sensor, SlamStep& step);
   Eigen::Isometry3d reference_world_pose() const;
+  /// A verified placement of the frame in keyframe `kf`: taken (the frame becomes the reference,
+  /// located there) when enough placements of other frames agree with it, else kept as a
+  /// hypothesis (RelocalisationOptions). True when taken.
+  bool accept_placement(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera, const Keyframe& kf,
+                        const LoopConstraint& located);
   /// Makes the frame the reference at its predicted pose, in the reference's keyframe.
   void carry_reference(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera, OdometryLink link,
                        const Matrix6d& predicted, SlamStep& step);
@@ -227,7 +235,10 @@ class Slam {
   size_t feature_bytes_ = 0;  ///< of those keyframes
   int thinned_ = 0;
   int session_ = 0;
+  std::vector<int64_t> session_start_utime_;  ///< per session, its first keyframe's utime
+  int64_t first_frame_utime_ = 0;
   bool localized_ = true;
+  int64_t lost_since_utime_ = -1;  ///< localisation only: located too far at this frame (-1: not lost)
   std::optional<Relocalisation> relocalisation_;
   int relocalisation_tries_ = 0;
   struct Placement {  ///< a verified relocalisation hypothesis

@@ -106,9 +106,11 @@ struct SlamOptions {
   RelocalisationOptions relocalisation;
   /// Localisation only (on a saved map): over the map no keyframe is added. A frame that would
   /// be one is re-anchored on the map, or carried at its predicted pose when its view does not
-  /// verify; one located beyond the correction bound, or after a break of the odometry, is
-  /// relocalised again (RelocalisationOptions) instead of closing a loop. Where no keyframe
-  /// is near (the vehicle left the map) keyframes are added as in mapping.
+  /// verify (thinned keyframes still cover their views); one located beyond the correction
+  /// bound is carried and the next frames are relocalised (RelocalisationOptions) instead of
+  /// closing a loop, for at most max_span_s (then the estimate carries on). Where no keyframe is
+  /// near (the vehicle left the map), and after a break of the odometry until a loop re-attaches
+  /// it, keyframes are added as in mapping.
   bool localize_only = false;
   /// A verified loop must agree with the odometry between its keyframes (when the estimate is
   /// trustworthy): rejects perceptual aliasing (loop_consistency.h).

@@ -197,6 +197,8 @@ void read_keyframes(Reader& r, SlamMap& map) {
     kf.id = r.get<int64_t>();
     kf.utime = r.get<int64_t>();
     kf.session = r.get<int32_t>();
+    // Sessions number the flights that made the keyframes: never more than the keyframes.
+    if (kf.session < 0 || static_cast<size_t>(kf.session) >= n) r.fail("has keyframe " + std::to_string(k) + " of an impossible session");
     const auto link = r.get<uint8_t>();
     if (link > static_cast<uint8_t>(OdometryLink::kBroken)) r.fail("has keyframe " + std::to_string(k) + " with an unknown link");
     kf.link = static_cast<OdometryLink>(link);
@@ -327,6 +329,10 @@ SlamMap read_map(const std::string& dir, std::string* head) {
       throw InputError(what + " fails its checksum (the file is damaged)");
     }
     Reader r(payload, size, what);
+    const bool repeated = (tag == tag_of("HEAD") && seen_head) || (tag == tag_of("VOCB") && seen_vocabulary) ||
+                          (tag == tag_of("KEYF") && seen_keyframes) || (tag == tag_of("GRPH") && seen_graph);
+    if (repeated) throw InputError(what + " comes twice");
+    if (tag == tag_of("END.") && size != 0) throw InputError(what + " has content (an end section has none)");
     if (tag == tag_of("HEAD")) {
       if (head) *head = std::string(reinterpret_cast<const char*>(payload), size);
       seen_head = true;

@@ -4,8 +4,8 @@
 //
 //   "KESTREL-SLAM-MAP" (16 bytes), format version (u32), then sections, each
 //   tag (4 bytes) | payload size (u64) | payload | CRC-32 of tag, size and payload (u32):
-//     HEAD  text, "key: value" lines: what made the map, when, its counts (for people and
-//           for errors; nothing is read back from it but the counts it is checked against)
+//     HEAD  text, "key: value" lines: what made the map, when, its counts (for people; it
+//           is returned as read, nothing in it is relied on)
 //     VOCB  the vocabulary (slam/place/vocabulary.h's format; empty: none trained)
 //     KEYF  the keyframes: poses, session, link, sensor, camera, features
 //     GRPH  the pose graph's vertices and edges, the loop gate's model per edge, the revision
@@ -14,8 +14,8 @@
 //
 // Errors: a missing file, another format, a newer version, a cut or damaged file (a CRC that
 // fails), impossible sizes or values, or a map that breaks slam_map.h's invariants throw
-// InputError naming the file and what is wrong (the tools exit 3). The reader allocates
-// nothing larger than the file. The writer goes through AtomicFile: an existing map is never
+// InputError naming the file and what is wrong (the tools exit 3). Every count is checked
+// against the bytes left before anything is sized (a keyframe in memory is about 3x its bytes). The writer goes through AtomicFile: an existing map is never
 // left half-replaced.
 
 #include <string>

@@ -260,6 +260,15 @@ Vocabulary Vocabulary::read(std::istream& in, const std::string& path) {
       num_nodes > 50'000'000) {
     throw corrupt("impossible sizes");
   }
+  // Nothing is sized beyond what the stream still holds (a node is 44 bytes): a damaged or
+  // hostile count is an error, not an allocation.
+  const std::streampos here = in.tellg();
+  in.seekg(0, std::ios::end);
+  const std::streamoff left = in.tellg() - here;
+  in.seekg(here);
+  if (!in || left < static_cast<std::streamoff>(num_nodes) * static_cast<std::streamoff>(sizeof(Descriptor) + 12)) {
+    throw corrupt("shorter than its " + std::to_string(num_nodes) + " nodes");
+  }
   v.nodes_.resize(static_cast<size_t>(num_nodes));
   v.words_.assign(static_cast<size_t>(num_words), -1);
   for (int32_t i = 0; i < num_nodes; ++i) {
@@ -273,8 +282,9 @@ Vocabulary Vocabulary::read(std::istream& in, const std::string& path) {
     n.num_children = fields[1];
     n.word = fields[2];
     const bool leaf = n.word >= 0;
-    const bool children_ok = n.num_children >= 1 && n.num_children <= v.branching_ &&
-                             n.first_child > i && n.first_child + n.num_children <= num_nodes;
+    // In 64 bits: first_child + num_children must not wrap around.
+    const bool children_ok = n.num_children >= 1 && n.num_children <= v.branching_ && n.first_child > i &&
+                             static_cast<int64_t>(n.first_child) + n.num_children <= num_nodes;
     if (leaf ? (n.word >= num_words || v.words_[n.word] >= 0) : !children_ok) {
       throw corrupt("bad node " + std::to_string(i));
     }

@@ -166,7 +166,8 @@ TEST(ProcessSets, ASavedMapIsWiredIntoSlamTheMapperAndTheEstimator) {
   };
   const ProcessSet first = with_saved_map(shipped, "/maps/b1", false, 30.0);
   EXPECT_EQ(args_of(first, "slam").argv, (std::vector<std::string>{"slam", "--save-map", "/maps/b1"}));
-  EXPECT_EQ(args_of(first, "mapper").argv, (std::vector<std::string>{"mapper", "--journal", "/maps/b1/mapper.journal"}));
+  EXPECT_EQ(args_of(first, "mapper").argv,
+            (std::vector<std::string>{"mapper", "--journal", "/maps/b1/mapper.journal", "--journal-is-map"}));
   EXPECT_EQ(args_of(first, "estimator").argv, args_of(shipped, "estimator").argv) << "the first flight defines the world";
   const ProcessSet again = with_saved_map(shipped, "/maps/b1", true, 30.0);
   EXPECT_EQ(args_of(again, "slam").argv,
@@ -176,6 +177,12 @@ TEST(ProcessSets, ASavedMapIsWiredIntoSlamTheMapperAndTheEstimator) {
   EXPECT_TRUE(estimator.restart_args.empty()) << "a restart awaits the map's world as long, once";
   EXPECT_EQ(command_of_start(estimator, 2), estimator.argv);
   EXPECT_EQ(args_of(again, "vo").argv, args_of(shipped, "vo").argv);
+  // A set whose slam already names a map gets the launch's, once (a repeated option is exit 2).
+  ProcessSet named = shipped;
+  for (auto& p : named)
+    if (p.name == "slam") p.argv.insert(p.argv.end(), {"--map", "/old", "--save-map", "/old"});
+  EXPECT_EQ(args_of(with_saved_map(named, "/maps/b1", true, 30.0), "slam").argv,
+            (std::vector<std::string>{"slam", "--map", "/maps/b1", "--save-map", "/maps/b1"}));
 }
 
 TEST(ResolveExecutable, PrefersKestrelToolsThenPath) {

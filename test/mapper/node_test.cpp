@@ -344,6 +344,30 @@ TEST(MapNode, AResetStartsTheJournalAgainAndKeepsTheOldOneWhole) {
   EXPECT_EQ(MapNode(options).stats().keyframes_restored, 0) << "a restart after the reset has the reset's map";
 }
 
+// A journal that is a building's saved map (kestrel launch --map): the RESET a lock-step session
+// sends before its first event keeps the map restored from it; a later one forgets it.
+TEST(MapNode, ASavedMapsJournalSurvivesTheResetBeforeAnyInput) {
+  const test::Scene scene = test::room_with_a_box();
+  kestrel::test::TempDir dir;
+  NodeOptions options;
+  options.journal_path = (dir / "mapper.journal").string();
+  {
+    MapNode flight(options);
+    flight.on_graph(feed_keyframes(flight, scene, 0, 2, 1), "SLAM_GRAPH");
+  }
+  options.journal_is_map = true;
+  MapNode node(options);
+  ASSERT_EQ(node.stats().keyframes_restored, 3);
+  node.reset();
+  EXPECT_EQ(node.mapper().keyframes().size(), 3u) << "the saved map is where the new flight begins";
+  EXPECT_EQ(node.journal_kept_aside(), "") << "nothing set aside";
+  EXPECT_EQ(read_journal(options.journal_path).records.size(), 3u);
+  node.on_graph(feed_keyframes(node, scene, 3, 3, 2), "SLAM_GRAPH");
+  node.reset();
+  EXPECT_EQ(node.mapper().keyframes().size(), 0u) << "after input, a RESET forgets as always";
+  EXPECT_NE(node.journal_kept_aside(), "");
+}
+
 // A disk that fills up in flight: the journal is given up with the reason, the map goes on.
 TEST(MapNode, AJournalThatCannotBeWrittenIsGivenUpAndTheMapGoesOn) {
   const test::Scene scene = test::room_with_a_box();

@@ -514,7 +514,9 @@ TEST_F(AdapterTest, OnASavedMapTheRelocalisingFrameSendsTheFirstCorrectionInTheM
     const AdapterOutputs out = adapter.on_vo_update(update(k));
     EXPECT_FALSE(out.anchored);
     correction = out.correction;
-    if (correction) EXPECT_TRUE(out.step && out.step->relocalised);
+    if (correction) {
+      EXPECT_TRUE(out.step && out.step->relocalised);
+    }
   }
   ASSERT_TRUE(correction) << "never relocalised";
   EXPECT_LE(k, 3);

@@ -10,6 +10,7 @@
 #include <fstream>
 #include <iostream>
 #include <iterator>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -157,6 +158,30 @@ TEST(SlamMapFile, RefusesEveryKindOfDamage) {
   EXPECT_THROW(read_map((dir.path / "absent").string()), InputError);
 }
 
+// A map's vocabulary section is read by Vocabulary::read: crafted counts (valid CRCs do not
+// stop them) are errors, never a wrap-around index or a huge allocation.
+TEST(SlamMapFile, AVocabularyWithImpossibleCountsIsRefusedBeforeAnythingIsSized) {
+  auto stream = [](int32_t num_nodes, int32_t first_child) {
+    std::string bytes = "KESTREL-VOCABULARY 1\n";
+    const int32_t header[4] = {2, 1, num_nodes, 2};
+    bytes.append(reinterpret_cast<const char*>(header), sizeof(header));
+    for (int i = 0; i < 3; ++i) {  // a root and two leaves
+      bytes.append(32, '\0');
+      const int32_t fields[3] = {i == 0 ? first_child : -1, i == 0 ? 2 : 0, i == 0 ? -1 : i - 1};
+      bytes.append(reinterpret_cast<const char*>(fields), sizeof(fields));
+    }
+    const double idf[2] = {1.0, 1.0};
+    bytes.append(reinterpret_cast<const char*>(idf), sizeof(idf));
+    return bytes;
+  };
+  const std::string good = stream(3, 1);
+  EXPECT_EQ(Vocabulary::load_from_memory(good.data(), good.size(), "good").num_words(), 2);
+  const std::string wraps = stream(3, std::numeric_limits<int32_t>::max() - 1);  // + 2 children wraps
+  EXPECT_THROW(Vocabulary::load_from_memory(wraps.data(), wraps.size(), "wraps"), InputError);
+  const std::string huge = stream(50'000'000, 1);  // 2.2 GB of nodes claimed in 200 bytes
+  EXPECT_THROW(Vocabulary::load_from_memory(huge.data(), huge.size(), "huge"), InputError);
+}
+
 TEST(SlamMapFile, ASaveThatFailsLeavesTheOldMapWhole) {
   const TempDir dir;
   write_map(dir.path.string(), saved(), {"first", ""});
@@ -234,12 +259,13 @@ TEST(Relocalisation, OnePlacementIsNotEnoughAndABrokenOdometryForgetsTheHypothes
   const Flight f;
   const SlamStep first = slam.add(room().render(path[5], test::test_camera(), 100'000), f.T_odom_world * path[5]);
   EXPECT_FALSE(first.relocalised);
-  // The next frame agrees with it, but the odometry broke in between: it is a first placement again.
+  // The next frame's placement agrees with it (its odometry happens to go on in the same
+  // frame), but the odometry broke in between, so nothing relates the two: a first placement again.
   const SlamStep after_break = slam.add(room().render(path[6], test::test_camera(), 200'000),
-                                        Eigen::Isometry3d::Identity(), OdometryLink::kBroken);
-  EXPECT_FALSE(after_break.relocalised);
+                                        f.T_odom_world * path[6], OdometryLink::kBroken);
+  EXPECT_FALSE(after_break.relocalised) << "a placement from before the break was counted";
   const SlamStep confirmed = slam.add(room().render(path[7], test::test_camera(), 300'000),
-                                      path[6].inverse() * path[7]);  // the odometry since the break
+                                      f.T_odom_world * path[7]);  // the odometry since the break
   EXPECT_TRUE(confirmed.relocalised);
   // reset() goes back to the saved map, not to nothing.
   slam.reset();
@@ -280,7 +306,9 @@ TEST_P(LocalisationOnly, LapsOverTheMapAddNothingAndStayOnIt) {
             << " cm, " << relocalisations << " relocalisations, " << slam.num_reanchors() << " re-anchorings\n";
   EXPECT_EQ(slam.keyframes().size(), saved().keyframes.size());
   EXPECT_GE(relocalisations, drift_deg > 1.0 ? 3 : 1);
-  if (drift_deg < 1.0) ASSERT_TRUE(slam.localized());
+  if (drift_deg < 1.0) {
+    ASSERT_TRUE(slam.localized());
+  }
   EXPECT_LT(worst_m, 0.10);
   // Looking up at the ceiling, which the lap never saw: the vehicle left the map, keyframes again
   // (once localised: with the larger drift the last frame may be waiting for its confirmation).
@@ -292,6 +320,35 @@ TEST_P(LocalisationOnly, LapsOverTheMapAddNothingAndStayOnIt) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Drift, LocalisationOnly, ::testing::Values(0.3, 1.5));
+
+// Localisation only: one frame located far off (a VO glitch) just before the vehicle turns to
+// what the map never saw (the ceiling) must not leave it waiting for a placement for ever: after
+// max_span_s without one, the estimate carries on and the new view is mapped.
+TEST(LocalisationOnlyGlitch, AGlitchBeforeLeavingTheMapDoesNotStopMapping) {
+  SlamOptions options;
+  options.localize_only = true;
+  Slam slam(std::make_shared<const SlamMap>(saved()), options);
+  const auto lap = test::circle_path(48, 1.0, 1.0);
+  int64_t utime = 0;
+  for (int i = 0; i < 6; ++i) slam.add(room().render(lap[static_cast<size_t>(i)], test::test_camera(), utime += 100'000), lap[static_cast<size_t>(i)]);
+  ASSERT_TRUE(slam.localized());
+  Eigen::Isometry3d glitch = lap[7];
+  glitch.translation().x() += 0.10;  // the odometry jumps 10 cm: located beyond the correction bound
+  const SlamStep off = slam.add(room().render(lap[7], test::test_camera(), utime += 100'000), glitch);
+  EXPECT_FALSE(off.keyframe);
+  EXPECT_FALSE(slam.localized()) << "one far placement is not taken, and relocalisation begins";
+  int keyframes = 0;
+  Eigen::Isometry3d up = lap[7];
+  up.linear() = up.linear() * Eigen::AngleAxisd(-kPi / 2, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  const Eigen::Isometry3d T_odom_up = glitch * lap[7].inverse() * up;
+  for (int i = 0; i < 30; ++i) {
+    Eigen::Isometry3d T = up;
+    T.translation().y() += 0.02 * i;  // drifting along under the ceiling
+    keyframes += slam.add(room().render(T, test::test_camera(), utime += 100'000), T_odom_up * up.inverse() * T).keyframe;
+  }
+  EXPECT_TRUE(slam.localized());
+  EXPECT_GE(keyframes, 1) << "the ceiling is not in the map: it is mapped once the wait is over";
+}
 
 TEST(Relocalisation, AMapOfNothingMapsFromTheStart) {
   Slam empty_run(SlamOptions{}, builtin_vocabulary());

@@ -72,9 +72,19 @@ TEST(SlamTool, SaveMapAsksARunningSlamToSaveItsMapNow) {
   if (!::kestrel::test::can_isolate_network()) KESTREL_SKIP_ENVIRONMENT() << "no network namespace available";
   TempDir dir;
   const std::string slam = tool("slam").string(), save = tool("save-map").string(), map = (dir / "m").string();
-  const auto saved = ::kestrel::test::run_isolated(
+  // Before any keyframe there is nothing to save, and it says so.
+  const auto empty = ::kestrel::test::run_isolated(
       "'" + slam + "' -q --save-map '" + map + "' & S=$!; '" + save + "' --timeout 20; R=$?; kill -INT $S; wait $S; exit $R",
       60.0);
+  EXPECT_EQ(empty.exit_code, kExitFailure) << empty.out << empty.err;
+  EXPECT_NE(empty.out.find("no keyframe yet"), std::string::npos) << empty.out;
+  EXPECT_FALSE(std::filesystem::exists(dir / "m" / "slam.map")) << "a map of nothing is not written, on exit either";
+  // After 3 s of the sim's room through the VO: saved.
+  const auto saved = ::kestrel::test::run_isolated(
+      "'" + tool("vo").string() + "' -q & V=$!; '" + slam + "' -q --save-map '" + map + "' & S=$!; sleep 0.5; '" +
+          tool("sim").string() + "' -q --world room --flight figure8 --duration 3 > /dev/null; sleep 1; '" + save +
+          "' --timeout 20; R=$?; kill -INT $S $V; wait $S $V; exit $R",
+      90.0);
   EXPECT_EQ(saved.exit_code, kExitOk) << saved.out << saved.err;
   EXPECT_NE(saved.out.find("map saved for request"), std::string::npos) << saved.out;
   EXPECT_TRUE(std::filesystem::is_regular_file(dir / "m" / "slam.map"));

@@ -110,11 +110,13 @@ ProcessSet with_saved_map(ProcessSet set, const std::filesystem::path& map_dir, 
   for (ProcessSpec& p : set) {
     const std::string& tool = p.argv.front();
     if (tool == "slam") {
+      drop_option(p.argv, "--map");
+      drop_option(p.argv, "--save-map");
       if (map_exists) p.argv.insert(p.argv.end(), {"--map", map_dir.string()});
       p.argv.insert(p.argv.end(), {"--save-map", map_dir.string()});
     } else if (tool == "mapper") {
       drop_option(p.argv, "--journal");
-      p.argv.insert(p.argv.end(), {"--journal", (map_dir / "mapper.journal").string()});
+      p.argv.insert(p.argv.end(), {"--journal", (map_dir / "mapper.journal").string(), "--journal-is-map"});
     } else if (tool == "estimator" && map_exists) {
       // Every start awaits the map's world, the first one too (and for as long).
       drop_option(p.argv, "--await-world");
