@@ -15,7 +15,8 @@ namespace kestrel::fuzz {
 const std::vector<Target>& targets() {
   static const std::vector<Target> all = [] {
     std::vector<Target> v;
-    for (auto group : {message_targets, text_targets, image_targets, journal_targets, estimator_targets}) {
+    for (auto group : {message_targets, text_targets, image_targets, journal_targets, slam_map_targets,
+                       estimator_targets}) {
       for (Target& t : group()) v.push_back(t);
     }
 #if KESTREL_FUZZ_STATION
