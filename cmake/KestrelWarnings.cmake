@@ -41,6 +41,14 @@ if(KESTREL_SANITIZE)
     -O1 -g1)
   target_link_options(kestrel_options INTERFACE
     -fsanitize=address,undefined -fno-sanitize=object-size,pointer-overflow,null,vptr)
+  # UBSan's alignment check only where bytes from outside are read: not in the ALGORITHM
+  # libraries (which know nothing of files or LCM: their inputs are typed values that the
+  # decoders in common/, drivers/, ros/ and station/ made, and those keep the check) nor in the
+  # tests' own code. It was 7-21 % of the compile time of their heaviest files, the Eigen-heavy
+  # ones, where Eigen's own assertion (on in this build: no NDEBUG) already stops an unaligned
+  # fixed-size object. docs/decisions/2026-12-05-ci-time-alignment-check-and-shorter-flights.md.
+  target_compile_options(kestrel_options INTERFACE
+    "$<$<OR:$<BOOL:$<TARGET_PROPERTY:KESTREL_ALGORITHM>>,$<BOOL:$<TARGET_PROPERTY:KESTREL_TEST_CODE>>>:-fno-sanitize=alignment>")
   if(CMAKE_CXX_COMPILER_ID MATCHES "Clang")
     # No instrumentation for use-after-return, which ASAN_OPTIONS never turns on (clang 14
     # emits it for every function with a stack object all the same): the sanitized unit tests

@@ -144,9 +144,16 @@ std::shared_ptr<const SlamMap> load_map(const std::string& dir) {
   return map;
 }
 
-void save_map(const std::string& dir, const SlamMap& map, const std::string& made_by) {
+// Writes the map; false, writing nothing, when it has no keyframe: a map of nothing would be
+// taken by the next flight for a building's map.
+bool save_map(const std::string& dir, const SlamMap& map, const std::string& made_by) {
+  if (map.keyframes.empty()) {
+    spdlog::warn("map not saved in {}: no keyframe yet", dir);
+    return false;
+  }
   write_map(dir, map, MapProvenance{made_by, utc_now()});
   spdlog::info("map saved: {} ({} keyframes, {} session(s))", map_file_in(dir), map.keyframes.size(), map.sessions);
+  return true;
 }
 
 void report_relocalisation(const std::optional<Relocalisation>& r, bool from_map) {
@@ -257,12 +264,11 @@ int serve(const Options& o, const SlamOptions& options, std::shared_ptr<const Vo
       if (!answered.insert(m.request_id).second) return;
       try {
         const SlamMap now = adapter.slam().map();
-        if (now.keyframes.empty()) {
+        if (!save_map(o.save_map, now, "kestrel-slam (process " + o.name + ", on request)")) {
           node->set_health(process_status_t::STATE_RUNNING,
                            fmt::format("map not saved for request {}: no keyframe yet", m.request_id));
           return;
         }
-        save_map(o.save_map, now, "kestrel-slam (process " + o.name + ", on request)");
         node->set_health(process_status_t::STATE_RUNNING,
                          fmt::format("map saved for request {}: {} keyframes in {}", m.request_id,
                                      now.keyframes.size(), map_file_in(o.save_map)));
@@ -278,8 +284,7 @@ int serve(const Options& o, const SlamOptions& options, std::shared_ptr<const Vo
                o.graph_channel, o.correction_channel);
   const int status = node->spin();
   if (map && !adapter.slam().relocalisation()) report_relocalisation(std::nullopt, true);  // placed: said when it was
-  // A map of nothing is not saved: the next flight would take it for a building's map.
-  if (!o.save_map.empty() && !adapter.slam().keyframes().empty())
+  if (!o.save_map.empty())
     save_map(o.save_map, adapter.slam().map(), "kestrel-slam (process " + o.name + ")");
   const auto& misses = adapter.slam().coverage_misses();
   spdlog::info("{} keyframes ({} thinned, features {:.1f} MB), {} loop closures, {} frames re-anchored on a "

@@ -312,7 +312,7 @@ SlamStep Slam::add(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camer
     localized_ = true;
     lost_since_utime_ = -1;
   }
-  if (!localized_) return relocalise(frame, T_odom_camera, link, motion, sensor);
+  if (!localized_) return relocalise(frame, T_odom_camera, motion, sensor);  // a break cleared the placements (above)
   SlamStep step;
   if (!wants_keyframe(T_odom_camera, link)) return step;
 
@@ -432,12 +432,11 @@ bool Slam::accept_placement(const RgbdFrame& frame, const Eigen::Isometry3d& T_o
   return true;
 }
 
-SlamStep Slam::relocalise(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera, OdometryLink link,
+SlamStep Slam::relocalise(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera,
                           const sensors::FrameMotion& motion, const sensors::SensorProfile& sensor) {
   const RelocalisationOptions& r = options_.relocalisation;
   SlamStep step;
   ++relocalisation_tries_;
-  (void)link;  // a break cleared the hypotheses already (add())
   const FrameFeatures features = extractor_.extract(frame, motion);
   if (static_cast<int>(features.num_points()) < options_.verification.min_inliers) return step;
   const std::vector<BowMatch> candidates = places_->query(

@@ -207,8 +207,8 @@ class Slam {
   /// Starts from the loaded map (reset()).
   void restore(const SlamMap& map);
   /// Not localized: places the frame in the map, or keeps it as a hypothesis (RelocalisationOptions).
-  SlamStep relocalise(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera, OdometryLink link,
-                      const sensors::FrameMotion& motion, const sensors::SensorProfile& sensor);
+  SlamStep relocalise(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera, const sensors::FrameMotion& motion,
+                      const sensors::SensorProfile& sensor);
   /// Puts the keyframes that keep their features in the bins of their optimised poses.
   void rebin();
   /// Thins keyframes (never `newest`) while their features exceed the budget.

@@ -44,16 +44,19 @@ std::vector<Row> read_samples(const fs::path& csv) {
   return rows;
 }
 
-TEST(Soak, AMinuteOfTheWholeSystemIsSampledAndReportedPerProcess) {
+TEST(Soak, HalfAMinuteOfTheWholeSystemIsSampledAndReportedPerProcess) {
   if (!test::can_isolate_network()) KESTREL_SKIP_ENVIRONMENT() << "no network namespace available";
   test::TempDir dir;
   const auto t0 = std::chrono::steady_clock::now();
-  const auto r = test::run({test::tool("soak").string(), "--minutes", "1", "--sample-period", "1", "--out",
-                            dir.path().string()},
+  // Half a minute: long enough for a warm-up (a third of it) and a fit over 20 samples; the
+  // soak's figures come from its 30-minute runs (tools/soak/README.md).
+  const double run_s = 30.0;
+  const auto r = test::run({test::tool("soak").string(), "--minutes", std::to_string(run_s / 60.0), "--sample-period",
+                            "1", "--out", dir.path().string()},
                            300.0);
   const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  // Every process sampled, over the whole minute, with memory.
+  // Every process sampled, over the whole run, with memory.
   const auto rows = read_samples(dir / "samples.csv");
   std::map<std::string, std::vector<Row>> by_process;
   for (const Row& row : rows) by_process[row.process].push_back(row);
@@ -67,18 +70,18 @@ TEST(Soak, AMinuteOfTheWholeSystemIsSampledAndReportedPerProcess) {
       EXPECT_LT(row.rss_mb, 4000.0) << name;
       EXPECT_EQ(row.pid, rs.front().pid) << name << ": restarted";
     }
-    EXPECT_GT(rs.back().sim_s, 50.0) << name;
+    EXPECT_GT(rs.back().sim_s, run_s - 5.0) << name;
   }
-  // The simulated time reached the minute, and the samples follow it.
+  // The simulated time reached the run's length, and the samples follow it.
   const nlohmann::json j = nlohmann::json::parse(test::read_file(dir / "soak.json"));
-  EXPECT_GT(j["sim_s"].get<double>(), 55.0) << j.dump(2);
-  EXPECT_LE(j["sim_s"].get<double>(), 60.5) << j.dump(2);
+  EXPECT_GT(j["sim_s"].get<double>(), run_s - 2.5) << j.dump(2);
+  EXPECT_LE(j["sim_s"].get<double>(), run_s + 0.5) << j.dump(2);
   EXPECT_TRUE(j["usable"].get<bool>());
   EXPECT_EQ(j["failure"], "");
   // 30 frames a second measured by the VO; the vehicle flew the route (0.5 m/s less the start).
-  EXPECT_GT(j["frames"].get<int>(), 1500) << j.dump(2);
-  EXPECT_GT(j["distance_m"].get<double>(), 15.0) << j.dump(2);
-  EXPECT_LT(j["distance_m"].get<double>(), 40.0) << j.dump(2);
+  EXPECT_GT(j["frames"].get<int>(), 25 * run_s) << j.dump(2);
+  EXPECT_GT(j["distance_m"].get<double>(), 0.25 * run_s) << j.dump(2);
+  EXPECT_LT(j["distance_m"].get<double>(), 0.67 * run_s) << j.dump(2);
   EXPECT_GE(j["keyframes"].get<int>(), 5) << j.dump(2);
   ASSERT_EQ(j["processes"].size(), kProcesses.size()) << j.dump(2);
   for (const auto& p : j["processes"]) {
@@ -89,7 +92,7 @@ TEST(Soak, AMinuteOfTheWholeSystemIsSampledAndReportedPerProcess) {
     EXPECT_GT(p["rss_end_mb"].get<double>(), 1.0) << name;
     EXPECT_GE(p["rss_peak_mb"].get<double>(), p["rss_end_mb"].get<double>()) << name;
     // The warm-up is a third of a short run; the fit is over the last two thirds.
-    EXPECT_NEAR(p["warmup_at_s"].get<double>(), 20.0, 5.0) << name;
+    EXPECT_NEAR(p["warmup_at_s"].get<double>(), run_s / 3.0, 5.0) << name;
     EXPECT_GE(p["fit_samples"].get<int>(), 5) << name;
     EXPECT_TRUE(p["growth_mb_per_10min"].is_number()) << name;
     EXPECT_TRUE(p["verdict"] == "flat" || p["verdict"] == "grows") << name << ": " << p["verdict"];
@@ -103,7 +106,7 @@ TEST(Soak, AMinuteOfTheWholeSystemIsSampledAndReportedPerProcess) {
   EXPECT_TRUE(fs::exists(dir / "progress.csv"));
   for (const std::string& name : kProcesses) EXPECT_TRUE(fs::exists(dir / "flight" / (name + ".log"))) << name;
   EXPECT_FALSE(fs::exists(dir / "flight" / "flight.lcmlog"));  // a soak records nothing
-  std::cout << "the 1-minute soak took " << wall_s << " s of wall time\n";
+  std::cout << "the " << run_s << " s soak took " << wall_s << " s of wall time\n";
 }
 
 // SLAM killed while the system flies: the soak ends with 1, naming it, and still writes what it
