@@ -36,6 +36,21 @@ bool run_command(const uint8_t* data, size_t size) {
   try {
     const station::Command c =
         station::parse_command(std::string_view(reinterpret_cast<const char*>(data), size), "0123456789abcdef");
+    if (const auto* p = std::get_if<station::PlaybackCommand>(&c)) {
+      // Against a replay of 20 s: what is sent lies within its log, at a speed it can play.
+      kestrel::playback_status_t replay{};
+      replay.start_utime = 1'000'000;
+      replay.end_utime = 21'000'000;
+      replay.speed = 1.0;
+      std::string refusal;
+      const kestrel::playback_command_t m = station::playback_command(*p, replay, 1, refusal);
+      if (refusal.empty() && m.command == kestrel::playback_command_t::COMMAND_SEEK &&
+          (m.seek_utime < replay.start_utime || m.seek_utime > replay.end_utime))
+        defect("station-command", "an accepted seek lies outside the log");
+      if (m.command == kestrel::playback_command_t::COMMAND_SPEED &&
+          !(m.speed > 0.0 && m.speed <= station::kMaxPlaybackSpeed))
+        defect("station-command", "an accepted speed is not one the replay can play");
+    }
     if (const auto* g = std::get_if<station::GoalCommand>(&c)) {
       const std::string why = station::check_goal(*g, &command_map(), {});
       if (why.empty()) {
@@ -53,7 +68,9 @@ bool run_command(const uint8_t* data, size_t size) {
 std::vector<Bytes> command_seeds() {
   return {text(R"({"cmd":"goal","goal":[0,0,1,0],"token":"0123456789abcdef"})"),
           text(R"({"cmd":"hold","token":"0123456789abcdef"})"),
-          text(R"({"token":"0123456789abcdef","cmd":"goal","goal":[-1.5,1.25,2.0,3.1]})")};
+          text(R"({"token":"0123456789abcdef","cmd":"goal","goal":[-1.5,1.25,2.0,3.1]})"),
+          text(R"({"cmd":"seek","t":12.5,"token":"0123456789abcdef"})"),
+          text(R"({"cmd":"speed","speed":4,"token":"0123456789abcdef"})")};
 }
 
 // The first byte picks the message type, the rest is that message as LCM encodes it; the
@@ -65,13 +82,16 @@ bool run_update(const uint8_t* data, size_t size) {
   const uint8_t* m = data + 1;
   const size_t n = size - 1;
   return accepted([&] {
-    switch (data[0] % 6) {
+    switch (data[0] % 7) {
       case 0: st.on_state(decode_message<kestrel::state_t>(m, n, "STATE"), "STATE"); break;
       case 1: st.on_plan(decode_message<kestrel::plan_t>(m, n, "PLAN"), "PLAN"); break;
       case 2: st.on_graph(decode_message<kestrel::slam_graph_t>(m, n, "SLAM_GRAPH"), "SLAM_GRAPH"); break;
       case 3: st.on_truth(decode_message<kestrel::ground_truth_t>(m, n, "GROUND_TRUTH"), "GROUND_TRUTH"); break;
       case 4: st.on_map(decode_message<kestrel::octomap_t>(m, n, "MAP_OCTOMAP"), "MAP_OCTOMAP"); break;
-      default: st.on_frame(decode_message<kestrel::rgbd_frame_t>(m, n, "CAMERA_RGBD"), "CAMERA_RGBD"); break;
+      case 5: st.on_frame(decode_message<kestrel::rgbd_frame_t>(m, n, "CAMERA_RGBD"), "CAMERA_RGBD"); break;
+      default:
+        st.on_playback(decode_message<kestrel::playback_status_t>(m, n, "PLAYBACK_STATUS"), "PLAYBACK_STATUS");
+        break;
     }
   });
 }
@@ -102,7 +122,13 @@ std::vector<Bytes> update_seeds() {
   g.num_keyframes = 2;
   kestrel::ground_truth_t t{};
   t.T_world_frame = transport::to_message(T);
-  return {tagged(0, s), tagged(1, p), tagged(2, g), tagged(3, t)};
+  kestrel::playback_status_t r{};
+  r.start_utime = 1'000'000;
+  r.end_utime = 21'000'000;
+  r.utime = 6'000'000;
+  r.speed = 1.0;
+  r.log_name = "flight.lcmlog";
+  return {tagged(0, s), tagged(1, p), tagged(2, g), tagged(3, t), tagged(6, r)};
 }
 
 }  // namespace

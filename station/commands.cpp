@@ -45,6 +45,22 @@ Command parse_command(std::string_view text, const std::string& token) {
   if (cmd == j.end() || !cmd->is_string()) throw CommandError("command refused: no \"cmd\"");
   const std::string& name = cmd->get_ref<const std::string&>();
   if (name == "hold") return HoldCommand{};
+  if (name == "play") return PlaybackCommand{kestrel::playback_command_t::COMMAND_PLAY, 0.0, 1.0};
+  if (name == "pause") return PlaybackCommand{kestrel::playback_command_t::COMMAND_PAUSE, 0.0, 1.0};
+  if (name == "seek" || name == "speed") {
+    const char* field = name == "seek" ? "t" : "speed";
+    const auto v = j.find(field);
+    if (v == j.end() || !v->is_number() || !std::isfinite(v->get<double>()))
+      throw CommandError(name + " refused: \"" + field + "\" must be a finite number");
+    const double x = v->get<double>();
+    if (name == "seek") {
+      if (x < 0.0) throw CommandError("seek refused: t is seconds from the log's start, not negative");
+      return PlaybackCommand{kestrel::playback_command_t::COMMAND_SEEK, x, 1.0};
+    }
+    if (!(x > 0.0 && x <= kMaxPlaybackSpeed))
+      throw CommandError("speed refused: it must be above 0 and at most " + std::to_string(static_cast<int>(kMaxPlaybackSpeed)));
+    return PlaybackCommand{kestrel::playback_command_t::COMMAND_SPEED, 0.0, x};
+  }
   if (name != "goal") throw CommandError("command refused: unknown cmd '" + name.substr(0, 40) + "'");
   const auto goal = j.find("goal");
   if (goal == j.end() || !goal->is_array() || goal->size() != 4)
@@ -87,6 +103,27 @@ kestrel::plan_request_t plan_request(const GoalCommand& goal, int64_t request_id
   r.objective = kestrel::plan_request_t::OBJECTIVE_MIN_GOAL_UNCERTAINTY;
   r.max_covariance_trace = 0.0;
   return r;
+}
+
+kestrel::playback_command_t playback_command(const PlaybackCommand& c, const kestrel::playback_status_t& replay,
+                                             int64_t request_id, std::string& refusal) {
+  kestrel::playback_command_t m{};
+  m.request_id = request_id;
+  m.command = c.command;
+  m.speed = c.speed;
+  refusal.clear();
+  if (c.command == kestrel::playback_command_t::COMMAND_SEEK) {
+    const double length_s = 1e-6 * static_cast<double>(replay.end_utime - replay.start_utime);
+    if (c.seek_s > length_s) {
+      std::ostringstream s;
+      s.setf(std::ios::fixed);
+      s.precision(1);
+      s << "seek to " << c.seek_s << " s refused: the log is " << length_s << " s long";
+      refusal = s.str();
+    }
+    m.seek_utime = replay.start_utime + static_cast<int64_t>(std::llround(c.seek_s * 1e6));
+  }
+  return m;
 }
 
 kestrel::plan_t hold_plan(int64_t request_id, int64_t utime) {

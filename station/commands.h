@@ -2,6 +2,9 @@
 // What the page may ask, and whether it may: commands arrive as JSON text on the socket,
 //   {"cmd":"goal", "goal":[x, y, z, yaw], "token":"..."}   fly there (a PLAN_REQUEST)
 //   {"cmd":"hold", "token":"..."}                            stop and hold (see hold_plan)
+//   {"cmd":"play"} {"cmd":"pause"} {"cmd":"seek", "t":s} {"cmd":"speed", "speed":x}
+//                         a replay's transport (`kestrel replay LOG --control`): t in seconds
+//                         from the log's start, 0 < speed <= kMaxPlaybackSpeed
 // parse_command checks the form and the token; check_goal checks a goal against the map
 // before anything reaches the bus.
 //
@@ -18,6 +21,8 @@
 #include <variant>
 
 #include "kestrel/plan_request_t.hpp"
+#include "kestrel/playback_command_t.hpp"
+#include "kestrel/playback_status_t.hpp"
 #include "kestrel/plan_t.hpp"
 #include "station/map_cells.h"
 
@@ -32,7 +37,15 @@ struct GoalCommand {
   std::array<double, 4> goal{};  ///< x, y, z (m), yaw (rad), world frame
 };
 struct HoldCommand {};
-using Command = std::variant<GoalCommand, HoldCommand>;
+struct PlaybackCommand {
+  int8_t command = 0;   ///< kestrel::playback_command_t::COMMAND_*
+  double seek_s = 0.0;  ///< COMMAND_SEEK: seconds from the log's start, >= 0
+  double speed = 1.0;   ///< COMMAND_SPEED
+};
+using Command = std::variant<GoalCommand, HoldCommand, PlaybackCommand>;
+
+/// The fastest replay the page may ask for (log seconds per wall second).
+inline constexpr double kMaxPlaybackSpeed = 100.0;
 
 /// Longest command text accepted, bytes: a goal is under 200.
 inline constexpr size_t kMaxCommandBytes = 4096;
@@ -55,6 +68,11 @@ std::string check_goal(const GoalCommand& goal, const CellSet* map, const GoalCh
 /// The request `kestrel goto` sends for this goal: from the latest STATE, BRM, the smallest
 /// uncertainty at the goal.
 kestrel::plan_request_t plan_request(const GoalCommand& goal, int64_t request_id, int64_t utime);
+
+/// The command for the replay whose latest status is `replay`; "" in `refusal` if it may be
+/// sent, else why not (a seek beyond the log's end).
+kestrel::playback_command_t playback_command(const PlaybackCommand& c, const kestrel::playback_status_t& replay,
+                                             int64_t request_id, std::string& refusal);
 
 /// The hold command: a PLAN without a path. It is how kestrel already says "stop": the
 /// follower drops its path on any PLAN that is not OK and commands MODE_HOLD where the vehicle

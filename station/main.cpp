@@ -1,7 +1,8 @@
 // kestrel-station: the ground station in a browser. Listens to the bus (STATE, GROUND_TRUTH,
-// SLAM_GRAPH, PLAN, MAP_OCTOMAP, CAMERA_RGBD, PROCESS_STATUS and every channel's rate) and
-// serves one page over HTTP + WebSocket that draws them live; the page's goals go out as
-// PLAN_REQUEST and its hold as a PLAN without a path. The logic is Station (station.h), the
+// SLAM_GRAPH, PLAN, MAP_OCTOMAP, CAMERA_RGBD, PROCESS_STATUS, PLAYBACK_STATUS and every
+// channel's rate) and serves one page over HTTP + WebSocket that draws them live; the page's
+// goals go out as PLAN_REQUEST, its hold as a PLAN without a path, and its transport bar (a
+// replay under review) as PLAYBACK_COMMAND. The logic is Station (station.h), the
 // server WebServer (web_server.h); this file wires them to a Node.
 #include <spdlog/spdlog.h>
 #include <unistd.h>
@@ -69,6 +70,7 @@ int serve(Options& o) {
   transport::Node node(o.name, o.lcm_url);  // UnavailableError: exit 4
   node.advertise(channel::kPlanRequest);
   node.advertise(channel::kPlan);
+  node.advertise(channel::kPlaybackCommand);
   node.on_reset([&] { st.reset(); });
   // A viewer: short queues everywhere, so that a busy station loses messages rather than
   // memory or time (LCM drops the oldest).
@@ -78,6 +80,8 @@ int serve(Options& o) {
   node.subscribe<plan_t>(channel::kPlan, [&](const plan_t& m) { st.on_plan(m, channel::kPlan); }, 8);
   node.subscribe<octomap_t>(channel::kMapOctomap, [&](const octomap_t& m) { st.on_map(m, channel::kMapOctomap); }, 2);
   node.subscribe<rgbd_frame_t>(channel::kCameraRgbd, [&](const rgbd_frame_t& m) { st.on_frame(m, channel::kCameraRgbd); }, 2);
+  node.subscribe<playback_status_t>(channel::kPlaybackStatus,
+                                    [&](const playback_status_t& m) { st.on_playback(m, channel::kPlaybackStatus); }, 8);
   // Every channel's traffic for the rates, and the heartbeats for the health table, straight
   // from LCM rather than through the Node: they are telemetry, not inputs, so under lock-step
   // replay they must not be acknowledged (an acknowledgement of a heartbeat stalls the replay).
@@ -111,7 +115,7 @@ int serve(Options& o) {
   node.set_health(process_status_t::STATE_RUNNING, "");
 
   double next_periodic_s = 0.0;
-  int64_t requests = 0, holds = 0, refused = 0;
+  int64_t requests = 0, holds = 0, transport = 0, refused = 0;
   while (node.spin_once(50)) {
     for (auto& [client, text] : server.take_commands()) {
       const station::CommandResult r = st.on_command(client, text);
@@ -123,6 +127,14 @@ int serve(Options& o) {
         node.publish(channel::kPlan, *r.hold);
         ++holds;
       }
+      if (r.playback) {
+        playback_command_t command = *r.playback;
+        command.utime = std::chrono::duration_cast<std::chrono::microseconds>(
+                            std::chrono::system_clock::now().time_since_epoch())
+                            .count();
+        node.publish(channel::kPlaybackCommand, command);
+        ++transport;
+      }
       if (!r.ok) ++refused;
       spdlog::info("page: {}", cli::printable(r.notice));
     }
@@ -133,8 +145,9 @@ int serve(Options& o) {
     }
   }
   const auto stats = hub.stats();
-  spdlog::info("{} requests, {} holds, {} commands refused; {} updates sent, {} replaced before sending (slow browsers)",
-               requests, holds, refused, stats.taken, stats.dropped);
+  spdlog::info("{} requests, {} holds, {} replay commands, {} commands refused; {} updates sent, {} replaced before "
+               "sending (slow browsers)",
+               requests, holds, transport, refused, stats.taken, stats.dropped);
   return kExitOk;
 }
 

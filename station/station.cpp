@@ -1,6 +1,7 @@
 #include "station/station.h"
 
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 
 #include "station/wire.h"
@@ -115,6 +116,13 @@ void Station::on_frame(const kestrel::rgbd_frame_t& m, const char* channel) {
 
 void Station::on_status(const kestrel::process_status_t& m, double now_s) { health_.on_status(m, now_s); }
 
+void Station::on_playback(const kestrel::playback_status_t& m, const char* channel) {
+  const nlohmann::json u = playback_update(m, channel);  // throws before anything changes
+  if (playback_ && m.seeks != playback_->seeks) reset();
+  playback_ = m;
+  post_json("playback", u);
+}
+
 void Station::post_periodic(double now_s) {
   post_json("rates", rates_.snapshot(now_s));
   post_json("health", health_.to_json(now_s));
@@ -124,7 +132,20 @@ CommandResult Station::on_command(UpdateHub::ClientId client, std::string_view t
   CommandResult r;
   try {
     const Command c = parse_command(text, options_.token);
-    if (std::holds_alternative<HoldCommand>(c)) {
+    if (const auto* p = std::get_if<PlaybackCommand>(&c)) {
+      if (!playback_) {
+        r.notice = "no replay to control: the transport is for `kestrel replay LOG --control`";
+      } else {
+        r.playback = playback_command(*p, *playback_, next_request_id_++, r.notice);
+        r.ok = r.notice.empty();
+        if (!r.ok) r.playback.reset();
+        static constexpr const char* kNames[] = {"play", "pause", "seek", "speed"};
+        char value[48] = "";
+        if (p->command == kestrel::playback_command_t::COMMAND_SEEK) std::snprintf(value, sizeof value, " to %.1f s", p->seek_s);
+        if (p->command == kestrel::playback_command_t::COMMAND_SPEED) std::snprintf(value, sizeof value, " %gx", p->speed);
+        if (r.ok) r.notice = std::string(kNames[p->command]) + value + " sent to the replay";
+      }
+    } else if (std::holds_alternative<HoldCommand>(c)) {
       r.hold = hold_plan(next_request_id_++, latest_utime_);
       r.ok = true;
       r.notice = "hold sent (PLAN without a path: the follower holds where the vehicle is)";

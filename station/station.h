@@ -11,7 +11,11 @@
 //  * A command is answered on its own socket with a "notice" (what was sent, or why not), and
 //    yields at most one message to publish: a PLAN_REQUEST for an accepted goal, a PLAN
 //    without a path for a hold (commands.h).
-//  * reset() (lock-step RESET) forgets the flight: map, paths, graph, plan, previews.
+//  * reset() (lock-step RESET) forgets the flight: map, paths, graph, plan, previews; so does a
+//    controlled replay's seek (a new seek count on PLAYBACK_STATUS): what follows the seek
+//    draws the flight at its new position.
+//  * A transport command (play, pause, seek, speed) is sent only once a controlled replay has
+//    said where it is, and a seek only within its log.
 
 #include <memory>
 #include <optional>
@@ -49,6 +53,7 @@ struct StationOptions {
 struct CommandResult {
   std::optional<kestrel::plan_request_t> request;  ///< on PLAN_REQUEST
   std::optional<kestrel::plan_t> hold;             ///< on PLAN
+  std::optional<kestrel::playback_command_t> playback;  ///< on PLAYBACK_COMMAND (utime left to the sender)
   std::string notice;                              ///< what the page shows
   bool ok = false;
 };
@@ -66,6 +71,7 @@ class Station {
   void on_map(const kestrel::octomap_t& m, const char* channel);
   void on_frame(const kestrel::rgbd_frame_t& m, const char* channel);
   void on_status(const kestrel::process_status_t& m, double now_s);
+  void on_playback(const kestrel::playback_status_t& m, const char* channel);
   /// Every message on the bus, for the rates.
   void on_traffic(const std::string& channel, size_t bytes) { rates_.on_message(channel, bytes); }
   /// Posts the rates and the health table (call about once a second).
@@ -94,6 +100,7 @@ class Station {
   std::optional<int64_t> last_state_utime_, last_path_utime_, last_truth_utime_;
   int64_t path_posted_ = -1, truth_path_posted_ = -1;  ///< added() when last posted: unchanged paths are not sent again
   int64_t latest_utime_ = 0;  ///< newest sensor time seen, stamps what the station sends
+  std::optional<kestrel::playback_status_t> playback_;  ///< the controlled replay's latest status
 };
 
 /// A JSON update as text, invalid UTF-8 (a name off the bus) replaced rather than thrown on.

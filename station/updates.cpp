@@ -110,6 +110,19 @@ json plan_update(const kestrel::plan_t& m, const char* channel) {
               {"sigma", std::move(sigma)}};
 }
 
+json playback_update(const kestrel::playback_status_t& m, const char* channel) {
+  constexpr int64_t kYearUs = int64_t{366} * 24 * 3600 * 1'000'000;
+  // Differences in double: the stamps come off the bus and may lie anywhere.
+  const double length_us = static_cast<double>(m.end_utime) - static_cast<double>(m.start_utime);
+  if (!(length_us >= 0.0 && length_us <= static_cast<double>(kYearUs)))
+    throw InputError(std::string(channel) + ": the log's window ends before it starts or spans more than a year");
+  if (!(m.speed > 0.0) || !std::isfinite(m.speed))
+    throw InputError(std::string(channel) + ": the speed is not a positive number");
+  const double t_us = std::clamp(static_cast<double>(m.utime) - static_cast<double>(m.start_utime), 0.0, length_us);
+  return {{"kind", "playback"}, {"log", m.log_name},       {"t", 1e-6 * t_us},         {"length", 1e-6 * length_us},
+          {"speed", m.speed},   {"paused", m.paused},      {"at_end", m.at_end},       {"seeks", m.seeks}};
+}
+
 PathTrace::PathTrace(double min_step_m, size_t max_points) : min_step_m_(min_step_m), max_points_(std::max<size_t>(max_points, 2)) {}
 
 bool PathTrace::add(const Eigen::Vector3d& p) {

@@ -21,6 +21,7 @@
 
 #include "kestrel/ground_truth_t.hpp"
 #include "kestrel/plan_t.hpp"
+#include "kestrel/playback_status_t.hpp"
 #include "kestrel/process_status_t.hpp"
 #include "kestrel/slam_graph_t.hpp"
 #include "kestrel/state_t.hpp"
@@ -44,6 +45,11 @@ nlohmann::json graph_update(const kestrel::slam_graph_t& m, const char* channel)
 ///  sigma:[...]}: sigma_i = sqrt(tr(Sigma_i) / 4), the RMS 1-sigma over (x, y, z, yaw) that the
 /// planner's predicted trace gives (PLAN carries the trace only, not the full ellipse).
 nlohmann::json plan_update(const kestrel::plan_t& m, const char* channel);
+
+/// {"kind":"playback", log, t, length, speed, paused, at_end, seeks}: where a controlled replay
+/// is (t and length in seconds from the log's start). Throws InputError on a window that ends
+/// before it starts or spans more than a year, or a speed that is not a positive number.
+nlohmann::json playback_update(const kestrel::playback_status_t& m, const char* channel);
 
 /// A path thinned by distance: a point is kept when it is at least `min_step_m` from the last
 /// kept one; beyond `max_points` every second point is dropped (the path's start stays), so it

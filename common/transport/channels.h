@@ -19,5 +19,7 @@ inline constexpr const char* kProcessStatus = "PROCESS_STATUS"; // process_statu
 inline constexpr const char* kProcessRejections = "PROCESS_REJECTIONS"; // rejection_counts_t
 inline constexpr const char* kReplayControl = "REPLAY_CONTROL"; // replay_control_t
 inline constexpr const char* kReplayAck = "REPLAY_ACK";         // replay_ack_t
+inline constexpr const char* kPlaybackCommand = "PLAYBACK_COMMAND"; // playback_command_t
+inline constexpr const char* kPlaybackStatus = "PLAYBACK_STATUS";   // playback_status_t
 
 }  // namespace kestrel::channel

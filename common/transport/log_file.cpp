@@ -46,6 +46,14 @@ LogReader::LogReader(const std::string& path) : path_(path) {
   }
 }
 
+void LogReader::rewind() {
+  std::fseek(file_, 0, SEEK_SET);
+  corrupt_regions_ = 0;
+  skipped_bytes_ = 0;
+  first_damage_offset_ = -1;
+  truncated_ = false;
+}
+
 LogReader::~LogReader() {
   if (file_) std::fclose(file_);
 }

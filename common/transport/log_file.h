@@ -33,6 +33,9 @@ class LogReader {
 
   /// The next intact event, or empty at the end of the file.
   std::optional<LogEvent> next();
+  /// Back to the first event (a replay seeking backwards reads the file again); the damage
+  /// counts start again with it, so that damage read twice is counted once.
+  void rewind();
 
   /// Damage seen so far: bytes skipped to find the next event, and a truncated tail.
   int64_t corrupt_regions() const { return corrupt_regions_; }

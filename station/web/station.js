@@ -266,7 +266,8 @@
   // --- the panel -------------------------------------------------------------------------
   const $ = (id) => document.getElementById(id);
   const fmt = (v, n = 2) => Number(v).toFixed(n);
-  const state = { vehicle: null, health: [], notice: null, notices: 0, frames: 0, plan: null, mapInfo: null };
+  const state = { vehicle: null, health: [], notice: null, notices: 0, frames: 0, plan: null, mapInfo: null, playback: null };
+  let seeking = false;  // the seek bar is being dragged: the replay's position does not move it
 
   function onJson(u) {
     switch (u.kind) {
@@ -340,6 +341,19 @@
         $('rates').tBodies[0].innerHTML = u.channels.map((c) =>
           `<tr><td>${esc(c.channel)}</td><td>${fmt(c.hz, 1)}</td><td>${fmt(c.bytes_per_s / 1000, 1)}</td></tr>`).join('');
         break;
+      case 'playback': {
+        // A controlled replay (`kestrel replay LOG --control`): its transport bar.
+        state.playback = u;
+        $('playback').hidden = false;
+        $('playpause').textContent = u.at_end ? 'replay' : u.paused ? 'play' : 'pause';
+        $('seek').max = u.length;
+        if (!seeking) $('seek').value = u.t;
+        $('ptime').textContent = `${fmt(u.t, 1)} / ${fmt(u.length, 1)} s`;
+        $('ptime').title = u.log;
+        const speed = [...$('pspeed').options].find((o) => parseFloat(o.value) === u.speed);
+        if (speed) $('pspeed').value = speed.value;
+        break;
+      }
       case 'notice':
         state.notice = u;
         state.notices += 1;
@@ -412,6 +426,15 @@
   }
   $('goal').addEventListener('submit', (e) => { e.preventDefault(); sendGoal(); });
   $('hold').addEventListener('click', () => send({ cmd: 'hold' }));
+  $('playpause').addEventListener('click', () => {
+    const p = state.playback;
+    if (!p) return;
+    if (p.at_end) { send({ cmd: 'seek', t: 0 }); send({ cmd: 'play' }); return; }
+    send({ cmd: p.paused ? 'play' : 'pause' });
+  });
+  $('seek').addEventListener('input', () => { seeking = true; });
+  $('seek').addEventListener('change', () => { seeking = false; send({ cmd: 'seek', t: parseFloat($('seek').value) }); });
+  $('pspeed').addEventListener('change', () => send({ cmd: 'speed', speed: parseFloat($('pspeed').value) }));
 
   // A click (not a drag) on the map: the point under it at height z becomes the goal.
   const raycaster = new THREE.Raycaster();
@@ -460,6 +483,7 @@
     frames: () => state.frames,
     mapInfo: () => state.mapInfo,
     plan: () => state.plan,
+    playback: () => state.playback,
     worldToClient,
     // Frames the map's message path (applyMap) exactly as the socket does; for measurements.
     applyMapMessage: (buffer) => applyMap(buffer),

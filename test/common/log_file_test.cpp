@@ -99,6 +99,26 @@ TEST(LogFile, CorruptEventIsSkippedAndTheRestRead) {
   EXPECT_EQ(r.skipped_bytes(), static_cast<int64_t>(2 * event_size));
 }
 
+TEST(LogFile, RewindReadsTheSameEventsAgainAndCountsTheDamageOnce) {
+  test::TempDir dir;
+  write_log(dir / "a.lcmlog");
+  auto bytes = read_bytes(dir / "a.lcmlog");
+  bytes[3 * (bytes.size() / 10)] ^= 0xff;  // event 3's sync word
+  bytes.resize(bytes.size() - 10);         // and a truncated tail
+  write_bytes(dir / "d.lcmlog", bytes);
+  LogReader r(dir / "d.lcmlog");
+  ASSERT_TRUE(r.next().has_value());
+  r.rewind();  // mid-file
+  const auto first = read_seqs(r);
+  const std::string damage = r.damage_report();
+  r.rewind();  // at the end
+  EXPECT_EQ(read_seqs(r), first);
+  EXPECT_EQ(first, (std::vector<int64_t>{0, 1, 2, 4, 5, 6, 7, 8}));
+  EXPECT_EQ(r.corrupt_regions(), 1);
+  EXPECT_TRUE(r.truncated());
+  EXPECT_EQ(r.damage_report(), damage);
+}
+
 TEST(LogFile, NotALogAndMissingFileAreInputErrors) {
   test::TempDir dir;
   write_bytes(dir / "junk.lcmlog", std::vector<uint8_t>(100, 0x42));

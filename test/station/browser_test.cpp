@@ -7,6 +7,8 @@
 //  * the colour and depth images arrive and decode at the camera's size;
 //  * a goal outside the map is refused with a message in the page, and nothing is sent;
 //  * a click on the map sends a PLAN_REQUEST that appears on LCM with the clicked point;
+//  * a replay's PLAYBACK_STATUS shows the transport bar, whose pause button sends a
+//    PLAYBACK_COMMAND (the replay's side: test/replay/playback_test.cpp);
 //  * the screenshot's canvas is not blank.
 // Under CI=true, a missing chromium, node or puppeteer-core fails the test instead of skipping.
 #include <gtest/gtest.h>
@@ -24,6 +26,8 @@
 #include "kestrel/ground_truth_t.hpp"
 #include "kestrel/octomap_t.hpp"
 #include "kestrel/plan_request_t.hpp"
+#include "kestrel/playback_command_t.hpp"
+#include "kestrel/playback_status_t.hpp"
 #include "kestrel/state_t.hpp"
 #include "mapper/octree_io.h"
 #include "test/support/live_system.h"
@@ -57,7 +61,7 @@ TEST(StationBrowser, ThePageShowsTheFlightAndAClickSendsAPlanRequest) {
   ASSERT_EQ(sim.exit_code, 0) << sim.err;
 
   test::LiveSystem::Options options;
-  options.channels = {channel::kMapOctomap, channel::kPlanRequest, channel::kGroundTruth};
+  options.channels = {channel::kMapOctomap, channel::kPlanRequest, channel::kGroundTruth, channel::kPlaybackCommand};
   test::LiveSystem sys(dir.path(), options);
   sys.start("mapper", {test::tool("mapper").string(), "--pose-source", "ground-truth", "--publish-period", "0.5"});
   sys.start("station", {test::tool("station").string(), "--port", "8765"});
@@ -88,6 +92,14 @@ TEST(StationBrowser, ThePageShowsTheFlightAndAClickSendsAPlanRequest) {
   state.covariance.assign(15, std::vector<double>(15, 0.0));
   for (size_t i = 0; i < 15; ++i) state.covariance[i][i] = 1e-3;
   lcm.publish(channel::kState, &state);
+  // A controlled replay's status, as `kestrel replay LOG --control` says it: 20 s of log, at 5 s.
+  kestrel::playback_status_t playback{};
+  playback.start_utime = 1'000'000;
+  playback.end_utime = 21'000'000;
+  playback.utime = 6'000'000;
+  playback.speed = 1.0;
+  playback.log_name = "flight.lcmlog";
+  lcm.publish(channel::kPlaybackStatus, &playback);
 
   // The goal: where the vehicle truly was mid-flight (free space the camera saw around it).
   const auto truths = sys.messages(channel::kGroundTruth);
@@ -110,7 +122,7 @@ TEST(StationBrowser, ThePageShowsTheFlightAndAClickSendsAPlanRequest) {
                                (test::source_dir() / "test/station/browser/check.js").string(), "--url",
                                "http://127.0.0.1:8765/", "--out", result_path.string(), "--screenshot",
                                screenshot.string(), "--cells", std::to_string(occupied), "--vehicle", csv(p_vehicle),
-                               "--processes", names, "--goal", csv(goal), "--refused-goal", "100,100,1", "--chromium",
+                               "--processes", names, "--goal", csv(goal), "--refused-goal", "100,100,1", "--playback-length", "20", "--chromium",
                                KESTREL_CHROMIUM},
                               90.0);
   ASSERT_EQ(browser, 0) << sys.output("browser");
@@ -151,6 +163,16 @@ TEST(StationBrowser, ThePageShowsTheFlightAndAClickSendsAPlanRequest) {
   EXPECT_NEAR(request->goal[0], r["goal_fields"][0].get<double>(), 1e-9);
   EXPECT_NEAR(request->goal[1], r["goal_fields"][1].get<double>(), 1e-9);
   EXPECT_EQ(request->start_mode, kestrel::plan_request_t::START_FROM_STATE);
+
+  // The transport bar: where the replay is, and its pause on the bus.
+  ASSERT_TRUE(r["playback"].is_object()) << r.dump(1);
+  EXPECT_DOUBLE_EQ(r["playback"]["t"].get<double>(), 5.0);
+  EXPECT_DOUBLE_EQ(r["playback"]["length"].get<double>(), 20.0);
+  EXPECT_TRUE(r["pause_notice"]["ok"].get<bool>()) << r["pause_notice"].dump();
+  const auto pause = sys.wait_for<kestrel::playback_command_t>(
+      channel::kPlaybackCommand, [](const kestrel::playback_command_t&) { return true; }, 10.0, "the pause", 0);
+  ASSERT_TRUE(pause.has_value());
+  EXPECT_EQ(pause->command, kestrel::playback_command_t::COMMAND_PAUSE);
 
   // Not a blank canvas: the cells and the vehicle cover part of it in many colours.
   EXPECT_GT(r["canvas"]["non_background"].get<double>(), 0.01) << r["canvas"].dump();

@@ -25,6 +25,21 @@ TEST(StationCommands, AGoalAndAHoldParse) {
   EXPECT_TRUE(std::holds_alternative<HoldCommand>(parse_command(R"({"cmd":"hold"})", "")));
 }
 
+TEST(StationCommands, TheTransportOfAReplayParsesAndNonsenseIsRefused) {
+  const auto playback = [](std::string_view text) { return std::get<PlaybackCommand>(parse_command(text, "")); };
+  EXPECT_EQ(playback(R"({"cmd":"play"})").command, kestrel::playback_command_t::COMMAND_PLAY);
+  EXPECT_EQ(playback(R"({"cmd":"pause"})").command, kestrel::playback_command_t::COMMAND_PAUSE);
+  EXPECT_DOUBLE_EQ(playback(R"({"cmd":"seek","t":12.5})").seek_s, 12.5);
+  EXPECT_DOUBLE_EQ(playback(R"({"cmd":"speed","speed":0.25})").speed, 0.25);
+  EXPECT_NE(refusal(R"({"cmd":"seek"})").find("\"t\" must be a finite number"), std::string::npos);
+  EXPECT_NE(refusal(R"({"cmd":"seek","t":"3"})").find("finite number"), std::string::npos);
+  EXPECT_NE(refusal(R"({"cmd":"seek","t":-1})").find("not negative"), std::string::npos);
+  EXPECT_NE(refusal(R"({"cmd":"speed","speed":0})").find("above 0"), std::string::npos);
+  EXPECT_NE(refusal(R"({"cmd":"speed","speed":1000})").find("at most 100"), std::string::npos);
+  EXPECT_NE(refusal(R"({"cmd":"speed","speed":1e999})"), "");
+  EXPECT_NE(refusal(R"({"cmd":"pause"})", "secret").find("token"), std::string::npos);
+}
+
 TEST(StationCommands, MalformedCommandsAreRefusedSayingWhy) {
   EXPECT_NE(refusal("{not json"), "");
   EXPECT_NE(refusal("[1,2]").find("not a JSON object"), std::string::npos);

@@ -1,6 +1,10 @@
 // The browsers' mailboxes: newest per kind, bounded, map differences per client.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <nlohmann/json.hpp>
+
+#include "common/error.h"
 #include "station/hub.h"
 #include "station/station.h"
 #include "station/wire.h"
@@ -136,6 +140,72 @@ TEST(StationStation, APathThatDidNotGrowIsNotSentAgain) {
   s.T_world_body.position[0] = 0.5;  // moved: the path grew
   st.on_state(s, "STATE");
   EXPECT_TRUE(has_kind(hub.take(*id), "path"));
+}
+
+// A controlled replay's transport: nothing is sent before the replay has said where it is, a
+// seek beyond its log is refused, and a new seek count forgets the flight drawn so far.
+TEST(StationStation, TheTransportBarDrivesAControlledReplayOnly) {
+  UpdateHub hub;
+  const auto id = hub.add_client({});
+  Station st({}, hub, 500);
+  CommandResult r = st.on_command(*id, R"({"cmd":"pause"})");
+  EXPECT_FALSE(r.ok);
+  EXPECT_FALSE(r.playback.has_value());
+  EXPECT_NE(r.notice.find("no replay to control"), std::string::npos) << r.notice;
+
+  kestrel::playback_status_t p{};
+  p.start_utime = 10'000'000;
+  p.end_utime = 30'000'000;
+  p.utime = 15'000'000;
+  p.speed = 1.0;
+  p.log_name = "flight.lcmlog";
+  st.on_playback(p, "PLAYBACK_STATUS");
+  auto out = hub.take(*id);
+  ASSERT_TRUE(has_kind(out, "playback"));
+  for (const Outgoing& m : out)
+    if (m.bytes.find("\"kind\":\"playback\"") != std::string::npos) {
+      const auto j = nlohmann::json::parse(m.bytes);
+      EXPECT_DOUBLE_EQ(j["t"].get<double>(), 5.0);
+      EXPECT_DOUBLE_EQ(j["length"].get<double>(), 20.0);
+    }
+  r = st.on_command(*id, R"({"cmd":"seek","t":12.5})");
+  ASSERT_TRUE(r.ok) << r.notice;
+  ASSERT_TRUE(r.playback.has_value());
+  EXPECT_EQ(r.playback->command, kestrel::playback_command_t::COMMAND_SEEK);
+  EXPECT_EQ(r.playback->seek_utime, 22'500'000);
+  EXPECT_EQ(r.playback->request_id, 500);
+  r = st.on_command(*id, R"({"cmd":"seek","t":20.5})");
+  EXPECT_FALSE(r.ok);
+  EXPECT_FALSE(r.playback.has_value());
+  EXPECT_NE(r.notice.find("the log is 20.0 s long"), std::string::npos) << r.notice;
+  r = st.on_command(*id, R"({"cmd":"speed","speed":4})");
+  ASSERT_TRUE(r.playback.has_value());
+  EXPECT_EQ(r.playback->command, kestrel::playback_command_t::COMMAND_SPEED);
+  EXPECT_DOUBLE_EQ(r.playback->speed, 4.0);
+
+  // The flight so far, then a seek: the path is forgotten.
+  kestrel::state_t s{};
+  s.utime = 15'000'000;
+  s.status = kestrel::state_t::STATUS_OK;
+  s.T_world_body.orientation[0] = 1.0;
+  st.on_state(s, "STATE");
+  hub.take(*id);
+  p.seeks = 1;
+  p.utime = 22'500'000;
+  st.on_playback(p, "PLAYBACK_STATUS");
+  out = hub.take(*id);
+  bool empty_path = false;
+  for (const Outgoing& m : out)
+    if (m.bytes.find("\"kind\":\"path\"") != std::string::npos)
+      empty_path = nlohmann::json::parse(m.bytes)["points"].empty();
+  EXPECT_TRUE(empty_path) << "the path of before the seek is still drawn";
+
+  // A status off the bus that cannot be drawn changes nothing.
+  p.end_utime = p.start_utime - 1;
+  EXPECT_THROW(st.on_playback(p, "PLAYBACK_STATUS"), InputError);
+  p.end_utime = 30'000'000;
+  p.speed = std::nan("");
+  EXPECT_THROW(st.on_playback(p, "PLAYBACK_STATUS"), InputError);
 }
 
 }  // namespace

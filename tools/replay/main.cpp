@@ -71,10 +71,15 @@ int main(int argc, char** argv) {
                  "Replay only channels matching this regex (whole name); also replays channels "
                  "that a live process publishes")
       ->check(CLI::Validator(replay::check_channel_regex, "REGEX"));
+  bool control = false;
+  app.add_flag("--control", control,
+               "Timed (at --speed, else the log's pace): take play, pause, seek and speed from "
+               "PLAYBACK_COMMAND (the ground station's transport bar), say the position on "
+               "PLAYBACK_STATUS, and wait at the end of the log for a seek back, until Ctrl-C");
   app.add_flag("--json", json, "Print the report as JSON");
 
   return app.run(argc, argv, [&]() -> int {
-    const bool timed = realtime || speed > 0.0;
+    const bool timed = realtime || speed > 0.0 || control;
     if (timed && !lockstep.driver.record_path.empty())
       throw CLI::ValidationError("--record", "records only in lock-step mode (not with --realtime/--speed)");
     const auto& interrupted = catch_interrupts();
@@ -83,7 +88,7 @@ int main(int argc, char** argv) {
     try {
       if (timed) {
         report = replay::replay_timed(
-            log, {lockstep.lcm_url, realtime ? 1.0 : speed, lockstep.selection, max_gap_s}, interrupted);
+            log, {lockstep.lcm_url, speed > 0.0 ? speed : 1.0, lockstep.selection, max_gap_s, control}, interrupted);
       } else {
         report = replay::replay_lockstep(log, lockstep, interrupted);
       }

@@ -42,6 +42,10 @@ struct TimedOptions {
   /// Longest gap between consecutive events that is waited out, in log seconds (0 = no cap).
   /// A longer gap (an event stamped an hour ahead) is played as this long, and said once.
   double max_gap_s = 5.0;
+  /// Take play, pause, seek and speed from PLAYBACK_COMMAND and say the position on
+  /// PLAYBACK_STATUS (PlaybackClock); at the end of the log, wait for a seek back (until
+  /// interrupted) instead of ending.
+  bool control = false;
 };
 
 /// Throws PeerError, NetworkUnavailable, InputError (recording file). Returns early with

@@ -4,7 +4,7 @@
 // nothing itself: a timeout only ends the wait, and the test then finds the values wrong.
 //
 //   node check.js --url URL [--size 1280x800] --out RESULT.json --screenshot PNG --cells N --vehicle x,y,z
-//                 --processes a,b --goal x,y,z --refused-goal x,y,z [--chromium PATH]
+//                 --processes a,b --goal x,y,z --refused-goal x,y,z [--playback-length S] [--chromium PATH]
 // Also --watch S [--until-plan 1 --after A]: instead, stay connected S seconds (or until a plan
 // with a path shows, then A seconds more) and report the bytes received per kind.
 // Also --fps N: instead, load N synthetic cells through the page's map path and measure the
@@ -149,6 +149,15 @@ async function measureFps(page, cells) {
     result.click = at;
     result.click_notice = await page.evaluate(() => window.station.lastNotice());
     result.goal_fields = await page.evaluate(() => ['gx', 'gy', 'gz'].map((id) => Number(document.getElementById(id).value)));
+    // A replay's transport bar (the test published a PLAYBACK_STATUS): pause the replay.
+    if (a['playback-length']) {
+      result.playback_shown = await waitUntil(page, () => !document.getElementById('playback').hidden, null, 10000);
+      result.playback = await page.evaluate(() => window.station.playback());
+      before = await page.evaluate(() => window.station.notices());
+      await page.click('#playpause');
+      await waitUntil(page, (n) => window.station.notices() > n, before, 5000);
+      result.pause_notice = await page.evaluate(() => window.station.lastNotice());
+    }
     await sleep(300);  // a frame with the vehicle and the map drawn
     result.canvas = await canvasContent(page);
     if (a.screenshot) await page.screenshot({ path: a.screenshot });
