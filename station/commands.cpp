@@ -120,6 +120,7 @@ kestrel::playback_command_t playback_command(const PlaybackCommand& c, const kes
       s.precision(1);
       s << "seek to " << c.seek_s << " s refused: the log is " << length_s << " s long";
       refusal = s.str();
+      return m;  // no seek_utime: t may be far beyond what a utime holds
     }
     m.seek_utime = replay.start_utime + static_cast<int64_t>(std::llround(c.seek_s * 1e6));
   }

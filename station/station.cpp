@@ -139,11 +139,11 @@ CommandResult Station::on_command(UpdateHub::ClientId client, std::string_view t
         r.playback = playback_command(*p, *playback_, next_request_id_++, r.notice);
         r.ok = r.notice.empty();
         if (!r.ok) r.playback.reset();
-        static constexpr const char* kNames[] = {"play", "pause", "seek", "speed"};
-        char value[48] = "";
-        if (p->command == kestrel::playback_command_t::COMMAND_SEEK) std::snprintf(value, sizeof value, " to %.1f s", p->seek_s);
-        if (p->command == kestrel::playback_command_t::COMMAND_SPEED) std::snprintf(value, sizeof value, " %gx", p->speed);
-        if (r.ok) r.notice = std::string(kNames[p->command]) + value + " sent to the replay";
+        char what[64] = "play";
+        if (p->command == kestrel::playback_command_t::COMMAND_PAUSE) std::snprintf(what, sizeof what, "pause");
+        if (p->command == kestrel::playback_command_t::COMMAND_SEEK) std::snprintf(what, sizeof what, "seek to %.1f s", p->seek_s);
+        if (p->command == kestrel::playback_command_t::COMMAND_SPEED) std::snprintf(what, sizeof what, "speed %gx", p->speed);
+        if (r.ok) r.notice = std::string(what) + " sent to the replay";
       }
     } else if (std::holds_alternative<HoldCommand>(c)) {
       r.hold = hold_plan(next_request_id_++, latest_utime_);
@@ -188,6 +188,8 @@ void Station::reset() {
   post_json("truth_path", truth_path_.to_json("truth_path"));
   post_json("graph", {{"kind", "graph"}, {"revision", -1}, {"keyframes", nlohmann::json::array()},
                       {"odometry", nlohmann::json::array()}, {"loops", nlohmann::json::array()}});
+  post_json("plan", {{"kind", "plan"}, {"request_id", -1}, {"status", -1}, {"status_name", ""}, {"message", ""},
+                     {"length", 0.0}, {"waypoints", nlohmann::json::array()}, {"sigma", nlohmann::json::array()}});
 }
 
 }  // namespace kestrel::station

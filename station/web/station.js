@@ -314,7 +314,8 @@
           d.scale.setScalar(u.sigma[i]);
           planDiscs.add(d);
         });
-        $('planinfo').textContent = `plan ${u.request_id}: ${u.status_name}, ${u.waypoints.length} waypoints, ${fmt(u.length)} m` +
+        $('planinfo').textContent = u.request_id < 0 ? 'plan: none' :
+          `plan ${u.request_id}: ${u.status_name}, ${u.waypoints.length} waypoints, ${fmt(u.length)} m` +
           (u.message ? ` (${u.message})` : '');
         break;
       }
@@ -433,6 +434,9 @@
     send({ cmd: p.paused ? 'play' : 'pause' });
   });
   $('seek').addEventListener('input', () => { seeking = true; });
+  // A drag that ends where it began fires no change: the bar follows the replay again anyway.
+  $('seek').addEventListener('pointerup', () => { seeking = false; });
+  $('seek').addEventListener('blur', () => { seeking = false; });
   $('seek').addEventListener('change', () => { seeking = false; send({ cmd: 'seek', t: parseFloat($('seek').value) }); });
   $('pspeed').addEventListener('change', () => send({ cmd: 'speed', speed: parseFloat($('pspeed').value) }));
 

@@ -77,9 +77,13 @@ TEST(PlaybackClock, ASpeedThatIsNotPositiveAndFiniteIsRefused) {
 }
 
 TEST(PlaybackClock, StampsFarApartDoNotOverflow) {
-  const PlaybackClock clock(1.0, INT64_MIN + 1, 0.0);
+  PlaybackClock clock(1.0, INT64_MIN + 1, 0.0);
   EXPECT_GT(clock.due_s(INT64_MAX), 1e12);
   EXPECT_TRUE(std::isfinite(clock.due_s(INT64_MAX)));
+  clock.seek(INT64_MAX - 10, 0.0);
+  EXPECT_EQ(clock.position_us(1e6), INT64_MAX);  // 1e12 us ahead of near the end: the end
+  clock.skip(int64_t{1} << 62);
+  EXPECT_EQ(clock.position_us(0.0), INT64_MAX);
 }
 
 }  // namespace

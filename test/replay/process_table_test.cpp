@@ -47,7 +47,8 @@ TEST(ProcessTable, KnowsConsumersAndPublishersWithoutProtocolChannels) {
 // recording of a replay must not hold them (they carry the wall clock and, for the counts,
 // what earlier runs refused, so two replays of one log would differ).
 TEST(ProcessTable, TelemetryAndProtocolChannelsAreNotData) {
-  for (const char* c : {"PROCESS_STATUS", "PROCESS_REJECTIONS", "REPLAY_CONTROL", "REPLAY_ACK"})
+  for (const char* c :
+       {"PROCESS_STATUS", "PROCESS_REJECTIONS", "REPLAY_CONTROL", "REPLAY_ACK", "PLAYBACK_COMMAND", "PLAYBACK_STATUS"})
     EXPECT_TRUE(is_protocol_channel(c)) << c;
   for (const char* c : {"STATE", "IMU", "PROCESS_STATUS_X"}) EXPECT_FALSE(is_protocol_channel(c)) << c;
 }

@@ -49,8 +49,7 @@ Flown read_flight(const std::filesystem::path& path) {
       const auto m = transport::decode_message<kestrel::state_t>(data.data(), data.size(), "STATE");
       if (m.status != kestrel::state_t::STATUS_OK) continue;
       if (!f.first_usable) f.first_usable = m.utime;
-      if (const auto t = true_at.find(m.utime); t != true_at.end())
-      {
+      if (const auto t = true_at.find(m.utime); t != true_at.end()) {
         f.matched.emplace_back(transport::from_message(m.T_world_body, "STATE").translation(), t->second);
         f.matched_utimes.push_back(m.utime);
       }

@@ -444,7 +444,8 @@ TEST(System, AVoKilledInFlightLeavesTheStateAndTheGraphInOneWorld) {
 // flight's time have passed after the last GROUND_TRUTH heard (which the LiveSystem must hear):
 // the vehicle has had time to settle where it was sent, and the rest of the --duration would
 // only hover. The simulator stops on SIGINT as at its end, with its summary; its exit code is
-// then kExitInterrupted, returned here (-1 if the flight ended before).
+// then kExitInterrupted, returned here; -1, with a test failure, if no GROUND_TRUTH comes that
+// late (the flight ended first).
 int end_flight(test::LiveSystem& live, double settle_s) {
   const auto truths = live.messages(channel::kGroundTruth);
   if (truths.empty()) return -1;

@@ -16,6 +16,9 @@
 #include "kestrel/rejection_counts_t.hpp"
 #include "kestrel/rejection_reason_t.hpp"
 #include "kestrel/replay_ack_t.hpp"
+#include "kestrel/map_save_request_t.hpp"
+#include "kestrel/playback_command_t.hpp"
+#include "kestrel/playback_status_t.hpp"
 #include "kestrel/replay_control_t.hpp"
 #include "kestrel/rgbd_frame_t.hpp"
 #include "kestrel/slam_correction_t.hpp"
@@ -58,7 +61,8 @@ const std::vector<MessageType>& kestrel_types() {
       type_of<kestrel::slam_correction_t>(), type_of<kestrel::slam_edge_t>(),
       type_of<kestrel::slam_graph_t>(),      type_of<kestrel::slam_keyframe_t>(),
       type_of<kestrel::state_t>(),           type_of<kestrel::vehicle_command_t>(),
-      type_of<kestrel::vo_update_t>(),
+      type_of<kestrel::vo_update_t>(),       type_of<kestrel::map_save_request_t>(),
+      type_of<kestrel::playback_command_t>(), type_of<kestrel::playback_status_t>(),
   };
   return types;
 }
@@ -90,6 +94,8 @@ std::map<std::string, const MessageType*> default_channel_types() {
       {ch::kVehicleCommand, "vehicle_command_t"}, {ch::kProcessStatus, "process_status_t"},
       {ch::kReplayControl, "replay_control_t"},   {ch::kReplayAck, "replay_ack_t"},
       {ch::kProcessRejections, "rejection_counts_t"},
+      {ch::kSlamSaveMap, "map_save_request_t"},   {ch::kPlaybackCommand, "playback_command_t"},
+      {ch::kPlaybackStatus, "playback_status_t"},
   };
   std::map<std::string, const MessageType*> map;
   for (const auto& [channel, type] : table) map[channel] = find_type(type);

@@ -81,7 +81,7 @@ int main(int argc, char** argv) {
   return app.run(argc, argv, [&]() -> int {
     const bool timed = realtime || speed > 0.0 || control;
     if (timed && !lockstep.driver.record_path.empty())
-      throw CLI::ValidationError("--record", "records only in lock-step mode (not with --realtime/--speed)");
+      throw CLI::ValidationError("--record", "records only in lock-step mode (not with --realtime, --speed or --control)");
     const auto& interrupted = catch_interrupts();
     transport::LogReader log(log_path);
     replay::ReplayReport report;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -28,9 +29,13 @@ double PlaybackClock::due_s(int64_t log_us) const {
 
 int64_t PlaybackClock::position_us(double now_s) const {
   if (paused_ || !(now_s > anchor_wall_s_)) return anchor_log_us_;
-  // Bounded far beyond any log so that it converts.
-  const double ahead_us = std::min((now_s - anchor_wall_s_) * speed_ * 1e6, 1e15);
-  return anchor_log_us_ + static_cast<int64_t>(std::llround(ahead_us));
+  // In double, then bounded to what an int64 holds: near its end the sum would overflow.
+  const double at = static_cast<double>(anchor_log_us_) + (now_s - anchor_wall_s_) * speed_ * 1e6;
+  return at >= 9.2e18 ? INT64_MAX : static_cast<int64_t>(std::llround(at));
+}
+
+void PlaybackClock::skip(int64_t cut_us) {
+  anchor_log_us_ = cut_us > INT64_MAX - anchor_log_us_ ? INT64_MAX : anchor_log_us_ + cut_us;
 }
 
 void PlaybackClock::pause(double now_s) {

@@ -33,9 +33,9 @@ class PlaybackClock {
   void set_speed(double speed, double now_s);
   /// The position becomes `log_us` at `now_s`; paused or playing as before.
   void seek(int64_t log_us, double now_s);
-  /// A gap in the log played shorter by `cut_us` (the replay's --max-gap): the position jumps
-  /// ahead by it, so that the event after the gap is due sooner.
-  void skip(int64_t cut_us) { anchor_log_us_ += cut_us; }
+  /// A gap in the log played shorter by `cut_us` >= 0 (the replay's --max-gap): the position
+  /// jumps ahead by it (at most to the end of int64), so that the event after the gap is due sooner.
+  void skip(int64_t cut_us);
 
   bool paused() const { return paused_; }
   double speed() const { return speed_; }

@@ -27,7 +27,9 @@ std::string cell(const std::vector<std::string>& items) {
 
 bool is_protocol_channel(const std::string& channel) {
   return channel == channel::kProcessStatus || channel == channel::kProcessRejections ||
-         channel == channel::kReplayControl || channel == channel::kReplayAck;
+         channel == channel::kReplayControl || channel == channel::kReplayAck ||
+         // A review's transport: replayed, a recorded command would drive the replay itself.
+         channel == channel::kPlaybackCommand || channel == channel::kPlaybackStatus;
 }
 
 bool ProcessTable::update(const kestrel::process_status_t& status, double now_s) {

@@ -74,8 +74,9 @@ class Transport {
   // Waits for commands until `until` (at most 50 ms at a time, so that an interrupt is seen);
   // true if one arrived.
   bool wait(Clock::time_point until) {
-    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(until - Clock::now()).count();
-    const int ms = static_cast<int>(std::clamp<int64_t>(left, 0, 50));
+    // Rounded up: a wait of under a millisecond is one, not a spin on handleTimeout(0).
+    const auto left_us = std::chrono::duration_cast<std::chrono::microseconds>(until - Clock::now()).count();
+    const int ms = static_cast<int>(std::clamp<int64_t>((left_us + 999) / 1000, 0, 50));
     lcm_.handleTimeout(ms);
     return !commands_.empty();
   }
@@ -139,6 +140,7 @@ ReplayReport replay_timed(transport::LogReader& log, const TimedOptions& o,
   std::optional<Transport> control;
   if (o.control) {
     const auto window = window_of(log, o.selection);
+    if (!window) spdlog::warn("{}: no event to replay (--channels, --start, --duration): nothing to control", log.path());
     if (window) {
       control.emplace(lcm, std::filesystem::path(log.path()).filename().string(), *window);
       spdlog::info("{}: {:.1f} s of log; play, pause, seek and speed on {}, the position on {}", log.path(),
@@ -153,6 +155,7 @@ ReplayReport replay_timed(transport::LogReader& log, const TimedOptions& o,
   std::optional<PlaybackClock> clock;
   std::optional<int64_t> first_ts, seek_to;
   int64_t latest_ts = 0, last_request_id = 0;
+  int64_t published_ts = 0;  // the position a status says: the last event published (or the seek's target)
   int seeks = 0;
   bool at_end = false;
   std::optional<transport::LogEvent> pending;  // read while seeking: the first event at the new position
@@ -175,7 +178,7 @@ ReplayReport replay_timed(transport::LogReader& log, const TimedOptions& o,
       } catch (const std::invalid_argument& e) {
         spdlog::warn("{}; ignored", e.what());
       }
-      control->say(*clock, seek_to.value_or(latest_ts), at_end, seeks, last_request_id, true);
+      control->say(*clock, seek_to.value_or(published_ts), at_end, seeks, last_request_id, true);
     }
   };
 
@@ -187,7 +190,9 @@ ReplayReport replay_timed(transport::LogReader& log, const TimedOptions& o,
       filter = std::make_unique<EventFilter>(o.selection, nullptr);
       std::map<std::string, transport::LogEvent> last_of;
       std::optional<transport::LogEvent> next_event;
-      while (auto event = log.next()) {
+      while (!interrupted) {
+        auto event = log.next();
+        if (!event) break;
         if (!filter->accept(*event)) continue;
         if (event->timestamp >= *seek_to) {
           next_event = std::move(event);
@@ -195,16 +200,20 @@ ReplayReport replay_timed(transport::LogReader& log, const TimedOptions& o,
         }
         last_of[event->channel] = std::move(*event);
       }
+      if (interrupted) break;
       clock->seek(*seek_to, now_s());
-      latest_ts = *seek_to;
+      latest_ts = published_ts = *seek_to;
       seek_to.reset();
       ++seeks;
       at_end = !next_event;
       // The status first: a viewer forgets the flight it drew on a new seek count, then
       // draws the moment from what follows.
-      control->say(*clock, latest_ts, at_end, seeks, last_request_id, true);
-      for (const auto& [channel, event] : last_of)
-        lcm.publish(channel, event.data.data(), static_cast<unsigned>(event.data.size()));
+      control->say(*clock, published_ts, at_end, seeks, last_request_id, true);
+      std::vector<const transport::LogEvent*> moment;
+      for (const auto& [channel, event] : last_of) moment.push_back(&event);
+      std::sort(moment.begin(), moment.end(), [](const auto* a, const auto* b) { return a->timestamp < b->timestamp; });
+      for (const transport::LogEvent* e : moment)
+        lcm.publish(e->channel, e->data.data(), static_cast<unsigned>(e->data.size()));
       pending = std::move(next_event);  // published below as any other event, paced from the new position
     }
     std::optional<transport::LogEvent> event = pending ? std::move(pending) : log.next();
@@ -216,7 +225,7 @@ ReplayReport replay_timed(transport::LogReader& log, const TimedOptions& o,
       while (!interrupted && !seek_to) {
         control->wait(Clock::now() + std::chrono::milliseconds(50));
         act();
-        control->say(*clock, latest_ts, at_end, seeks, last_request_id, false);
+        control->say(*clock, published_ts, at_end, seeks, last_request_id, false);
       }
       at_end = false;
       continue;
@@ -250,9 +259,17 @@ ReplayReport replay_timed(transport::LogReader& log, const TimedOptions& o,
                        o.max_gap_s);
         ++report.gaps_capped;
         report.gap_time_cut_s += 1e-6 * static_cast<double>(gap_us - max_gap_us);
-        clock->skip(static_cast<int64_t>(gap_us - max_gap_us));
+        // At most an int64's half: two stamps may lie further apart than an int64 holds.
+        clock->skip(static_cast<int64_t>(std::min<uint64_t>(gap_us - max_gap_us, uint64_t{1} << 62)));
       }
       latest_ts = event->timestamp;
+      if (control) {
+        // Commands are heard even when the replay is behind (every event already due).
+        control->wait(Clock::now());
+        act();
+        if (seek_to) continue;
+        control->say(*clock, published_ts, false, seeks, last_request_id, false);
+      }
       // Wait until it is due, in short steps so that Ctrl-C (and a command) is honoured
       // promptly; bounded so that it converts (a log without a cap may span more than the
       // clock holds: 30 years is still "wait").
@@ -264,16 +281,17 @@ ReplayReport replay_timed(transport::LogReader& log, const TimedOptions& o,
           control->wait(until);
           act();
           if (seek_to) break;
-          control->say(*clock, latest_ts, false, seeks, last_request_id, false);
+          control->say(*clock, published_ts, false, seeks, last_request_id, false);
         } else {
           std::this_thread::sleep_for(std::min<Clock::duration>(until - Clock::now(), std::chrono::milliseconds(50)));
         }
       }
       if (interrupted) break;
       if (seek_to) continue;  // the event is read again after the seek, if it lies beyond it
-      report.data_s = std::max(report.data_s, 1e-6 * static_cast<double>(span_us(*first_ts, latest_ts)));
+      report.data_s = 1e-6 * static_cast<double>(span_us(*first_ts, latest_ts));
     }
     lcm.publish(event->channel, event->data.data(), static_cast<unsigned>(event->data.size()));
+    published_ts = event->timestamp;
     ++report.events_replayed;
     ++report.replayed[event->channel];
   }
