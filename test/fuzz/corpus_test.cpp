@@ -82,8 +82,8 @@ TEST_P(FuzzTarget, RunsEveryDamagedSeedToAnEnd) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Each, FuzzTarget, ::testing::ValuesIn(target_names()),
-                         [](const auto& info) {
-                           std::string name = info.param;
+                         [](const auto& test_param) {
+                           std::string name = test_param.param;
                            std::replace(name.begin(), name.end(), '-', '_');
                            return name;
                          });

@@ -8,6 +8,7 @@
 #include <signal.h>
 
 #include <cerrno>
+#include <stdexcept>
 #include <string>
 
 #include "common/transport/channels.h"
@@ -47,6 +48,18 @@ TEST(LiveSystem, AWaitThatTimesOutFailsNamingWhatItWaitedFor) {
   EXPECT_FALSE(got.has_value());
   live.start("sleeper", {"sleep", "600"});
   EXPECT_NONFATAL_FAILURE(live.exit_status("sleeper", 0.1), "sleeper");
+}
+
+TEST(LiveSystem, ARecordedChannelItDoesNotSubscribeToIsRefused) {
+  if (const std::string why = LiveSystem::isolate(); !why.empty())
+    KESTREL_SKIP_ENVIRONMENT() << "no network namespace available: " << why;
+  TempDir dir;
+  try {
+    LiveSystem live(dir.path(), {{channel::kGroundTruth}, dir / "flight.lcmlog", {channel::kGroundTruth, channel::kState}});
+    FAIL() << "a log that would silently lack STATE was started";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("STATE"), std::string::npos) << e.what();
+  }
 }
 
 TEST(LiveSystem, NothingStartedOutlivesIt) {

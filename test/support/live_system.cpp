@@ -105,6 +105,9 @@ LiveSystem::LiveSystem(std::filesystem::path dir, Options options)
   if (!options_.record.empty()) {
     listener_->recording.emplace(options_.record.string());
     listener_->recorded = options_.recorded.empty() ? options_.channels : options_.recorded;
+    for (const auto& c : listener_->recorded)
+      if (std::find(options_.channels.begin(), options_.channels.end(), c) == options_.channels.end())
+        throw std::invalid_argument("LiveSystem: channel " + c + " is to be recorded but not subscribed to");
   }
   std::vector<std::string> channels = options_.channels;
   if (std::find(channels.begin(), channels.end(), channel::kProcessStatus) == channels.end())

@@ -202,6 +202,11 @@ TempDir::TempDir() {
 }
 
 TempDir::~TempDir() {
+  if (::testing::Test::HasFailure()) {
+    // A system test's only account of a rare failure is what its processes wrote here.
+    std::fprintf(stderr, "kept %s: the test failed\n", path_.c_str());
+    return;
+  }
   std::error_code ec;
   std::filesystem::remove_all(path_, ec);
 }

@@ -25,7 +25,8 @@ std::filesystem::path source_dir();
 /// The whole file's bytes (empty if it cannot be read).
 std::string read_file(const std::filesystem::path& path);
 
-/// A fresh folder removed at destruction.
+/// A fresh folder, removed at destruction unless the running test has failed: then it stays,
+/// with the processes' logs and flight logs a failure needs, and its path is printed.
 class TempDir {
  public:
   TempDir();

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <cmath>
 #include <filesystem>
 #include <map>
 #include <optional>
@@ -96,21 +97,29 @@ TEST(System, ASecondFlightStartedElsewhereIsPlacedInTheSavedMapAndFliesToAGoalIn
   const Eigen::Isometry3d T_map_truth = metrics::align_positions(p_est, p_gt).T_gt_est.inverse();
   const Flown second = read_flight(two / "flight.lcmlog");
   ASSERT_TRUE(second.first_usable && second.first_truth && second.last_truth);
-  double worst_m = 0.0;
+  double worst_m = 0.0, sum_squared_m2 = 0.0;
   int64_t worst_utime = 0;
   for (size_t i = 0; i < second.matched.size(); ++i) {
     const double error_m = (second.matched[i].first - T_map_truth * second.matched[i].second).norm();
+    sum_squared_m2 += error_m * error_m;
     if (error_m > worst_m) std::tie(worst_m, worst_utime) = std::pair{error_m, second.matched_utimes[i]};
   }
+  ASSERT_FALSE(second.matched.empty());
+  const double rms_m = std::sqrt(sum_squared_m2 / static_cast<double>(second.matched.size()));
   const double placed_s = 1e-6 * static_cast<double>(*second.first_usable - *second.first_truth);
   const double arrived_m = (T_map_truth * *second.last_truth - goal).norm();
-  std::cout << "second flight: STATE usable " << placed_s << " s after the start, worst position error "
+  std::cout << "second flight: STATE usable " << placed_s << " s after the start, position error RMS " << rms_m * 100.0
+            << " cm, worst "
             << worst_m * 100.0 << " cm in the map's world (" << 1e-6 * static_cast<double>(worst_utime - *second.first_truth)
             << " s after the start), ended " << arrived_m * 100.0 << " cm from the goal ("
             << (goal - start).norm() << " m away); the map's world is "
             << (T_map_truth.translation()).norm() * 100.0 << " cm from the sim's\n";
   EXPECT_LT(placed_s, 2.0);
-  EXPECT_LT(worst_m, 0.06) << "STATE in the map's world, against the truth";
+  // Over 20 runs: RMS 1.7-2.5 cm; the worst 3.4-6.6 cm, either at the relocalisation or while
+  // the state drifts on the odometry between two of SLAM's corrections in flight (up to 6 cm/s,
+  // for a quarter of a second). A wrong placement is decimetres off.
+  EXPECT_LT(rms_m, 0.04) << "STATE in the map's world, against the truth";
+  EXPECT_LT(worst_m, 0.10) << "STATE in the map's world, against the truth";
   EXPECT_LT(arrived_m, 0.15) << "where the vehicle really ended";
 }
 

@@ -473,9 +473,10 @@ TEST(System, APlannerKilledWhileTheVehicleHoversPlansAgainOnceRestarted) {
   const std::vector<std::string> planner = {bin("planner"), "--height", "1.3", "--sensor", "kinect"};
   int sim_status = -1, goto_status = -1;
   {
-    test::LiveSystem live(dir.path(), {{channel::kPlan, channel::kMapOctomap, channel::kGroundTruth, channel::kPlanRequest},
+    test::LiveSystem live(dir.path(), {{channel::kPlan, channel::kMapOctomap, channel::kGroundTruth, channel::kPlanRequest,
+                                        channel::kState},
                                        dir / "flight.lcmlog",
-                                       {channel::kPlan, channel::kMapOctomap, channel::kGroundTruth}});
+                                       {channel::kPlan, channel::kMapOctomap, channel::kGroundTruth, channel::kState}});
     live.start("vo", {bin("vo"), "-q"});
     live.start("estimator", {bin("estimator"), "-q", "--init-position", "8,3.5,1.3"});
     live.start("slam", {bin("slam"), "-q"});
@@ -522,12 +523,18 @@ TEST(System, APlannerKilledWhileTheVehicleHoversPlansAgainOnceRestarted) {
   EXPECT_NE(go.find("arrived"), std::string::npos) << go;
 
   int ok_plans = 0;
-  std::optional<Eigen::Vector3d> truth;
+  std::optional<Eigen::Vector3d> truth;  // the last
+  std::map<int64_t, Eigen::Vector3d> truth_at;
+  std::optional<std::pair<Eigen::Vector3d, Eigen::Vector3d>> last_matched;  // the last STATE, the truth then
   std::map<std::pair<int64_t, int64_t>, int> sent;  // MAP_OCTOMAP (revision, utime): times sent
   transport::LogReader log((dir / "flight.lcmlog").string());
   while (auto e = log.next()) {
     const auto& data = e->data;
-    if (e->channel == channel::kPlan) {
+    if (e->channel == channel::kState) {
+      const auto m = transport::decode_message<kestrel::state_t>(data.data(), data.size(), "STATE");
+      if (const auto t = truth_at.find(m.utime); t != truth_at.end())
+        last_matched = {transport::from_message(m.T_world_body, "STATE").translation(), t->second};
+    } else if (e->channel == channel::kPlan) {
       ok_plans += transport::decode_message<kestrel::plan_t>(data.data(), data.size(), "PLAN").status ==
                   kestrel::plan_t::STATUS_OK;
     } else if (e->channel == channel::kMapOctomap) {
@@ -536,16 +543,25 @@ TEST(System, APlannerKilledWhileTheVehicleHoversPlansAgainOnceRestarted) {
     } else if (e->channel == channel::kGroundTruth) {
       const auto m = transport::decode_message<kestrel::ground_truth_t>(data.data(), data.size(), "GROUND_TRUTH");
       truth = transport::from_message(m.T_world_frame, "GROUND_TRUTH").translation();
+      truth_at[m.utime] = *truth;
     }
   }
   int repeats = 0;
   for (const auto& [key, n] : sent) repeats += n - 1;
-  std::printf("%d plans, %zu maps, %d sent again; the vehicle ended at (%.3f, %.3f, %.3f)\n", ok_plans, sent.size(),
-              repeats, truth ? truth->x() : 0.0, truth ? truth->y() : 0.0, truth ? truth->z() : 0.0);
+  ASSERT_TRUE(truth && last_matched);
+  const auto& [state_end, truth_end] = *last_matched;
+  const double state_error_m = (state_end - truth_end).norm();
+  std::printf("%d plans, %zu maps, %d sent again; the vehicle ended at (%.3f, %.3f, %.3f), its STATE %.3f m from it\n",
+              ok_plans, sent.size(), repeats, truth->x(), truth->y(), truth->z(), state_error_m);
   EXPECT_GE(ok_plans, 1);
   EXPECT_GE(repeats, 1) << "the hover's map went out again\n" << test::read_file(dir / "mapper.log");
-  ASSERT_TRUE(truth.has_value());
-  EXPECT_LT((*truth - Eigen::Vector3d(9.5, 3.5, 1.3)).norm(), 0.10) << "where the vehicle really ended";
+  // goto's arrival is judged on STATE (--arrive-radius 0.1), so the vehicle really ends that
+  // close to the goal give or take the state's error (1-2 cm in 6 runs here). Once (CI, and 1
+  // in 6 here) it ended 15 cm off, arrived at 9.9 cm by its state, with STATE not recorded.
+  const Eigen::Vector3d goal(9.5, 3.5, 1.3);
+  EXPECT_LT((state_end - goal).norm(), 0.10) << "where the vehicle ended by its STATE";
+  EXPECT_LT(state_error_m, 0.10) << "the STATE at the end, against the truth";
+  EXPECT_LT((truth_end - goal).norm(), 0.10 + state_error_m) << "where the vehicle really ended";
 }
 
 
@@ -683,7 +699,11 @@ TEST(System, AnEstimatorKilledWhileTheVehicleHoversTakesTheMapsWorldAtOnce) {
   std::printf("the new filter's first state %.3f m off (sigma %.4f m, NEES %.2f), in the map's world %.3f s later "
               "(%zu states after)\n",
               first.distance, first.sigma, first.nees, delay, errors.size() - aligned);
-  EXPECT_LT(delay, 0.5) << "a hover makes no keyframe: the world must not wait for one";
+  // Once in CI (1 of ~15 runs) the first state was 0.58 m off with SLAM's 5 cm sigma, and
+  // in the map's world 1.8 s later: what the new filter and SLAM said is then shown.
+  const std::string said = "\nthe new estimator said:\n" + test::read_file(dir / "estimator2.log") +
+                           "\nslam said:\n" + test::read_file(dir / "slam.log");
+  EXPECT_LT(delay, 0.5) << "a hover makes no keyframe: the world must not wait for one" << said;
   // It is as uncertain as SLAM's pose in the map's world, not as its own start in its old
   // one (1 mm): its error lies within what it reports (3 dof, chi2 at 1e-3: 16.3).
   EXPECT_LT(first.nees, 16.3) << first.distance << " m off, reporting sigma " << first.sigma << " m";
