@@ -1,7 +1,9 @@
 #include "common/transport/log_file.h"
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
+#include <stdexcept>
 
 #include "common/error.h"
 
@@ -46,12 +48,9 @@ LogReader::LogReader(const std::string& path) : path_(path) {
   }
 }
 
-void LogReader::rewind() {
-  std::fseek(file_, 0, SEEK_SET);
-  corrupt_regions_ = 0;
-  skipped_bytes_ = 0;
-  first_damage_offset_ = -1;
-  truncated_ = false;
+void LogReader::seek(int64_t offset) {
+  if (offset < 0 || offset > file_size_) throw std::out_of_range(path_ + ": no event at byte " + std::to_string(offset));
+  if (file_) std::fseek(file_, offset, SEEK_SET);
 }
 
 LogReader::~LogReader() {
@@ -83,17 +82,24 @@ std::optional<LogEvent> LogReader::next() {
     uint8_t header[kHeaderSize];
     const size_t got = std::fread(header, 1, kHeaderSize, file_);
     auto damaged = [&](bool is_truncation) {
-      if (first_damage_offset_ < 0) first_damage_offset_ = offset;
+      // Read before (a rewind, a seek back): counted then.
+      const bool counted = offset < damage_counted_until_;
+      const int64_t skipped_before = skipped_bytes_;
+      if (!counted && first_damage_offset_ < 0) first_damage_offset_ = offset;
       if (is_truncation) {
-        truncated_ = true;
-        skipped_bytes_ += file_size_ - offset;
+        if (!counted) {
+          truncated_ = true;
+          skipped_bytes_ += file_size_ - offset;
+        }
         std::fseek(file_, 0, SEEK_END);
-        return;
+      } else {
+        if (!counted) ++corrupt_regions_;
+        std::fseek(file_, offset + 1, SEEK_SET);
+        skipped_bytes_ += 1;  // the byte at `offset` that started the bad event
+        resync();
+        if (counted) skipped_bytes_ = skipped_before;
       }
-      ++corrupt_regions_;
-      std::fseek(file_, offset + 1, SEEK_SET);
-      skipped_bytes_ += 1;  // the byte at `offset` that started the bad event
-      resync();
+      damage_counted_until_ = std::max<int64_t>(damage_counted_until_, std::ftell(file_));
     };
     if (got < 4) {
       damaged(true);
@@ -108,6 +114,7 @@ std::optional<LogEvent> LogReader::next() {
       return std::nullopt;
     }
     LogEvent event;
+    event.offset = offset;
     event.event_number = get_i64(header + 4);
     event.timestamp = get_i64(header + 12);
     const uint32_t channel_length = get_u32(header + 20);
@@ -141,6 +148,7 @@ std::optional<LogEvent> LogReader::next() {
       damaged(true);
       return std::nullopt;
     }
+    damage_counted_until_ = std::max(damage_counted_until_, end);
     return event;
   }
   return std::nullopt;

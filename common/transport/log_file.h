@@ -17,6 +17,7 @@
 namespace kestrel::transport {
 
 struct LogEvent {
+  int64_t offset = 0;  ///< where the event starts in its file (LogReader::seek goes back to it)
   int64_t event_number = 0;
   int64_t timestamp = 0;  ///< microseconds; kestrel writers use the message utime
   std::string channel;
@@ -33,9 +34,11 @@ class LogReader {
 
   /// The next intact event, or empty at the end of the file.
   std::optional<LogEvent> next();
-  /// Back to the first event (a replay seeking backwards reads the file again); the damage
-  /// counts start again with it, so that damage read twice is counted once.
-  void rewind();
+  /// Back to the first event (a replay seeking backwards reads the file again).
+  void rewind() { seek(0); }
+  /// On to the event at `offset` (a LogEvent's offset, or 0): the next next() reads it.
+  /// Damage is counted once however often it is read.
+  void seek(int64_t offset);
 
   /// Damage seen so far: bytes skipped to find the next event, and a truncated tail.
   int64_t corrupt_regions() const { return corrupt_regions_; }
@@ -48,6 +51,7 @@ class LogReader {
  private:
   bool resync();
   std::string path_;
+  int64_t damage_counted_until_ = 0;  ///< damage before this offset was counted already
   std::FILE* file_ = nullptr;
   int64_t file_size_ = 0;
   int64_t corrupt_regions_ = 0;

@@ -1,6 +1,9 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
 
 #include "common/error.h"
 #include "common/transport/log_file.h"
@@ -117,6 +120,29 @@ TEST(LogFile, RewindReadsTheSameEventsAgainAndCountsTheDamageOnce) {
   EXPECT_EQ(r.corrupt_regions(), 1);
   EXPECT_TRUE(r.truncated());
   EXPECT_EQ(r.damage_report(), damage);
+}
+
+TEST(LogFile, ASeekToAnEventsOffsetReadsItAgainAndDamageIsCountedOnce) {
+  test::TempDir dir;
+  write_log(dir / "a.lcmlog");
+  auto bytes = read_bytes(dir / "a.lcmlog");
+  bytes[3 * (bytes.size() / 10)] ^= 0xff;  // event 3's sync word
+  write_bytes(dir / "d.lcmlog", bytes);
+  LogReader r(dir / "d.lcmlog");
+  std::vector<int64_t> offsets;
+  while (auto e = r.next()) offsets.push_back(e->offset);
+  ASSERT_EQ(offsets.size(), 9u);
+  EXPECT_EQ(offsets.front(), 0);
+  const std::string damage = r.damage_report();
+  // Back over the damage, to event 2 (the third read), then to the last.
+  r.seek(offsets[2]);
+  EXPECT_EQ(read_seqs(r), (std::vector<int64_t>{2, 4, 5, 6, 7, 8, 9}));
+  r.seek(offsets.back());
+  EXPECT_EQ(read_seqs(r), (std::vector<int64_t>{9}));
+  EXPECT_EQ(r.corrupt_regions(), 1);
+  EXPECT_EQ(r.damage_report(), damage);
+  EXPECT_THROW(r.seek(-1), std::out_of_range);
+  EXPECT_THROW(r.seek(static_cast<int64_t>(bytes.size()) + 1), std::out_of_range);
 }
 
 TEST(LogFile, NotALogAndMissingFileAreInputErrors) {

@@ -59,6 +59,17 @@ TEST(EventFilter, KeepsTheTimeWindowRelativeToTheFirstEvent) {
   EXPECT_EQ(filter.outside_window(), 3);
 }
 
+TEST(EventFilter, OneThatStartsMidLogCountsTheWindowFromTheLogsStartItIsGiven) {
+  // A seek reads from a checkpoint in the middle of the log (seek_index.h): its first event
+  // is not the log's.
+  const int64_t t0 = 5'000'000;
+  EventFilter filter({"", 1.0, 2.0}, nullptr, t0);
+  EXPECT_TRUE(filter.accept(event("IMU", t0 + 2'500'000)));   // 2.5 s of the log's time
+  EXPECT_TRUE(filter.accept(event("IMU", t0 + 3'000'000)));
+  EXPECT_FALSE(filter.accept(event("IMU", t0 + 3'000'001)));  // beyond 1 + 2 s
+  EXPECT_EQ(filter.outside_window(), 1);
+}
+
 TEST(EventFilter, WithoutAWindowNothingIsOutsideIt) {
   EventFilter filter({}, nullptr);  // neither --start nor --duration
   const int64_t t0 = 5'000'000;

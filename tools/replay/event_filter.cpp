@@ -5,8 +5,9 @@
 namespace kestrel::replay {
 
 EventFilter::EventFilter(const SelectionOptions& options,
-                         std::function<std::vector<std::string>(const std::string&)> live_publishers)
-    : options_(options), live_publishers_(std::move(live_publishers)) {
+                         std::function<std::vector<std::string>(const std::string&)> live_publishers,
+                         std::optional<int64_t> log_start)
+    : options_(options), live_publishers_(std::move(live_publishers)), first_timestamp_(log_start) {
   if (!options.channels_regex.empty()) regex_.emplace(options.channels_regex);
 }
 

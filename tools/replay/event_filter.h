@@ -32,8 +32,12 @@ class EventFilter {
   /// `live_publishers(channel)` names the running processes that publish `channel` (null in
   /// timed mode); their channels are skipped unless a regex selects channels explicitly.
   /// Throws std::regex_error for a bad regex (check_channel_regex() tells beforehand).
+  /// `log_start`: the timestamp of the log's first event, which the window counts from, for a
+  /// filter that starts reading in the middle of the log (a seek); without it, the first
+  /// event the filter sees.
   EventFilter(const SelectionOptions& options,
-              std::function<std::vector<std::string>(const std::string&)> live_publishers);
+              std::function<std::vector<std::string>(const std::string&)> live_publishers,
+              std::optional<int64_t> log_start = std::nullopt);
 
   /// True if `event` is to be replayed; otherwise counts why not.
   bool accept(const transport::LogEvent& event);

@@ -30,6 +30,7 @@
 #include "kestrel/playback_command_t.hpp"
 #include "kestrel/playback_status_t.hpp"
 #include "tools/replay/playback_clock.h"
+#include "tools/replay/seek_index.h"
 #include "tools/replay/replayer.h"
 
 namespace kestrel::replay {
@@ -49,12 +50,16 @@ uint64_t cap_us(double seconds) {
   return static_cast<uint64_t>(std::llround(std::min(seconds, 1e12) * 1e6));
 }
 
-// The first and last log time of the events the selection replays (one pass over the log).
-std::optional<std::pair<int64_t, int64_t>> window_of(transport::LogReader& log, const SelectionOptions& selection) {
+// The first and last log time of the events the selection replays, and the seek index: one
+// pass over the log.
+std::optional<std::pair<int64_t, int64_t>> window_of(transport::LogReader& log, const SelectionOptions& selection,
+                                                     SeekIndex& index) {
   EventFilter filter(selection, nullptr);
   std::optional<std::pair<int64_t, int64_t>> window;
   while (auto event = log.next()) {
-    if (!filter.accept(*event)) continue;
+    const bool replayed = filter.accept(*event);
+    index.read(event->offset, event->timestamp, event->channel, replayed);
+    if (!replayed) continue;
     if (!window) window = std::pair{event->timestamp, event->timestamp};
     window->first = std::min(window->first, event->timestamp);
     window->second = std::max(window->second, event->timestamp);
@@ -138,8 +143,9 @@ ReplayReport replay_timed(transport::LogReader& log, const TimedOptions& o,
   report.log_path = log.path();
   report.mode = fmt::format("timed (speed {:g}{})", o.speed, o.control ? ", controlled" : "");
   std::optional<Transport> control;
+  SeekIndex index;
   if (o.control) {
-    const auto window = window_of(log, o.selection);
+    const auto window = window_of(log, o.selection, index);
     if (!window) spdlog::warn("{}: no event to replay (--channels, --start, --duration): nothing to control", log.path());
     if (window) {
       control.emplace(lcm, std::filesystem::path(log.path()).filename().string(), *window);
@@ -184,11 +190,17 @@ ReplayReport replay_timed(transport::LogReader& log, const TimedOptions& o,
 
   while (!interrupted) {
     if (seek_to) {
-      // Read the log again up to the new position, publishing for each channel the last
-      // event before it (the map, graph, plan and image of that moment), then play on.
-      log.rewind();
-      filter = std::make_unique<EventFilter>(o.selection, nullptr);
+      // Publish for each channel the last event before the new position (the map, graph,
+      // plan and image of that moment), then play on. The index's checkpoint before it names
+      // them up to there; the log is read from there to the position (seek_index.h).
+      const Checkpoint& from = index.start_for(*seek_to);
+      filter = std::make_unique<EventFilter>(o.selection, nullptr, index.first_timestamp());
       std::map<std::string, transport::LogEvent> last_of;
+      for (const auto& [channel, offset] : from.last_of) {
+        log.seek(offset);
+        if (auto e = log.next()) last_of[channel] = std::move(*e);
+      }
+      log.seek(from.offset);
       std::optional<transport::LogEvent> next_event;
       while (!interrupted) {
         auto event = log.next();
