@@ -56,6 +56,32 @@ TEST(HealthBoard, FollowsEachProcessThroughItsLife) {
   EXPECT_EQ(rows.back().name, "vo (not launched here)");  // the stale pid, shown apart
 }
 
+// What a process sends as it stops (its STOPPING heartbeat, its counts) often arrives after
+// the launch has reaped it: it is still that process's, not a stranger's.
+TEST(HealthBoard, WhatAProcessSaysAsItStopsIsItsOwnAfterItEnded) {
+  HealthBoard board(3.0);
+  const auto t0 = Clock::now();
+  board.started("slam", 300, t0);
+  board.started("source", 301, t0);
+  board.heartbeat(beat("slam", 300, process_status_t::STATE_RUNNING), t0 + milliseconds(100));
+  board.ended("slam", "exited with status 0", t0 + milliseconds(200));
+  board.ended("source", "exited with status 0", t0 + milliseconds(200));
+  board.heartbeat(beat("slam", 300, process_status_t::STATE_STOPPING), t0 + milliseconds(250));
+  // The source never said its name before it ended: its launch name is not its own.
+  board.heartbeat(beat("ros-bridge", 301, process_status_t::STATE_STOPPING), t0 + milliseconds(250));
+  rejection_counts_t counts{};
+  counts.name = "slam";
+  counts.pid = 300;
+  counts.num_reasons = 0;
+  board.rejections(counts);
+  const auto rows = board.rows(t0 + milliseconds(300));
+  ASSERT_EQ(rows.size(), 3u);
+  EXPECT_EQ(rows[0].name, "slam");
+  EXPECT_EQ(rows[0].state, "ended: exited with status 0");
+  EXPECT_EQ(rows[1].name, "source");
+  EXPECT_EQ(rows[2].name, "ros-bridge (not launched here)");
+}
+
 // A heartbeat's name and message reach the terminal escaped, whatever bytes they hold (found
 // by fuzzing: a backspace and invalid UTF-8 in a message went to the table raw).
 TEST(HealthBoard, TheTableEscapesBytesThatDoNotPrint) {

@@ -43,9 +43,13 @@ void HealthBoard::cpu(const std::string& name, double cpu_s) {
 }
 
 HealthBoard::Entry& HealthBoard::entry_of(pid_t pid, const std::string& name) {
-  // By pid first: a launched process may call itself anything.
+  // By pid first: a launched process may call itself anything. One that has ended is still
+  // the sender of its last heartbeat and counts, which often arrive after it was reaped (under
+  // the name it went by, or its launch name): another process with its pid would call itself
+  // something else.
   auto it = std::find_if(entries_.begin(), entries_.end(), [&](const auto& kv) {
-    return kv.second.launched && kv.second.pid == pid && !kv.second.ended;
+    const Entry& e = kv.second;
+    return e.launched && e.pid == pid && (!e.ended || kv.first == name || (e.last && e.last->name == name));
   });
   if (it == entries_.end()) {
     const std::string key = name + " (not launched here)";

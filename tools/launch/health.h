@@ -75,8 +75,8 @@ class HealthBoard {
     bool launched = false;
     bool heartbeats = true;
   };
-  // The entry of the process with this pid (a launched one still running), else one kept
-  // under "<name> (not launched here)".
+  // The entry of the process with this pid (a launched one, still running or ended under
+  // that name), else one kept under "<name> (not launched here)".
   Entry& entry_of(pid_t pid, const std::string& name);
 
   double silent_after_s_;
