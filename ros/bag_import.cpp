@@ -18,6 +18,7 @@
 #include "ros/camera_source.h"
 #include "ros/legacy_camera_info.h"
 #include "ros/ros_convert.h"
+#include "ros/tf_tree.h"
 
 namespace kestrel::ros1 {
 namespace {
@@ -86,75 +87,6 @@ struct Event {
   Kind kind = Kind::kFrame;
   size_t index = 0;  // into the pairs, imu or poses
 };
-
-struct Pose {
-  int64_t utime = 0;
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-};
-
-// One edge of the tf tree: the child's transforms in its parent, sorted by time.
-struct Edge {
-  std::string parent;
-  std::vector<Pose> samples;
-};
-
-// The latest transform of `edge` (samples sorted by time) at or before `utime`, or its first
-// (a rigid mount published only after the motion started).
-const Eigen::Isometry3d& value_at(const Edge& edge, int64_t utime) {
-  auto it = std::upper_bound(edge.samples.begin(), edge.samples.end(), utime,
-                             [](int64_t t, const Pose& p) { return t < p.utime; });
-  return it == edge.samples.begin() ? it->T : std::prev(it)->T;
-}
-
-// `frame` in the root of its tf tree at `utime`, and the root's name.
-std::pair<std::string, Eigen::Isometry3d> in_root(const std::map<std::string, Edge>& edges, const std::string& frame,
-                                                  int64_t utime) {
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  std::string f = frame;
-  for (size_t depth = 0; depth < 64; ++depth) {
-    const auto it = edges.find(f);
-    if (it == edges.end()) break;
-    T = value_at(it->second, utime) * T;
-    f = it->second.parent;
-  }
-  return {f, T};
-}
-
-// The pose of `camera` in `world` along the tf tree, at each transform of the chain's busiest
-// edge; `why` says what was used or why nothing was.
-std::vector<Pose> poses_from_tf(const std::map<std::string, Edge>& edges, const std::string& world,
-                                const std::string& camera, const std::string& topic, std::string& why) {
-  std::vector<const Edge*> chain;  // camera's edge first
-  std::string path = camera;
-  for (std::string frame = camera; frame != world;) {
-    const auto it = edges.find(frame);
-    if (it == edges.end() || chain.size() > 64) {
-      why = "none: no chain of transforms from '" + world + "' to '" + camera + "' on " + topic +
-            (edges.empty() ? " (no transforms)" : "");
-      return {};
-    }
-    chain.push_back(&it->second);
-    frame = it->second.parent;
-    path = frame + " -> " + path;
-  }
-  if (chain.empty()) {
-    why = "none: the world and camera frames are the same ('" + world + "')";
-    return {};
-  }
-  const Edge* driving = *std::max_element(chain.begin(), chain.end(), [](const Edge* a, const Edge* b) {
-    return a->samples.size() < b->samples.size();
-  });
-  std::vector<Pose> poses;
-  poses.reserve(driving->samples.size());
-  for (const Pose& s : driving->samples) {
-    if (!poses.empty() && poses.back().utime == s.utime) continue;
-    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-    for (const Edge* e : chain) T = value_at(*e, s.utime) * T;
-    poses.push_back({s.utime, T});
-  }
-  why = topic + ": " + path;
-  return poses;
-}
 
 BagImportStats import(rosbag::Bag& bag, const std::string& path, const BagImportOptions& o, const ImportSink& sink) {
   BagImportStats stats;
@@ -245,43 +177,26 @@ BagImportStats import(rosbag::Bag& bag, const std::string& path, const BagImport
     std::stable_sort(imu.begin(), imu.end(), [](const ImuReading& a, const ImuReading& b) { return a.utime < b.utime; });
   }
 
-  // The tf tree (for the ground truth and the IMU's axes): each child's transforms in its parent.
-  std::map<std::string, Edge> edges;
+  // The tf tree (for the ground truth and the IMU's axes).
+  TfTree tree;
   const bool have_tf = !o.tf_topic.empty() && (topics.has(o.tf_topic) || topics.has(o.tf_topic + "_static"));
   if (have_tf) {
     for (const std::string& topic : {o.tf_topic, o.tf_topic + "_static"}) {
       if (!topics.has(topic)) continue;
       topics.require_type<tf2_msgs::TFMessage>(path, topic);
       rosbag::View view(bag, rosbag::TopicQuery(topic));
-      for (const rosbag::MessageInstance& m : view) {
-        const auto msg = read_as<tf2_msgs::TFMessage>(m, path);
-        for (const geometry_msgs::TransformStamped& t : msg->transforms) {
-          const std::string child = frame_name(t.child_frame_id);
-          const std::string parent = frame_name(t.header.frame_id);
-          auto [it, added] = edges.try_emplace(child, Edge{parent, {}});
-          // A frame has one parent in a tf tree; a second parent is another tree's frame.
-          if (!added && it->second.parent != parent) continue;
-          it->second.samples.push_back(
-              {to_utime(t.header.stamp), to_isometry(t.transform, path + ": " + at(topic, t.header.stamp) + ": " +
-                                                                     parent + " -> " + child)});
-        }
-      }
+      for (const rosbag::MessageInstance& m : view) tree.add(*read_as<tf2_msgs::TFMessage>(m, path), path + ": " + topic);
     }
-    for (auto& [child, edge] : edges)
-      std::stable_sort(edge.samples.begin(), edge.samples.end(), [](const Pose& a, const Pose& b) { return a.utime < b.utime; });
   }
 
   // The IMU in the body's axes (the camera's optical frame): rotated by the tf tree's mount when
   // its frame is another one the tree joins to the camera's; the lever arm is not modelled.
   stats.imu_axes = "as published";
   if (!imu.empty() && !imu_frame.empty() && !colour_frame.empty() && imu_frame != colour_frame) {
-    const auto [imu_root, T_root_imu] = in_root(edges, imu_frame, imu.front().utime);
-    const auto [camera_root, T_root_camera] = in_root(edges, colour_frame, imu.front().utime);
-    if (imu_root == camera_root) {
-      const Eigen::Matrix3d R = (T_root_camera.inverse() * T_root_imu).linear();
+    if (const auto R_camera_imu = tree.rotation(colour_frame, imu_frame, imu.front().utime)) {
       for (ImuReading& r : imu) {
-        r.angular_velocity = R * r.angular_velocity;
-        r.linear_acceleration = R * r.linear_acceleration;
+        r.angular_velocity = *R_camera_imu * r.angular_velocity;
+        r.linear_acceleration = *R_camera_imu * r.linear_acceleration;
       }
       stats.imu_axes = "rotated from '" + imu_frame + "' to '" + colour_frame + "' by " + o.tf_topic;
     } else {
@@ -290,7 +205,7 @@ BagImportStats import(rosbag::Bag& bag, const std::string& path, const BagImport
     }
   }
 
-  std::vector<Pose> poses;
+  std::vector<TimedPose> poses;
   if (!o.pose_topic.empty()) {
     if (!topics.has(o.pose_topic)) throw InputError(path + ": " + o.pose_topic + ": no such topic (ground-truth poses; the bag has: " + topics.list() + ")");
     topics.require_type<geometry_msgs::PoseStamped>(path, o.pose_topic);
@@ -299,10 +214,10 @@ BagImportStats import(rosbag::Bag& bag, const std::string& path, const BagImport
       const auto msg = read_as<geometry_msgs::PoseStamped>(m, path);
       poses.push_back({to_utime(msg->header.stamp), to_isometry(msg->pose, path + ": " + at(o.pose_topic, msg->header.stamp))});
     }
-    std::stable_sort(poses.begin(), poses.end(), [](const Pose& a, const Pose& b) { return a.utime < b.utime; });
+    std::stable_sort(poses.begin(), poses.end(), [](const TimedPose& a, const TimedPose& b) { return a.utime < b.utime; });
     stats.ground_truth = o.pose_topic + " (geometry_msgs/PoseStamped)";
   } else if (have_tf) {
-    poses = poses_from_tf(edges, frame_name(o.world_frame), frame_name(o.camera_frame), o.tf_topic, stats.ground_truth);
+    poses = tree.poses(frame_name(o.world_frame), frame_name(o.camera_frame), o.tf_topic, stats.ground_truth);
   } else {
     stats.ground_truth = o.tf_topic.empty() ? "none: no tf topic given" : "none: no " + o.tf_topic + " topic";
   }

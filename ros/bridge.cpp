@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include <chrono>
+#include <limits>
 #include <map>
 #include <optional>
 
@@ -12,6 +13,8 @@
 
 #include "common/transport/channels.h"
 #include "common/transport/node.h"
+#include "ros/ros_convert.h"
+#include "ros/tf_tree.h"
 
 namespace kestrel::ros1 {
 namespace {
@@ -74,6 +77,9 @@ void check_topic_types(const std::vector<ros::Subscriber>& subscribers, const st
 // periods of a 30 Hz camera, far longer than a depth image arrives behind its colour image.
 constexpr std::chrono::milliseconds kQuietCamera{250};
 
+// The tf history kept per edge: a mount or a motion capture is looked up at the newest stamps.
+constexpr int64_t kTfHistoryUs = 10'000'000;
+
 }  // namespace
 
 BridgeSummary run_bridge(const BridgeOptions& o) {
@@ -91,9 +97,11 @@ BridgeSummary run_bridge(const BridgeOptions& o) {
   auto last_camera_message = std::chrono::steady_clock::now();
 
   // ROS -> LCM.
-  CameraStream camera(o.camera, "ros-bridge", [&](const std::string& channel, int64_t, const std::vector<uint8_t>& bytes) {
-    node.publish_bytes(channel, bytes);
-  });
+  TfTree tree(kTfHistoryUs);
+  CameraStream camera(
+      o.camera, "ros-bridge",
+      [&](const std::string& channel, int64_t, const std::vector<uint8_t>& bytes) { node.publish_bytes(channel, bytes); },
+      o.tf_topic.empty() ? nullptr : &tree, o.tf_topic);
   std::vector<ros::Subscriber> subscribers;
   std::vector<std::string> types;  // of each subscriber's messages
   // Each callback: a bad message is dropped and counted; a stream that cannot give a frame ends
@@ -131,6 +139,50 @@ BridgeSummary run_bridge(const BridgeOptions& o) {
     if (!c.imu_topic.empty()) types.push_back(ros::message_traits::DataType<sensor_msgs::Imu>::value());
     node.advertise(channel::kCameraRgbd);
     node.advertise(channel::kImu);
+  }
+  int64_t last_truth_utime = std::numeric_limits<int64_t>::min();
+  summary.ground_truth = o.tf_topic.empty() ? "none: no tf read (--tf-topic \"\")" : "none: no transform on " + o.tf_topic;
+  if (!o.tf_topic.empty()) {
+    // The ground truth: the truth frame's pose in the truth world at each transform of the
+    // chain's busiest edge, in stamp order. (The handlers below outlive this block: what they
+    // hold by reference lives as long as the loop.)
+    const std::string world = frame_name(o.mocap_world_frame), truth = frame_name(o.mocap_frame);
+    const auto publish_truth = [&, world, truth](const std::vector<std::pair<std::string, int64_t>>& took) {
+      std::string why;
+      const std::vector<std::string> chain = tree.chain(world, truth, why);
+      if (chain.empty()) {
+        summary.ground_truth = "none: " + why + " on " + o.tf_topic;
+        return;
+      }
+      const std::string driving = tree.busiest(chain);
+      for (const auto& [child, utime] : took) {
+        if (child != driving || utime <= last_truth_utime) continue;
+        node.publish_bytes(channel::kGroundTruth, ground_truth_message(utime, tree.along(chain, utime)));
+        last_truth_utime = utime;
+        ++summary.ground_truth_poses;
+        summary.ground_truth = o.tf_topic + ": " + tree.path(chain);
+      }
+    };
+    const std::string self = ros::this_node::getName();
+    for (const bool is_static : {false, true}) {
+      const std::string topic = o.tf_topic + (is_static ? "_static" : "");
+      const boost::function<void(const ros::MessageEvent<tf2_msgs::TFMessage const>&)> on_tf =
+          [&, self, topic, is_static, publish_truth](const ros::MessageEvent<tf2_msgs::TFMessage const>& event) {
+            // Its own transforms (STATE's map -> base_link) are not the world's.
+            if (fatal || event.getPublisherName() == self) return;
+            try {
+              const auto took = tree.add(*event.getConstMessage(), "ros-bridge: " + topic);
+              summary.tf_transforms += static_cast<int64_t>(took.size());
+              if (!is_static) publish_truth(took);
+            } catch (const InputError& e) {
+              rejections.reject(e.what());
+            }
+          };
+      subscribers.push_back(nh.subscribe<tf2_msgs::TFMessage, const ros::MessageEvent<tf2_msgs::TFMessage const>&>(
+          topic, is_static ? 10 : 100, on_tf));
+      types.push_back(ros::message_traits::DataType<tf2_msgs::TFMessage>::value());
+    }
+    node.advertise(channel::kGroundTruth);
   }
 
   // LCM -> ROS: the Exporter, as bag-export uses it, publishing on topics.

@@ -29,6 +29,8 @@ int run(Options& o) {
             << "), IMU samples " << c.imu_samples << " (axes " << c.imu_axes << "), CameraInfo messages "
             << c.camera_infos << " (" << c.camera_info_changes << " unlike the first), bad messages dropped "
             << s.ros_messages_rejected << "\n";
+  std::cout << "ground truth: " << s.ground_truth_poses << " poses (" << s.ground_truth << "); tf transforms "
+            << s.tf_transforms << "\n";
   std::cout << "LCM -> ROS:";
   for (const auto& [topic, n] : s.exported.messages) std::cout << " " << topic << " " << n << ";";
   std::cout << " messages " << s.exported.total() << "\n";
@@ -46,6 +48,12 @@ int main(int argc, char** argv) {
   auto& e = b.exporter;
   o.camera.add_to(app, b.camera);
   app.add_flag("!--no-export", b.to_ros, "Do not publish kestrel's output on ROS topics");
+  app.add_option("--tf-topic", b.tf_topic,
+                 "tf2_msgs/TFMessage (and <topic>_static): the IMU's mount, the ground truth; \"\" = none")
+      ->capture_default_str();
+  app.add_option("--mocap-world-frame", b.mocap_world_frame, "Ground truth: the world frame (tf)")->capture_default_str();
+  app.add_option("--mocap-frame", b.mocap_frame, "Ground truth: the frame whose pose is the truth (tf)")
+      ->capture_default_str();
   app.add_option("--world-frame", e.world_frame, "tf frame of the estimator's world (STATE's)")->capture_default_str();
   app.add_option("--body-frame", e.body_frame, "tf frame of the vehicle body")->capture_default_str();
   app.add_option("--camera-frame", e.camera_frame, "tf frame of the RGB camera (optical)")->capture_default_str();

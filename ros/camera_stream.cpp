@@ -6,8 +6,13 @@
 
 namespace kestrel::ros1 {
 
-CameraStream::CameraStream(CameraTopicOptions options, std::string source, Publish publish)
-    : o_(std::move(options)), source_(std::move(source)), publish_(std::move(publish)) {}
+CameraStream::CameraStream(CameraTopicOptions options, std::string source, Publish publish, const TfTree* tree,
+                           std::string tf_topic)
+    : o_(std::move(options)),
+      source_(std::move(source)),
+      publish_(std::move(publish)),
+      tree_(tree),
+      tf_topic_(std::move(tf_topic)) {}
 
 std::string CameraStream::at(const std::string& topic, const ros::Time& stamp) const {
   return source_ + ": " + topic + " at " + format_seconds(to_utime(stamp)) + " s";
@@ -51,7 +56,10 @@ void CameraStream::colour(const sensor_msgs::Image& image) {
     return;
   }
   cv::Mat rgb = colour_to_rgb(image, what);
-  if (colour_frame_.empty()) colour_frame_ = frame_name(image.header.frame_id);
+  if (colour_frame_.empty()) {
+    colour_frame_ = frame_name(image.header.frame_id);
+    release_imu(false);
+  }
   if (!camera_ && o_.intrinsics) camera_ = intrinsics_camera(*o_.intrinsics, rgb.cols, rgb.rows);
   last_colour_utime_ = utime;
   pending_colour_.push_back({utime, static_cast<int64_t>(stats_.colour_images++), std::move(rgb)});
@@ -104,12 +112,47 @@ void CameraStream::imu(const sensor_msgs::Imu& message) {
     ++stats_.out_of_order;
     return;
   }
-  const std::string frame = frame_name(message.header.frame_id);
-  if (stats_.imu_samples == 0 && !frame.empty() && !colour_frame_.empty() && frame != colour_frame_)
-    stats_.imu_axes = "as published: '" + frame + "', not the images' '" + colour_frame_ + "' (the bridge reads no tf)";
   last_imu_utime_ = r.utime;
-  publish_(channel::kImu, r.utime, imu_message(r, imu_seq_++));
-  ++stats_.imu_samples;
+  pending_imu_.push_back({r, frame_name(message.header.frame_id)});
+  while (pending_imu_.size() > kMaxPendingImu) {
+    pending_imu_.pop_front();
+    ++stats_.imu_unaxed;
+  }
+  release_imu(false);
+}
+
+void CameraStream::release_imu(bool now) {
+  if (pending_imu_.empty()) return;
+  if (!imu_axes_decided_) {
+    const std::string& frame = pending_imu_.front().frame;
+    const int64_t first_utime = pending_imu_.front().reading.utime;
+    if (!tree_ || frame.empty() || frame == colour_frame_) {
+      stats_.imu_axes = "as published";
+      if (!tree_ && !frame.empty()) stats_.imu_axes += " ('" + frame + "'; no tf read)";
+    } else if (colour_frame_.empty() && !now) {
+      return;  // the images' frame comes with the first colour image
+    } else if (const auto R = colour_frame_.empty() ? std::nullopt : tree_->rotation(colour_frame_, frame, first_utime)) {
+      R_camera_imu_ = R;
+      stats_.imu_axes = "rotated from '" + frame + "' to '" + colour_frame_ + "' by " + tf_topic_;
+    } else if (!now && pending_imu_.back().reading.utime - first_utime < kImuMountWaitUs) {
+      return;  // the mount may come yet (a tf_static published late)
+    } else {
+      stats_.imu_axes = "as published: '" + frame + "' is not joined to the images' '" +
+                        (colour_frame_.empty() ? std::string("(no colour image yet)") : colour_frame_) + "' on " +
+                        tf_topic_;
+    }
+    imu_axes_decided_ = true;
+  }
+  for (PendingImu& p : pending_imu_) {
+    ImuReading& r = p.reading;
+    if (R_camera_imu_) {
+      r.angular_velocity = *R_camera_imu_ * r.angular_velocity;
+      r.linear_acceleration = *R_camera_imu_ * r.linear_acceleration;
+    }
+    publish_(channel::kImu, r.utime, imu_message(r, imu_seq_++));
+    ++stats_.imu_samples;
+  }
+  pending_imu_.clear();
 }
 
 void CameraStream::decide() {
@@ -135,6 +178,7 @@ void CameraStream::decide() {
 }
 
 void CameraStream::flush() {
+  release_imu(true);
   if (!camera_) return;
   while (!pending_colour_.empty()) decide_front();
 }

@@ -18,9 +18,12 @@
 // the end of a bag.
 //
 // seq counts the colour images accepted, from 0: bag-import's index in stamp order when the
-// bridge hears the whole recording. IMU samples go out at once, in the axes their message has
-// (bag-import rotates them by the bag's tf; the bridge reads no tf: the summary says so when
-// the Imu's frame is not the images').
+// bridge hears the whole recording. IMU samples are turned into the colour images' axes (the
+// body's) as bag-import turns them: by the tf tree's mount when the Imu's frame is another one
+// the tree joins to the images' (no lever arm), else as published. That is decided once, when
+// both frames are known; the samples before wait for it (at most kMaxPendingImu), and while the
+// tree does not join the frames they wait kImuMountWaitUs of IMU time for its mount to come
+// (a tf_static published late) before going out as published. Without a tree, as published.
 //
 // Errors: a message that cannot be converted (cut pixels, a non-finite IMU value) throws
 // InputError naming the topic and stamp and changes nothing; a stream that can never give a
@@ -42,6 +45,7 @@
 
 #include "common/error.h"
 #include "ros/camera_source.h"
+#include "ros/tf_tree.h"
 
 namespace kestrel::ros1 {
 
@@ -62,6 +66,7 @@ struct CameraStreamStats {
   size_t camera_info_changes = 0;  ///< CameraInfo messages unlike the first (the first is used)
   size_t imu_samples = 0;       ///< published
   size_t imu_empty = 0;         ///< Imu messages that measure nothing: skipped
+  size_t imu_unaxed = 0;        ///< dropped while waiting for their axes beyond kMaxPendingImu
   std::string imu_axes = "as published";
 };
 
@@ -69,19 +74,25 @@ class CameraStream {
  public:
   using Publish = std::function<void(const std::string& channel, int64_t utime, const std::vector<uint8_t>& bytes)>;
   static constexpr size_t kMaxPending = 30;
+  static constexpr size_t kMaxPendingImu = 400;        ///< 2 s of a 200 Hz IMU
+  static constexpr int64_t kImuMountWaitUs = 1'000'000;
 
-  /// `source` names the stream in errors ("ros-bridge").
-  CameraStream(CameraTopicOptions options, std::string source, Publish publish);
+  /// `source` names the stream in errors ("ros-bridge"). `tree` (kept by the owner, fed with
+  /// `tf_topic`) gives the IMU's mount; null: IMU samples as published.
+  CameraStream(CameraTopicOptions options, std::string source, Publish publish, const TfTree* tree = nullptr,
+               std::string tf_topic = "");
 
   void colour(const sensor_msgs::Image& image);
   void depth(const sensor_msgs::Image& image);
   void camera_info(const sensor_msgs::CameraInfo& info);
   void imu(const sensor_msgs::Imu& imu);
 
-  /// Decides every colour image still waiting (given a camera) with the depth images held.
+  /// Decides every colour image still waiting (given a camera) with the depth images held,
+  /// and the IMU's axes with what is known.
   void flush();
-  /// True while colour images wait for a depth image or the first CameraInfo.
-  bool waiting() const { return !pending_colour_.empty(); }
+  /// True while colour images wait for a depth image or the first CameraInfo, or IMU samples
+  /// for their axes.
+  bool waiting() const { return !pending_colour_.empty() || !pending_imu_.empty(); }
 
   const CameraStreamStats& stats() const { return stats_; }
   /// The frames' camera, once known.
@@ -97,6 +108,9 @@ class CameraStream {
   void check_size(const sensor_msgs::Image& image, bool depth, const std::string& what);
   void decide();
   void decide_front();
+  // Decides the IMU's axes when it can (`now`: with what is known) and publishes the samples
+  // that waited for them.
+  void release_imu(bool now);
 
   CameraTopicOptions o_;
   std::string source_;
@@ -109,6 +123,15 @@ class CameraStream {
   std::deque<Stamped> depth_;           // increasing utime
   std::optional<int64_t> last_colour_utime_, last_imu_utime_;
   int64_t imu_seq_ = 0;
+  const TfTree* tree_;
+  std::string tf_topic_;
+  struct PendingImu {
+    ImuReading reading;
+    std::string frame;
+  };
+  std::deque<PendingImu> pending_imu_;  // waiting for their axes
+  bool imu_axes_decided_ = false;
+  std::optional<Eigen::Matrix3d> R_camera_imu_;  // once decided: the mount's rotation, or none (as published)
 };
 
 }  // namespace kestrel::ros1

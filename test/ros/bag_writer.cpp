@@ -15,9 +15,6 @@
 #include "ros/ros_convert.h"
 
 namespace kestrel::test {
-namespace {
-
-namespace fs = std::filesystem;
 
 geometry_msgs::TransformStamped transform(int64_t utime, const std::string& parent, const std::string& child,
                                           const Eigen::Isometry3d& T) {
@@ -36,7 +33,7 @@ geometry_msgs::TransformStamped transform(int64_t utime, const std::string& pare
   return t;
 }
 
-}  // namespace
+namespace fs = std::filesystem;
 
 Eigen::Isometry3d tum_bag_mount() {
   Eigen::Isometry3d M = Eigen::Isometry3d::Identity();

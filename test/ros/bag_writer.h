@@ -8,6 +8,7 @@
 
 #include <Eigen/Geometry>
 
+#include <geometry_msgs/TransformStamped.h>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
 #include <sensor_msgs/Imu.h>
@@ -48,5 +49,8 @@ sensor_msgs::Image depth_image_mm(int64_t utime, int w, int h, uint16_t mm);
 sensor_msgs::CameraInfo camera_info(int64_t utime, int w, int h, double fx, double fy);
 /// An accelerometer-only Imu message.
 sensor_msgs::Imu accel_sample(int64_t utime, const Eigen::Vector3d& accel);
+/// The transform of `child` in `parent` (T_parent_child) at `utime`, as tf publishes it.
+geometry_msgs::TransformStamped transform(int64_t utime, const std::string& parent, const std::string& child,
+                                          const Eigen::Isometry3d& T);
 
 }  // namespace kestrel::test

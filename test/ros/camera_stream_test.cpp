@@ -12,6 +12,9 @@
 #include "common/transport/channels.h"
 #include "ros/bag_import.h"
 #include "ros/camera_stream.h"
+#include "common/transport/message.h"
+#include "kestrel/imu_t.hpp"
+#include "ros/tf_tree.h"
 #include "test/ros/bag_writer.h"
 #include "test/support/test_support.h"
 
@@ -114,6 +117,99 @@ TEST(CameraStream, FramesAreBagImportsByteForByteWhateverTheTopicsInterleaving) 
       EXPECT_EQ(stats.unmatched_colour, 1u);
       EXPECT_EQ(stats.camera_infos, 1u);
     }
+}
+
+// The hand-made stream with its colour images in a RealSense's optical frame and the IMU in
+// the IMU's; both hang from camera_link (the camera turned 90 degrees about z), as a driver's
+// /tf_static says.
+Stream mounted_stream() {
+  Stream s = hand_made_stream();
+  for (auto& c : s.colour) c.header.frame_id = "camera_color_optical_frame";
+  for (auto& m : s.imu) m.header.frame_id = "camera_imu_optical_frame";
+  return s;
+}
+tf2_msgs::TFMessage realsense_mounts() {
+  Eigen::Isometry3d optical = Eigen::Isometry3d::Identity(), imu = Eigen::Isometry3d::Identity();
+  optical.translation() = Eigen::Vector3d(0.01, 0, 0);
+  optical.linear() = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  imu.translation() = Eigen::Vector3d(0, 0.02, 0);
+  tf2_msgs::TFMessage m;
+  m.transforms.push_back(test::transform(0, "camera_link", "camera_color_optical_frame", optical));
+  m.transforms.push_back(test::transform(0, "camera_link", "camera_imu_optical_frame", imu));
+  return m;
+}
+
+TEST(CameraStream, ImuSamplesTakeTheImagesAxesByTheTreesMountAsBagImportTurnsThem) {
+  const Stream s = mounted_stream();
+  test::TempDir dir;
+  {
+    rosbag::Bag bag((dir / "a.bag").string(), rosbag::bagmode::Write);
+    for (size_t i = 0; i < s.colour.size(); ++i) {
+      bag.write("/camera/rgb/image_color", s.colour[i].header.stamp, s.colour[i]);
+      bag.write("/camera/rgb/camera_info", s.info[i].header.stamp, s.info[i]);
+    }
+    for (const auto& d : s.depth) bag.write("/camera/depth/image", d.header.stamp, d);
+    for (const auto& m : s.imu) bag.write("/imu", m.header.stamp, m);
+    bag.write("/tf_static", ros::Time(1), realsense_mounts());
+  }
+  std::vector<Published> want;
+  ros1::ImportSink sink;
+  sink.publish = [&](const std::string& c, int64_t u, const std::vector<uint8_t>& b) { want.push_back({c, u, b}); };
+  ros1::BagImportStats imported;
+  imported = ros1::import_bag((dir / "a.bag").string(), ros1::BagImportOptions{}, sink);
+  ASSERT_EQ(imported.imu_axes, "rotated from 'camera_imu_optical_frame' to 'camera_color_optical_frame' by /tf");
+
+  // Live: the mounts come first (latched), the IMU before any colour image waits for the
+  // images' frame, and goes out rotated with the first colour image.
+  ros1::TfTree tree;
+  tree.add(realsense_mounts(), "test: /tf_static");
+  std::vector<Published> out;
+  ros1::CameraStream stream(
+      ros1::CameraTopicOptions{}, "ros-bridge",
+      [&](const std::string& c, int64_t u, const std::vector<uint8_t>& b) { out.push_back({c, u, b}); }, &tree, "/tf");
+  for (size_t i = 0; i < 5; ++i) stream.imu(s.imu[i]);
+  EXPECT_TRUE(out.empty());
+  EXPECT_TRUE(stream.waiting());
+  stream.camera_info(s.info[0]);
+  stream.colour(s.colour[0]);
+  EXPECT_EQ(only(out, channel::kImu).size(), 5u);
+  for (size_t i = 5; i < s.imu.size(); ++i) stream.imu(s.imu[i]);
+  EXPECT_EQ(stream.stats().imu_axes, imported.imu_axes);
+  EXPECT_TRUE(only(out, channel::kImu) == only(want, channel::kImu)) << "the IMU samples are bag-import's, byte for byte";
+}
+
+TEST(CameraStream, ImuSamplesTheTreeDoesNotJoinToTheImagesGoOutAsPublishedAfterASecond) {
+  Stream s = mounted_stream();
+  for (size_t i = 0; i < s.imu.size(); ++i) s.imu[i].header.stamp = ros1::to_ros_time(kStreamT0 + 100'000 * static_cast<int64_t>(i));
+  ros1::TfTree tree;  // no mounts
+  std::vector<Published> out;
+  ros1::CameraStream stream(
+      ros1::CameraTopicOptions{}, "ros-bridge",
+      [&](const std::string& c, int64_t u, const std::vector<uint8_t>& b) { out.push_back({c, u, b}); }, &tree, "/tf");
+  stream.colour(s.colour[0]);
+  for (size_t i = 0; i < 10; ++i) stream.imu(s.imu[i]);  // 0.9 s of IMU time: the mount may come yet
+  EXPECT_TRUE(out.empty());
+  stream.imu(s.imu[10]);  // 1 s
+  const auto imu = only(out, channel::kImu);
+  ASSERT_EQ(imu.size(), 11u);
+  const auto first = transport::decode_message<imu_t>(imu[0].bytes.data(), imu[0].bytes.size(), "IMU");
+  EXPECT_EQ(first.linear_acceleration[1], 9.8) << "as published";
+  EXPECT_EQ(stream.stats().imu_axes,
+            "as published: 'camera_imu_optical_frame' is not joined to the images' 'camera_color_optical_frame' on /tf");
+  // A camera gone quiet releases what waits; without a tree, nothing waits.
+  ros1::CameraStream no_tree(ros1::CameraTopicOptions{}, "ros-bridge",
+                             [&](const std::string& c, int64_t u, const std::vector<uint8_t>& b) { out.push_back({c, u, b}); });
+  no_tree.imu(s.imu[0]);
+  EXPECT_FALSE(no_tree.waiting());
+  EXPECT_EQ(no_tree.stats().imu_axes, "as published ('camera_imu_optical_frame'; no tf read)");
+  ros1::CameraStream quiet(ros1::CameraTopicOptions{}, "ros-bridge",
+                           [&](const std::string& c, int64_t u, const std::vector<uint8_t>& b) { out.push_back({c, u, b}); },
+                           &tree, "/tf");
+  quiet.imu(s.imu[0]);
+  EXPECT_TRUE(quiet.waiting());
+  quiet.flush();
+  EXPECT_FALSE(quiet.waiting());
+  EXPECT_EQ(quiet.stats().imu_samples, 1u);
 }
 
 TEST(CameraStream, AColourImageWaitsForADepthImageAfterIt) {

@@ -2,8 +2,9 @@
 // namespace, the first 2 s of fr1_xyz written as a bag by librosbag (as TUM publishes its bags)
 // and played by `rosbag play` into the bridge, the VO and the estimator on the bridge's LCM
 // side, and this test as a ROS node on /kestrel/odom. Known answers:
-//  * every CAMERA_RGBD and IMU message the bridge publishes is bag-import's of the same bag,
-//    byte for byte and in the same order (same conversions, same pairing);
+//  * every CAMERA_RGBD, IMU and GROUND_TRUTH message the bridge publishes is bag-import's of
+//    the same bag, byte for byte and in the same order (same conversions, same pairing, the
+//    mocap's chain on /tf composed by the same tree);
 //  * the estimator's STATE, one per frame, and /kestrel/odom on ROS carry the same poses: one
 //    Odometry per STATE, same stamp, position and rotation to 1e-9.
 
@@ -65,11 +66,13 @@ TEST(RosBridgeData, Fr1XyzPlayedIntoTheBridgeGivesImportsFramesAndTheStateOnBoth
   ASSERT_EQ(imported.exit_code, 0) << imported.err;
   const auto want_frames = log_payloads(dir / "xyz.lcmlog", channel::kCameraRgbd);
   const auto want_imu = log_payloads(dir / "xyz.lcmlog", channel::kImu);
+  const auto want_truth = log_payloads(dir / "xyz.lcmlog", channel::kGroundTruth);
+  ASSERT_GE(want_truth.size(), 200u);
   ASSERT_GE(want_frames.size(), 58u);
 
   test::use_ros_master(dir.path());
   test::LiveSystem::Options heard;
-  heard.channels = {channel::kCameraRgbd, channel::kImu, channel::kState};
+  heard.channels = {channel::kCameraRgbd, channel::kImu, channel::kState, channel::kGroundTruth};
   test::LiveSystem system(dir.path(), heard);
   ASSERT_TRUE(test::start_roscore(system));
   std::vector<std::string> bridge = {test::tool("ros-bridge").string()};
@@ -107,9 +110,10 @@ TEST(RosBridgeData, Fr1XyzPlayedIntoTheBridgeGivesImportsFramesAndTheStateOnBoth
     for (int i = 0; i < 400 && sub.getNumPublishers() == 0; ++i) ros::WallDuration(0.05).sleep();
     ASSERT_EQ(sub.getNumPublishers(), 1u) << "/kestrel/odom not connected to the bridge";
 
-    // The camera's topics (the bridge reads no /tf, and --wait-for-subscribers waits on each).
+    // The camera's topics and the mocap's /tf (--wait-for-subscribers waits on each).
     ASSERT_EQ(system.run("play", {"rosbag", "play", "-q", "--wait-for-subscribers", bag.string(), "--topics",
-                                  "/camera/rgb/image_color", "/camera/depth/image", "/camera/rgb/camera_info", "/imu"},
+                                  "/camera/rgb/image_color", "/camera/depth/image", "/camera/rgb/camera_info", "/imu",
+                                  "/tf"},
                          40.0),
               0)
         << system.output("play");
@@ -148,6 +152,8 @@ TEST(RosBridgeData, Fr1XyzPlayedIntoTheBridgeGivesImportsFramesAndTheStateOnBoth
       << " imported\n" << system.output("bridge");
   EXPECT_TRUE(payloads(system.messages(channel::kImu)) == want_imu)
       << system.messages(channel::kImu).size() << " IMU from the bridge, " << want_imu.size() << " imported";
+  EXPECT_TRUE(payloads(system.messages(channel::kGroundTruth)) == want_truth)
+      << system.messages(channel::kGroundTruth).size() << " truths from the bridge, " << want_truth.size() << " imported";
 
   // One STATE per frame (the visual-only estimator: the accelerometer alone), and each is an
   // Odometry on /kestrel/odom.
