@@ -147,20 +147,12 @@ BridgeSummary run_bridge(const BridgeOptions& o) {
     // chain's busiest edge, in stamp order. (The handlers below outlive this block: what they
     // hold by reference lives as long as the loop.)
     const std::string world = frame_name(o.mocap_world_frame), truth = frame_name(o.mocap_frame);
-    const auto publish_truth = [&, world, truth](const std::vector<std::pair<std::string, int64_t>>& took) {
-      std::string why;
-      const std::vector<std::string> chain = tree.chain(world, truth, why);
-      if (chain.empty()) {
-        summary.ground_truth = "none: " + why + " on " + o.tf_topic;
-        return;
-      }
-      const std::string driving = tree.busiest(chain);
-      for (const auto& [child, utime] : took) {
-        if (child != driving || utime <= last_truth_utime) continue;
-        node.publish_bytes(channel::kGroundTruth, ground_truth_message(utime, tree.along(chain, utime)));
-        last_truth_utime = utime;
+    const auto publish_truth = [&, world, truth](const std::vector<std::pair<std::string, int64_t>>& taken) {
+      for (const TimedPose& p : tree.poses_at(taken, world, truth, o.tf_topic, summary.ground_truth)) {
+        if (p.utime <= last_truth_utime) continue;  // in stamp order: a late one is dropped
+        node.publish_bytes(channel::kGroundTruth, ground_truth_message(p.utime, p.T));
+        last_truth_utime = p.utime;
         ++summary.ground_truth_poses;
-        summary.ground_truth = o.tf_topic + ": " + tree.path(chain);
       }
     };
     const std::string self = ros::this_node::getName();

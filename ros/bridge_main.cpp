@@ -26,7 +26,8 @@ int run(Options& o) {
   std::cout << "ROS -> LCM: frames " << c.frames << " (colour images " << c.colour_images << ", depth images "
             << c.depth_images << ", colour without depth within the tolerance " << c.unmatched_colour
             << ", dropped before a CameraInfo " << c.without_camera << ", out of order " << c.out_of_order
-            << "), IMU samples " << c.imu_samples << " (axes " << c.imu_axes << "), CameraInfo messages "
+            << "), IMU samples " << c.imu_samples << " (axes " << c.imu_axes << "; dropped before the first colour image "
+            << c.imu_dropped_awaiting_axes << "), CameraInfo messages "
             << c.camera_infos << " (" << c.camera_info_changes << " unlike the first), bad messages dropped "
             << s.ros_messages_rejected << "\n";
   std::cout << "ground truth: " << s.ground_truth_poses << " poses (" << s.ground_truth << "); tf transforms "

@@ -114,11 +114,13 @@ void CameraStream::imu(const sensor_msgs::Imu& message) {
   }
   last_imu_utime_ = r.utime;
   pending_imu_.push_back({r, frame_name(message.header.frame_id)});
-  while (pending_imu_.size() > kMaxPendingImu) {
-    pending_imu_.pop_front();
-    ++stats_.imu_unaxed;
+  if (colour_frame_.empty()) {
+    while (pending_imu_.size() > kMaxPendingImu) {
+      pending_imu_.pop_front();
+      ++stats_.imu_dropped_awaiting_axes;
+    }
   }
-  release_imu(false);
+  release_imu(pending_imu_.size() >= kMaxPendingImu && !colour_frame_.empty());
 }
 
 void CameraStream::release_imu(bool now) {
@@ -134,8 +136,10 @@ void CameraStream::release_imu(bool now) {
     } else if (const auto R = colour_frame_.empty() ? std::nullopt : tree_->rotation(colour_frame_, frame, first_utime)) {
       R_camera_imu_ = R;
       stats_.imu_axes = "rotated from '" + frame + "' to '" + colour_frame_ + "' by " + tf_topic_;
-    } else if (!now && pending_imu_.back().reading.utime - first_utime < kImuMountWaitUs) {
-      return;  // the mount may come yet (a tf_static published late)
+    } else if (!now && (!mount_wait_from_ || pending_imu_.back().reading.utime - *mount_wait_from_ < kImuMountWaitUs)) {
+      // The mount may come yet (a tf_static published late).
+      if (!mount_wait_from_) mount_wait_from_ = pending_imu_.back().reading.utime;
+      return;
     } else {
       stats_.imu_axes = "as published: '" + frame + "' is not joined to the images' '" +
                         (colour_frame_.empty() ? std::string("(no colour image yet)") : colour_frame_) + "' on " +
@@ -143,16 +147,17 @@ void CameraStream::release_imu(bool now) {
     }
     imu_axes_decided_ = true;
   }
-  for (PendingImu& p : pending_imu_) {
-    ImuReading& r = p.reading;
+  while (!pending_imu_.empty()) {
+    ImuReading r = pending_imu_.front().reading;
     if (R_camera_imu_) {
       r.angular_velocity = *R_camera_imu_ * r.angular_velocity;
       r.linear_acceleration = *R_camera_imu_ * r.linear_acceleration;
     }
-    publish_(channel::kImu, r.utime, imu_message(r, imu_seq_++));
+    publish_(channel::kImu, r.utime, imu_message(r, imu_seq_));
+    ++imu_seq_;
     ++stats_.imu_samples;
+    pending_imu_.pop_front();
   }
-  pending_imu_.clear();
 }
 
 void CameraStream::decide() {

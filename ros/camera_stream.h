@@ -21,9 +21,10 @@
 // bridge hears the whole recording. IMU samples are turned into the colour images' axes (the
 // body's) as bag-import turns them: by the tf tree's mount when the Imu's frame is another one
 // the tree joins to the images' (no lever arm), else as published. That is decided once, when
-// both frames are known; the samples before wait for it (at most kMaxPendingImu), and while the
-// tree does not join the frames they wait kImuMountWaitUs of IMU time for its mount to come
-// (a tf_static published late) before going out as published. Without a tree, as published.
+// both frames are known: before the first colour image the samples wait (the oldest dropped
+// beyond kMaxPendingImu, counted); then, while the tree does not join the frames, they wait
+// kImuMountWaitUs of IMU time (or until kMaxPendingImu wait) for its mount to come (a tf_static
+// published late) before going out as published. Without a tree, as published.
 //
 // Errors: a message that cannot be converted (cut pixels, a non-finite IMU value) throws
 // InputError naming the topic and stamp and changes nothing; a stream that can never give a
@@ -66,7 +67,7 @@ struct CameraStreamStats {
   size_t camera_info_changes = 0;  ///< CameraInfo messages unlike the first (the first is used)
   size_t imu_samples = 0;       ///< published
   size_t imu_empty = 0;         ///< Imu messages that measure nothing: skipped
-  size_t imu_unaxed = 0;        ///< dropped while waiting for their axes beyond kMaxPendingImu
+  size_t imu_dropped_awaiting_axes = 0;  ///< before the first colour image, beyond kMaxPendingImu
   std::string imu_axes = "as published";
 };
 
@@ -129,7 +130,8 @@ class CameraStream {
     ImuReading reading;
     std::string frame;
   };
-  std::deque<PendingImu> pending_imu_;  // waiting for their axes
+  std::deque<PendingImu> pending_imu_;       // waiting for their axes
+  std::optional<int64_t> mount_wait_from_;   // the IMU time the wait for the mount began
   bool imu_axes_decided_ = false;
   std::optional<Eigen::Matrix3d> R_camera_imu_;  // once decided: the mount's rotation, or none (as published)
 };

@@ -1,6 +1,7 @@
 #include "ros/tf_tree.h"
 
 #include <algorithm>
+#include <stdexcept>
 
 #include "common/time.h"
 #include "ros/ros_convert.h"
@@ -37,7 +38,7 @@ bool TfTree::add(const std::string& parent, const std::string& child, int64_t ut
     ++second_parents_;
     return false;
   }
-  ++edge.received;
+  ++edge.transforms_taken;
   // After the equal times: they keep the order they came in.
   const auto at = std::upper_bound(edge.samples.begin(), edge.samples.end(), utime,
                                    [](int64_t t, const TimedPose& p) { return t < p.utime; });
@@ -99,18 +100,26 @@ Eigen::Isometry3d TfTree::along(const std::vector<std::string>& chain, int64_t u
 }
 
 std::string TfTree::busiest(const std::vector<std::string>& chain) const {
+  if (chain.empty()) throw std::invalid_argument("TfTree::busiest: an empty chain");
   return *std::max_element(chain.begin(), chain.end(), [&](const std::string& a, const std::string& b) {
-    return edges_.at(a).received < edges_.at(b).received;
+    return edges_.at(a).transforms_taken < edges_.at(b).transforms_taken;
   });
+}
+
+std::vector<std::string> TfTree::truth_chain(const std::string& world, const std::string& frame,
+                                             const std::string& source, std::string& why) const {
+  std::vector<std::string> children = chain(world, frame, why);
+  if (children.empty())
+    why = "none: " + why + (frame == world ? "" : " on " + source + (edges_.empty() ? " (no transforms)" : ""));
+  else
+    why = source + ": " + path(children);
+  return children;
 }
 
 std::vector<TimedPose> TfTree::poses(const std::string& world, const std::string& frame, const std::string& source,
                                      std::string& why) const {
-  const std::vector<std::string> children = chain(world, frame, why);
-  if (children.empty()) {
-    why = "none: " + why + (frame == world ? "" : " on " + source + (edges_.empty() ? " (no transforms)" : ""));
-    return {};
-  }
+  const std::vector<std::string> children = truth_chain(world, frame, source, why);
+  if (children.empty()) return {};
   std::vector<TimedPose> out;
   const Edge& driving = edges_.at(busiest(children));
   out.reserve(driving.samples.size());
@@ -118,7 +127,18 @@ std::vector<TimedPose> TfTree::poses(const std::string& world, const std::string
     if (!out.empty() && out.back().utime == s.utime) continue;
     out.push_back({s.utime, along(children, s.utime)});
   }
-  why = source + ": " + path(children);
+  return out;
+}
+
+std::vector<TimedPose> TfTree::poses_at(const std::vector<std::pair<std::string, int64_t>>& taken,
+                                        const std::string& world, const std::string& frame, const std::string& source,
+                                        std::string& why) const {
+  const std::vector<std::string> children = truth_chain(world, frame, source, why);
+  if (children.empty()) return {};
+  const std::string driving = busiest(children);
+  std::vector<TimedPose> out;
+  for (const auto& [child, utime] : taken)
+    if (child == driving && (out.empty() || out.back().utime != utime)) out.push_back({utime, along(children, utime)});
   return out;
 }
 

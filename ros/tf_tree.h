@@ -55,7 +55,7 @@ class TfTree {
   /// The pose of the chain's first frame in its last parent at `utime` (chain from chain()).
   Eigen::Isometry3d along(const std::vector<std::string>& chain, int64_t utime) const;
   /// The child of the chain whose edge has taken the most transforms (all of them counted,
-  /// also those no longer kept): the motion capture's; the first such.
+  /// also those no longer kept): the motion capture's; the first such. The chain is not empty.
   std::string busiest(const std::vector<std::string>& chain) const;
   /// "world -> ... -> frame" for a chain from chain().
   std::string path(const std::vector<std::string>& chain) const;
@@ -63,6 +63,10 @@ class TfTree {
   /// which chain (`source` names the topic) or why there is none.
   std::vector<TimedPose> poses(const std::string& world, const std::string& frame, const std::string& source,
                                std::string& why) const;
+  /// Live: the same, at those of `taken` (add()'s answer: the transforms just added) that are
+  /// the busiest edge's so far. Before the chain is whole there is none.
+  std::vector<TimedPose> poses_at(const std::vector<std::pair<std::string, int64_t>>& taken, const std::string& world,
+                                  const std::string& frame, const std::string& source, std::string& why) const;
 
   bool empty() const { return edges_.empty(); }
   /// Transforms ignored because they gave a frame a second parent.
@@ -72,9 +76,12 @@ class TfTree {
   struct Edge {
     std::string parent;
     std::vector<TimedPose> samples;  // by time
-    int64_t received = 0;
+    int64_t transforms_taken = 0;    // all of them, also those no longer kept
   };
   const Eigen::Isometry3d& value_at(const Edge& edge, int64_t utime) const;
+  // chain() for poses() and poses_at(), `why` in their words when there is none.
+  std::vector<std::string> truth_chain(const std::string& world, const std::string& frame, const std::string& source,
+                                       std::string& why) const;
 
   int64_t keep_us_;
   std::map<std::string, Edge> edges_;  // by child

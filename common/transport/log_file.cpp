@@ -50,7 +50,7 @@ LogReader::LogReader(const std::string& path) : path_(path) {
 
 void LogReader::seek(int64_t offset) {
   if (offset < 0 || offset > file_size_) throw std::out_of_range(path_ + ": no event at byte " + std::to_string(offset));
-  if (file_) std::fseek(file_, offset, SEEK_SET);
+  std::fseek(file_, offset, SEEK_SET);
 }
 
 LogReader::~LogReader() {
@@ -83,7 +83,7 @@ std::optional<LogEvent> LogReader::next() {
     const size_t got = std::fread(header, 1, kHeaderSize, file_);
     auto damaged = [&](bool is_truncation) {
       // Read before (a rewind, a seek back): counted then.
-      const bool counted = offset < damage_counted_until_;
+      const bool counted = !damage_counted_.insert(offset).second;
       const int64_t skipped_before = skipped_bytes_;
       if (!counted && first_damage_offset_ < 0) first_damage_offset_ = offset;
       if (is_truncation) {
@@ -99,7 +99,6 @@ std::optional<LogEvent> LogReader::next() {
         resync();
         if (counted) skipped_bytes_ = skipped_before;
       }
-      damage_counted_until_ = std::max<int64_t>(damage_counted_until_, std::ftell(file_));
     };
     if (got < 4) {
       damaged(true);
@@ -148,7 +147,6 @@ std::optional<LogEvent> LogReader::next() {
       damaged(true);
       return std::nullopt;
     }
-    damage_counted_until_ = std::max(damage_counted_until_, end);
     return event;
   }
   return std::nullopt;

@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <memory>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -51,7 +52,7 @@ class LogReader {
  private:
   bool resync();
   std::string path_;
-  int64_t damage_counted_until_ = 0;  ///< damage before this offset was counted already
+  std::set<int64_t> damage_counted_;  ///< where the damage read so far starts: counted once
   std::FILE* file_ = nullptr;
   int64_t file_size_ = 0;
   int64_t corrupt_regions_ = 0;

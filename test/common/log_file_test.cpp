@@ -141,6 +141,14 @@ TEST(LogFile, ASeekToAnEventsOffsetReadsItAgainAndDamageIsCountedOnce) {
   EXPECT_EQ(read_seqs(r), (std::vector<int64_t>{9}));
   EXPECT_EQ(r.corrupt_regions(), 1);
   EXPECT_EQ(r.damage_report(), damage);
+  // Past the damage unread, then back over it: counted once all the same.
+  LogReader skipping(dir / "d.lcmlog");
+  skipping.seek(offsets[5]);
+  EXPECT_EQ(read_seqs(skipping), (std::vector<int64_t>{6, 7, 8, 9}));
+  EXPECT_EQ(skipping.corrupt_regions(), 0);
+  skipping.rewind();
+  EXPECT_EQ(read_seqs(skipping), (std::vector<int64_t>{0, 1, 2, 4, 5, 6, 7, 8, 9}));
+  EXPECT_EQ(skipping.damage_report(), damage);
   EXPECT_THROW(r.seek(-1), std::out_of_range);
   EXPECT_THROW(r.seek(static_cast<int64_t>(bytes.size()) + 1), std::out_of_range);
 }

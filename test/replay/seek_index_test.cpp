@@ -47,11 +47,11 @@ Moment seek(const SeekIndex& index, const std::vector<Event>& log, int64_t targe
   size_t from = 0;
   while (from < log.size() && log[from].offset < c.offset) ++from;
   EXPECT_TRUE(from == log.size() || log[from].offset == c.offset) << "a checkpoint at an event's offset";
-  return scan(log, from, c.last_of, target);
+  return scan(log, from, c.last_offset_of, target);
 }
 SeekIndex indexed(const std::vector<Event>& log, int64_t spacing_us) {
   SeekIndex index(spacing_us);
-  for (const Event& e : log) index.read(e.offset, e.timestamp, e.channel, e.replayed);
+  for (const Event& e : log) index.add_event(e.offset, e.timestamp, e.channel, e.replayed);
   return index;
 }
 
@@ -69,7 +69,7 @@ TEST(SeekIndex, ACheckpointEverySpacingOfLogTimeNamesEachChannelsLastEvent) {
   const Checkpoint& c = index.start_for(3'550'000);
   EXPECT_EQ(c.offset, 2100);
   EXPECT_EQ(c.latest_timestamp, 3'000'000);
-  EXPECT_EQ(c.last_of, (std::map<std::string, int64_t>{{"A", 2000}, {"B", 1900}}));
+  EXPECT_EQ(c.last_offset_of, (std::map<std::string, int64_t>{{"A", 2000}, {"B", 1900}}));
   // Before the first checkpoint after the start, and exactly at a checkpoint's latest event:
   // the one before it (the read from the start stops at that event).
   EXPECT_EQ(index.start_for(1'500'000).offset, 0);
@@ -103,11 +103,26 @@ TEST(SeekIndex, ASeekFromItsCheckpointFindsWhatAReadFromTheStartFinds) {
   }
 }
 
+TEST(SeekIndex, AnEventAddedAgainAndOnesNotReplayedMakeNoCheckpoint) {
+  SeekIndex index(1'000'000);
+  index.add_event(0, 0, "A", true);
+  index.add_event(100, 1'500'000, "A", true);
+  index.add_event(200, 2'000'000, "A", true);  // a checkpoint before it: 1.5 s since the first
+  ASSERT_EQ(index.size(), 2u);
+  // Read again (a seek in a pass that is not the first), then skipped channels far in time.
+  index.add_event(100, 9'000'000, "B", true);
+  index.add_event(300, 90'000'000, "SKIPPED", false);
+  index.add_event(400, 2'100'000, "A", true);
+  EXPECT_EQ(index.size(), 2u);
+  EXPECT_EQ(index.start_for(2'000'001).offset, 200);
+  EXPECT_EQ(index.start_for(2'000'001).last_offset_of, (std::map<std::string, int64_t>{{"A", 100}}));
+}
+
 TEST(SeekIndex, AnEmptyLogSeeksToItsStartAndASpacingMustBePositive) {
   const SeekIndex index(1'000'000);
   EXPECT_EQ(index.size(), 1u);
   EXPECT_EQ(index.start_for(123).offset, 0);
-  EXPECT_TRUE(index.start_for(123).last_of.empty());
+  EXPECT_TRUE(index.start_for(123).last_offset_of.empty());
   EXPECT_FALSE(index.first_timestamp().has_value());
   EXPECT_THROW(SeekIndex(0), std::invalid_argument);
   EXPECT_THROW(SeekIndex(-5), std::invalid_argument);

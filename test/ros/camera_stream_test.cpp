@@ -196,6 +196,21 @@ TEST(CameraStream, ImuSamplesTheTreeDoesNotJoinToTheImagesGoOutAsPublishedAfterA
   EXPECT_EQ(first.linear_acceleration[1], 9.8) << "as published";
   EXPECT_EQ(stream.stats().imu_axes,
             "as published: 'camera_imu_optical_frame' is not joined to the images' 'camera_color_optical_frame' on /tf");
+  // A 1 kHz IMU: 400 samples wait at most (0.4 s), then go out as published.
+  ros1::CameraStream fast(ros1::CameraTopicOptions{}, "ros-bridge",
+                          [&](const std::string& c, int64_t u, const std::vector<uint8_t>& b) { out.push_back({c, u, b}); },
+                          &tree, "/tf");
+  fast.colour(s.colour[0]);
+  for (int i = 0; i < 399; ++i) {
+    sensor_msgs::Imu m = s.imu[0];
+    m.header.stamp = ros1::to_ros_time(kStreamT0 + 1000 * i);
+    fast.imu(m);
+  }
+  EXPECT_EQ(fast.stats().imu_samples, 0u);
+  sensor_msgs::Imu last = s.imu[0];
+  last.header.stamp = ros1::to_ros_time(kStreamT0 + 399'000);
+  fast.imu(last);
+  EXPECT_EQ(fast.stats().imu_samples, 400u);
   // A camera gone quiet releases what waits; without a tree, nothing waits.
   ros1::CameraStream no_tree(ros1::CameraTopicOptions{}, "ros-bridge",
                              [&](const std::string& c, int64_t u, const std::vector<uint8_t>& b) { out.push_back({c, u, b}); });

@@ -98,6 +98,12 @@ LiveSystem::LiveSystem(std::filesystem::path dir, Options options)
     : dir_(std::move(dir)), options_(std::move(options)) {
   const std::string why = isolate();
   if (!why.empty()) throw std::runtime_error("LiveSystem without a private network: " + why);
+  std::vector<std::string> channels = options_.channels;
+  if (std::find(channels.begin(), channels.end(), channel::kProcessStatus) == channels.end())
+    channels.push_back(channel::kProcessStatus);
+  for (const auto& c : options_.recorded)
+    if (std::find(channels.begin(), channels.end(), c) == channels.end())
+      throw std::invalid_argument("LiveSystem: channel " + c + " is to be recorded but not subscribed to");
   std::filesystem::create_directories(dir_);
   listener_ = std::make_unique<Listener>(transport::resolve_lcm_url(""));
   if (!listener_->lcm.good()) throw std::runtime_error("LiveSystem: LCM did not start in the private network");
@@ -105,13 +111,7 @@ LiveSystem::LiveSystem(std::filesystem::path dir, Options options)
   if (!options_.record.empty()) {
     listener_->recording.emplace(options_.record.string());
     listener_->recorded = options_.recorded.empty() ? options_.channels : options_.recorded;
-    for (const auto& c : listener_->recorded)
-      if (std::find(options_.channels.begin(), options_.channels.end(), c) == options_.channels.end())
-        throw std::invalid_argument("LiveSystem: channel " + c + " is to be recorded but not subscribed to");
   }
-  std::vector<std::string> channels = options_.channels;
-  if (std::find(channels.begin(), channels.end(), channel::kProcessStatus) == channels.end())
-    channels.push_back(channel::kProcessStatus);
   for (const auto& c : channels) listener_->lcm.subscribe(c, &Listener::handle, listener_.get());
   listener_->thread = std::thread([this] { listen(); });
 }

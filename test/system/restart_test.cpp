@@ -555,13 +555,14 @@ TEST(System, APlannerKilledWhileTheVehicleHoversPlansAgainOnceRestarted) {
               ok_plans, sent.size(), repeats, truth->x(), truth->y(), truth->z(), state_error_m);
   EXPECT_GE(ok_plans, 1);
   EXPECT_GE(repeats, 1) << "the hover's map went out again\n" << test::read_file(dir / "mapper.log");
-  // goto's arrival is judged on STATE (--arrive-radius 0.1), so the vehicle really ends that
-  // close to the goal give or take the state's error (1-2 cm in 6 runs here). Once (CI, and 1
-  // in 6 here) it ended 15 cm off, arrived at 9.9 cm by its state, with STATE not recorded.
+  // goto's arrival is judged on STATE (--arrive-radius 0.1), and the follower holds the goal
+  // for the 2 s after it: in 6 runs here the vehicle really ended 2-7 cm from the goal, its
+  // STATE 1-2 cm from the truth. Once (in CI, and 1 in 6 here, STATE not recorded then) it
+  // ended 15 cm off, having arrived at 9.9 cm by its state: these bounds tell the two apart.
   const Eigen::Vector3d goal(9.5, 3.5, 1.3);
-  EXPECT_LT((state_end - goal).norm(), 0.10) << "where the vehicle ended by its STATE";
-  EXPECT_LT(state_error_m, 0.10) << "the STATE at the end, against the truth";
-  EXPECT_LT((truth_end - goal).norm(), 0.10 + state_error_m) << "where the vehicle really ended";
+  EXPECT_LT(state_error_m, 0.06) << "the STATE at the end, against the truth";
+  EXPECT_LT((truth_end - goal).norm(), 0.12) << "where the vehicle really ended (its STATE " << (state_end - goal).norm()
+                                             << " m from the goal)";
 }
 
 

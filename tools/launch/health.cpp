@@ -48,9 +48,13 @@ HealthBoard::Entry& HealthBoard::entry_of(pid_t pid, const std::string& name) {
   // the name it went by, or its launch name): another process with its pid would call itself
   // something else.
   auto it = std::find_if(entries_.begin(), entries_.end(), [&](const auto& kv) {
-    const Entry& e = kv.second;
-    return e.launched && e.pid == pid && (!e.ended || kv.first == name || (e.last && e.last->name == name));
+    return kv.second.launched && kv.second.pid == pid && !kv.second.ended;
   });
+  if (it == entries_.end())
+    it = std::find_if(entries_.begin(), entries_.end(), [&](const auto& kv) {
+      const Entry& e = kv.second;
+      return e.launched && e.pid == pid && e.ended && (kv.first == name || (e.last && e.last->name == name));
+    });
   if (it == entries_.end()) {
     const std::string key = name + " (not launched here)";
     if (!entries_.count(key)) order_.push_back(key);

@@ -50,15 +50,13 @@ uint64_t cap_us(double seconds) {
   return static_cast<uint64_t>(std::llround(std::min(seconds, 1e12) * 1e6));
 }
 
-// The first and last log time of the events the selection replays, and the seek index: one
-// pass over the log.
-std::optional<std::pair<int64_t, int64_t>> window_of(transport::LogReader& log, const SelectionOptions& selection,
-                                                     SeekIndex& index) {
-  EventFilter filter(selection, nullptr);
+// The first and last log time of the events `filter` replays, and the seek index: one pass
+// over the log, the filter seeing each event once.
+std::optional<std::pair<int64_t, int64_t>> window_of(transport::LogReader& log, EventFilter& filter, SeekIndex& index) {
   std::optional<std::pair<int64_t, int64_t>> window;
   while (auto event = log.next()) {
     const bool replayed = filter.accept(*event);
-    index.read(event->offset, event->timestamp, event->channel, replayed);
+    index.add_event(event->offset, event->timestamp, event->channel, replayed);
     if (!replayed) continue;
     if (!window) window = std::pair{event->timestamp, event->timestamp};
     window->first = std::min(window->first, event->timestamp);
@@ -144,8 +142,11 @@ ReplayReport replay_timed(transport::LogReader& log, const TimedOptions& o,
   report.mode = fmt::format("timed (speed {:g}{})", o.speed, o.control ? ", controlled" : "");
   std::optional<Transport> control;
   SeekIndex index;
+  // Under control the report's skip counts are the first pass's: a seek reads parts again.
+  std::optional<EventFilter> first_pass;
   if (o.control) {
-    const auto window = window_of(log, o.selection, index);
+    first_pass.emplace(o.selection, nullptr);
+    const auto window = window_of(log, *first_pass, index);
     if (!window) spdlog::warn("{}: no event to replay (--channels, --start, --duration): nothing to control", log.path());
     if (window) {
       control.emplace(lcm, std::filesystem::path(log.path()).filename().string(), *window);
@@ -196,9 +197,13 @@ ReplayReport replay_timed(transport::LogReader& log, const TimedOptions& o,
       const Checkpoint& from = index.start_for(*seek_to);
       filter = std::make_unique<EventFilter>(o.selection, nullptr, index.first_timestamp());
       std::map<std::string, transport::LogEvent> last_of;
-      for (const auto& [channel, offset] : from.last_of) {
+      for (const auto& [channel, offset] : from.last_offset_of) {
         log.seek(offset);
-        if (auto e = log.next()) last_of[channel] = std::move(*e);
+        auto e = log.next();
+        if (!e || e->offset != offset || e->channel != channel)
+          throw InputError(log.path() + ": changed while it was replayed (no " + channel + " event at byte " +
+                           std::to_string(offset) + " any more)");
+        last_of[channel] = std::move(*e);
       }
       log.seek(from.offset);
       std::optional<transport::LogEvent> next_event;
@@ -309,8 +314,9 @@ ReplayReport replay_timed(transport::LogReader& log, const TimedOptions& o,
   }
   report.interrupted = interrupted;
   report.wall_s = std::chrono::duration<double>(Clock::now() - wall_start).count();
-  report.skipped = filter->skipped_channels();
-  report.outside_window = filter->outside_window();
+  const EventFilter& counted = first_pass ? *first_pass : *filter;
+  report.skipped = counted.skipped_channels();
+  report.outside_window = counted.outside_window();
   report.damage = log.damage_report();
   return report;
 }
