@@ -82,13 +82,16 @@ bool run_update(const uint8_t* data, size_t size) {
   const uint8_t* m = data + 1;
   const size_t n = size - 1;
   return accepted([&] {
-    switch (data[0] % 7) {
+    switch (data[0] % 8) {
       case 0: st.on_state(decode_message<kestrel::state_t>(m, n, "STATE"), "STATE"); break;
       case 1: st.on_plan(decode_message<kestrel::plan_t>(m, n, "PLAN"), "PLAN"); break;
       case 2: st.on_graph(decode_message<kestrel::slam_graph_t>(m, n, "SLAM_GRAPH"), "SLAM_GRAPH"); break;
       case 3: st.on_truth(decode_message<kestrel::ground_truth_t>(m, n, "GROUND_TRUTH"), "GROUND_TRUTH"); break;
       case 4: st.on_map(decode_message<kestrel::octomap_t>(m, n, "MAP_OCTOMAP"), "MAP_OCTOMAP"); break;
       case 5: st.on_frame(decode_message<kestrel::rgbd_frame_t>(m, n, "CAMERA_RGBD"), "CAMERA_RGBD"); break;
+      case 7:
+        st.on_plan_covariance(decode_message<kestrel::plan_covariance_t>(m, n, "PLAN_COVARIANCE"), "PLAN_COVARIANCE");
+        break;
       default:
         st.on_playback(decode_message<kestrel::playback_status_t>(m, n, "PLAYBACK_STATUS"), "PLAYBACK_STATUS");
         break;
@@ -128,7 +131,13 @@ std::vector<Bytes> update_seeds() {
   r.utime = 6'000'000;
   r.speed = 1.0;
   r.log_name = "flight.lcmlog";
-  return {tagged(0, s), tagged(1, p), tagged(2, g), tagged(3, t), tagged(6, r)};
+  kestrel::plan_covariance_t c{};  // the plan's (utime and request id 0)
+  c.num_waypoints = 2;
+  c.covariance = {std::vector<double>(16, 0.0), std::vector<double>(16, 0.0)};
+  c.covariance[0][0] = c.covariance[0][5] = 0.01;
+  c.covariance[1][0] = 0.04;
+  c.covariance[1][5] = 0.01;
+  return {tagged(0, s), tagged(1, p), tagged(2, g), tagged(3, t), tagged(6, r), tagged(7, c)};
 }
 
 }  // namespace

@@ -58,6 +58,7 @@ int main(int argc, char** argv) {
     OnlinePlanner planner(o);
     transport::Node node("planner", lcm_url);
     node.advertise(channel::kPlan);
+    node.advertise(channel::kPlanCovariance);
     node.set_health(kestrel::process_status_t::STATE_DEGRADED, "no map yet");
     // The mapper sends its last map again while it has no new one (for a planner started since):
     // the one held already is not projected again.
@@ -91,7 +92,9 @@ int main(int argc, char** argv) {
       const auto t0 = std::chrono::steady_clock::now();
       const PlanAnswer a = planner.plan(q);
       const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-      node.publish(channel::kPlan, plan_message(r, a, ms));
+      const kestrel::plan_t plan = plan_message(r, a, ms);
+      node.publish(channel::kPlan, plan);
+      if (const auto covariance = plan_covariance_message(plan, a)) node.publish(channel::kPlanCovariance, *covariance);
     });
     node.on_reset([&] {
       planner.reset();

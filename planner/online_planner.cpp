@@ -128,6 +128,7 @@ PlanAnswer OnlinePlanner::plan(const PlanQuery& query) const {
     if (i > 0) sigma = propagate_ekf(sigma, model.steps(a.waypoints.back(), q));
     a.waypoints.push_back(q);
     a.traces.push_back(sigma.trace());
+    a.covariances.push_back(sigma);
   }
   return a;
 }

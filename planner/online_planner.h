@@ -58,6 +58,7 @@ struct PlanAnswer {
   std::string message;
   std::vector<Config> waypoints;
   std::vector<double> traces;  ///< predicted tr(Sigma) at each waypoint
+  std::vector<Mat4> covariances;  ///< the predicted Sigma at each waypoint (traces are theirs)
   double length_m = 0.0;
 };
 

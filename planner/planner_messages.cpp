@@ -1,5 +1,8 @@
 #include "planner/planner_messages.h"
 
+#include <utility>
+#include <vector>
+
 #include <octomap/OcTree.h>
 
 #include <Eigen/Geometry>
@@ -112,6 +115,21 @@ kestrel::plan_t plan_message(const kestrel::plan_request_t& r, const PlanAnswer&
   }
   out.length = a.length_m;
   out.planning_ms = planning_ms;
+  return out;
+}
+
+std::optional<kestrel::plan_covariance_t> plan_covariance_message(const kestrel::plan_t& plan, const PlanAnswer& a) {
+  if (a.covariances.empty() || a.covariances.size() != static_cast<size_t>(plan.num_waypoints)) return std::nullopt;
+  kestrel::plan_covariance_t out;
+  out.utime = plan.utime;
+  out.request_id = plan.request_id;
+  out.num_waypoints = plan.num_waypoints;
+  for (const Mat4& sigma : a.covariances) {
+    std::vector<double> row_major(16);
+    for (int r = 0; r < 4; ++r)
+      for (int c = 0; c < 4; ++c) row_major[static_cast<size_t>(4 * r + c)] = sigma(r, c);
+    out.covariance.push_back(std::move(row_major));
+  }
   return out;
 }
 

@@ -8,10 +8,12 @@
 // covariance trace is negative (or, as a bound, not positive), or its start mode, planner or
 // objective is none this version knows.
 
+#include <optional>
 #include <utility>
 
 #include "kestrel/octomap_t.hpp"
 #include "kestrel/plan_request_t.hpp"
+#include "kestrel/plan_covariance_t.hpp"
 #include "kestrel/plan_t.hpp"
 #include "kestrel/state_t.hpp"
 #include "planner/grid_environment.h"
@@ -36,5 +38,8 @@ OccupancyGrid map_from_message(const kestrel::octomap_t& m, double z_min, double
 
 /// The PLAN answering `r`.
 kestrel::plan_t plan_message(const kestrel::plan_request_t& r, const PlanAnswer& answer, double planning_ms);
+/// The PLAN_COVARIANCE that goes with `plan` (its utime, request_id and waypoints), from the
+/// answer it was made of; none when the answer has no covariances (no path).
+std::optional<kestrel::plan_covariance_t> plan_covariance_message(const kestrel::plan_t& plan, const PlanAnswer& answer);
 
 }  // namespace kestrel::planner

@@ -78,6 +78,8 @@ int serve(Options& o) {
   node.subscribe<ground_truth_t>(channel::kGroundTruth, [&](const ground_truth_t& m) { st.on_truth(m, channel::kGroundTruth); }, 30);
   node.subscribe<slam_graph_t>(channel::kSlamGraph, [&](const slam_graph_t& m) { st.on_graph(m, channel::kSlamGraph); }, 4);
   node.subscribe<plan_t>(channel::kPlan, [&](const plan_t& m) { st.on_plan(m, channel::kPlan); }, 8);
+  node.subscribe<plan_covariance_t>(channel::kPlanCovariance,
+                                    [&](const plan_covariance_t& m) { st.on_plan_covariance(m, channel::kPlanCovariance); }, 8);
   node.subscribe<octomap_t>(channel::kMapOctomap, [&](const octomap_t& m) { st.on_map(m, channel::kMapOctomap); }, 2);
   node.subscribe<rgbd_frame_t>(channel::kCameraRgbd, [&](const rgbd_frame_t& m) { st.on_frame(m, channel::kCameraRgbd); }, 2);
   node.subscribe<playback_status_t>(channel::kPlaybackStatus,

@@ -83,8 +83,21 @@ void Station::on_graph(const kestrel::slam_graph_t& m, const char* channel) {
   post_json("graph", graph_update(m, channel));
 }
 
+namespace {
+bool same_plan(const kestrel::plan_t& plan, const kestrel::plan_covariance_t& covariance) {
+  return plan.utime == covariance.utime && plan.request_id == covariance.request_id;
+}
+}  // namespace
+
 void Station::on_plan(const kestrel::plan_t& m, const char* channel) {
-  post_json("plan", plan_update(m, channel));
+  const bool matched = plan_covariance_ && same_plan(m, *plan_covariance_);
+  post_json("plan", plan_update(m, channel, matched ? &*plan_covariance_ : nullptr));
+  plan_ = m;
+}
+
+void Station::on_plan_covariance(const kestrel::plan_covariance_t& m, const char* channel) {
+  if (plan_ && same_plan(*plan_, m)) post_json("plan", plan_update(*plan_, channel, &m));
+  plan_covariance_ = m;
 }
 
 void Station::on_map(const kestrel::octomap_t& m, const char* channel) {
@@ -182,6 +195,8 @@ void Station::reset() {
   last_state_utime_.reset();
   last_path_utime_.reset();
   last_truth_utime_.reset();
+  plan_.reset();
+  plan_covariance_.reset();
   path_posted_ = truth_path_posted_ = -1;
   latest_utime_ = 0;
   post_json("path", path_.to_json("path"));

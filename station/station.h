@@ -68,6 +68,9 @@ class Station {
   void on_truth(const kestrel::ground_truth_t& m, const char* channel);
   void on_graph(const kestrel::slam_graph_t& m, const char* channel);
   void on_plan(const kestrel::plan_t& m, const char* channel);
+  /// The belief model's Sigma along a PLAN: the plan is drawn again with its ellipses once
+  /// both have come (either may come first; they are matched by utime and request_id).
+  void on_plan_covariance(const kestrel::plan_covariance_t& m, const char* channel);
   void on_map(const kestrel::octomap_t& m, const char* channel);
   void on_frame(const kestrel::rgbd_frame_t& m, const char* channel);
   void on_status(const kestrel::process_status_t& m, double now_s);
@@ -98,6 +101,8 @@ class Station {
   ChannelRates rates_;
   PreviewThinner previews_;
   std::optional<int64_t> last_state_utime_, last_path_utime_, last_truth_utime_;
+  std::optional<kestrel::plan_t> plan_;                        // the last PLAN
+  std::optional<kestrel::plan_covariance_t> plan_covariance_;  // the last PLAN_COVARIANCE
   int64_t path_posted_ = -1, truth_path_posted_ = -1;  ///< added() when last posted: unchanged paths are not sent again
   int64_t latest_utime_ = 0;  ///< newest sensor time seen, stamps what the station sends
   std::optional<kestrel::playback_status_t> playback_;  ///< the controlled replay's latest status

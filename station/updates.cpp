@@ -86,7 +86,7 @@ json graph_update(const kestrel::slam_graph_t& m, const char* channel) {
               {"odometry", std::move(odometry)}, {"loops", std::move(loops)}};
 }
 
-json plan_update(const kestrel::plan_t& m, const char* channel) {
+json plan_update(const kestrel::plan_t& m, const char* channel, const kestrel::plan_covariance_t* covariance) {
   const std::string where = std::string(channel) + ": plan " + std::to_string(m.request_id) + ": ";
   if (m.num_waypoints < 0 || static_cast<size_t>(m.num_waypoints) != m.waypoints.size() ||
       m.waypoints.size() != m.covariance_trace.size())
@@ -100,7 +100,7 @@ json plan_update(const kestrel::plan_t& m, const char* channel) {
     const double trace = m.covariance_trace[i];
     sigma.push_back(std::isfinite(trace) && trace >= 0.0 ? std::sqrt(trace / 4.0) : 0.0);
   }
-  return json{{"kind", "plan"},
+  json update{{"kind", "plan"},
               {"request_id", m.request_id},
               {"status", m.status},
               {"status_name", plan_status_name(m.status)},
@@ -108,6 +108,27 @@ json plan_update(const kestrel::plan_t& m, const char* channel) {
               {"length", std::isfinite(m.length) ? m.length : 0.0},
               {"waypoints", std::move(waypoints)},
               {"sigma", std::move(sigma)}};
+  if (!covariance) return update;
+  if (covariance->utime != m.utime || covariance->request_id != m.request_id)
+    throw InputError(where + "the covariance given is another plan's (" + std::to_string(covariance->request_id) + ")");
+  if (covariance->num_waypoints != m.num_waypoints ||
+      covariance->covariance.size() != static_cast<size_t>(std::max(covariance->num_waypoints, 0)))
+    throw InputError(where + "PLAN_COVARIANCE has " + std::to_string(covariance->num_waypoints) + " waypoints, the plan " +
+                     std::to_string(m.num_waypoints));
+  json ellipses = json::array();
+  for (size_t i = 0; i < covariance->covariance.size(); ++i) {
+    const auto& c = covariance->covariance[i];  // row-major 4 x 4; the horizontal block is c[0], c[1], c[5]
+    if (c.size() != 16) throw InputError(where + "covariance " + std::to_string(i) + " is not 4 x 4");
+    const double xx = c[0], xy = 0.5 * (c[1] + c[4]), yy = c[5];
+    if (!std::isfinite(xx) || !std::isfinite(xy) || !std::isfinite(yy))
+      throw InputError(where + "covariance " + std::to_string(i) + " is not finite");
+    // The eigen-decomposition of the symmetric 2 x 2 block, in closed form.
+    const double mean = 0.5 * (xx + yy), half_gap = std::hypot(0.5 * (xx - yy), xy);
+    const double major = std::sqrt(std::max(mean + half_gap, 0.0)), minor = std::sqrt(std::max(mean - half_gap, 0.0));
+    ellipses.push_back(json::array({major, minor, 0.5 * std::atan2(2.0 * xy, xx - yy)}));
+  }
+  update["ellipses"] = std::move(ellipses);
+  return update;
 }
 
 json playback_update(const kestrel::playback_status_t& m, const char* channel) {

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "kestrel/ground_truth_t.hpp"
+#include "kestrel/plan_covariance_t.hpp"
 #include "kestrel/plan_t.hpp"
 #include "kestrel/playback_status_t.hpp"
 #include "kestrel/process_status_t.hpp"
@@ -43,8 +44,12 @@ nlohmann::json graph_update(const kestrel::slam_graph_t& m, const char* channel)
 
 /// {"kind":"plan", request_id, status, status_name, message, length, waypoints:[[x,y,z,yaw]...],
 ///  sigma:[...]}: sigma_i = sqrt(tr(Sigma_i) / 4), the RMS 1-sigma over (x, y, z, yaw) that the
-/// planner's predicted trace gives (PLAN carries the trace only, not the full ellipse).
-nlohmann::json plan_update(const kestrel::plan_t& m, const char* channel);
+/// planner's predicted trace gives; with the plan's PLAN_COVARIANCE (same utime and request_id)
+/// also ellipses:[[a, b, angle]...]: the 1-sigma ellipse of each waypoint's horizontal position
+/// (semi-axes in m, a along `angle` rad from x). Throws InputError on arrays that disagree, a
+/// covariance of another plan, or one that is not finite.
+nlohmann::json plan_update(const kestrel::plan_t& m, const char* channel,
+                           const kestrel::plan_covariance_t* covariance = nullptr);
 
 /// {"kind":"playback", log, t, length, speed, paused, at_end, seeks}: where a controlled replay
 /// is (t and length in seconds from the log's start). Throws InputError on a window that ends

@@ -14,6 +14,7 @@ inline constexpr const char* kSlamSaveMap = "SLAM_SAVE_MAP";    // map_save_requ
 inline constexpr const char* kMapOctomap = "MAP_OCTOMAP";       // octomap_t
 inline constexpr const char* kPlanRequest = "PLAN_REQUEST";     // plan_request_t
 inline constexpr const char* kPlan = "PLAN";                    // plan_t
+inline constexpr const char* kPlanCovariance = "PLAN_COVARIANCE";  // plan_covariance_t
 inline constexpr const char* kVehicleCommand = "VEHICLE_COMMAND"; // vehicle_command_t
 inline constexpr const char* kProcessStatus = "PROCESS_STATUS"; // process_status_t
 inline constexpr const char* kProcessRejections = "PROCESS_REJECTIONS"; // rejection_counts_t

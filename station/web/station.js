@@ -307,11 +307,15 @@
         state.plan = u;
         setLine(planLine, u.waypoints);
         while (planDiscs.children.length) planDiscs.remove(planDiscs.children[0]);
+        // The belief model's 1-sigma horizontal ellipse at each waypoint when PLAN_COVARIANCE
+        // came with the plan, else a disc of the RMS sigma its trace gives.
         u.waypoints.forEach((w, i) => {
-          if (!(u.sigma[i] > 0)) return;
+          const e = u.ellipses ? u.ellipses[i] : [u.sigma[i], u.sigma[i], 0];
+          if (!(e[0] > 0)) return;
           const d = new THREE.Mesh(discGeometry, discMaterial);
           d.position.set(w[0], w[1], w[2]);
-          d.scale.setScalar(u.sigma[i]);
+          d.scale.set(e[0], Math.max(e[1], 1e-3), 1);
+          d.rotation.z = e[2];
           planDiscs.add(d);
         });
         $('planinfo').textContent = u.request_id < 0 ? 'plan: none' :

@@ -56,6 +56,13 @@ TEST(OnlinePlanner, PlansReproduciblyAndPredictsCovariances) {
   EXPECT_TRUE(a.waypoints.back().isApprox(q.goal));
   EXPECT_NEAR(a.traces.front(), 0.4, 1e-12);
   EXPECT_GE(a.length_m, (q.goal - *q.start).head<3>().norm());
+  // The covariance at each waypoint is the one whose trace PLAN carries: symmetric, positive.
+  ASSERT_EQ(a.covariances.size(), a.waypoints.size());
+  for (size_t i = 0; i < a.covariances.size(); ++i) {
+    EXPECT_EQ(a.covariances[i].trace(), a.traces[i]) << i;
+    EXPECT_TRUE(a.covariances[i].isApprox(a.covariances[i].transpose(), 1e-12)) << i;
+    EXPECT_GT(a.covariances[i].ldlt().vectorD().minCoeff(), 0.0) << i;
+  }
 }
 
 TEST(OnlinePlanner, CovarianceDominanceSearchesTheSameRoadmapExactlyOrWithinItsSlack) {

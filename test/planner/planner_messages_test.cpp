@@ -109,6 +109,31 @@ TEST(PlanRequestGate, ARefusedRequestIsAnsweredWithItsIdAndWhy) {
   EXPECT_EQ(p.num_waypoints, 0);
 }
 
+TEST(PlanCovariance, GoesWithItsPlanRowMajorAndOnlyWithAPath) {
+  R r = usable();
+  PlanAnswer a;
+  a.status = PlanAnswer::kOk;
+  a.waypoints = {Config(0, 0, 1, 0), Config(1, 0, 1, 0)};
+  a.traces = {0.1, 0.2};
+  Mat4 sigma = Mat4::Identity() * 0.05;
+  sigma(0, 1) = 0.01;  // x-y, row 0 column 1
+  sigma(1, 0) = 0.02;  // (not symmetric, so that the order shows)
+  a.covariances = {Mat4::Identity() * 0.025, sigma};
+  const kestrel::plan_t p = plan_message(r, a, 1.0);
+  const auto c = plan_covariance_message(p, a);
+  ASSERT_TRUE(c.has_value());
+  EXPECT_EQ(c->utime, p.utime);
+  EXPECT_EQ(c->request_id, p.request_id);
+  EXPECT_EQ(c->num_waypoints, 2);
+  ASSERT_EQ(c->covariance.size(), 2u);
+  EXPECT_EQ(c->covariance[1][1], 0.01);
+  EXPECT_EQ(c->covariance[1][4], 0.02);
+  EXPECT_EQ(c->covariance[1][15], 0.05);
+  PlanAnswer none;
+  none.status = PlanAnswer::kNoPath;
+  EXPECT_FALSE(plan_covariance_message(plan_message(r, none, 1.0), none).has_value());
+}
+
 TEST(StateForThePlanner, NonFiniteOrNonRigidStatesAreRefused) {
   kestrel::state_t s{};
   s.T_world_body.orientation[0] = 1.0;

@@ -12,6 +12,7 @@
 
 #include "common/error.h"
 #include "common/transport/channels.h"
+#include "kestrel/plan_covariance_t.hpp"
 #include "common/transport/log_file.h"
 #include "kestrel/octomap_t.hpp"
 #include "kestrel/plan_request_t.hpp"
@@ -156,6 +157,21 @@ TEST(PlannerProcess, AnswersEveryRequestOverLcmAndRepeatsAfterReset) {
     // Clear of the walls by the vehicle radius less the map's half-cell rounding.
     EXPECT_GT(check_path(p, 0.3 - 0.05), kGapY) << "plan " << k + 1 << " does not go through the gap";
     EXPECT_GE(p.length, 5.0);
+  }
+  // Each plan with a path is followed by its PLAN_COVARIANCE, whose traces are the plan's.
+  const auto covariances =
+      transport::read_messages<kestrel::plan_covariance_t>((dir / "a.lcmlog").string(), channel::kPlanCovariance);
+  ASSERT_EQ(covariances.size(), 3u);
+  for (size_t j = 0; j < covariances.size(); ++j) {
+    const kestrel::plan_t& p = a[std::vector<size_t>{1, 2, 5}[j]];
+    const kestrel::plan_covariance_t& c = covariances[j];
+    EXPECT_EQ(c.request_id, p.request_id);
+    EXPECT_EQ(c.utime, p.utime);
+    ASSERT_EQ(c.num_waypoints, p.num_waypoints);
+    for (int i = 0; i < c.num_waypoints; ++i) {
+      const auto& m = c.covariance[static_cast<size_t>(i)];
+      EXPECT_NEAR(m[0] + m[5] + m[10] + m[15], p.covariance_trace[static_cast<size_t>(i)], 1e-12) << i;
+    }
   }
   // A negative slack is refused on the command line.
   EXPECT_EQ(kestrel::test::run({planner, "--dominance-slack", "-0.1"}, 10.0).exit_code, kExitUsage);

@@ -142,6 +142,49 @@ TEST(StationStation, APathThatDidNotGrowIsNotSentAgain) {
   EXPECT_TRUE(has_kind(hub.take(*id), "path"));
 }
 
+// A PLAN and its PLAN_COVARIANCE, in either order: the plan is drawn at once, and again with
+// its ellipses once both are there; another plan's covariance changes nothing.
+TEST(StationStation, APlanIsDrawnWithItsEllipsesWhicheverComesFirst) {
+  kestrel::plan_t plan{};
+  plan.utime = 7;
+  plan.request_id = 3;
+  plan.num_waypoints = 1;
+  plan.waypoints = {{1, 2, 1, 0}};
+  plan.covariance_trace = {0.2};
+  kestrel::plan_covariance_t covariance{};
+  covariance.utime = 7;
+  covariance.request_id = 3;
+  covariance.num_waypoints = 1;
+  covariance.covariance = {{0.04, 0, 0, 0, 0, 0.01, 0, 0, 0, 0, 0.1, 0, 0, 0, 0, 0.05}};
+  const auto ellipses_in = [](const std::vector<Outgoing>& out) {
+    for (const Outgoing& m : out)
+      if (!m.binary && m.bytes.find("\"kind\":\"plan\"") != std::string::npos)
+        return m.bytes.find("\"ellipses\"") != std::string::npos ? 1 : 0;
+    return -1;  // no plan sent
+  };
+  for (const bool covariance_first : {false, true}) {
+    UpdateHub hub;
+    const auto id = hub.add_client({});
+    Station st({}, hub, 1);
+    hub.take(*id);
+    if (covariance_first) {
+      st.on_plan_covariance(covariance, "PLAN_COVARIANCE");
+      EXPECT_EQ(ellipses_in(hub.take(*id)), -1) << "no plan to draw yet";
+      st.on_plan(plan, "PLAN");
+      EXPECT_EQ(ellipses_in(hub.take(*id)), 1);
+    } else {
+      st.on_plan(plan, "PLAN");
+      EXPECT_EQ(ellipses_in(hub.take(*id)), 0);
+      kestrel::plan_covariance_t other = covariance;
+      other.request_id = 4;
+      st.on_plan_covariance(other, "PLAN_COVARIANCE");
+      EXPECT_EQ(ellipses_in(hub.take(*id)), -1);
+      st.on_plan_covariance(covariance, "PLAN_COVARIANCE");
+      EXPECT_EQ(ellipses_in(hub.take(*id)), 1);
+    }
+  }
+}
+
 // A controlled replay's transport: nothing is sent before the replay has said where it is, a
 // seek beyond its log is refused, and a new seek count forgets the flight drawn so far.
 TEST(StationStation, TheTransportBarDrivesAControlledReplayOnly) {

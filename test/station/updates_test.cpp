@@ -85,6 +85,44 @@ TEST(StationUpdates, APlanCarriesItsWaypointsAndTheSigmaOfItsTrace) {
   EXPECT_THROW(plan_update(p, "PLAN"), InputError);
 }
 
+TEST(StationUpdates, APlanWithItsCovarianceCarriesEachWaypointsHorizontalEllipse) {
+  kestrel::plan_t p{};
+  p.utime = 5;
+  p.request_id = 12;
+  p.num_waypoints = 2;
+  p.waypoints = {{0, 0, 1, 0}, {2, 1, 1, 0.5}};
+  p.covariance_trace = {5.0, 2.0};
+  kestrel::plan_covariance_t c{};
+  c.utime = 5;
+  c.request_id = 12;
+  c.num_waypoints = 2;
+  c.covariance.resize(2);
+  // Waypoint 0: var x 4, var y 1 (uncorrelated): semi-axes 2 and 1 along x. Waypoint 1: the
+  // same turned by 30 degrees, R diag(4, 1) R^T = [[3.25, 1.299], [1.299, 1.75]].
+  c.covariance[0] = {4, 0, 0, 0, 0, 1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0};
+  const double a = M_PI / 6, ca = std::cos(a), sa = std::sin(a);
+  const double xx = 4 * ca * ca + sa * sa, yy = 4 * sa * sa + ca * ca, xy = 3 * ca * sa;
+  c.covariance[1] = {xx, xy, 0, 0, xy, yy, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0};
+  const nlohmann::json u = plan_update(p, "PLAN_COVARIANCE", &c);
+  ASSERT_EQ(u["ellipses"].size(), 2u);
+  EXPECT_NEAR(u["ellipses"][0][0].get<double>(), 2.0, 1e-12);
+  EXPECT_NEAR(u["ellipses"][0][1].get<double>(), 1.0, 1e-12);
+  EXPECT_NEAR(u["ellipses"][0][2].get<double>(), 0.0, 1e-12);
+  EXPECT_NEAR(u["ellipses"][1][0].get<double>(), 2.0, 1e-12);
+  EXPECT_NEAR(u["ellipses"][1][1].get<double>(), 1.0, 1e-12);
+  EXPECT_NEAR(u["ellipses"][1][2].get<double>(), a, 1e-12);
+  EXPECT_FALSE(plan_update(p, "PLAN").contains("ellipses"));
+  // Another plan's, a count that disagrees, a value that is not finite: refused.
+  c.request_id = 13;
+  EXPECT_THROW(plan_update(p, "PLAN_COVARIANCE", &c), InputError);
+  c.request_id = 12;
+  c.num_waypoints = 1;
+  EXPECT_THROW(plan_update(p, "PLAN_COVARIANCE", &c), InputError);
+  c.num_waypoints = 2;
+  c.covariance[1][5] = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(plan_update(p, "PLAN_COVARIANCE", &c), InputError);
+}
+
 TEST(StationUpdates, TheGraphNamesEdgesByKeyframeIndex) {
   kestrel::slam_graph_t g{};
   g.revision = 4;

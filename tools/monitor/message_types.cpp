@@ -8,6 +8,7 @@
 #include "kestrel/ground_truth_t.hpp"
 #include "kestrel/imu_t.hpp"
 #include "kestrel/octomap_t.hpp"
+#include "kestrel/plan_covariance_t.hpp"
 #include "kestrel/plan_request_t.hpp"
 #include "kestrel/plan_t.hpp"
 #include "kestrel/pose3_t.hpp"
@@ -54,7 +55,8 @@ const std::vector<MessageType>& kestrel_types() {
       type_of<kestrel::camera_info_t>(),     type_of<kestrel::ground_truth_t>(),
       type_of<kestrel::imu_t>(),             type_of<kestrel::octomap_t>(),
       type_of<kestrel::plan_request_t>(),    type_of<kestrel::plan_t>(),
-      type_of<kestrel::pose3_t>(),           type_of<kestrel::pose_t>(),
+      type_of<kestrel::plan_covariance_t>(), type_of<kestrel::pose3_t>(),
+      type_of<kestrel::pose_t>(),
       type_of<kestrel::process_status_t>(),  type_of<kestrel::rejection_counts_t>(),
       type_of<kestrel::rejection_reason_t>(), type_of<kestrel::replay_ack_t>(),
       type_of<kestrel::replay_control_t>(),  type_of<kestrel::rgbd_frame_t>(),
@@ -91,6 +93,7 @@ std::map<std::string, const MessageType*> default_channel_types() {
       {ch::kState, "state_t"},                    {ch::kSlamCorrection, "slam_correction_t"},
       {ch::kSlamGraph, "slam_graph_t"},           {ch::kMapOctomap, "octomap_t"},
       {ch::kPlanRequest, "plan_request_t"},       {ch::kPlan, "plan_t"},
+      {ch::kPlanCovariance, "plan_covariance_t"},
       {ch::kVehicleCommand, "vehicle_command_t"}, {ch::kProcessStatus, "process_status_t"},
       {ch::kReplayControl, "replay_control_t"},   {ch::kReplayAck, "replay_ack_t"},
       {ch::kProcessRejections, "rejection_counts_t"},
