@@ -192,17 +192,15 @@ BagImportStats import(rosbag::Bag& bag, const std::string& path, const BagImport
   // The IMU in the body's axes (the camera's optical frame): rotated by the tf tree's mount when
   // its frame is another one the tree joins to the camera's; the lever arm is not modelled.
   stats.imu_axes = "as published";
-  if (!imu.empty() && !imu_frame.empty() && !colour_frame.empty() && imu_frame != colour_frame) {
-    if (const auto R_camera_imu = tree.rotation(colour_frame, imu_frame, imu.front().utime)) {
+  if (!imu.empty() && !colour_frame.empty()) {
+    const ImuAxes axes =
+        imu_axes(tree, imu_frame, colour_frame, imu.front().utime, have_tf ? o.tf_topic : "tf (no tf topic)");
+    if (axes.R_camera_imu)
       for (ImuReading& r : imu) {
-        r.angular_velocity = *R_camera_imu * r.angular_velocity;
-        r.linear_acceleration = *R_camera_imu * r.linear_acceleration;
+        r.angular_velocity = *axes.R_camera_imu * r.angular_velocity;
+        r.linear_acceleration = *axes.R_camera_imu * r.linear_acceleration;
       }
-      stats.imu_axes = "rotated from '" + imu_frame + "' to '" + colour_frame + "' by " + o.tf_topic;
-    } else {
-      stats.imu_axes = "as published: '" + imu_frame + "' is not joined to the images' '" + colour_frame + "' on " +
-                       (have_tf ? o.tf_topic : "tf (no tf topic)");
-    }
+    stats.imu_axes = axes.description;
   }
 
   std::vector<TimedPose> poses;

@@ -128,22 +128,21 @@ void CameraStream::release_imu(bool now) {
   if (!imu_axes_decided_) {
     const std::string& frame = pending_imu_.front().frame;
     const int64_t first_utime = pending_imu_.front().reading.utime;
-    if (!tree_ || frame.empty() || frame == colour_frame_) {
-      stats_.imu_axes = "as published";
-      if (!tree_ && !frame.empty()) stats_.imu_axes += " ('" + frame + "'; no tf read)";
-    } else if (colour_frame_.empty() && !now) {
+    if (!tree_) {
+      stats_.imu_axes = frame.empty() ? "as published" : "as published ('" + frame + "'; no tf read)";
+    } else if (colour_frame_.empty() && !frame.empty() && !now) {
       return;  // the images' frame comes with the first colour image
-    } else if (const auto R = colour_frame_.empty() ? std::nullopt : tree_->rotation(colour_frame_, frame, first_utime)) {
-      R_camera_imu_ = R;
-      stats_.imu_axes = "rotated from '" + frame + "' to '" + colour_frame_ + "' by " + tf_topic_;
-    } else if (!now && (!mount_wait_from_ || pending_imu_.back().reading.utime - *mount_wait_from_ < kImuMountWaitUs)) {
-      // The mount may come yet (a tf_static published late).
-      if (!mount_wait_from_) mount_wait_from_ = pending_imu_.back().reading.utime;
-      return;
     } else {
-      stats_.imu_axes = "as published: '" + frame + "' is not joined to the images' '" +
-                        (colour_frame_.empty() ? std::string("(no colour image yet)") : colour_frame_) + "' on " +
-                        tf_topic_;
+      ImuAxes axes = imu_axes(*tree_, frame, colour_frame_, first_utime, tf_topic_);
+      const bool unjoined = !axes.R_camera_imu && !frame.empty() && frame != colour_frame_;
+      if (unjoined && !now &&
+          (!mount_wait_from_ || pending_imu_.back().reading.utime - *mount_wait_from_ < kImuMountWaitUs)) {
+        // The mount may come yet (a tf_static published late).
+        if (!mount_wait_from_) mount_wait_from_ = pending_imu_.back().reading.utime;
+        return;
+      }
+      R_camera_imu_ = axes.R_camera_imu;
+      stats_.imu_axes = std::move(axes.description);
     }
     imu_axes_decided_ = true;
   }

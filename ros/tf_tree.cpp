@@ -148,4 +148,14 @@ std::string TfTree::path(const std::vector<std::string>& chain) const {
   return p;
 }
 
+ImuAxes imu_axes(const TfTree& tree, const std::string& imu_frame, const std::string& colour_frame, int64_t utime,
+                 const std::string& source) {
+  if (imu_frame.empty() || imu_frame == colour_frame) return {std::nullopt, "as published"};
+  if (const auto R = colour_frame.empty() ? std::nullopt : tree.rotation(colour_frame, imu_frame, utime))
+    return {R, "rotated from '" + imu_frame + "' to '" + colour_frame + "' by " + source};
+  return {std::nullopt, "as published: '" + imu_frame + "' is not joined to the images' '" +
+                            (colour_frame.empty() ? std::string("(no colour image yet)") : colour_frame) + "' on " +
+                            source};
+}
+
 }  // namespace kestrel::ros1

@@ -88,4 +88,15 @@ class TfTree {
   int64_t second_parents_ = 0;
 };
 
+/// How IMU samples published in `imu_frame` are turned into the colour images' axes (the
+/// body's), bag-import's and ros-bridge's one rule: by the tree's mount when it joins the two
+/// frames (no lever arm), else as published; `description` is what the summaries say
+/// (`source`: the tf topic, or why there is none).
+struct ImuAxes {
+  std::optional<Eigen::Matrix3d> R_camera_imu;  ///< none: as published
+  std::string description;
+};
+ImuAxes imu_axes(const TfTree& tree, const std::string& imu_frame, const std::string& colour_frame, int64_t utime,
+                 const std::string& source);
+
 }  // namespace kestrel::ros1
