@@ -85,7 +85,6 @@ std::optional<LogEvent> LogReader::next() {
       // Read before (a rewind, a seek back): counted then.
       const bool counted = !damage_counted_.insert(offset).second;
       const int64_t skipped_before = skipped_bytes_;
-      if (!counted && first_damage_offset_ < 0) first_damage_offset_ = offset;
       if (is_truncation) {
         if (!counted) {
           truncated_ = true;
@@ -159,7 +158,7 @@ std::string LogReader::damage_report() const {
     s += std::to_string(corrupt_regions_) + " corrupt region(s), ";
   if (truncated_) s += "truncated last event, ";
   s += std::to_string(skipped_bytes_) + " bytes skipped (first at byte " +
-       std::to_string(first_damage_offset_) + ")";
+       std::to_string(*damage_counted_.begin()) + ")";
   return s;
 }
 

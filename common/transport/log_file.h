@@ -57,7 +57,6 @@ class LogReader {
   int64_t file_size_ = 0;
   int64_t corrupt_regions_ = 0;
   int64_t skipped_bytes_ = 0;
-  int64_t first_damage_offset_ = -1;
   bool truncated_ = false;
 };
 

@@ -30,8 +30,11 @@ namespace {
 
 // A flight's usable STATE positions with the true positions at the same utimes.
 struct Flown {
-  std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> matched;  // (STATE, truth)
-  std::vector<int64_t> matched_utimes;                                // of each of `matched`
+  struct Matched {
+    int64_t utime = 0;
+    Eigen::Vector3d state, truth;
+  };
+  std::vector<Matched> matched;
   std::optional<int64_t> first_usable, first_truth;
   std::optional<Eigen::Vector3d> last_truth;
 };
@@ -51,8 +54,7 @@ Flown read_flight(const std::filesystem::path& path) {
       if (m.status != kestrel::state_t::STATUS_OK) continue;
       if (!f.first_usable) f.first_usable = m.utime;
       if (const auto t = true_at.find(m.utime); t != true_at.end()) {
-        f.matched.emplace_back(transport::from_message(m.T_world_body, "STATE").translation(), t->second);
-        f.matched_utimes.push_back(m.utime);
+        f.matched.push_back({m.utime, transport::from_message(m.T_world_body, "STATE").translation(), t->second});
       }
     }
   }
@@ -91,18 +93,18 @@ TEST(System, ASecondFlightStartedElsewhereIsPlacedInTheSavedMapAndFliesToAGoalIn
   ASSERT_GE(first.matched.size(), 100u);
   Eigen::Matrix3Xd p_est(3, first.matched.size()), p_gt(3, first.matched.size());
   for (size_t i = 0; i < first.matched.size(); ++i) {
-    p_est.col(static_cast<Eigen::Index>(i)) = first.matched[i].first;
-    p_gt.col(static_cast<Eigen::Index>(i)) = first.matched[i].second;
+    p_est.col(static_cast<Eigen::Index>(i)) = first.matched[i].state;
+    p_gt.col(static_cast<Eigen::Index>(i)) = first.matched[i].truth;
   }
   const Eigen::Isometry3d T_map_truth = metrics::align_positions(p_est, p_gt).T_gt_est.inverse();
   const Flown second = read_flight(two / "flight.lcmlog");
   ASSERT_TRUE(second.first_usable && second.first_truth && second.last_truth);
   double worst_m = 0.0, sum_squared_m2 = 0.0;
   int64_t worst_utime = 0;
-  for (size_t i = 0; i < second.matched.size(); ++i) {
-    const double error_m = (second.matched[i].first - T_map_truth * second.matched[i].second).norm();
+  for (const Flown::Matched& m : second.matched) {
+    const double error_m = (m.state - T_map_truth * m.truth).norm();
     sum_squared_m2 += error_m * error_m;
-    if (error_m > worst_m) std::tie(worst_m, worst_utime) = std::pair{error_m, second.matched_utimes[i]};
+    if (error_m > worst_m) std::tie(worst_m, worst_utime) = std::pair{error_m, m.utime};
   }
   ASSERT_FALSE(second.matched.empty());
   const double rms_m = std::sqrt(sum_squared_m2 / static_cast<double>(second.matched.size()));
