@@ -154,5 +154,59 @@ TEST(VoTool, UnreadableListsAndImagesExitThreeNamingTheFileAndLine) {
   }
 }
 
+// kestrel-vo-crossval (vo/cross_validation.h): each folder's best value scored on the other.
+// On two recordings of the same synthetic motion every fold has a value and a held-out score.
+TEST(VoCrossvalTool, TwoFoldsOverTwoFoldersAndEveryValueOnEach) {
+  TempDir dir;
+  TumFolderSpec spec;
+  spec.frames = 8;
+  const fs::path a = write_tum_folder(dir / "a", spec);
+  const fs::path b = write_tum_folder(dir / "b", spec);
+  const RunResult r = run({::kestrel::test::tool("vo-crossval").string(), "--tum", a.string(), "--tum", b.string(),
+                           "--param", "dense.weight=0.4,2", "--param", "covariance.translation_floor_m=0.001,0.01",
+                           "--objective", "ate", "-q"});
+  ASSERT_EQ(r.exit_code, kExitOk) << r.out << r.err;
+  // The two folders share a name: they are told apart by the paths given.
+  EXPECT_NE(r.out.find("| fitted on " + a.string() + ": value, held-out score (best there) | fitted on " + b.string()),
+            std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("| `dense.weight` | ATE cm | 0.4 | "), std::string::npos) << "the simulator's profile value: " << r.out;
+  EXPECT_NE(r.out.find("| `covariance.translation_floor_m` | ATE cm | "), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("n/a"), std::string::npos) << "every value measured on both: " << r.out;
+  EXPECT_NE(r.out.find("| 2 | "), std::string::npos) << "the grid of every value: " << r.out;
+}
+
+TEST(VoCrossvalTool, WhatItCannotUseIsAnErrorNamingIt) {
+  TempDir dir;
+  TumFolderSpec spec;
+  spec.frames = 6;
+  const fs::path a = write_tum_folder(dir / "a", spec);
+  TumFolderSpec blank = spec;
+  blank.blank_depth_from = 0;
+  const fs::path b = write_tum_folder(dir / "b", blank);
+  const std::string tool = ::kestrel::test::tool("vo-crossval").string();
+  struct Case {
+    std::vector<std::string> args;
+    int exit_code;
+    std::string says;
+  };
+  const std::vector<Case> cases{
+      {{"--tum", a.string()}, kExitUsage, "two sequences or more"},
+      {{"--tum", a.string(), "--tum", a.string(), "--param", "no.such_key=1"}, kExitUsage, "no.such_key"},
+      {{"--tum", a.string(), "--tum", a.string(), "--param", "dense.weight"}, kExitUsage, "KEY=V1,V2"},
+      {{"--tum", a.string(), "--tum", a.string(), "--param", "dense.weight=1,,2"}, kExitUsage, "empty value"},
+      {{"--tum", a.string(), "--tum", a.string(), "--param", "dense.weight=-1"}, kExitUsage, "dense.weight"},
+      {{"--tum", a.string(), "--tum", a.string(), "--objective", "ATE"}, kExitUsage, "'ATE'"},
+      {{"--tum", a.string(), "--tum", b.string(), "--param", "dense.weight=1"}, kExitBadInput, b.string()},
+      {{"--tum", a.string(), "--tum", (dir / "none").string(), "--param", "dense.weight=1"}, kExitBadInput, "none"},
+  };
+  for (const Case& c : cases) {
+    std::vector<std::string> argv{tool};
+    argv.insert(argv.end(), c.args.begin(), c.args.end());
+    const RunResult r = run(argv);
+    EXPECT_EQ(r.exit_code, c.exit_code) << c.says << ": " << r.out << r.err;
+    EXPECT_NE(r.err.find(c.says), std::string::npos) << r.err;
+  }
+}
+
 }  // namespace
 }  // namespace kestrel::vo
