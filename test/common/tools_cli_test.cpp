@@ -33,6 +33,7 @@ const std::map<std::string, std::vector<std::string>>& required_arguments() {
       {"tum-to-fakenect", {"{dir}", "{out}"}},
       {"sim-realism", {"--tum", "{dir}"}},
       {"vo-ablation", {"--tum", "{dir}"}},
+      {"vo-crossval", {"--tum", "{dir}", "--tum", "{dir}"}},
       {"estimate", {"--log", "{file}", "--out", "{out}"}},
       {"fit-vo-noise", {"--log", "{file}"}},
       {"hold", {"--log", "{file}"}},
