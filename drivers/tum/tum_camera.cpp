@@ -24,7 +24,11 @@ PinholeCamera camera_intrinsics(TumCamera camera) {
       return c;
     }
     case TumCamera::kFreiburg2:
-      return PinholeCamera::vga(520.9, 521.0, 325.1, 249.7);
+    {
+      PinholeCamera c = PinholeCamera::vga(520.9, 521.0, 325.1, 249.7);
+      c.distortion = {0.2312, -0.7849, -0.0033, -0.0001, 0.9172};
+      return c;
+    }
     case TumCamera::kFreiburg3:
       return PinholeCamera::vga(535.4, 539.2, 320.1, 247.6);
     case TumCamera::kUnknown:

@@ -8,9 +8,10 @@
 // 525/525/319.5/239.5 is used, as TUM advises for uncalibrated use. Images are 640x480.
 //
 // The images are not undistorted here (TUM's registered depth cannot be undistorted exactly):
-// freiburg1 reports TUM's calibrated lens distortion with its raw images (2-3 % radial over
-// most of the image, 5-8 px; up to ~25 px in the corners), for consumers that map raw pixels
-// to ideal ones (sensors::Lens); freiburg2/3 and unknown folders report none (not measured here).
+// freiburg1 and freiburg2 report TUM's calibrated lens distortion with their raw images (fr1:
+// 2-3 % radial over most of the image, 5-8 px; up to ~25 px in the corners), for consumers that
+// map raw pixels to ideal ones (sensors::Lens); freiburg3's images are undistorted by TUM
+// already, and unknown folders report none.
 
 #include <string>
 
@@ -25,7 +26,7 @@ enum class TumCamera { kFreiburg1, kFreiburg2, kFreiburg3, kUnknown };
 TumCamera detect_camera(const std::string& folder);
 
 /// TUM's calibrated intrinsics for `camera` (ROS default for kUnknown), 640x480; distortion
-/// for freiburg1 only.
+/// (k1, k2, p1, p2, k3) for freiburg1 and freiburg2.
 PinholeCamera camera_intrinsics(TumCamera camera);
 
 /// "freiburg1", ..., "unknown (ROS default intrinsics)".

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
+
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -101,6 +103,13 @@ TEST(TumSequence, IntrinsicsAndSensorModelFollowTheFolderNameOrTheOverride) {
     EXPECT_EQ(s.camera().cy, c.cy);
     EXPECT_EQ(s.camera().width, 640);
     EXPECT_EQ(s.frame(0).camera.fx, c.fx);
+    // TUM's calibrated lens of the raw images: freiburg1's and freiburg2's; freiburg3's images
+    // come undistorted, and an unknown camera's lens is unknown.
+    std::array<double, 5> lens{};
+    if (c.camera == TumCamera::kFreiburg1) lens = {0.2624, -0.9531, -0.0054, 0.0026, 1.1633};
+    if (c.camera == TumCamera::kFreiburg2) lens = {0.2312, -0.7849, -0.0033, -0.0001, 0.9172};
+    EXPECT_EQ(s.camera().distortion, lens) << c.name;
+    EXPECT_EQ(s.frame(0).camera.distortion, s.camera().distortion) << c.name;
     // Only freiburg1's Kinect has a measured profile (sensors/profiles/kinect1.yaml) for its frames to name.
     EXPECT_EQ(s.frame(0).sensor, c.camera == TumCamera::kFreiburg1 ? "kinect1" : "") << c.name;
   }
