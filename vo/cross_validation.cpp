@@ -28,13 +28,16 @@ std::vector<Fold> leave_one_out(const std::vector<CandidateScores>& table) {
     if (!chosen) continue;
     Fold f;
     f.fitted_on = fit;
+    f.chosen_row = *chosen;
     f.chosen = table[*chosen].value;
     f.fitted_score = table[*chosen].scores[fit];
     for (size_t s = 0; s < sequences; ++s) {
       if (s == fit) continue;
+      f.held_out.push_back(s);
       f.held_out_scores.push_back(table[*chosen].scores[s]);
       const std::optional<size_t> best = best_of(s);
       f.held_out_best.push_back(best ? table[*best].scores[s] : std::nan(""));
+      f.held_out_best_rows.push_back(best.value_or(kNoRow));
     }
     folds.push_back(std::move(f));
   }

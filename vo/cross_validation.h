@@ -22,14 +22,21 @@ struct CandidateScores {
   std::vector<double> scores;  ///< per sequence; not finite = not measured
 };
 
+/// Row number of no candidate (a sequence where none was measured).
+inline constexpr size_t kNoRow = static_cast<size_t>(-1);
+
 struct Fold {
   size_t fitted_on = 0;        ///< the sequence the value was chosen on
-  std::string chosen;          ///< the candidate with the lowest score there
+  size_t chosen_row = 0;       ///< the candidate with the lowest score there (its row in the table)
+  std::string chosen;          ///< its value
   double fitted_score = 0.0;   ///< its score there
-  /// Its score on each other sequence (in sequence order, `fitted_on` left out), and the best any
-  /// candidate reaches there (what a fit to that sequence itself would claim).
+  /// Each other sequence (in sequence order, `fitted_on` left out): the chosen value's score
+  /// there, and the best any candidate reaches there (what a fit to that sequence itself would
+  /// claim) with its row (kNoRow: none measured).
+  std::vector<size_t> held_out;
   std::vector<double> held_out_scores;
   std::vector<double> held_out_best;
+  std::vector<size_t> held_out_best_rows;
 };
 
 /// One fold per sequence that has a measured candidate (a sequence with none has no fold).

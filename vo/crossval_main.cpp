@@ -95,6 +95,13 @@ const char* shown_unit(vo::Objective objective) {
   return "";
 }
 
+// A folder as a path to compare: normalised, without a trailing separator.
+std::filesystem::path folder_path(const std::string& folder) {
+  std::filesystem::path p = std::filesystem::path(folder).lexically_normal();
+  if (p.filename().empty()) p = p.parent_path();
+  return p;
+}
+
 std::string option_value(const vo::VoOptions& options, const std::string& key) {
   for (const std::string& line : vo::describe_options(options))
     if (line.rfind(key + " = ", 0) == 0) return line.substr(key.size() + 3);
@@ -107,7 +114,8 @@ int main(int argc, char** argv) {
   cli::App app("vo-crossval",
                "Leave-one-sequence-out cross-validation of the odometry's parameters fitted to recorded data: each "
                "value chosen on one TUM sequence is scored on the others (Markdown). Without --param: the kinect1 "
-               "profile's fitted parameters.");
+               "profile's fitted parameters. Exit 1 when some value could not be scored on some sequence (the "
+               "tables say n/a there).");
   std::vector<std::string> folders;
   std::vector<std::string> params;
   std::string objective_name = "ate";
@@ -120,6 +128,12 @@ int main(int argc, char** argv) {
     if (!objective)
       throw CLI::ValidationError("--objective", "'" + objective_name + "' is not ate, rpe-rotation, velocity or nees");
     if (folders.size() < 2) throw CLI::ValidationError("--tum", "cross-validation needs two sequences or more");
+    for (size_t a = 0; a < folders.size(); ++a)
+      for (size_t b = a + 1; b < folders.size(); ++b)
+        if (folder_path(folders[a]) == folder_path(folders[b]))
+          throw CLI::ValidationError("--tum", folders[b] + " is given twice: a sequence cannot be held out from itself");
+    if (params.empty() && app.count("--objective") > 0)
+      throw CLI::ValidationError("--objective", "goes with --param (the kinect1 parameters have their own objectives)");
     std::vector<Parameter> parameters;
     for (const std::string& p : params) parameters.push_back(parse_parameter(p, *objective));
     if (parameters.empty()) parameters = kinect_parameters();
@@ -142,9 +156,7 @@ int main(int argc, char** argv) {
       if (sequences.back().ground_truth.empty()) throw InputError(folder + ": no groundtruth.txt to score against");
       // A folder the profile's own options estimate nothing on is bad input, not a bad value.
       vo::require_usable(vo::run_sequence(sequences.back().frames, vo::with_tum_sensor(folder, {})).results, folder);
-      std::filesystem::path p = std::filesystem::path(folder).lexically_normal();
-      if (p.filename().empty()) p = p.parent_path();
-      names.push_back(p.filename().string());
+      names.push_back(folder_path(folder).filename().string());
     }
     const std::vector<std::string> base = names;
     for (size_t s = 0; s < names.size(); ++s)
@@ -175,41 +187,36 @@ int main(int argc, char** argv) {
           const Measured m = measure(f, p.objective);
           if (!std::isfinite(m.score)) {
             ++unmeasured;
-            spdlog::warn("{} = {} on {}: not measured ({})", p.key, v, names[s], f.scored ? "no NEES" : f.not_scored);
+            spdlog::warn("{} = {} on {}: {} not measured ({})", p.key, v, names[s], shown_unit(p.objective),
+                         f.scored ? "the run has too few frames for it" : f.not_scored);
           }
           row.scores.push_back(m.score);
           shown.back().push_back(m.shown);
         }
         table.push_back(std::move(row));
       }
-      // Shown figures by value, to print the held-out score in the objective's own unit.
-      const auto shown_of = [&](const std::string& value, size_t s) {
-        for (size_t r = 0; r < table.size(); ++r)
-          if (table[r].value == value) return shown[r][s];
-        return std::string("n/a");
-      };
-      const auto best_shown = [&](size_t s) {
-        size_t best = table.size();
-        for (size_t r = 0; r < table.size(); ++r)
-          if (std::isfinite(table[r].scores[s]) && (best == table.size() || table[r].scores[s] < table[best].scores[s]))
-            best = r;
-        return best == table.size() ? std::string("n/a") : shown[best][s];
-      };
       const std::vector<vo::Fold> folds = vo::leave_one_out(table);
-      folds_table += "| `" + p.key + "` | " + shown_unit(p.objective) + " | " +
-                     option_value(vo::with_tum_sensor(folders.front(), {}), p.key) + " |";
+      // The profile's value of each folder (one, unless the folders take different profiles).
+      std::vector<std::string> profile_values;
+      for (const std::string& folder : folders) {
+        const std::string v = option_value(vo::with_tum_sensor(folder, {}), p.key);
+        if (std::find(profile_values.begin(), profile_values.end(), v) == profile_values.end()) profile_values.push_back(v);
+      }
+      std::string profile;
+      for (const std::string& v : profile_values) profile += (profile.empty() ? "" : " / ") + v;
+      folds_table += "| `" + p.key + "` | " + shown_unit(p.objective) + " | " + profile + " |";
       for (size_t s = 0; s < sequences.size(); ++s) {
-        const vo::Fold* fold = nullptr;
-        for (const vo::Fold& f : folds)
-          if (f.fitted_on == s) fold = &f;
-        if (!fold) {
+        const auto fold = std::find_if(folds.begin(), folds.end(), [&](const vo::Fold& f) { return f.fitted_on == s; });
+        if (fold == folds.end()) {
           folds_table += " not measured |";
           continue;
         }
         std::string cell = " " + fold->chosen + ":";
-        for (size_t o = 0; o < sequences.size(); ++o) {
-          if (o == s) continue;
-          cell += " " + shown_of(fold->chosen, o) + " on " + names[o] + " (" + best_shown(o) + ")";
+        for (size_t i = 0; i < fold->held_out.size(); ++i) {
+          const size_t o = fold->held_out[i];
+          const size_t best = fold->held_out_best_rows[i];
+          cell += " " + shown[fold->chosen_row][o] + " on " + names[o] + " (" +
+                  (best == vo::kNoRow ? std::string("n/a") : shown[best][o]) + ")";
         }
         folds_table += cell + " |";
       }
@@ -224,9 +231,10 @@ int main(int argc, char** argv) {
         for (size_t s = 0; s < sequences.size(); ++s) grids += " " + shown[r][s] + " |";
         grids += "\n";
       }
-      std::cout << "." << std::flush;
+      std::cerr << "." << std::flush;  // progress, apart from the Markdown
     }
-    std::cout << "\n\n" << folds_table << "\nEvery value:\n" << grids;
+    std::cerr << "\n";
+    std::cout << folds_table << "\nEvery value:\n" << grids;
     return unmeasured == 0 ? kExitOk : kExitFailure;
   });
 }

@@ -19,7 +19,10 @@ TEST(CrossValidation, EachSequenceChoosesItsBestAndIsScoredOnTheOther) {
   ASSERT_EQ(folds.size(), 2u);
   EXPECT_EQ(folds[0].fitted_on, 0u);
   EXPECT_EQ(folds[0].chosen, "2");
+  EXPECT_EQ(folds[0].chosen_row, 1u);
   EXPECT_EQ(folds[0].fitted_score, 0.2);
+  EXPECT_EQ(folds[0].held_out, std::vector<size_t>{1});
+  EXPECT_EQ(folds[0].held_out_best_rows, std::vector<size_t>{2});
   ASSERT_EQ(folds[0].held_out_scores.size(), 1u);
   EXPECT_EQ(folds[0].held_out_scores[0], 3.0) << "value 2 on B";
   EXPECT_EQ(folds[0].held_out_best[0], 1.0) << "what a fit to B itself claims";
@@ -48,6 +51,7 @@ TEST(CrossValidation, ASequenceWithNothingMeasuredHasNoFold) {
   ASSERT_EQ(folds.size(), 1u);
   EXPECT_EQ(folds[0].fitted_on, 0u);
   EXPECT_TRUE(std::isnan(folds[0].held_out_best[0]));
+  EXPECT_EQ(folds[0].held_out_best_rows[0], kNoRow);
 }
 
 TEST(CrossValidation, RefusesATableItCannotRead) {

@@ -183,6 +183,7 @@ TEST(VoCrossvalTool, WhatItCannotUseIsAnErrorNamingIt) {
   TumFolderSpec blank = spec;
   blank.blank_depth_from = 0;
   const fs::path b = write_tum_folder(dir / "b", blank);
+  const fs::path c2 = write_tum_folder(dir / "c", spec);
   const std::string tool = ::kestrel::test::tool("vo-crossval").string();
   struct Case {
     std::vector<std::string> args;
@@ -191,11 +192,15 @@ TEST(VoCrossvalTool, WhatItCannotUseIsAnErrorNamingIt) {
   };
   const std::vector<Case> cases{
       {{"--tum", a.string()}, kExitUsage, "two sequences or more"},
-      {{"--tum", a.string(), "--tum", a.string(), "--param", "no.such_key=1"}, kExitUsage, "no.such_key"},
-      {{"--tum", a.string(), "--tum", a.string(), "--param", "dense.weight"}, kExitUsage, "KEY=V1,V2"},
-      {{"--tum", a.string(), "--tum", a.string(), "--param", "dense.weight=1,,2"}, kExitUsage, "empty value"},
-      {{"--tum", a.string(), "--tum", a.string(), "--param", "dense.weight=-1"}, kExitUsage, "dense.weight"},
-      {{"--tum", a.string(), "--tum", a.string(), "--objective", "ATE"}, kExitUsage, "'ATE'"},
+      {{"--tum", a.string(), "--tum", a.string() + "/"}, kExitUsage, "given twice"},
+      {{"--tum", a.string(), "--tum", c2.string(), "--param", "no.such_key=1"}, kExitUsage, "no.such_key"},
+      {{"--tum", a.string(), "--tum", c2.string(), "--param", "dense.weight"}, kExitUsage, "KEY=V1,V2"},
+      {{"--tum", a.string(), "--tum", c2.string(), "--param", "dense.weight=1,,2"}, kExitUsage, "empty value"},
+      {{"--tum", a.string(), "--tum", c2.string(), "--param", "dense.weight=-1"}, kExitUsage, "dense.weight"},
+      {{"--tum", a.string(), "--tum", c2.string(), "--objective", "ATE", "--param", "dense.weight=1"}, kExitUsage, "'ATE'"},
+      {{"--tum", a.string(), "--tum", c2.string(), "--objective", "nees"}, kExitUsage, "goes with --param"},
+      // Usable folders, but a value with which the odometry measures nothing: its scores are n/a.
+      {{"--tum", a.string(), "--tum", c2.string(), "--param", "min_features=0,1000000"}, kExitFailure, "not measured"},
       {{"--tum", a.string(), "--tum", b.string(), "--param", "dense.weight=1"}, kExitBadInput, b.string()},
       {{"--tum", a.string(), "--tum", (dir / "none").string(), "--param", "dense.weight=1"}, kExitBadInput, "none"},
   };
