@@ -267,7 +267,10 @@ AdapterOutputs SlamAdapter::process(const kestrel::rgbd_frame_t& message, const 
   // (in SLAM's odometry frame it would pull the state by the frames' difference). A frame
   // re-anchored on the map is located in it: that is a correction too.
   // Strictly after: the filter takes a correction only after its oldest state (estimator.cpp).
-  const bool new_estimator_waits = restart_correction_due_ && message.utime > restart_state_utime_;
+  // Never from a pose across an odometry break that no loop has placed yet: it assumes no motion
+  // in the gap, and a new estimator would take it as the map's world whatever its error.
+  const bool new_estimator_waits =
+      restart_correction_due_ && message.utime > restart_state_utime_ && slam_.odometry_placed();
   if ((step.optimisation || step.reanchored || step.relocalised || new_estimator_waits) && anchored_) {
     out.correction = correction_message(slam_, options_.correction_sigma_m, options_.correction_sigma_rad);
     if (new_estimator_waits) restart_correction_due_ = false;
@@ -277,7 +280,9 @@ AdapterOutputs SlamAdapter::process(const kestrel::rgbd_frame_t& message, const 
 
 void SlamAdapter::correct_new_estimator(int64_t utime, const ChainedPose& chained, OdometryLink link,
                                         AdapterOutputs& out) {
-  if (!restart_correction_due_ || !anchored_ || !slam_.localized() || utime <= restart_state_utime_) return;
+  if (!restart_correction_due_ || !anchored_ || !slam_.localized() || !slam_.odometry_placed() ||
+      utime <= restart_state_utime_)
+    return;
   if (link != OdometryLink::kContinuous || !reference_pose_ || !last_pose_) return;
   const std::optional<Matrix6d> odometry = chain_.relative_covariance(*reference_pose_, chained.pose);
   if (!odometry) return;

@@ -28,7 +28,9 @@
 // SLAM's reference composed with the odometry since, Slam::world_pose), which the new
 // filter takes as the map's world (estimator.h) without waiting for a loop closure, nor for a
 // keyframe, which a hovering vehicle never makes. Where the odometry since the keyframe has
-// no covariance (the VO restarted since), the correction waits for the next keyframe.
+// no covariance (the VO restarted since), the correction waits for the next keyframe; where
+// the VO restarted and nothing bridged it (Slam::odometry_placed()), for the loop closure that
+// places the new odometry in the map, never going out from a pose that assumes no motion.
 //
 // VO restarts: when the visual odometry loses its reference (a blank wall, a fast turn) its
 // new segment is unrelated to the old one, and the heading turned in the gap would be lost for

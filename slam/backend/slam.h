@@ -163,6 +163,10 @@ class Slam {
   int num_thinned() const { return thinned_; }
   size_t feature_bytes() const { return feature_bytes_; }
   const OdometryReference& reference() const { return reference_; }
+  /// False from a break of the odometry (a VO restart nothing bridged) until a loop closure
+  /// places the new odometry in the map: until then world_pose() assumes no motion across the
+  /// break, and is no measurement of where the camera is.
+  bool odometry_placed() const { return gate_by_pose_; }
   /// Verified loops refused because they disagreed with the odometry (loop_consistency.h).
   int num_inconsistent_loops() const { return inconsistent_loops_; }
   /// Marginal covariance of the reference keyframe's optimised T_world_camera after the last
