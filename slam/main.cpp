@@ -68,6 +68,11 @@ void add_options(cli::App& app, Options& o, SlamOptions& s) {
   app.add_option("--reuse-max-correction", s.coverage.max_correction_m,
                  "A frame is located in a covering keyframe only within this of its estimate, m (more: a loop closure)")
       ->check(CLI::NonNegativeNumber)->capture_default_str();
+  app.add_option("--reuse-carry-sigmas", s.coverage.carry_within_sigmas,
+                 "A covered frame no keyframe verifies is carried at its predicted pose, not made a keyframe, while "
+                 "this many of the prediction's sigmas lie within --reuse-max-correction (and 2 degrees) and its reference's "
+                 "keyframe is near; 0: never (localising only: always carried)")
+      ->check(CLI::NonNegativeNumber)->capture_default_str();
   app.add_option("--keyframe-megabytes", s.memory.max_megabytes,
                  "Memory budget of the keyframes' features, MB: over it, keyframes of places seen from many similar "
                  "views are thinned (kept in the graph, no longer matched)")
@@ -201,7 +206,9 @@ int run_offline(const Options& o, const SlamOptions& options, std::shared_ptr<co
             << " verified but refused by the odometry check), re-anchored on a covering keyframe: "
             << run.reanchors << " (keyframes instead: " << run.coverage_misses.none_near << " with none near, "
             << run.coverage_misses.not_verified << " none verified, " << run.coverage_misses.too_far
-            << " located too far; " << run.coverage_misses.featureless << " too featureless to locate, carried)\n";
+            << " located too far; carried instead: " << run.coverage_misses.featureless
+            << " too featureless to locate, " << run.coverage_misses.unverified_carried
+            << " none verified)\n";
   if (!ms.empty()) {
     std::cout << "ms per keyframe: median " << ms[ms.size() / 2] << ", p95 " << ms[ms.size() * 95 / 100]
               << ", max " << ms.back() << "\n";
@@ -288,12 +295,13 @@ int serve(const Options& o, const SlamOptions& options, std::shared_ptr<const Vo
     save_map(o.save_map, adapter.slam().map(), "kestrel-slam (process " + o.name + ")");
   const auto& misses = adapter.slam().coverage_misses();
   spdlog::info("{} keyframes ({} thinned, features {:.1f} MB), {} loop closures, {} frames re-anchored on a "
-               "covering keyframe (keyframes instead: {} with none near, {} none verified, {} located too far; {} too "
-               "featureless to locate, carried), {} VO restarts "
+               "covering keyframe (keyframes instead: {} with none near, {} none verified, {} located too far; carried "
+               "instead: {} too featureless to locate, {} none verified), {} VO restarts "
                "bridged by the estimator, {} estimator restarts, {} messages rejected",
                adapter.slam().keyframes().size(), adapter.slam().num_thinned(), adapter.slam().feature_bytes() / 1e6,
                adapter.slam().num_loop_closures(), adapter.slam().num_reanchors(),
-               misses.none_near, misses.not_verified, misses.too_far, misses.featureless, adapter.bridges(),
+               misses.none_near, misses.not_verified, misses.too_far, misses.featureless, misses.unverified_carried,
+               adapter.bridges(),
                adapter.estimator_restarts(), node->counters().messages_rejected);
   return status;
 }

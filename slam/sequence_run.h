@@ -32,7 +32,7 @@ struct SlamRun {
   int keyframes = 0;
   int loop_closures = 0;
   int reanchors = 0;               ///< frames located in a covering keyframe instead of becoming one
-  Slam::CoverageMisses coverage_misses;  ///< why frames over covered ground became keyframes
+  Slam::CoverageMisses coverage_misses;  ///< why frames over covered ground became keyframes, or were carried
   int candidates_verified = 0;
   int inconsistent_loops = 0;      ///< verified loops refused as disagreeing with the odometry
   std::vector<double> keyframe_ms; ///< SLAM time per keyframe (features, loop search, optimisation)

@@ -22,8 +22,9 @@ void check_options(const SlamOptions& o) {
           "keyframe thresholds must be >= 0");
   const CoverageOptions& c = o.coverage;
   require(c.max_translation_m >= 0.0 && c.max_rotation_rad >= 0.0 && c.max_correction_m >= 0.0 &&
-              c.max_correction_rad >= 0.0 && c.max_candidates >= 1,
-          "coverage distances must be >= 0 and max_candidates >= 1");
+              c.max_correction_rad >= 0.0 && c.carry_within_sigmas >= 0.0 &&
+              c.max_candidates >= 1,
+          "coverage distances and carry_within_sigmas must be >= 0 and max_candidates >= 1");
   const KeyframeMemoryOptions& m = o.memory;
   require(std::isfinite(m.max_megabytes) && m.max_megabytes > 0.0, "memory.max_megabytes must be > 0");
   require(std::isfinite(m.bin_size_m) && m.bin_size_m > 0.0, "memory.bin_size_m must be > 0");
@@ -104,6 +105,12 @@ Matrix6d composed_information(const Eigen::Isometry3d& B, const Matrix6d& covari
   if (covariance_A.isZero(0.0)) return information_B;
   const Matrix6d Ad = se3::adjoint(B.inverse());
   return information_of(Ad * covariance_A * Ad.transpose() + right_covariance(information_B));
+}
+
+// The standard deviation along the most uncertain axis of a 3x3 covariance (NaN when it is not finite).
+double largest_sigma(const Eigen::Matrix3d& covariance) {
+  if (!covariance.allFinite()) return std::nan("");
+  return std::sqrt(std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(covariance).eigenvalues().maxCoeff()));
 }
 
 }  // namespace
@@ -549,11 +556,36 @@ bool Slam::reanchor(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_came
     ++reanchors_;
     return true;
   }
-  ++coverage_misses_.not_verified;
-  if (!options_.localize_only) return false;
-  // Localisation only: a view of the map that does not verify adds no keyframe either.
+  // Localisation only, a view of the map that does not verify adds no keyframe either; in
+  // mapping, none does while the prediction is certain enough (CoverageOptions): the covering
+  // keyframes are the reference keyframe's neighbours, and the prediction from it is precise.
+  if (!options_.localize_only && !carriable(T_world_frame, predicted)) {
+    ++coverage_misses_.not_verified;
+    return false;
+  }
+  ++coverage_misses_.unverified_carried;
   carry_reference(frame, T_odom_camera, link, predicted, step);
   return true;
+}
+
+bool Slam::carriable(const Eigen::Isometry3d& T_world_frame, const Matrix6d& predicted) const {
+  const CoverageOptions& c = options_.coverage;
+  const double sigmas = c.carry_within_sigmas;
+  if (!(sigmas > 0.0)) return false;
+  // The prediction is relative to the reference's keyframe; the covering keyframes are judged
+  // by the world estimate. The two agree only where that keyframe is one of their neighbours:
+  // the reference was within coverage of it and the odometry has since moved one keyframe
+  // spacing at most. Anywhere else (a revisit after a long way round, the world estimate
+  // drifted) the frame is a keyframe and its loop is searched for.
+  const Eigen::Isometry3d& T_world_reference_keyframe = graph_.poses.at(static_cast<size_t>(reference_.keyframe_id));
+  if (!(se3::translation_distance(T_world_reference_keyframe, T_world_frame) <=
+            c.max_translation_m + options_.keyframes.min_translation_m &&
+        se3::rotation_distance(T_world_reference_keyframe, T_world_frame) <=
+            c.max_rotation_rad + options_.keyframes.min_rotation_rad))
+    return false;
+  // Written so that a covariance that is not finite is never certain.
+  return sigmas * largest_sigma(predicted.topLeftCorner<3, 3>()) <= c.max_correction_m &&
+         sigmas * largest_sigma(predicted.bottomRightCorner<3, 3>()) <= c.max_correction_rad;
 }
 
 void Slam::carry_reference(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera, OdometryLink link,

@@ -67,8 +67,9 @@ struct SlamStep {
   int64_t keyframe_id = -1;
   bool reanchored = false;        ///< instead, it was located in a covering keyframe...
   int64_t reanchor_keyframe_id = -1;  ///< ...this one (`loop` holds the constraint)
-  /// Or, over covered ground but with too few features ever to be located, it became the
-  /// reference at its predicted pose (nothing measured: no correction to send).
+  /// Or, over covered ground but with too few features ever to be located, or with none of the
+  /// covering keyframes verifying a certain prediction (CoverageOptions::carry_within_sigmas), it
+  /// became the reference at its predicted pose (nothing measured: no correction to send).
   bool carried = false;
   /// Or, started from a saved map, the frame placed the camera in it (Slam::relocalisation());
   /// or, localising only, a confirmed placement moved it beyond the correction bound.
@@ -152,10 +153,13 @@ class Slam {
   /// Frames re-anchored on a covering keyframe instead of becoming keyframes.
   int num_reanchors() const { return reanchors_; }
   /// Why frames tried for re-anchoring became keyframes instead: no keyframe near their
-  /// estimate, none verified, or located beyond the correction bound.
+  /// estimate, none verified (and the prediction too uncertain to carry), or located beyond the
+  /// correction bound; and why others were carried at their predicted pose, neither located
+  /// nor a keyframe.
   struct CoverageMisses {
     int none_near = 0, not_verified = 0, too_far = 0;
-    int featureless = 0;  ///< covered, too few features to verify: carried, no keyframe either
+    int featureless = 0;         ///< covered, too few features to verify: carried
+    int unverified_carried = 0;  ///< covered, none verified, prediction certain (localising only: any): carried
   };
   const CoverageMisses& coverage_misses() const { return coverage_misses_; }
   /// Keyframes that let their features go to keep within the memory budget, and the bytes the
@@ -194,8 +198,9 @@ class Slam {
   void add_odometry_edge(const Keyframe& current, OdometryLink link, const std::optional<Matrix6d>& covariance);
   SlamStep close_loop(SlamStep step);
   /// Locates the frame in a covering keyframe and makes it the reference, or carries the
-  /// reference to it when it is covered but too featureless to locate; false (and nothing
-  /// changed) when no keyframe covers it or none verifies within the correction bound.
+  /// reference to it when it is covered but too featureless to locate, or none verifies and its
+  /// prediction is certain (CoverageOptions); false (and nothing changed) when no keyframe covers
+  /// it, one locates it beyond the correction bound, or none verifies an uncertain prediction.
   bool reanchor(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera, OdometryLink link,
                 const std::optional<Matrix6d>& odometry_covariance, const FrameFeatures& features,
                 const sensors::SensorProfile& sensor, SlamStep& step);
@@ -205,6 +210,9 @@ class Slam {
   /// hypothesis (RelocalisationOptions). True when taken.
   bool accept_placement(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera, const Keyframe& kf,
                         const LoopConstraint& located);
+  /// May a covered frame that no keyframe verified be carried at its prediction (T_world_frame,
+  /// and `predicted` in the reference's keyframe) rather than become a keyframe (CoverageOptions)?
+  bool carriable(const Eigen::Isometry3d& T_world_frame, const Matrix6d& predicted) const;
   /// Makes the frame the reference at its predicted pose, in the reference's keyframe.
   void carry_reference(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera, OdometryLink link,
                        const Matrix6d& predicted, SlamStep& step);

@@ -33,6 +33,17 @@ struct CoverageOptions {
   /// loop closure, through a new keyframe and an optimisation of the graph.
   double max_correction_m = 0.05;
   double max_correction_rad = 2.0 * kPi / 180.0;
+  /// A covered frame that no covering keyframe verifies (blur, a view the keyframes see at
+  /// another scale) is carried at its predicted pose rather than made a keyframe while that
+  /// prediction is certain: the reference's keyframe is near (within the coverage bounds plus
+  /// one keyframe spacing of the frame's estimate, so the covering keyframes are its
+  /// neighbours), and this many of the prediction's standard deviations (largest axis) lie
+  /// within the correction bound above, in translation and in rotation, so that a later frame
+  /// of the carried chain can still be located within the bound. A keyframe there would add a
+  /// view the map holds and an odometry edge the carried reference holds as well; otherwise the
+  /// frame becomes a keyframe and its loop is searched for. 0: never (in mapping; localising
+  /// only, every unverified covered frame is carried).
+  double carry_within_sigmas = 3.0;
 };
 
 /// The memory bound: keyframes keep their features (keypoints, descriptors, 3-D points: what

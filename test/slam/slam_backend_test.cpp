@@ -278,6 +278,86 @@ TEST(Slam, AFeaturelessFrameOverCoveredGroundIsCarriedNotAKeyframe) {
   EXPECT_EQ(slam.keyframes().back().link, OdometryLink::kBridged) << "as weak as the weakest link since";
 }
 
+// A covered frame that no covering keyframe verifies (here: the same pose in a room of other
+// texture) is carried at its predicted pose while that prediction is certain and made from a
+// neighbouring keyframe (CoverageOptions::carry_within_sigmas). It is a keyframe, whose loop is
+// searched for, when the odometry is uncertain (a VO restart the estimator bridged: 3 sigmas of
+// the bridge's 5 cm floor exceed the 5 cm correction bound) or when the reference's keyframe is
+// far (a revisit after a long way round, where the world estimate may have drifted).
+TEST(Slam, AnUnverifiedCoveredFrameIsCarriedWhileItsPredictionIsCertainAndLocal) {
+  const SyntheticRoom room(5, 3.0, 2.5, 2.5);
+  const SyntheticRoom repainted(6, 3.0, 2.5, 2.5);
+  const auto path = test::circle_path(30, 1.0, 0.5);
+  // The VO's own covariance of the motion since the reference: a few millimetres.
+  const Matrix6d vo_covariance = Matrix6d::Identity() * 1e-5;
+  const auto fly_out = [&](Slam& slam, int64_t& utime) {
+    for (const auto& T : path) slam.add(room.render(T, test::test_camera(), utime += 200'000), T);
+  };
+
+  {  // Back the way it came: located in the keyframes of the way out, then a repainted view.
+    Slam slam(SlamOptions{}, builtin_vocabulary());
+    int64_t utime = 1'000'000;
+    fly_out(slam, utime);
+    const size_t keyframes = slam.keyframes().size();
+    size_t k = path.size() - 1;
+    bool located = false;
+    while (!located && k-- > 0)
+      located = slam.add(room.render(path[k], test::test_camera(), utime += 200'000), path[k], OdometryLink::kContinuous,
+                         vo_covariance).reanchored;
+    ASSERT_TRUE(located) << "the way back should be located in the way out's keyframes";
+    SlamStep tried;
+    while (!tried.new_reference() && k-- > 0)
+      tried = slam.add(repainted.render(path[k], test::test_camera(), utime += 200'000), path[k],
+                       OdometryLink::kContinuous, vo_covariance);
+    ASSERT_TRUE(tried.new_reference()) << "a frame of the way back should have been tried";
+    EXPECT_TRUE(tried.carried);
+    EXPECT_FALSE(tried.keyframe || tried.reanchored);
+    EXPECT_EQ(slam.keyframes().size(), keyframes);
+    EXPECT_EQ(slam.coverage_misses().unverified_carried, 1);
+    EXPECT_EQ(slam.coverage_misses().not_verified, 0);
+    EXPECT_EQ(slam.coverage_misses().featureless, 0) << "it has features, they just do not match";
+
+    // The next, after a VO restart the estimator bridged: too uncertain to carry.
+    SlamStep bridged;
+    while (!bridged.new_reference() && k-- > 0)
+      bridged = slam.add(repainted.render(path[k], test::test_camera(), utime += 200'000), path[k],
+                         OdometryLink::kBridged);
+    EXPECT_TRUE(bridged.keyframe);
+    EXPECT_EQ(slam.keyframes().size(), keyframes + 1);
+    EXPECT_EQ(slam.coverage_misses().not_verified, 1);
+    EXPECT_EQ(slam.coverage_misses().unverified_carried, 1);
+  }
+  {  // From the end of the way out straight to its start, 2 m and 180 degrees from the reference.
+    Slam slam(SlamOptions{}, builtin_vocabulary());
+    int64_t utime = 1'000'000;
+    fly_out(slam, utime);
+    const SlamStep revisit = slam.add(repainted.render(path.front(), test::test_camera(), utime += 200'000),
+                                      path.front(), OdometryLink::kContinuous, vo_covariance);
+    EXPECT_TRUE(revisit.keyframe) << "a revisit far from the reference's keyframe searches for its loop";
+    EXPECT_EQ(slam.coverage_misses().not_verified, 1);
+    EXPECT_EQ(slam.coverage_misses().unverified_carried, 0);
+  }
+  {  // Off: the same way back makes a keyframe.
+    SlamOptions never;
+    never.coverage.carry_within_sigmas = 0.0;
+    Slam slam(never, builtin_vocabulary());
+    int64_t utime = 1'000'000;
+    fly_out(slam, utime);
+    size_t k = path.size() - 1;
+    bool located = false;
+    while (!located && k-- > 0)
+      located = slam.add(room.render(path[k], test::test_camera(), utime += 200'000), path[k], OdometryLink::kContinuous,
+                         vo_covariance).reanchored;
+    SlamStep tried;
+    while (!tried.new_reference() && k-- > 0)
+      tried = slam.add(repainted.render(path[k], test::test_camera(), utime += 200'000), path[k],
+                       OdometryLink::kContinuous, vo_covariance);
+    EXPECT_TRUE(tried.keyframe);
+    EXPECT_EQ(slam.coverage_misses().not_verified, 1);
+    EXPECT_EQ(slam.coverage_misses().unverified_carried, 0);
+  }
+}
+
 TEST(Slam, ALoopFreeRunClosesNoLoop) {
   const SyntheticRoom room(5, 7.0, 1.5, 2.5);
   const LoopRun r = run(room, test::straight_path(40, 12.0), 0.004);
