@@ -208,6 +208,7 @@ void Slam::reset() {
   last_utime_ = 0;
   have_frame_ = false;
   gate_by_pose_ = true;
+  unplaced_from_ = -1;
   reference_marginal_.reset();
   reference_ = OdometryReference{};
   reanchors_ = 0;
@@ -310,7 +311,11 @@ SlamStep Slam::add(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camer
   if (!have_frame_) first_frame_utime_ = frame.utime;
   have_frame_ = true;
   last_utime_ = frame.utime;
-  if (odometry_broken) gate_by_pose_ = false;
+  if (odometry_broken) {
+    // The keyframe this frame makes is the first of odometry that nothing places in the map.
+    if (gate_by_pose_) unplaced_from_ = static_cast<int64_t>(keyframes_.size());
+    gate_by_pose_ = false;
+  }
   // Placement hypotheses place the odometry frame: across a break that frame changes.
   if (odometry_broken) placements_.clear();
   if (!localized_ && lost_since_utime_ >= 0 &&
@@ -406,7 +411,11 @@ SlamStep Slam::close_loop(SlamStep step) {
     rebin();
     reference_marginal_ = marginal_covariance(graph_, static_cast<int>(query.id), options_.optimizer.kernel);
     ++revision_;
-    gate_by_pose_ = true;
+    // Only a loop to a keyframe from before the break places the odometry since it in the map.
+    if (!gate_by_pose_ && earlier.id < unplaced_from_) {
+      gate_by_pose_ = true;
+      unplaced_from_ = -1;
+    }
     break;  // the paper stops at the first success
   }
   return step;
@@ -460,6 +469,7 @@ SlamStep Slam::relocalise(const RgbdFrame& frame, const Eigen::Isometry3d& T_odo
     localized_ = true;
     lost_since_utime_ = -1;
     gate_by_pose_ = true;
+    unplaced_from_ = -1;
     relocalisation_ = Relocalisation{frame.utime, relocalisation_tries_, kf.id, reference_world_pose()};
     relocalisation_tries_ = 0;
     step.relocalised = true;
@@ -557,9 +567,10 @@ bool Slam::reanchor(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_came
     return true;
   }
   // Localisation only, a view of the map that does not verify adds no keyframe either; in
-  // mapping, none does while the prediction is certain enough (CoverageOptions): the covering
-  // keyframes are the reference keyframe's neighbours, and the prediction from it is precise.
-  if (!options_.localize_only && !carriable(T_world_frame, predicted)) {
+  // mapping, none does while the prediction is certain and local (CoverageOptions).
+  std::vector<size_t> covering_keyframes;
+  for (const auto& entry : covering) covering_keyframes.push_back(entry.second);
+  if (!options_.localize_only && !carriable(covering_keyframes, predicted)) {
     ++coverage_misses_.not_verified;
     return false;
   }
@@ -568,21 +579,26 @@ bool Slam::reanchor(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_came
   return true;
 }
 
-bool Slam::carriable(const Eigen::Isometry3d& T_world_frame, const Matrix6d& predicted) const {
+bool Slam::carriable(const std::vector<size_t>& covering, const Matrix6d& predicted) const {
   const CoverageOptions& c = options_.coverage;
   const double sigmas = c.carry_within_sigmas;
   if (!(sigmas > 0.0)) return false;
-  // The prediction is relative to the reference's keyframe; the covering keyframes are judged
-  // by the world estimate. The two agree only where that keyframe is one of their neighbours:
-  // the reference was within coverage of it and the odometry has since moved one keyframe
-  // spacing at most. Anywhere else (a revisit after a long way round, the world estimate
-  // drifted) the frame is a keyframe and its loop is searched for.
-  const Eigen::Isometry3d& T_world_reference_keyframe = graph_.poses.at(static_cast<size_t>(reference_.keyframe_id));
-  if (!(se3::translation_distance(T_world_reference_keyframe, T_world_frame) <=
-            c.max_translation_m + options_.keyframes.min_translation_m &&
-        se3::rotation_distance(T_world_reference_keyframe, T_world_frame) <=
-            c.max_rotation_rad + options_.keyframes.min_rotation_rad))
+  // The prediction is relative to the reference's keyframe, while "covered" and the correction
+  // bound are judged against the covering keyframes in the world. The two agree only where the
+  // graph relates them by one odometry edge at most (the reference's keyframe covers the frame,
+  // or is an odometry neighbour of one that does). Anywhere else (a revisit after a long way
+  // round, where the world estimate may have drifted) the frame is a keyframe and its loop is
+  // searched for.
+  const int reference = static_cast<int>(reference_.keyframe_id);
+  const auto neighbour = [&](size_t k) {
+    if (static_cast<int>(k) == reference) return true;
+    for (const auto& e : graph_.edges)
+      if (e.kind == EdgeKind::kOdometry && ((e.from == reference && e.to == static_cast<int>(k)) ||
+                                            (e.to == reference && e.from == static_cast<int>(k))))
+        return true;
     return false;
+  };
+  if (std::none_of(covering.begin(), covering.end(), neighbour)) return false;
   // Written so that a covariance that is not finite is never certain.
   return sigmas * largest_sigma(predicted.topLeftCorner<3, 3>()) <= c.max_correction_m &&
          sigmas * largest_sigma(predicted.bottomRightCorner<3, 3>()) <= c.max_correction_rad;

@@ -167,10 +167,11 @@ class Slam {
   int num_thinned() const { return thinned_; }
   size_t feature_bytes() const { return feature_bytes_; }
   const OdometryReference& reference() const { return reference_; }
-  /// False from a break of the odometry (a VO restart nothing bridged) until a loop closure
-  /// places the new odometry in the map: until then world_pose() assumes no motion across the
-  /// break, and is no measurement of where the camera is.
-  bool odometry_placed() const { return gate_by_pose_; }
+  /// False from a break of the odometry (a VO restart nothing bridged) until a loop closure to a
+  /// keyframe from before the break places the new odometry in the map (until then world_pose()
+  /// assumes no motion across the break, and is no measurement of where the camera is), and
+  /// while not localized() in a saved map.
+  bool odometry_placed() const { return gate_by_pose_ && localized_; }
   /// Verified loops refused because they disagreed with the odometry (loop_consistency.h).
   int num_inconsistent_loops() const { return inconsistent_loops_; }
   /// Marginal covariance of the reference keyframe's optimised T_world_camera after the last
@@ -199,8 +200,9 @@ class Slam {
   SlamStep close_loop(SlamStep step);
   /// Locates the frame in a covering keyframe and makes it the reference, or carries the
   /// reference to it when it is covered but too featureless to locate, or none verifies and its
-  /// prediction is certain (CoverageOptions); false (and nothing changed) when no keyframe covers
-  /// it, one locates it beyond the correction bound, or none verifies an uncertain prediction.
+  /// prediction is certain and local (carriable()); false (and nothing changed) after an
+  /// unplaced odometry break, when no keyframe covers it, one locates it beyond the correction
+  /// bound, or none verifies it and it is not carriable.
   bool reanchor(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera, OdometryLink link,
                 const std::optional<Matrix6d>& odometry_covariance, const FrameFeatures& features,
                 const sensors::SensorProfile& sensor, SlamStep& step);
@@ -210,9 +212,10 @@ class Slam {
   /// hypothesis (RelocalisationOptions). True when taken.
   bool accept_placement(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera, const Keyframe& kf,
                         const LoopConstraint& located);
-  /// May a covered frame that no keyframe verified be carried at its prediction (T_world_frame,
-  /// and `predicted` in the reference's keyframe) rather than become a keyframe (CoverageOptions)?
-  bool carriable(const Eigen::Isometry3d& T_world_frame, const Matrix6d& predicted) const;
+  /// May a covered frame that none of its `covering` keyframes verified be carried at its
+  /// prediction (`predicted`: in the reference's keyframe) rather than become a keyframe
+  /// (CoverageOptions::carry_within_sigmas)?
+  bool carriable(const std::vector<size_t>& covering, const Matrix6d& predicted) const;
   /// Makes the frame the reference at its predicted pose, in the reference's keyframe.
   void carry_reference(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera, OdometryLink link,
                        const Matrix6d& predicted, SlamStep& step);
@@ -242,7 +245,8 @@ class Slam {
   OdometryReference reference_;
   int reanchors_ = 0;
   CoverageMisses coverage_misses_;
-  bool gate_by_pose_ = true;  ///< off from an odometry break until a loop closure re-anchors
+  bool gate_by_pose_ = true;  ///< off from an odometry break until a loop closure places it
+  int64_t unplaced_from_ = -1;  ///< gate off: the first keyframe after the break (loops to older ones place it)
   ViewBins matchable_;        ///< keyframes that still have their features, by view
   size_t feature_bytes_ = 0;  ///< of those keyframes
   int thinned_ = 0;

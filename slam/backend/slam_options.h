@@ -35,14 +35,15 @@ struct CoverageOptions {
   double max_correction_rad = 2.0 * kPi / 180.0;
   /// A covered frame that no covering keyframe verifies (blur, a view the keyframes see at
   /// another scale) is carried at its predicted pose rather than made a keyframe while that
-  /// prediction is certain: the reference's keyframe is near (within the coverage bounds plus
-  /// one keyframe spacing of the frame's estimate, so the covering keyframes are its
-  /// neighbours), and this many of the prediction's standard deviations (largest axis) lie
+  /// prediction is certain and local: this many of its standard deviations (largest axis) lie
   /// within the correction bound above, in translation and in rotation, so that a later frame
-  /// of the carried chain can still be located within the bound. A keyframe there would add a
-  /// view the map holds and an odometry edge the carried reference holds as well; otherwise the
-  /// frame becomes a keyframe and its loop is searched for. 0: never (in mapping; localising
-  /// only, every unverified covered frame is carried).
+  /// of the carried chain can still be located within the bound; and the reference's keyframe
+  /// covers the frame or is an odometry neighbour of one that does, so that the prediction,
+  /// relative to it, says where the frame is against the covering keyframes (a revisit after a
+  /// long way round, where the world estimate may have drifted, is a keyframe and searches its
+  /// loop). A keyframe there would add a view the map holds and an odometry edge the carried
+  /// reference holds as well. 0: never (in mapping; localising only, every unverified covered
+  /// frame is carried).
   double carry_within_sigmas = 3.0;
 };
 

@@ -282,8 +282,9 @@ TEST(Slam, AFeaturelessFrameOverCoveredGroundIsCarriedNotAKeyframe) {
 // texture) is carried at its predicted pose while that prediction is certain and made from a
 // neighbouring keyframe (CoverageOptions::carry_within_sigmas). It is a keyframe, whose loop is
 // searched for, when the odometry is uncertain (a VO restart the estimator bridged: 3 sigmas of
-// the bridge's 5 cm floor exceed the 5 cm correction bound) or when the reference's keyframe is
-// far (a revisit after a long way round, where the world estimate may have drifted).
+// the bridge's 5 cm floor exceed the 5 cm correction bound) or when the graph does not relate the
+// reference's keyframe to the covering ones (a revisit after a long way round, where the world
+// estimate may have drifted).
 TEST(Slam, AnUnverifiedCoveredFrameIsCarriedWhileItsPredictionIsCertainAndLocal) {
   const SyntheticRoom room(5, 3.0, 2.5, 2.5);
   const SyntheticRoom repainted(6, 3.0, 2.5, 2.5);
@@ -327,13 +328,17 @@ TEST(Slam, AnUnverifiedCoveredFrameIsCarriedWhileItsPredictionIsCertainAndLocal)
     EXPECT_EQ(slam.coverage_misses().not_verified, 1);
     EXPECT_EQ(slam.coverage_misses().unverified_carried, 1);
   }
-  {  // From the end of the way out straight to its start, 2 m and 180 degrees from the reference.
+  {  // Round a whole circle back to its start: 18 degrees from the reference's keyframe, whose
+     // odometry may have drifted since the start's keyframe, which alone covers the view.
+    const auto circle = test::circle_path(40, 1.0, 1.0);
     Slam slam(SlamOptions{}, builtin_vocabulary());
     int64_t utime = 1'000'000;
-    fly_out(slam, utime);
-    const SlamStep revisit = slam.add(repainted.render(path.front(), test::test_camera(), utime += 200'000),
-                                      path.front(), OdometryLink::kContinuous, vo_covariance);
-    EXPECT_TRUE(revisit.keyframe) << "a revisit far from the reference's keyframe searches for its loop";
+    for (size_t k = 0; k + 2 < circle.size(); ++k)
+      slam.add(room.render(circle[k], test::test_camera(), utime += 200'000), circle[k], OdometryLink::kContinuous,
+               vo_covariance);
+    const SlamStep revisit = slam.add(repainted.render(circle.back(), test::test_camera(), utime += 200'000),
+                                      circle.back(), OdometryLink::kContinuous, vo_covariance);
+    EXPECT_TRUE(revisit.keyframe) << "a revisit the graph does not relate to the reference searches for its loop";
     EXPECT_EQ(slam.coverage_misses().not_verified, 1);
     EXPECT_EQ(slam.coverage_misses().unverified_carried, 0);
   }
@@ -356,6 +361,48 @@ TEST(Slam, AnUnverifiedCoveredFrameIsCarriedWhileItsPredictionIsCertainAndLocal)
     EXPECT_EQ(slam.coverage_misses().not_verified, 1);
     EXPECT_EQ(slam.coverage_misses().unverified_carried, 0);
   }
+}
+
+// After a break of the odometry nothing bridged, the new odometry is placed in the map only by
+// a loop to a keyframe from before the break (Slam::odometry_placed()): a loop among the
+// keyframes made since relates them to each other, not to the map. Here the flight after the
+// break goes round a repainted room (nothing in it matches the first room's keyframes), closes
+// its own loop, and is placed only back in the first room.
+TEST(Slam, OnlyALoopToAKeyframeFromBeforeABreakPlacesTheOdometry) {
+  const SyntheticRoom room(5, 3.0, 2.5, 2.5);
+  const SyntheticRoom repainted(6, 3.0, 2.5, 2.5);
+  const auto half = test::circle_path(30, 1.0, 0.5);
+  const auto circle = test::circle_path(40, 1.0, 1.0);
+  Slam slam(SlamOptions{}, builtin_vocabulary());
+  int64_t utime = 1'000'000;
+  for (const auto& T : half) slam.add(room.render(T, test::test_camera(), utime += 200'000), T);
+  EXPECT_TRUE(slam.odometry_placed());
+  const size_t before_break = slam.keyframes().size();
+  // The break: the new odometry starts again from identity, wherever the camera is.
+  const Eigen::Isometry3d T_odom_world = circle.front().inverse();
+  slam.add(repainted.render(circle.front(), test::test_camera(), utime += 200'000), T_odom_world * circle.front(),
+           OdometryLink::kBroken);
+  EXPECT_FALSE(slam.odometry_placed());
+  int own_loops = 0;
+  for (size_t k = 1; k < circle.size(); ++k) {
+    const SlamStep step = slam.add(repainted.render(circle[k], test::test_camera(), utime += 200'000),
+                                   T_odom_world * circle[k]);
+    if (step.loop_closed) {
+      EXPECT_GE(step.loop_keyframe_id, static_cast<int64_t>(before_break)) << "the repainted room matches only itself";
+      ++own_loops;
+    }
+  }
+  ASSERT_GT(own_loops, 0) << "the circle should close its own loop";
+  EXPECT_FALSE(slam.odometry_placed()) << "a loop among the keyframes since the break places nothing";
+  // Back in the first room, where the map was made before the break.
+  bool placed = false;
+  for (size_t k = 0; k < half.size() && !placed; ++k) {
+    const SlamStep step =
+        slam.add(room.render(half[k], test::test_camera(), utime += 200'000), T_odom_world * half[k]);
+    if (step.loop_closed && step.loop_keyframe_id < static_cast<int64_t>(before_break)) placed = true;
+  }
+  ASSERT_TRUE(placed) << "the first room's keyframes should close a loop";
+  EXPECT_TRUE(slam.odometry_placed());
 }
 
 TEST(Slam, ALoopFreeRunClosesNoLoop) {
