@@ -70,8 +70,9 @@ void add_options(cli::App& app, Options& o, SlamOptions& s) {
       ->check(CLI::NonNegativeNumber)->capture_default_str();
   app.add_option("--reuse-carry-sigmas", s.coverage.carry_within_sigmas,
                  "A covered frame no keyframe verifies is carried at its predicted pose, not made a keyframe, while "
-                 "this many of the prediction's sigmas lie within --reuse-max-correction (and 2 degrees) and its reference's "
-                 "keyframe is near; 0: never (localising only: always carried)")
+                 "this many of the prediction's sigmas lie within the correction bounds (--reuse-max-correction and its "
+                 "angle) and its reference's keyframe is a graph neighbour of a covering one; 0: never (localising only: "
+                 "always carried)")
       ->check(CLI::NonNegativeNumber)->capture_default_str();
   app.add_option("--keyframe-megabytes", s.memory.max_megabytes,
                  "Memory budget of the keyframes' features, MB: over it, keyframes of places seen from many similar "

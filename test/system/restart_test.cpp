@@ -703,7 +703,9 @@ TEST(System, AnEstimatorKilledWhileTheVehicleHoversTakesTheMapsWorldAtOnce) {
   // Once in CI (1 of ~15 runs) the first state was 0.58 m off with SLAM's 5 cm sigma, and
   // in the map's world 1.8 s later: most likely a correction from a keyframe across a VO break
   // nothing bridged, which SLAM no longer sends (AdapterTest.ARestartedEstimatorGetsNoWorldFrom
-  // APoseAcrossAnUnbridgedVoBreak). What the new filter and SLAM said is shown if it fails.
+  // APoseAcrossAnUnbridgedVoBreak). Such a break would now fail here differently: SLAM waits for
+  // a loop to place the new odometry, and the new filter may fly on its own world after its 1 s
+  // (--await-world). What the new filter and SLAM said is shown if it fails.
   const std::string said = "\nthe new estimator said:\n" + test::read_file(dir / "estimator2.log") +
                            "\nslam said:\n" + test::read_file(dir / "slam.log");
   EXPECT_LT(delay, 0.5) << "a hover makes no keyframe: the world must not wait for one" << said;
