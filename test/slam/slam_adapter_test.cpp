@@ -62,6 +62,29 @@ class AdapterTest : public ::testing::Test {
     m.cov_dim = 0;
     return m;
   }
+  // update(k) with (2 mm)^2 per axis of translation noise in each motion, none in rotation.
+  kestrel::vo_update_t noisy_update(int k) const {
+    kestrel::vo_update_t u = update(k);
+    if (k > 0)
+      for (int i = 0; i < 3; ++i) u.covariance[7 * i] = 4e-6;
+    return u;
+  }
+  // Frames 0-3 with the estimator's states in world X around each (seq counting up from `seq`),
+  // until the graph is anchored in X.
+  void fly_anchored(SlamAdapter& adapter, const Eigen::Isometry3d& X, int64_t& seq) const {
+    for (int k = 0; k <= 3; ++k) {
+      adapter.on_frame(frame(k));
+      adapter.on_vo_update(noisy_update(k));
+      if (k > 0) {
+        kestrel::state_t m = state(k - 0.5, X);
+        m.seq = seq++;
+        adapter.on_state(m);
+      }
+    }
+    kestrel::state_t m = state(3.05, X);
+    m.seq = seq++;
+    adapter.on_state(m);
+  }
   static Eigen::Isometry3d estimator_world() {
     Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
     X.linear() = Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitZ()).toRotationMatrix() *
@@ -196,19 +219,8 @@ TEST_F(AdapterTest, ARestartedEstimatorGetsTheMapsWorldAtTheNextFrame) {
       m.seq = seq++;
       return adapter.on_state(m);
     };
-    // Each motion with (2 mm)^2 per axis of translation noise, none in rotation.
-    const auto measured = [&](int k) {
-      kestrel::vo_update_t u = update(k);
-      if (k > 0)
-        for (int i = 0; i < 3; ++i) u.covariance[7 * i] = 4e-6;
-      return adapter.on_vo_update(u);
-    };
-    for (int k = 0; k <= 3; ++k) {
-      adapter.on_frame(frame(k));
-      measured(k);
-      if (k > 0) state_at(k - 0.5, X);
-    }
-    state_at(3.05, X);
+    const auto measured = [&](int k) { return adapter.on_vo_update(noisy_update(k)); };
+    fly_anchored(adapter, X, seq);
     ASSERT_TRUE(adapter.anchored());
     if (restart) seq = 0;  // a new process, in its own world (here the odometry frame)
     state_at(4.5, restart ? Eigen::Isometry3d::Identity() : X);
@@ -257,21 +269,14 @@ TEST_F(AdapterTest, ARestartedEstimatorGetsNoWorldFromAPoseAcrossAnUnbridgedVoBr
       adapter.on_state(m);
     };
     const auto measured = [&](int k) {
-      kestrel::vo_update_t u = update(k);
-      if (k > 0)
-        for (int i = 0; i < 3; ++i) u.covariance[7 * i] = 4e-6;
+      kestrel::vo_update_t u = noisy_update(k);
       if (vo_break && k == 5) {
         u.status = kestrel::vo_update_t::STATUS_NO_REFERENCE;
         u.T_reference_current = transport::to_message(Eigen::Isometry3d::Identity());
       }
       return adapter.on_vo_update(u);
     };
-    for (int k = 0; k <= 3; ++k) {
-      adapter.on_frame(frame(k));
-      measured(k);
-      if (k > 0) state_at(k - 0.5, X);
-    }
-    state_at(3.05, X);
+    fly_anchored(adapter, X, seq);
     ASSERT_TRUE(adapter.anchored());
     seq = 0;  // the new filter, in a world of its own, from 4.5 on
     state_at(4.5, Eigen::Isometry3d::Identity());
