@@ -33,6 +33,7 @@ void SlamAdapter::reset() {
   last_processed_utime_ = 0;
   lost_break_ = false;
   anchored_ = map_loaded_;
+  anchor_.reset();
   states_.clear();
   recent_.clear();
   odometry_fix_ = Eigen::Isometry3d::Identity();
@@ -140,6 +141,17 @@ AdapterOutputs SlamAdapter::on_state(const kestrel::state_t& state) {
               (visual_only ||
                tilt_variance <= options_.anchor_max_tilt_sigma_rad * options_.anchor_max_tilt_sigma_rad);
   sample.T_world_body = transport::from_message(state.T_world_body, options_.state_channel.c_str());
+  // The pose's block of the error state ([dp; dv; dtheta; ...]: rows 0-2 and 6-8), which the
+  // graph inherits where it is anchored on this state.
+  if (state.cov_dim >= 9 && static_cast<int>(state.covariance.size()) >= 9) {
+    const int index[6] = {0, 1, 2, 6, 7, 8};
+    for (int r = 0; r < 6; ++r)
+      for (int c = 0; c < 6; ++c) {
+        const auto& row = state.covariance[static_cast<size_t>(index[r])];
+        if (static_cast<int>(row.size()) > index[c]) sample.pose_covariance(r, c) = row[static_cast<size_t>(index[c])];
+      }
+    if (!sample.pose_covariance.allFinite()) sample.ok = false;  // not to anchor on; a bridge needs only the pose
+  }
   for (int i = 0; i < 3; ++i) {
     sample.velocity[i] = state.velocity[i];
     sample.angular_velocity[i] = state.angular_velocity[i];
@@ -155,7 +167,7 @@ AdapterOutputs SlamAdapter::on_state(const kestrel::state_t& state) {
   return out;
 }
 
-std::optional<Eigen::Isometry3d> SlamAdapter::state_at(int64_t utime, bool ok_only) const {
+std::optional<WorldAnchor> SlamAdapter::state_at(int64_t utime, bool ok_only) const {
   const auto after = std::lower_bound(states_.begin(), states_.end(), utime,
                                       [](const StateSample& s, int64_t t) { return s.utime < t; });
   if (after == states_.end()) {
@@ -168,11 +180,11 @@ std::optional<Eigen::Isometry3d> SlamAdapter::state_at(int64_t utime, bool ok_on
     Eigen::Isometry3d T = last.T_world_body;
     T.translation() += dt * last.velocity;
     T.linear() = T.linear() * so3::exp(dt * last.angular_velocity);
-    return T;
+    return WorldAnchor{T, last.pose_covariance};
   }
   if (after->utime == utime) {
     if (ok_only && !after->ok) return std::nullopt;
-    return after->T_world_body;
+    return WorldAnchor{after->T_world_body, after->pose_covariance};
   }
   if (after == states_.begin()) return std::nullopt;  // the estimator started after it
   const auto before = std::prev(after);
@@ -180,7 +192,8 @@ std::optional<Eigen::Isometry3d> SlamAdapter::state_at(int64_t utime, bool ok_on
   const double gap_s = 1e-6 * static_cast<double>(after->utime - before->utime);
   if (gap_s > options_.max_state_gap_s) return std::nullopt;
   const double fraction = 1e-6 * static_cast<double>(utime - before->utime) / gap_s;
-  return se3::interpolate(before->T_world_body, after->T_world_body, fraction);
+  return WorldAnchor{se3::interpolate(before->T_world_body, after->T_world_body, fraction),
+                     (1.0 - fraction) * before->pose_covariance + fraction * after->pose_covariance};
 }
 
 void SlamAdapter::remember(const FramePose& frame, bool reference) {
@@ -194,10 +207,11 @@ void SlamAdapter::try_anchor(AdapterOutputs& out) {
   if (anchored_ || states_.empty() || slam_.keyframes().empty()) return;
   // The newest frame since the newest keyframe at which the estimator has an OK pose.
   for (auto f = recent_.rbegin(); f != recent_.rend(); ++f) {
-    const auto T_world_body = state_at(f->utime, true);
-    if (!T_world_body) continue;
-    slam_.change_world(*T_world_body * f->T_body_camera * slam_.world_pose(f->T_odom_camera).inverse());
+    const auto state = state_at(f->utime, true);
+    if (!state) continue;
+    slam_.change_world(state->T_world_body * f->T_body_camera * slam_.world_pose(f->T_odom_camera).inverse());
     anchored_ = true;
+    anchor_ = state;
     recent_.clear();
     out.anchored = true;
     out.graph = graph_message(slam_);
@@ -222,7 +236,8 @@ AdapterOutputs SlamAdapter::process(const kestrel::rgbd_frame_t& message, const 
     if (last_pose_ && 1e-6 * static_cast<double>(message.utime - last_pose_->utime) <= options_.max_bridge_s) {
       const auto before = state_at(last_pose_->utime, false), now = state_at(message.utime, false);
       if (before && now) {
-        const Eigen::Isometry3d T_before_now = (*before * last_pose_->T_body_camera).inverse() * (*now * T_body_camera);
+        const Eigen::Isometry3d T_before_now =
+            (before->T_world_body * last_pose_->T_body_camera).inverse() * (now->T_world_body * T_body_camera);
         pose.T_odom_camera = last_pose_->T_odom_camera * T_before_now;
         odometry_fix_ = pose.T_odom_camera * chained.T_odom_camera.inverse();
         link = OdometryLink::kBridged;
@@ -272,7 +287,8 @@ AdapterOutputs SlamAdapter::process(const kestrel::rgbd_frame_t& message, const 
   const bool new_estimator_waits =
       restart_correction_due_ && message.utime > restart_state_utime_ && slam_.odometry_placed();
   if ((step.optimisation || step.reanchored || step.relocalised || new_estimator_waits) && anchored_) {
-    out.correction = correction_message(slam_, options_.correction_sigma_m, options_.correction_sigma_rad);
+    out.correction =
+        correction_message(slam_, options_.correction_sigma_m, options_.correction_sigma_rad, std::nullopt, anchor_);
     if (new_estimator_waits) restart_correction_due_ = false;
   }
   return out;
@@ -288,7 +304,7 @@ void SlamAdapter::correct_new_estimator(int64_t utime, const ChainedPose& chaine
   if (!odometry) return;
   out.correction = correction_message(
       slam_, options_.correction_sigma_m, options_.correction_sigma_rad,
-      FrameSinceKeyframe{utime, last_pose_->T_odom_camera, last_pose_->T_body_camera, *odometry});
+      FrameSinceKeyframe{utime, last_pose_->T_odom_camera, last_pose_->T_body_camera, *odometry}, anchor_);
   restart_correction_due_ = false;
 }
 

@@ -130,9 +130,10 @@ class SlamAdapter {
     Eigen::Isometry3d T_previous_current = Eigen::Isometry3d::Identity();
   };
   AdapterOutputs process(const kestrel::rgbd_frame_t& frame, const ChainedPose& chained);
-  /// The estimator's T_world_body at utime: interpolated between two states, or carried on
-  /// from the newest by its velocities; nothing when the states do not cover it.
-  std::optional<Eigen::Isometry3d> state_at(int64_t utime, bool ok_only) const;
+  /// The estimator's T_world_body at utime and its covariance (pose_t's convention):
+  /// interpolated between two states, or carried on from the newest by its velocities (the
+  /// covariance the newest's); nothing when the states do not cover it.
+  std::optional<WorldAnchor> state_at(int64_t utime, bool ok_only) const;
   void trim_frames();
   /// Drops waiting poses [begin, end), remembering an odometry break among them.
   void drop_poses(std::map<int64_t, ChainedPose>::iterator end);
@@ -154,10 +155,12 @@ class SlamAdapter {
   int64_t last_processed_utime_ = 0;
   bool lost_break_ = false;  ///< a pose flagged broken was dropped: flag the next one
   bool anchored_ = false;
+  std::optional<WorldAnchor> anchor_;  ///< the state the graph was anchored on (none on a saved map)
   struct StateSample {
     int64_t utime = 0;
     bool ok = false;  ///< status OK and the tilt settled: fit to anchor on (else only to bridge)
     Eigen::Isometry3d T_world_body = Eigen::Isometry3d::Identity();
+    Matrix6d pose_covariance = Matrix6d::Zero();                 ///< pose_t's convention; zero if STATE has none
     Eigen::Vector3d velocity = Eigen::Vector3d::Zero();          ///< world
     Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();  ///< body
   };

@@ -74,9 +74,22 @@ Matrix6d body_covariance(const Eigen::Isometry3d& T_world_body, const Eigen::Iso
   return 0.5 * (covariance + covariance.transpose());
 }
 
+Matrix6d anchor_covariance_at(const WorldAnchor& anchor, const Eigen::Isometry3d& T_world_body) {
+  // The graph moved by the anchor's error: a left perturbation of the world, phi = R_anchor
+  // dtheta_anchor, turning every pose about the anchor's position.
+  const Eigen::Matrix3d R_anchor = anchor.T_world_body.linear();
+  Matrix6d J = Matrix6d::Zero();
+  J.topLeftCorner<3, 3>().setIdentity();
+  J.topRightCorner<3, 3>() = -so3::hat(T_world_body.translation() - anchor.T_world_body.translation()) * R_anchor;
+  J.bottomRightCorner<3, 3>() = T_world_body.linear().transpose() * R_anchor;
+  const Matrix6d covariance = J * anchor.covariance * J.transpose();
+  return 0.5 * (covariance + covariance.transpose());
+}
+
 kestrel::slam_correction_t correction_message(const Slam& slam, double sigma_translation_m,
                                               double sigma_rotation_rad,
-                                              const std::optional<FrameSinceKeyframe>& frame) {
+                                              const std::optional<FrameSinceKeyframe>& frame,
+                                              const std::optional<WorldAnchor>& anchor) {
   const OdometryReference& reference = slam.reference();
   const Keyframe& kf = slam.keyframes().at(static_cast<size_t>(reference.keyframe_id));
   kestrel::slam_correction_t m{};
@@ -106,6 +119,7 @@ kestrel::slam_correction_t correction_message(const Slam& slam, double sigma_tra
     covariance.diagonal().tail<3>().setConstant(sigma_rotation_rad * sigma_rotation_rad);
     covariance += body_covariance(T_world_body, T_body_camera, odometry);
   }
+  if (anchor) covariance += anchor_covariance_at(*anchor, T_world_body);
   transport::covariance_to(covariance, m.covariance);
   return m;
 }

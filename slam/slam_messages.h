@@ -54,6 +54,20 @@ struct FrameSinceKeyframe {
   Matrix6d odometry_covariance = Matrix6d::Zero();
 };
 
+/// Where the graph was anchored in the estimator's world (SlamAdapter: Slam::change_world onto a
+/// STATE): the body's pose there and that state's covariance in pose_t's convention. The whole
+/// graph shares the anchor's error, moved rigidly: its attitude error turns every pose about the
+/// anchor, so it weighs more the further a pose is from it (anchor_covariance_at).
+struct WorldAnchor {
+  Eigen::Isometry3d T_world_body = Eigen::Isometry3d::Identity();
+  Matrix6d covariance = Matrix6d::Zero();
+};
+
+/// The anchor's error as the error of another pose of the graph, T_world_body, both in pose_t's
+/// convention: dp = dp_anchor - [p - p_anchor]x R_anchor dtheta_anchor,
+/// dtheta = R^T R_anchor dtheta_anchor.
+Matrix6d anchor_covariance_at(const WorldAnchor& anchor, const Eigen::Isometry3d& T_world_body);
+
 /// The correction for SLAM's reference (the newest keyframe, or the frame re-anchored on a
 /// covering keyframe: Slam::reference()), or, given `frame`, for that later frame
 /// (Slam::world_pose: the reference's optimised pose composed with the odometry since, whose
@@ -61,9 +75,12 @@ struct FrameSinceKeyframe {
 /// covariance is the optimiser's marginal of that keyframe (Slam::reference_marginal) and the
 /// re-anchoring's, carried to the frame with the odometry's own added, then to the body frame
 /// in pose_t's convention; when there is no marginal, a diagonal one of the given standard
-/// deviations (metres, radians) stands for the keyframe's. The slam must have a keyframe.
+/// deviations (metres, radians) stands for the keyframe's. The marginal is relative to the
+/// graph's fixed first keyframe; given `anchor`, that keyframe's own error in the estimator's
+/// world (the anchoring state's) is added. The slam must have a keyframe.
 kestrel::slam_correction_t correction_message(const Slam& slam, double sigma_translation_m,
                                               double sigma_rotation_rad,
-                                              const std::optional<FrameSinceKeyframe>& frame = std::nullopt);
+                                              const std::optional<FrameSinceKeyframe>& frame = std::nullopt,
+                                              const std::optional<WorldAnchor>& anchor = std::nullopt);
 
 }  // namespace kestrel::slam

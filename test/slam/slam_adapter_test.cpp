@@ -252,6 +252,59 @@ TEST_F(AdapterTest, ARestartedEstimatorGetsTheMapsWorldAtTheNextFrame) {
   }
 }
 
+// The correction a restarted estimator takes as the map's world carries the error the map got
+// where it was anchored: the first estimator's state there (its covariance on STATE), carried
+// to the corrected frame. Without it the new filter's first state was reported as certain as
+// the graph's marginal relative to its first keyframe: in the room's hover (1.5 m from the
+// anchor) 5 mm against a true error of 1-2 cm (System.AnEstimatorKilledWhileTheVehicleHovers...).
+TEST_F(AdapterTest, ARestartCorrectionCarriesTheAnchoringStatesError) {
+  const Eigen::Isometry3d X = estimator_world();
+  Matrix6d state_covariance = Matrix6d::Zero();
+  // [dp world; dtheta body]: 0.01 rad about the body's (the camera's) x, across its motion.
+  state_covariance.diagonal() << 1e-6, 2e-6, 3e-6, 1e-4, 5e-6, 4e-6;
+  std::optional<kestrel::slam_correction_t> corrections[2];
+  for (const bool with_covariance : {false, true}) {
+    SlamAdapter adapter(SlamOptions{}, nullptr);
+    int64_t seq = 10;
+    const auto send = [&](double k, const Eigen::Isometry3d& world) {
+      kestrel::state_t m = state(k, world);
+      m.seq = seq++;
+      if (with_covariance) {
+        m.cov_dim = 15;
+        m.covariance.assign(15, std::vector<double>(15, 0.0));
+        const int index[6] = {0, 1, 2, 6, 7, 8};
+        for (int r = 0; r < 6; ++r)
+          for (int c = 0; c < 6; ++c) m.covariance[index[r]][index[c]] = state_covariance(r, c);
+      }
+      adapter.on_state(m);
+    };
+    for (int k = 0; k <= 3; ++k) {
+      adapter.on_frame(frame(k));
+      adapter.on_vo_update(noisy_update(k));
+      if (k > 0) send(k - 0.5, X);
+    }
+    send(3.05, X);
+    ASSERT_TRUE(adapter.anchored());
+    seq = 0;  // a new estimator
+    send(4.5, Eigen::Isometry3d::Identity());
+    adapter.on_frame(frame(4));
+    adapter.on_vo_update(noisy_update(4));
+    adapter.on_frame(frame(5));
+    corrections[with_covariance] = adapter.on_vo_update(noisy_update(5)).correction;
+    ASSERT_TRUE(corrections[with_covariance]) << with_covariance;
+  }
+  // Anchored at frame 1, the first that two OK states bracket (0.5, 1.5).
+  WorldAnchor anchor{X * pose(0).inverse() * pose(1), state_covariance};
+  const Eigen::Isometry3d T_world_body = transport::from_message(corrections[1]->T_world_body, "test");
+  const Matrix6d added = transport::covariance_from(corrections[1]->covariance) -
+                         transport::covariance_from(corrections[0]->covariance);
+  EXPECT_LT((added - anchor_covariance_at(anchor, T_world_body)).cwiseAbs().maxCoeff(), 1e-12) << added;
+  // 0.4 m ahead of the anchor, turned by 0.01 rad across: 4 mm more, beside the anchor's own.
+  const double position_trace = added.topLeftCorner<3, 3>().trace();
+  EXPECT_GT(position_trace, 6e-6 + 0.4 * 0.4 * 1e-4);
+  EXPECT_LT(position_trace, 6e-6 + 0.4 * 0.4 * 1.1e-4);
+}
+
 // A restarted estimator and a VO restart that nothing bridges (the old filter's states end
 // before the gap, the new one's begin after it): the keyframe after the break stands where the
 // last one was, an assumption, not a measurement, so no correction goes out from it or the
@@ -581,6 +634,29 @@ TEST_F(AdapterTest, OnASavedMapTheRelocalisingFrameSendsTheFirstCorrectionInTheM
   adapter.reset();
   EXPECT_TRUE(adapter.anchored());
   EXPECT_FALSE(adapter.slam().localized());
+}
+
+// The graph is moved rigidly onto the state it is anchored on, so it shares that state's error:
+// its heading error turns every pose about the anchor. A yaw sigma of 0.01 rad, a pose 2 m
+// along x from the anchor and turned by 90 degrees: 2 cm sideways (y) and the same yaw.
+TEST(CorrectionCovariance, TheAnchorsErrorTurnsTheGraphAboutTheAnchor) {
+  WorldAnchor anchor;
+  anchor.T_world_body.translation() = Eigen::Vector3d(1.0, 2.0, 0.0);
+  const double p2 = 1e-6, y2 = 1e-4;
+  anchor.covariance.diagonal().head<3>().setConstant(p2);
+  anchor.covariance(5, 5) = y2;
+  Eigen::Isometry3d T_world_body = Eigen::Isometry3d::Identity();
+  T_world_body.translation() = Eigen::Vector3d(3.0, 2.0, 0.0);
+  T_world_body.linear() = Eigen::AngleAxisd(kPi / 2, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const Matrix6d P = anchor_covariance_at(anchor, T_world_body);
+  Matrix6d expected = Matrix6d::Zero();
+  expected.diagonal().head<3>().setConstant(p2);
+  expected(1, 1) += 4.0 * y2;                  // (2 m)^2 of yaw variance, sideways
+  expected(5, 5) = y2;                         // the body's yaw is the anchor's
+  expected(1, 5) = expected(5, 1) = 2.0 * y2;  // turning left moves it along +y
+  EXPECT_LT((P - expected).cwiseAbs().maxCoeff(), 1e-15) << P;
+  // At the anchor itself: the anchor's covariance.
+  EXPECT_LT((anchor_covariance_at(anchor, anchor.T_world_body) - anchor.covariance).cwiseAbs().maxCoeff(), 1e-18);
 }
 
 TEST(CorrectionCovariance, CarriesTheCameraMarginalToTheBody) {
