@@ -1,6 +1,9 @@
 // kestrel-goto: sends the vehicle somewhere. Asks the planner for a path from the vehicle's
 // current STATE to --goal (PLAN_REQUEST), prints the answer and, with --wait, follows STATE
-// until the vehicle is within --arrive-radius of the goal (kestrel-follow flies the PLAN).
+// along the plan until the vehicle has come to its end within --arrive-radius of the goal
+// (kestrel-follow flies the PLAN). Its progress along the plan is kept as kestrel-follow keeps
+// it (control/follower_node.h): a plan that passes near the goal on its way (a detour the
+// belief model chose) is not "arrived" there, with the vehicle still flying.
 // A "no path" answer (no map yet, start or goal not in known free space, no way) is asked
 // again every second for --retry-for seconds from the first answer: at start-up the map
 // changes fast. A request without an answer is sent again every --resend-after seconds (a
@@ -18,6 +21,7 @@
 #include "common/error.h"
 #include "common/transport/channels.h"
 #include "common/transport/node.h"
+#include "control/follower_node.h"
 #include "kestrel/plan_request_t.hpp"
 #include "kestrel/plan_t.hpp"
 #include "kestrel/state_t.hpp"
@@ -77,9 +81,15 @@ int run(const Options& o) {
     return plan && plan->status != kestrel::plan_t::STATUS_OK && plan->status != kestrel::plan_t::STATUS_BAD_REQUEST &&
            seconds_since(now_utime, *first_answer_utime) < o.retry_s;
   };
+  // The vehicle's progress along the plan, as the follower flying it keeps it; every STATE.
+  control::FollowerNodeOptions progress_options;
+  progress_options.follower.arrive_radius_m = o.arrive_radius_m;
+  progress_options.command_period_s = 0.0;
+  control::FollowerNode progress(progress_options);
   node.subscribe<kestrel::state_t>(channel::kState, [&](const kestrel::state_t& m) {
     if (m.status != kestrel::state_t::STATUS_OK && m.status != kestrel::state_t::STATUS_DEGRADED) return;
     state = m;
+    progress.on_state(m);
     // No map yet, or no way on it yet: at start-up the map changes fast (the first keyframes,
     // SLAM moving it into the estimator's world), so ask again each second for --retry-for.
     if (no_path_yet(m.utime) && seconds_since(m.utime, sent_utime) >= 1.0) {
@@ -97,6 +107,7 @@ int run(const Options& o) {
     if (m.request_id != request_id) return;
     plan = m;
     if (!first_answer_utime) first_answer_utime = state ? state->utime : m.utime;
+    if (m.status == kestrel::plan_t::STATUS_OK) progress.on_plan(m);
   });
   while (elapsed() < o.timeout_s && node.spin_once(100)) {
     if (!plan || (state && no_path_yet(state->utime))) continue;
@@ -104,7 +115,7 @@ int run(const Options& o) {
     if (state) {
       const auto& p = state->T_world_body.position;
       const double d = std::hypot(p[0] - o.goal[0], p[1] - o.goal[1], p[2] - o.goal[2]);
-      if (d <= o.arrive_radius_m) {
+      if (d <= o.arrive_radius_m && progress.follower().status() == control::FollowStatus::kArrived) {
         std::cout << "arrived: " << d << " m from the goal after " << elapsed() << " s\n";
         return kExitOk;
       }
