@@ -347,6 +347,69 @@ TEST_F(AdapterTest, ARestartedEstimatorGetsNoWorldFromAPoseAcrossAnUnbridgedVoBr
   }
 }
 
+// The other half of the rule above: the new filter waits across the unbridged break until a
+// loop closure to a keyframe from before the break places the new odometry in the map; that
+// step sends it the map's world, at the truth (the map's world is X).
+TEST_F(AdapterTest, ARestartedEstimatorGetsTheMapsWorldOnceALoopPlacesTheOdometryAfterABreak) {
+  const Eigen::Isometry3d X = estimator_world();
+  SlamAdapter adapter(SlamOptions{}, nullptr);
+  int64_t seq = 10;
+  fly_anchored(adapter, X, seq);
+  ASSERT_TRUE(adapter.anchored());
+  const size_t before_break = adapter.slam().keyframes().size();
+  // The new filter's world is the odometry frame; its states bracket every frame from 4.5 on.
+  seq = 0;
+  const auto new_state = [&](int64_t utime, const Eigen::Isometry3d& T) {
+    kestrel::state_t m{};
+    m.utime = utime;
+    m.seq = seq++;
+    m.status = kestrel::state_t::STATUS_OK;
+    m.T_world_body = transport::to_message(T);
+    adapter.on_state(m);
+  };
+  new_state(utime(4) + 50'000, pose(4));
+  // Frame 4, then the break at frame 5, on along x to frame 9, a hover there (loop candidates
+  // are 4 s old), and back along the way to frame 0.
+  std::vector<Eigen::Isometry3d> way;
+  for (int k = 4; k <= 9; ++k) way.push_back(pose(k));
+  for (int i = 0; i < 30; ++i) way.push_back(pose(9));
+  for (int k = 8; k >= 0; --k) way.push_back(pose(k));
+  for (int i = 0; i < 5; ++i) way.push_back(pose(0));
+  int corrections = 0;
+  bool placed_before = false;
+  for (size_t j = 0; j < way.size(); ++j) {
+    const int64_t t = utime(4) + 100'000 * static_cast<int64_t>(j);
+    adapter.on_frame(transport::encode_rgbd(room_.render(way[j], test::test_camera(), t)));
+    kestrel::vo_update_t u{};
+    u.utime = t;
+    u.reference_utime = t - 100'000;
+    u.status = j == 1 ? kestrel::vo_update_t::STATUS_NO_REFERENCE : kestrel::vo_update_t::STATUS_OK;
+    u.flags = kestrel::vo_update_t::FLAG_NEW_REFERENCE;
+    u.T_reference_current =
+        transport::to_message(j <= 1 ? Eigen::Isometry3d::Identity() : way[j - 1].inverse() * way[j]);
+    u.T_body_camera = transport::to_message(Eigen::Isometry3d::Identity());
+    if (j > 1)
+      for (int i = 0; i < 3; ++i) u.covariance[7 * i] = 4e-6;
+    placed_before = adapter.slam().odometry_placed();
+    const AdapterOutputs out = adapter.on_vo_update(u);
+    if (j > 0) new_state(t + 50'000, way[j]);
+    if (!out.correction) continue;
+    // The first goes out at the step that placed the odometry (later loop optimisations send
+    // theirs, as to any filter); none before it.
+    if (++corrections == 1) {
+      EXPECT_FALSE(placed_before) << "sent at the step that placed the odometry, not later";
+      EXPECT_TRUE(adapter.slam().odometry_placed()) << "sent before the odometry was placed";
+    }
+    const Eigen::Isometry3d expected = X * pose(0).inverse() * way[j];
+    EXPECT_LT((transport::from_message(out.correction->T_world_body, "test").translation() - expected.translation()).norm(),
+              0.03);
+  }
+  EXPECT_EQ(adapter.bridges(), 0);
+  EXPECT_TRUE(adapter.slam().odometry_placed()) << "no loop to a keyframe from before the break";
+  EXPECT_GT(adapter.slam().keyframes().size(), before_break);
+  EXPECT_GE(corrections, 1);
+}
+
 TEST_F(AdapterTest, OdometryEdgesTakeTheVosReportedCovarianceChainedBetweenKeyframes) {
   // Every frame is the next one's reference, 2 mm (per axis) of translation noise per step:
   // keyframe 1 is frame 3, three steps on, so its edge has 3 * (2 mm)^2 plus the 1 mm floor.
