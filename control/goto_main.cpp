@@ -15,6 +15,7 @@
 #include <chrono>
 #include <cmath>
 #include <iostream>
+#include <limits>
 #include <optional>
 
 #include "common/cli.h"
@@ -82,8 +83,11 @@ int run(const Options& o) {
            seconds_since(now_utime, *first_answer_utime) < o.retry_s;
   };
   // The vehicle's progress along the plan, as the follower flying it keeps it; every STATE.
+  // Never "off the path" here: holding the vehicle is kestrel-follow's call, with its own
+  // --max-deviation; goto only waits for the end.
   control::FollowerNodeOptions progress_options;
   progress_options.follower.arrive_radius_m = o.arrive_radius_m;
+  progress_options.follower.max_deviation_m = std::numeric_limits<double>::infinity();
   progress_options.command_period_s = 0.0;
   control::FollowerNode progress(progress_options);
   node.subscribe<kestrel::state_t>(channel::kState, [&](const kestrel::state_t& m) {
@@ -102,12 +106,14 @@ int run(const Options& o) {
       sent = false;
     }
     if (!sent) send_request();
-  });
+  }, 400);  // as kestrel-follow: a stalled goto must not lose the states its progress needs
   node.subscribe<kestrel::plan_t>(channel::kPlan, [&](const kestrel::plan_t& m) {
     if (m.request_id != request_id) return;
+    // A plan the follower refuses (a non-finite waypoint: InputError, logged by the node) is
+    // no answer: asked again after --resend-after.
+    if (m.status == kestrel::plan_t::STATUS_OK) progress.on_plan(m);
     plan = m;
     if (!first_answer_utime) first_answer_utime = state ? state->utime : m.utime;
-    if (m.status == kestrel::plan_t::STATUS_OK) progress.on_plan(m);
   });
   while (elapsed() < o.timeout_s && node.spin_once(100)) {
     if (!plan || (state && no_path_yet(state->utime))) continue;

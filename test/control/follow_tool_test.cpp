@@ -140,15 +140,21 @@ TEST(GotoTool, ArrivesAtThePlansEndNotWhereThePlanFirstPassesByTheGoal) {
       while (i + 2 < corners.size() && left > (corners[i + 1] - corners[i]).norm()) left -= (corners[i + 1] - corners[i]).norm(), ++i;
       const Eigen::Vector2d at = corners[i] + left * (corners[i + 1] - corners[i]).normalized();
       fly_to(at.x(), at.y());
-      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
     }
   };
   fly_along(0.0, 2.5);
   EXPECT_FALSE(live.wait_exit("goto", 1.0)) << "goto stopped where the plan first passed by the goal:\n"
                                             << live.output("goto");
   fly_along(2.52, 6.0);
-  for (int i = 0; i < 100 && !live.wait_exit("goto", 0.0); ++i) fly_to(2.0, 0.0);
-  EXPECT_EQ(live.exit_status("goto", 10.0), 0) << live.output("goto");
+  // Holding at the end until goto has seen it (at most 30 s: a slow goto under the sanitizers).
+  std::optional<int> went;
+  for (int i = 0; i < 1500 && !(went = live.wait_exit("goto", 0.0)); ++i) {
+    fly_to(2.0, 0.0);
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  ASSERT_TRUE(went) << "goto did not arrive at the end:\n" << live.output("goto");
+  EXPECT_EQ(*went, 0) << live.output("goto");
   EXPECT_NE(live.output("goto").find("arrived"), std::string::npos) << live.output("goto");
   live.stop_all();
   live.finish();
