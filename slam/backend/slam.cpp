@@ -375,8 +375,12 @@ SlamStep Slam::close_loop(SlamStep step) {
   const bool gate = gate_by_pose_ && lo.max_distance_m > 0.0;
   auto allowed = [&](int entry) {
     const Keyframe& k = keyframes_[static_cast<size_t>(entry)];
-    // Time orders keyframes within a flight only (slam_map.h).
-    if (k.session == query.session && k.utime > query.utime - min_age_us) return false;
+    // Time orders keyframes within a flight only (slam_map.h). The minimum age keeps a loop
+    // from re-measuring what the odometry just measured; across a break no loop has placed
+    // yet, the keyframes from before it are no odometry neighbours, however recent (a VO lost
+    // over a hover gets its place back at once, not 4 s later).
+    const bool across_unplaced_break = !gate_by_pose_ && unplaced_from_ >= 0 && k.id < unplaced_from_;
+    if (k.session == query.session && !across_unplaced_break && k.utime > query.utime - min_age_us) return false;
     if (!gate) return true;
     const Eigen::Isometry3d& T_world_k = graph_.poses[static_cast<size_t>(entry)];
     return se3::translation_distance(T_world_k, T_world_query) <= lo.max_distance_m &&

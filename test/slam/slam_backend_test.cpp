@@ -405,6 +405,38 @@ TEST(Slam, OnlyALoopToAKeyframeFromBeforeABreakPlacesTheOdometry) {
   EXPECT_TRUE(slam.odometry_placed());
 }
 
+// A VO lost while the camera lingers (a hover over a blank patch, a fast turn and back): the
+// keyframes from just before the break are younger than the loops' minimum age (4 s), yet
+// across a break nothing placed they are no odometry neighbours, so a loop to them places the
+// new odometry at once; before, it waited until they were 4 s old. Along a wall every place
+// is seen once, so no older keyframe can do it here.
+TEST(Slam, AnOdometryBreakIsPlacedAtOnceByTheKeyframesJustBeforeIt) {
+  const SyntheticRoom room(5, 7.0, 1.5, 2.5);
+  const auto path = test::straight_path(40, 12.0);
+  Slam slam(SlamOptions{}, builtin_vocabulary());
+  int64_t utime = 1'000'000;
+  for (int k = 0; k < 20; ++k) slam.add(room.render(path[k], test::test_camera(), utime += 200'000), path[k]);
+  ASSERT_TRUE(slam.odometry_placed());
+  const auto before_break = static_cast<int64_t>(slam.keyframes().size());
+  const int64_t last_keyframe_utime = slam.keyframes().back().utime;
+  // The break at frame 20: the new odometry starts again from identity.
+  const Eigen::Isometry3d T_odom_world = path[20].inverse();
+  int placed_at = -1;
+  SlamStep placing;
+  for (int k = 20; k < 26 && placed_at < 0; ++k) {
+    const SlamStep step = slam.add(room.render(path[k], test::test_camera(), utime += 200'000), T_odom_world * path[k],
+                                   k == 20 ? OdometryLink::kBroken : OdometryLink::kContinuous);
+    if (slam.odometry_placed()) placed_at = k, placing = step;
+  }
+  ASSERT_GE(placed_at, 0) << "no loop to the keyframes just before the break";
+  EXPECT_LE(placed_at, 22);
+  EXPECT_TRUE(placing.loop_closed);
+  EXPECT_LT(placing.loop_keyframe_id, before_break);
+  EXPECT_LT(utime - last_keyframe_utime, 4'000'000) << "within the loops' minimum age";
+  // Placed where it is: the newest keyframe at the truth (the map's world is the first odometry's).
+  EXPECT_LT(se3::translation_distance(slam.graph().poses.back(), path[static_cast<size_t>(placed_at)]), 0.02);
+}
+
 TEST(Slam, ALoopFreeRunClosesNoLoop) {
   const SyntheticRoom room(5, 7.0, 1.5, 2.5);
   const LoopRun r = run(room, test::straight_path(40, 12.0), 0.004);
