@@ -11,6 +11,7 @@
 
 #include "common/error.h"
 #include "common/text.h"
+#include "common/transport/convert.h"
 #include "mapper/octree_io.h"
 #include "planner/map_sources.h"
 
@@ -50,9 +51,11 @@ std::pair<Config, Mat4> state_from_message(const kestrel::state_t& s) {
   if (!c.allFinite()) throw InputError("STATE: position not finite");
   Mat4 cov = Mat4::Identity();
   if (s.cov_dim >= 9) {
-    const int idx[4] = {0, 1, 2, 8};
+    // x, y, z and the rotation about body z (the heading, for a level vehicle).
+    const Matrix6d pose = transport::pose_covariance_from(s);
+    const int idx[4] = {0, 1, 2, 5};
     for (int i = 0; i < 4; ++i)
-      for (int j = 0; j < 4; ++j) cov(i, j) = s.covariance[idx[i]][idx[j]];
+      for (int j = 0; j < 4; ++j) cov(i, j) = pose(idx[i], idx[j]);
   }
   if (!cov.allFinite()) throw InputError("STATE: covariance not finite");
   return {c, cov};

@@ -141,17 +141,9 @@ AdapterOutputs SlamAdapter::on_state(const kestrel::state_t& state) {
               (visual_only ||
                tilt_variance <= options_.anchor_max_tilt_sigma_rad * options_.anchor_max_tilt_sigma_rad);
   sample.T_world_body = transport::from_message(state.T_world_body, options_.state_channel.c_str());
-  // The pose's block of the error state ([dp; dv; dtheta; ...]: rows 0-2 and 6-8), which the
-  // graph inherits where it is anchored on this state.
-  if (state.cov_dim >= 9 && static_cast<int>(state.covariance.size()) >= 9) {
-    const int index[6] = {0, 1, 2, 6, 7, 8};
-    for (int r = 0; r < 6; ++r)
-      for (int c = 0; c < 6; ++c) {
-        const auto& row = state.covariance[static_cast<size_t>(index[r])];
-        if (static_cast<int>(row.size()) > index[c]) sample.pose_covariance(r, c) = row[static_cast<size_t>(index[c])];
-      }
-    if (!sample.pose_covariance.allFinite()) sample.ok = false;  // not to anchor on; a bridge needs only the pose
-  }
+  // The pose's covariance, which the graph inherits where it is anchored on this state.
+  sample.pose_covariance = transport::pose_covariance_from(state);
+  if (!sample.pose_covariance.allFinite()) sample.ok = false;  // not to anchor on; a bridge needs only the pose
   for (int i = 0; i < 3; ++i) {
     sample.velocity[i] = state.velocity[i];
     sample.angular_velocity[i] = state.angular_velocity[i];

@@ -74,4 +74,19 @@ void covariance_to(const Matrix6d& m, double (&c)[36]) {
   out = m;
 }
 
+Matrix6d pose_covariance_from(const kestrel::state_t& m) {
+  Matrix6d P = Matrix6d::Zero();
+  if (m.cov_dim < 9) return P;
+  constexpr size_t kIndex[6] = {0, 1, 2, 6, 7, 8};
+  for (size_t r = 0; r < 6; ++r) {
+    if (m.covariance.size() <= kIndex[r]) return Matrix6d::Zero();
+    const std::vector<double>& row = m.covariance[kIndex[r]];
+    for (size_t c = 0; c < 6; ++c) {
+      if (row.size() <= kIndex[c]) return Matrix6d::Zero();
+      P(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(c)) = row[kIndex[c]];
+    }
+  }
+  return P;
+}
+
 }  // namespace kestrel::transport

@@ -8,6 +8,7 @@
 #include "common/geometry/se3.h"
 #include "kestrel/camera_info_t.hpp"
 #include "kestrel/pose3_t.hpp"
+#include "kestrel/state_t.hpp"
 
 namespace kestrel::transport {
 
@@ -23,5 +24,10 @@ PinholeCamera from_message(const kestrel::camera_info_t& m, const char* what);
 /// Row-major 6x6 from/to a message's double[36].
 Matrix6d covariance_from(const double (&c)[36]);
 void covariance_to(const Matrix6d& m, double (&c)[36]);
+
+/// The pose block of STATE's error-state covariance in pose_t's convention, [dp (world);
+/// dtheta (body)]: rows and columns 0-2 and 6-8 of state_t's. Zero where the state carries
+/// fewer (cov_dim < 9, or rows shorter than cov_dim says).
+Matrix6d pose_covariance_from(const kestrel::state_t& m);
 
 }  // namespace kestrel::transport

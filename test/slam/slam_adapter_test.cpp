@@ -69,21 +69,31 @@ class AdapterTest : public ::testing::Test {
       for (int i = 0; i < 3; ++i) u.covariance[7 * i] = 4e-6;
     return u;
   }
-  // Frames 0-3 with the estimator's states in world X around each (seq counting up from `seq`),
-  // until the graph is anchored in X.
-  void fly_anchored(SlamAdapter& adapter, const Eigen::Isometry3d& X, int64_t& seq) const {
+  // A state carrying a pose covariance P ([dp world; dtheta body]) in its 15-dof error state,
+  // as the IMU filter publishes it (rows and columns 0-2 and 6-8).
+  static void set_pose_covariance(kestrel::state_t& m, const Matrix6d& P) {
+    m.cov_dim = 15;
+    m.covariance.assign(15, std::vector<double>(15, 0.0));
+    const int index[6] = {0, 1, 2, 6, 7, 8};
+    for (int r = 0; r < 6; ++r)
+      for (int c = 0; c < 6; ++c) m.covariance[index[r]][index[c]] = P(r, c);
+  }
+  // Frames 0-3 with the estimator's states in world X around each (seq counting up from `seq`;
+  // with `P`, carrying that pose covariance), until the graph is anchored in X.
+  void fly_anchored(SlamAdapter& adapter, const Eigen::Isometry3d& X, int64_t& seq,
+                    const std::optional<Matrix6d>& P = std::nullopt) const {
+    const auto send = [&](double k) {
+      kestrel::state_t m = state(k, X);
+      m.seq = seq++;
+      if (P) set_pose_covariance(m, *P);
+      adapter.on_state(m);
+    };
     for (int k = 0; k <= 3; ++k) {
       adapter.on_frame(frame(k));
       adapter.on_vo_update(noisy_update(k));
-      if (k > 0) {
-        kestrel::state_t m = state(k - 0.5, X);
-        m.seq = seq++;
-        adapter.on_state(m);
-      }
+      if (k > 0) send(k - 0.5);
     }
-    kestrel::state_t m = state(3.05, X);
-    m.seq = seq++;
-    adapter.on_state(m);
+    send(3.05);
   }
   static Eigen::Isometry3d estimator_world() {
     Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
@@ -267,27 +277,11 @@ TEST_F(AdapterTest, ARestartCorrectionCarriesTheAnchoringStatesError) {
   for (const bool with_covariance : {false, true}) {
     SlamAdapter adapter(SlamOptions{}, nullptr);
     int64_t seq = 10;
-    const auto send = [&](double k, const Eigen::Isometry3d& world) {
-      kestrel::state_t m = state(k, world);
-      m.seq = seq++;
-      if (with_covariance) {
-        m.cov_dim = 15;
-        m.covariance.assign(15, std::vector<double>(15, 0.0));
-        const int index[6] = {0, 1, 2, 6, 7, 8};
-        for (int r = 0; r < 6; ++r)
-          for (int c = 0; c < 6; ++c) m.covariance[index[r]][index[c]] = state_covariance(r, c);
-      }
-      adapter.on_state(m);
-    };
-    for (int k = 0; k <= 3; ++k) {
-      adapter.on_frame(frame(k));
-      adapter.on_vo_update(noisy_update(k));
-      if (k > 0) send(k - 0.5, X);
-    }
-    send(3.05, X);
+    fly_anchored(adapter, X, seq, with_covariance ? std::optional<Matrix6d>(state_covariance) : std::nullopt);
     ASSERT_TRUE(adapter.anchored());
-    seq = 0;  // a new estimator
-    send(4.5, Eigen::Isometry3d::Identity());
+    kestrel::state_t restarted = state(4.5, Eigen::Isometry3d::Identity());
+    restarted.seq = 0;  // a new estimator
+    adapter.on_state(restarted);
     adapter.on_frame(frame(4));
     adapter.on_vo_update(noisy_update(4));
     adapter.on_frame(frame(5));
