@@ -117,6 +117,10 @@ void add_options(cli::App& app, Options& o, SlamOptions& s) {
   app.add_option("--relocalisation-confirmations", s.relocalisation.confirmations,
                  "With --map: verified placements from different frames that must agree before the camera is placed")
       ->check(CLI::PositiveNumber)->capture_default_str();
+  app.add_option("--map-unplaced-after", s.relocalisation.map_unplaced_after_s,
+                 "With --map: seconds without a placement after which keyframes are made in a frame of their own, "
+                 "joined to the map when the camera is placed (1e9: none before the placement)")
+      ->check(CLI::NonNegativeNumber)->capture_default_str();
   app.add_option("--tum", o.tum, "Offline: run VO + SLAM over this TUM RGB-D folder");
   app.add_option("--out", o.out, "Offline: write the optimised camera trajectory here (TUM format)");
   app.add_option("--vo-out", o.vo_out, "Offline: write the odometry-only trajectory here too");
@@ -169,8 +173,9 @@ void report_relocalisation(const std::optional<Relocalisation>& r, bool from_map
     return;
   }
   const Eigen::Vector3d p = r->T_world_camera.translation();
-  spdlog::info("relocalised at frame {} of those tried (utime {}) in keyframe {}: camera at ({:.3f}, {:.3f}, {:.3f}) m",
-               r->frames_tried, r->utime, r->keyframe_id, p.x(), p.y(), p.z());
+  spdlog::info("relocalised at frame {} of those tried (utime {}) in keyframe {}: camera at ({:.3f}, {:.3f}, {:.3f}) m; "
+               "{} keyframe(s) made before it joined the map",
+               r->frames_tried, r->utime, r->keyframe_id, p.x(), p.y(), p.z(), r->keyframes_joined);
 }
 
 int run_offline(const Options& o, const SlamOptions& options, std::shared_ptr<const Vocabulary> vocabulary) {

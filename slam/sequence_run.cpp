@@ -96,7 +96,11 @@ SlamRun run_slam_sequence(size_t count, const std::function<RgbdFrame(size_t)>& 
     corrections.push_back({r.reference.utime, T_world_reference * r.reference.T_odom_camera.inverse(),
                            r.continues_previous});
   }
-  for (const Placed& p : placed) run.slam.push_back(p.utime, place_frame(corrections, p.reference, p.utime, p.T_odom_camera));
+  // Frames whose reference stayed provisional (never placed in the saved map) are in no world
+  // the map knows: they are left out.
+  for (const Placed& p : placed)
+    if (slam.in_world(references[p.reference].reference.keyframe_id))
+      run.slam.push_back(p.utime, place_frame(corrections, p.reference, p.utime, p.T_odom_camera));
   for (const auto& e : slam.graph().edges) {
     if (e.kind != EdgeKind::kLoopClosure) continue;
     run.loops.push_back({slam.keyframes()[static_cast<size_t>(e.from)].utime,

@@ -267,7 +267,8 @@ AdapterOutputs SlamAdapter::process(const kestrel::rgbd_frame_t& message, const 
   }
   // Placed in a saved map: the map's graph goes out too, so that the mapper (restored from its
   // journal) publishes the map the planner flies in before this flight makes a keyframe.
-  if (step.keyframe || step.relocalised) out.graph = graph_message(slam_);
+  // Not before: provisional keyframes (made before the placement) are in a frame of their own.
+  if ((step.keyframe || step.relocalised) && slam_.localized()) out.graph = graph_message(slam_);
   out.step = step;
   try_anchor(out);
   // A correction is a pose in the estimator's world: none before the graph is anchored in it
@@ -278,7 +279,8 @@ AdapterOutputs SlamAdapter::process(const kestrel::rgbd_frame_t& message, const 
   // in the gap, and a new estimator would take it as the map's world whatever its error.
   const bool new_estimator_waits =
       restart_correction_due_ && message.utime > restart_state_utime_ && slam_.odometry_placed();
-  if ((step.optimisation || step.reanchored || step.relocalised || new_estimator_waits) && anchored_) {
+  if ((step.optimisation || step.reanchored || step.relocalised || new_estimator_waits) && anchored_ &&
+      slam_.localized()) {
     out.correction =
         correction_message(slam_, options_.correction_sigma_m, options_.correction_sigma_rad, std::nullopt, anchor_);
     if (new_estimator_waits) restart_correction_due_ = false;

@@ -36,6 +36,7 @@ void check_options(const SlamOptions& o) {
   require(r.max_candidates >= 1 && r.confirmations >= 1, "relocalisation: max_candidates and confirmations must be >= 1");
   require(r.max_disagreement_m >= 0.0 && r.max_disagreement_rad >= 0.0 && r.max_span_s >= 0.0,
           "relocalisation bounds must be >= 0");
+  require(r.map_unplaced_after_s >= 0.0, "relocalisation.map_unplaced_after_s must be >= 0 (infinite: never)");
   const OdometryNoise& n = o.odometry;
   require(n.translation_floor_m > 0.0 && n.rotation_floor_rad > 0.0, "odometry noise floors must be > 0");
   require(n.translation_per_m >= 0.0 && n.rotation_per_rad >= 0.0 && n.rotation_per_m >= 0.0,
@@ -163,8 +164,24 @@ SlamMap Slam::map() const {
   map.graph = graph_;
   map.gate_information = gate_information_;
   map.gate_information.resize(graph_.edges.size(), Matrix6d::Identity());
+  if (provisional_from_ >= 0) {
+    // The provisional keyframes are the newest and only their own edges touch them.
+    const auto kept = static_cast<size_t>(provisional_from_);
+    map.keyframes.resize(kept);
+    PoseGraph3d graph;
+    for (size_t v = 0; v < kept; ++v) graph.add_vertex(graph_.ids[v], graph_.poses[v], graph_.fixed[v] != 0);
+    std::vector<Matrix6d> gate;
+    for (size_t e = 0; e < graph_.edges.size(); ++e) {
+      const auto& edge = graph_.edges[e];
+      if (static_cast<size_t>(edge.from) >= kept || static_cast<size_t>(edge.to) >= kept) continue;
+      graph.edges.push_back(edge);
+      gate.push_back(map.gate_information[e]);
+    }
+    map.graph = std::move(graph);
+    map.gate_information = std::move(gate);
+  }
   map.vocabulary = places_->vocabulary_in_use();
-  const bool added = std::any_of(keyframes_.begin(), keyframes_.end(),
+  const bool added = std::any_of(map.keyframes.begin(), map.keyframes.end(),
                                  [this](const Keyframe& k) { return k.session == session_; });
   map.sessions = session_ + (added ? 1 : 0);
   map.revision = revision_;
@@ -224,6 +241,7 @@ void Slam::reset() {
   relocalisation_.reset();
   relocalisation_tries_ = 0;
   placements_.clear();
+  provisional_from_ = -1;
   if (loaded_) restore(*loaded_);
 }
 
@@ -259,6 +277,10 @@ void Slam::change_world(const Eigen::Isometry3d& T_new_world) {
 bool Slam::wants_keyframe(const Eigen::Isometry3d& T_odom_camera, OdometryLink link) const {
   if (!T_odom_camera.matrix().allFinite()) return false;
   if (!localized_) return true;
+  return keyframe_due(T_odom_camera, link);
+}
+
+bool Slam::keyframe_due(const Eigen::Isometry3d& T_odom_camera, OdometryLink link) const {
   // After a restart the earlier keyframe's odometry ends: the edge must span only the gap.
   if (keyframes_.empty() || link != OdometryLink::kContinuous) return true;
   const Eigen::Isometry3d T_last_cur = reference_.T_odom_camera.inverse() * T_odom_camera;
@@ -324,7 +346,16 @@ SlamStep Slam::add(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camer
     localized_ = true;
     lost_since_utime_ = -1;
   }
-  if (!localized_) return relocalise(frame, T_odom_camera, motion, sensor);  // a break cleared the placements (above)
+  if (!localized_) {
+    FrameFeatures features = extractor_.extract(frame, motion);
+    SlamStep step = relocalise(frame, T_odom_camera, odometry_covariance, features, sensor);  // a break cleared the placements (above)
+    // Lost while localising only (not a camera that was never placed): the wait is short, and
+    // the map is not to grow.
+    if (step.relocalised || lost_since_utime_ >= 0) return step;
+    const double unplaced_s = 1e-6 * static_cast<double>(frame.utime - first_frame_utime_);
+    if (!(unplaced_s >= options_.relocalisation.map_unplaced_after_s)) return step;
+    return map_unplaced(frame, T_odom_camera, link, odometry_covariance, motion, sensor, std::move(features), step);
+  }
   SlamStep step;
   if (!wants_keyframe(T_odom_camera, link)) return step;
 
@@ -336,6 +367,37 @@ SlamStep Slam::add(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camer
       reanchor(frame, T_odom_camera, link, odometry_covariance, features, sensor, step)) {
     return step;
   }
+  return add_keyframe(frame, T_odom_camera, link, odometry_covariance, motion, sensor, std::move(features), step);
+}
+
+SlamStep Slam::map_unplaced(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera, OdometryLink link,
+                            const std::optional<Matrix6d>& odometry_covariance, const sensors::FrameMotion& motion,
+                            const sensors::SensorProfile& sensor, FrameFeatures features, SlamStep step) {
+  const bool first = provisional_from_ < 0;
+  if (!first && !keyframe_due(T_odom_camera, link)) return step;
+  // Covered ground re-anchors on the provisional keyframes as it does on the map's
+  // (reanchor() looks at no other keyframe meanwhile).
+  if (!first && link != OdometryLink::kBroken && options_.coverage.reuse_keyframes &&
+      reanchor(frame, T_odom_camera, link, odometry_covariance, features, sensor, step)) {
+    return step;
+  }
+  if (first) {
+    // A frame of its own from here: a break before it is no break within it.
+    provisional_from_ = static_cast<int64_t>(keyframes_.size());
+    gate_by_pose_ = true;
+    unplaced_from_ = -1;
+  }
+  return add_keyframe(frame, T_odom_camera, link, odometry_covariance, motion, sensor, std::move(features), step);
+}
+
+SlamStep Slam::add_keyframe(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera, OdometryLink link,
+                            const std::optional<Matrix6d>& odometry_covariance, const sensors::FrameMotion& motion,
+                            const sensors::SensorProfile& sensor, FrameFeatures features, SlamStep step) {
+  const bool odometry_broken = link == OdometryLink::kBroken;
+  // The first keyframe of the flight, or the first provisional one: the first of its frame,
+  // where the odometry puts it, with no edge (the first provisional one is not the gauge: the
+  // optimiser holds a component that reaches no fixed vertex at its first vertex).
+  const bool first_of_frame = keyframes_.empty() || provisional_from_ == static_cast<int64_t>(keyframes_.size());
   Keyframe kf;
   kf.id = static_cast<int64_t>(keyframes_.size());
   kf.utime = frame.utime;
@@ -345,14 +407,13 @@ SlamStep Slam::add(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camer
   kf.T_odom_camera = T_odom_camera;
   kf.T_body_camera = frame.T_body_camera;
   kf.T_camera_depth = motion.T_rgb_depth();
-  kf.link = keyframes_.empty() ? OdometryLink::kContinuous : weaker(link, reference_.link);
+  kf.link = first_of_frame ? OdometryLink::kContinuous : weaker(link, reference_.link);
   kf.sensor = sensor;
   kf.features = std::move(features);
   const Eigen::Isometry3d T_world_camera =
-      keyframes_.empty() ? T_odom_camera
-                         : (odometry_broken ? reference_world_pose() : world_pose(T_odom_camera));
+      first_of_frame ? T_odom_camera : (odometry_broken ? reference_world_pose() : world_pose(T_odom_camera));
   graph_.add_vertex(kf.id, T_world_camera, keyframes_.empty());
-  if (!keyframes_.empty()) add_odometry_edge(kf, link, odometry_covariance);
+  if (!first_of_frame) add_odometry_edge(kf, link, odometry_covariance);
   reference_ = OdometryReference{kf.id, kf.utime, kf.T_odom_camera, kf.T_body_camera};
   reference_marginal_.reset();  // the previous reference's: a loop closure below gives this one's
   keyframes_.push_back(std::move(kf));
@@ -379,6 +440,9 @@ SlamStep Slam::close_loop(SlamStep step) {
     // from re-measuring what the odometry just measured; across a break no loop has placed
     // yet, the keyframes from before it are no odometry neighbours, however recent (a VO lost
     // over a hover gets its place back at once, not 4 s later).
+    // Not placed in the saved map yet: the map's keyframes are for relocalise() (which confirms
+    // a placement before it joins the two); only the provisional ones are loop candidates.
+    if (!in_world(query.id) && in_world(k.id)) return false;
     const bool across_unplaced_break = !gate_by_pose_ && unplaced_from_ >= 0 && k.id < unplaced_from_;
     if (k.session == query.session && !across_unplaced_break && k.utime > query.utime - min_age_us) return false;
     if (!gate) return true;
@@ -453,14 +517,15 @@ bool Slam::accept_placement(const RgbdFrame& frame, const Eigen::Isometry3d& T_o
 }
 
 SlamStep Slam::relocalise(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera,
-                          const sensors::FrameMotion& motion, const sensors::SensorProfile& sensor) {
+                          const std::optional<Matrix6d>& odometry_covariance, const FrameFeatures& features,
+                          const sensors::SensorProfile& sensor) {
   const RelocalisationOptions& r = options_.relocalisation;
   SlamStep step;
   ++relocalisation_tries_;
-  const FrameFeatures features = extractor_.extract(frame, motion);
   if (static_cast<int>(features.num_points()) < options_.verification.min_inliers) return step;
-  const std::vector<BowMatch> candidates = places_->query(
-      features.descriptors, r.max_candidates, [this](int entry) { return !keyframes_[static_cast<size_t>(entry)].thinned; });
+  const std::vector<BowMatch> candidates = places_->query(features.descriptors, r.max_candidates, [this](int entry) {
+    return !keyframes_[static_cast<size_t>(entry)].thinned && in_world(entry);
+  });
   for (const BowMatch& candidate : candidates) {
     ++step.candidates;
     const Keyframe& kf = keyframes_[static_cast<size_t>(candidate.entry)];
@@ -469,18 +534,61 @@ SlamStep Slam::relocalise(const RgbdFrame& frame, const Eigen::Isometry3d& T_odo
         verify_loop(features, kf.features, loop_verification(options_.verification, kf.sensor, sensor), seed);
     step.loop = located;
     if (!located.accepted) continue;
+    const OdometryReference provisional = reference_;  // accept_placement() replaces it
     if (!accept_placement(frame, T_odom_camera, kf, located)) return step;  // one placement per frame: the best verified
+    int joined = 0;
+    if (provisional_from_ >= 0) {
+      joined = static_cast<int>(keyframes_.size()) - static_cast<int>(provisional_from_);
+      join_provisional(provisional, T_odom_camera, odometry_covariance, kf, located, step);
+    }
     localized_ = true;
     lost_since_utime_ = -1;
     gate_by_pose_ = true;
     unplaced_from_ = -1;
-    relocalisation_ = Relocalisation{frame.utime, relocalisation_tries_, kf.id, reference_world_pose()};
+    relocalisation_ = Relocalisation{frame.utime, relocalisation_tries_, kf.id, reference_world_pose(), joined};
     relocalisation_tries_ = 0;
     step.relocalised = true;
     step.reanchor_keyframe_id = kf.id;
     return step;
   }
   return step;
+}
+
+void Slam::join_provisional(const OdometryReference& provisional, const Eigen::Isometry3d& T_odom_camera,
+                            const std::optional<Matrix6d>& odometry_covariance, const Keyframe& kf,
+                            const LoopConstraint& located, SlamStep& step) {
+  // The placed frame in the provisional reference's keyframe r, through the odometry since the
+  // reference (and the reference's own uncertainty in r, when it was re-anchored or carried).
+  const Eigen::Isometry3d T_ref_frame = provisional.T_odom_camera.inverse() * T_odom_camera;
+  const Eigen::Isometry3d T_r_frame = provisional.T_keyframe_camera * T_ref_frame;
+  const Matrix6d covariance_r_frame = right_covariance(composed_information(
+      T_ref_frame, provisional.covariance,
+      odometry_edge_information(T_ref_frame, options_.odometry, OdometryLink::kContinuous, odometry_covariance)));
+  // Inverted: T Exp(d) inverse = T^-1 Exp(-Ad(T) d).
+  const Eigen::Isometry3d T_frame_r = T_r_frame.inverse();
+  const Matrix6d Ad = se3::adjoint(T_r_frame);
+  const Matrix6d information_frame_r = information_of(Ad * covariance_r_frame * Ad.transpose());
+  // The join: r in the map's keyframe, as the placement and the odometry put it.
+  const Eigen::Isometry3d T_kf_r = located.T_candidate_query * T_frame_r;
+  const Matrix6d information =
+      composed_information(T_frame_r, right_covariance(located.information), information_frame_r);
+  // The provisional keyframes move rigidly so that r sits where the join puts it: they keep
+  // their shape, and the optimiser starts from a graph the join already agrees with.
+  const auto r = static_cast<size_t>(provisional.keyframe_id);
+  const auto k = static_cast<size_t>(kf.id);
+  const Eigen::Isometry3d T_world_provisional = graph_.poses[k] * T_kf_r * graph_.poses[r].inverse();
+  for (size_t v = static_cast<size_t>(provisional_from_); v < graph_.poses.size(); ++v)
+    graph_.poses[v] = T_world_provisional * graph_.poses[v];
+  graph_.add_edge(static_cast<int>(k), static_cast<int>(r), T_kf_r, information, EdgeKind::kLoopClosure);
+  provisional_from_ = -1;
+  step.loop_closed = true;
+  step.loop_keyframe_id = kf.id;
+  ++loop_closures_;
+  step.optimisation = optimize(graph_, options_.optimizer);
+  rebin();
+  ++revision_;
+  // The placed frame's reference (accept_placement) is in kf, whose marginal the join changed.
+  reference_marginal_ = marginal_covariance(graph_, static_cast<int>(k), options_.optimizer.kernel);
 }
 
 bool Slam::reanchor(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera, OdometryLink link,
@@ -491,7 +599,8 @@ bool Slam::reanchor(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_came
   if (!gate_by_pose_) return false;
   const Eigen::Isometry3d T_world_frame = world_pose(T_odom_camera);
   std::vector<std::pair<double, size_t>> covering;  // (distance in units of the bounds, keyframe)
-  for (size_t k = 0; k < keyframes_.size(); ++k) {
+  // Not placed in the saved map yet: "world" here is the provisional keyframes' own frame.
+  for (size_t k = provisional_from_ >= 0 ? static_cast<size_t>(provisional_from_) : 0; k < keyframes_.size(); ++k) {
     const double d = se3::translation_distance(graph_.poses[k], T_world_frame);
     const double a = se3::rotation_distance(graph_.poses[k], T_world_frame);
     // Localisation only: a thinned keyframe still covers its view (the map is not to grow there).

@@ -25,10 +25,15 @@
 // another frame (the process puts it in the state estimator's world, slam_adapter.h). Started
 // from a saved map (slam_map.h), "world" is the map's: the first frames are relocalised in it
 // (RelocalisationOptions), and the camera's odometry joins the map there, as at a re-anchoring.
+// A camera not placed soon (it started where the map never looked) maps in a provisional frame
+// of its own meanwhile; the placement moves those keyframes into the map's world and joins them
+// to it by one edge (a session that joins the map): one graph afterwards.
 // Invariants: keyframe k is vertex k of graph(); vertex 0 is fixed; the edge into keyframe
 // k > 0 from its reference (the previous keyframe, or the keyframe re-anchored on before it)
-// is odometry; revision() grows by one with every change of the optimised poses other than
-// appending a keyframe.
+// is odometry, but for the first provisional keyframe, which has none; provisional keyframes
+// are the newest ones (ids from provisional_from()) and no edge joins them to the others until
+// the placement does; revision() grows by one with every change of the optimised poses other
+// than appending a keyframe.
 
 #include <Eigen/Geometry>
 #include <memory>
@@ -98,6 +103,8 @@ struct Relocalisation {
   int frames_tried = 0;       ///< frames compared with the map until then, that one included
   int64_t keyframe_id = -1;   ///< the map's keyframe it was located in
   Eigen::Isometry3d T_world_camera = Eigen::Isometry3d::Identity();
+  /// Keyframes made before the placement, in a provisional frame, that it joined to the map.
+  int keyframes_joined = 0;
 };
 
 class Slam {
@@ -112,11 +119,18 @@ class Slam {
   /// its invariants, std::invalid_argument for an unusable option.
   Slam(std::shared_ptr<const SlamMap> map, const SlamOptions& options);
 
-  /// What a later flight needs to go on from here (slam_map.h): a copy.
+  /// What a later flight needs to go on from here (slam_map.h): a copy, without the provisional
+  /// keyframes (not placed in the map's world: saved, they would be somewhere wrong).
   SlamMap map() const;
   /// False from the start on a saved map until a frame places the camera in it.
   bool localized() const { return localized_; }
   const std::optional<Relocalisation>& relocalisation() const { return relocalisation_; }
+  /// The first provisional keyframe: this flight's, made before it was placed in the saved map,
+  /// in a frame of their own (RelocalisationOptions::map_unplaced_after_s); -1 when there are none
+  /// (never made, or joined to the map by the placement).
+  int64_t provisional_from() const { return provisional_from_; }
+  /// Is keyframe `id`'s optimised pose in the world (not provisional)?
+  bool in_world(int64_t id) const { return provisional_from_ < 0 || id < provisional_from_; }
   /// This flight's session number (keyframes it makes carry it).
   int session() const { return session_; }
   /// The utime of session `s`'s first keyframe (0: it has none yet), and of the first frame this
@@ -221,9 +235,27 @@ class Slam {
                        const Matrix6d& predicted, SlamStep& step);
   /// Starts from the loaded map (reset()).
   void restore(const SlamMap& map);
-  /// Not localized: places the frame in the map, or keeps it as a hypothesis (RelocalisationOptions).
-  SlamStep relocalise(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera, const sensors::FrameMotion& motion,
+  /// Not localized: places the frame in the map, or keeps it as a hypothesis (RelocalisationOptions);
+  /// a placement joins the provisional keyframes to the map (join_provisional).
+  SlamStep relocalise(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera,
+                      const std::optional<Matrix6d>& odometry_covariance, const FrameFeatures& features,
                       const sensors::SensorProfile& sensor);
+  /// Not placed yet, for long enough: the frame may be a provisional keyframe (or re-anchored on one).
+  SlamStep map_unplaced(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera, OdometryLink link,
+                        const std::optional<Matrix6d>& odometry_covariance, const sensors::FrameMotion& motion,
+                        const sensors::SensorProfile& sensor, FrameFeatures features, SlamStep step);
+  /// The placement of a frame in keyframe `kf` (`located`), whose odometry went on from the
+  /// provisional reference `provisional`: moves the provisional keyframes rigidly into the map's
+  /// world and joins them by one edge (kf to the reference's keyframe), then optimises.
+  void join_provisional(const OdometryReference& provisional, const Eigen::Isometry3d& T_odom_camera,
+                        const std::optional<Matrix6d>& odometry_covariance, const Keyframe& kf,
+                        const LoopConstraint& located, SlamStep& step);
+  /// Makes the frame a keyframe (features extracted), closes its loop if it has one.
+  SlamStep add_keyframe(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera, OdometryLink link,
+                        const std::optional<Matrix6d>& odometry_covariance, const sensors::FrameMotion& motion,
+                        const sensors::SensorProfile& sensor, FrameFeatures features, SlamStep step);
+  /// The keyframe spacing rule: has the camera moved or turned enough since the reference?
+  bool keyframe_due(const Eigen::Isometry3d& T_odom_camera, OdometryLink link) const;
   /// Puts the keyframes that keep their features in the bins of their optimised poses.
   void rebin();
   /// Thins keyframes (never `newest`) while their features exceed the budget.
@@ -262,6 +294,7 @@ class Slam {
     Eigen::Isometry3d T_world_odom;
   };
   std::vector<Placement> placements_;  ///< hypotheses within max_span_s, oldest first
+  int64_t provisional_from_ = -1;     ///< the first provisional keyframe (-1: none)
 };
 
 }  // namespace kestrel::slam

@@ -73,6 +73,11 @@ struct RelocalisationOptions {
   double max_disagreement_m = 0.05;
   double max_disagreement_rad = 2.0 * kPi / 180.0;
   double max_span_s = 2.0;         ///< placements of frames at most this far apart agree
+  /// Not placed this long after the first frame (a camera that starts where the map never
+  /// looked): keyframes are made in a frame of their own (provisional, Slam::provisional_from()),
+  /// and joined to the map, moved into its world, when a placement is confirmed. Infinite: the
+  /// camera adds nothing until it is placed.
+  double map_unplaced_after_s = 1.0;
 };
 
 struct LoopSearchOptions {

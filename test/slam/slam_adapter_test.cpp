@@ -694,6 +694,60 @@ TEST_F(AdapterTest, OnASavedMapTheRelocalisingFrameSendsTheFirstCorrectionInTheM
   EXPECT_FALSE(adapter.slam().localized());
 }
 
+// A camera started under the ceiling, which the map never saw, maps there in a frame of its own
+// (provisional keyframes): nothing of that goes out, neither a graph (the mapper would put
+// those keyframes' depth somewhere wrong) nor a correction. The frame that places it sends the
+// graph with them joined, in the map's world where the truth has them, and the first correction.
+TEST_F(AdapterTest, OnASavedMapKeyframesMadeBeforeThePlacementGoOutOnlyJoinedInTheMapsWorld) {
+  Slam mapping(SlamOptions{}, std::shared_ptr<const Vocabulary>{});
+  for (int k = 0; k < 12; ++k) mapping.add(room_.render(pose(k), test::test_camera(), utime(k)), pose(k));
+  const size_t mapped = mapping.keyframes().size();
+  SlamOptions options;
+  options.relocalisation.map_unplaced_after_s = 0.0;
+  SlamAdapter adapter(std::make_shared<const SlamMap>(mapping.map()), options);
+  // Under the ceiling, 5 cm a frame along x, then down to the path's view at frame 6.
+  std::vector<Eigen::Isometry3d> truth;
+  for (int i = 0; i < 12; ++i) {
+    Eigen::Isometry3d T = pose(6);
+    T.translation().x() -= 0.05 * (11 - i);
+    T.linear() = T.linear() * Eigen::AngleAxisd(-kPi / 2, Eigen::Vector3d::UnitX()).toRotationMatrix();
+    truth.push_back(T);
+  }
+  for (int i = 1; i <= 6; ++i) {
+    Eigen::Isometry3d T = pose(6);
+    T.linear() = T.linear() * Eigen::AngleAxisd(-kPi / 2 * (1.0 - i / 6.0), Eigen::Vector3d::UnitX()).toRotationMatrix();
+    truth.push_back(T);
+  }
+  std::optional<AdapterOutputs> placed;
+  size_t k = 0;
+  for (; k < truth.size() && !placed; ++k) {
+    adapter.on_frame(transport::encode_rgbd(room_.render(truth[k], test::test_camera(), utime(static_cast<int>(k)))));
+    kestrel::vo_update_t m = update(static_cast<int>(k));
+    m.T_reference_current = transport::to_message(k == 0 ? Eigen::Isometry3d::Identity() : truth[k - 1].inverse() * truth[k]);
+    AdapterOutputs out = adapter.on_vo_update(m);
+    if (out.step && out.step->relocalised) {
+      placed = std::move(out);
+      break;
+    }
+    EXPECT_FALSE(out.graph) << "frame " << k << ": a graph with provisional keyframes went out";
+    EXPECT_FALSE(out.correction) << "frame " << k << ": a correction before the placement";
+  }
+  ASSERT_TRUE(placed) << "never relocalised";
+  EXPECT_GE(k, 12u) << "placed under the ceiling, which the map never saw";
+  const int joined = adapter.slam().relocalisation()->keyframes_joined;
+  ASSERT_GE(joined, 2) << "nothing mapped under the ceiling: the test would pass without joining";
+  ASSERT_TRUE(placed->graph);
+  ASSERT_TRUE(placed->correction);
+  ASSERT_EQ(placed->graph->keyframes.size(), mapped + static_cast<size_t>(joined));
+  for (size_t i = mapped; i < placed->graph->keyframes.size(); ++i) {
+    const auto& kf = placed->graph->keyframes[i];
+    const size_t frame = static_cast<size_t>((kf.utime - utime(0)) / 100'000);
+    const Eigen::Isometry3d E = truth[frame].inverse() * keyframe_pose(*placed->graph, static_cast<int>(i));
+    EXPECT_LT(E.translation().norm(), 0.02) << "keyframe of frame " << frame;
+    EXPECT_LT(so3::angle(E.linear()), 1.0 * kPi / 180.0) << "keyframe of frame " << frame;
+  }
+}
+
 // The graph is moved rigidly onto the state it is anchored on, so it shares that state's error:
 // its heading error turns every pose about the anchor. A yaw sigma of 0.01 rad, a pose 2 m
 // along x from the anchor and turned by 90 degrees: 2 cm sideways (y) and the same yaw.
