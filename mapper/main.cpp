@@ -86,14 +86,23 @@ int serve(Options& o) {
   });
   if (o.node.pose_source == mapper::PoseSource::kSlamGraph) {
     // Graphs are rare and each may trigger a rebuild: never drop one.
-    node->subscribe<slam_graph_t>(channel::kSlamGraph, [&](const slam_graph_t& m) {
+    // Both may journal: a journal given up on the way is said at once.
+    auto journalled = [&](auto&& handle) {
       const bool journalling = !o.node.journal_path.empty() && map.journal_error().empty();
-      publish(map.on_graph(m, channel::kSlamGraph));
+      publish(handle());
       if (journalling && !map.journal_error().empty()) {
         spdlog::error("journal stopped (the map goes on without it): {}", map.journal_error());
         report_health();
       }
+    };
+    node->subscribe<slam_graph_t>(channel::kSlamGraph, [&](const slam_graph_t& m) {
+      journalled([&] { return map.on_graph(m, channel::kSlamGraph); });
     }, 0);
+    if (o.node.insert_located) {
+      node->subscribe<slam_correction_t>(channel::kSlamCorrection, [&](const slam_correction_t& m) {
+        journalled([&] { return map.on_correction(m, channel::kSlamCorrection); });
+      }, 0);
+    }
   } else {
     node->subscribe<ground_truth_t>(channel::kGroundTruth, [&](const ground_truth_t& m) {
       publish(map.on_ground_truth(m, channel::kGroundTruth));
@@ -110,6 +119,8 @@ int serve(Options& o) {
   spdlog::info("{} frames ({} inserted, {} without pose), {} graphs, {} rebuilds, {} maps published ({} sent again), {} rejected",
                s.frames, s.frames_inserted, s.frames_without_pose, s.graphs, s.rebuilds, s.published, s.repeated,
                node->counters().messages_rejected);
+  if (o.node.insert_located)
+    spdlog::info("{} frames SLAM located inserted, {} no longer buffered", s.located, s.located_missing);
   // Where the memory is (the soak's question): the map, the keyframes kept for rebuilds and the
   // rebuild checkpoints, each within its budget (--keyframe-megabytes, checkpoints' 128 MB).
   const mapper::Mapper& m = map.mapper();
@@ -152,6 +163,11 @@ int main(int argc, char** argv) {
   app.add_flag("--journal-is-map", o.node.journal_is_map,
                "The journal is a building's saved map (kestrel launch --map): a lock-step RESET before any input "
                "keeps the map restored from it (by default a RESET forgets it: a replay of its own flight)");
+  app.add_flag("--insert-located", o.node.insert_located,
+               "slam: also insert the frames SLAM located on its map without a keyframe (SLAM_CORRECTION), at the "
+               "corrected pose, kept and journaled as keyframes no graph moves: a localisation-only flight updates "
+               "the map")
+      ->capture_default_str();
   app.add_option("--journal-keep", o.node.journal_keep,
                  "Journals set aside kept of each kind (FILE.reset-*, FILE.damaged-*): the newest; each older one "
                  "is deleted, and logged, when another is set aside")

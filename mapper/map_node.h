@@ -22,6 +22,12 @@
 // (its folder cannot be written), is given up, not the map: journal_error() says why, health()
 // is DEGRADED with it, and mapping goes on.
 //
+// Located frames (NodeOptions::insert_located, kSlamGraph): a frame SLAM located on its map
+// without making it a keyframe (SLAM_CORRECTION at its utime) goes into the map at the
+// corrected pose, and into the store and the journal as a keyframe of its own (id -utime) that no
+// graph moves: a localisation-only flight makes no keyframes, yet what changed in the building
+// (a door closed) reaches the map. Its pose is its colour time's (no depth-time correction).
+//
 // MAP_OCTOMAP is produced at most once per publish_period_s of sensor time, and at once after
 // a rebuild. In kSlamGraph mode the map changes only with SLAM's keyframes, and a hovering
 // vehicle makes none: the last map then goes out again (same revision) each publish_period_s
@@ -41,6 +47,7 @@
 #include "kestrel/octomap_t.hpp"
 #include "kestrel/process_status_t.hpp"
 #include "kestrel/rgbd_frame_t.hpp"
+#include "kestrel/slam_correction_t.hpp"
 #include "kestrel/slam_graph_t.hpp"
 #include "mapper/keyframe_journal.h"
 #include "mapper/mapper.h"
@@ -64,6 +71,8 @@ struct NodeOptions {
   bool journal_is_map = false;
   /// Journals set aside kept of each kind (reset, damaged), the newest; >= 1.
   int journal_keep = kDefaultKeptJournals;
+  /// kSlamGraph: also insert the frames SLAM located on its map (above).
+  bool insert_located = false;
   void validate() const;
 };
 
@@ -77,6 +86,8 @@ struct NodeStats {
   int64_t repeated = 0;           ///< the last map sent again (kSlamGraph, no new map for a period)
   double last_rebuild_keyframes = 0;
   int64_t keyframes_restored = 0;  ///< from the journal at start
+  int64_t located = 0;             ///< located frames inserted (insert_located)
+  int64_t located_missing = 0;     ///< located frames no longer buffered
 };
 
 class MapNode {
@@ -91,6 +102,8 @@ class MapNode {
   std::optional<kestrel::octomap_t> on_graph(const kestrel::slam_graph_t& msg, const char* channel);
   std::optional<kestrel::octomap_t> on_ground_truth(const kestrel::ground_truth_t& msg,
                                                     const char* channel);
+  /// insert_located: the frame the correction is for, if SLAM located it without a keyframe.
+  std::optional<kestrel::octomap_t> on_correction(const kestrel::slam_correction_t& msg, const char* channel);
   /// The map as a message now, regardless of the rate limit (e.g. at shutdown).
   kestrel::octomap_t map_message();
   /// Forgets everything (lock-step replay RESET); the journal starts again, the old one kept

@@ -184,14 +184,8 @@ GraphResult Mapper::apply_graph(const std::vector<GraphKeyframe>& graph) {
       ++result.missing;
       continue;
     }
-    StoredKeyframe kf = stored(g, *frame);
-    // A keyframe older than a stored one breaks the live map's time order (a rebuild would
-    // insert it earlier), so the live map is no longer a checkpointable sequence.
-    const auto order = keyframes_.in_time_order();
-    if (!order.empty() && order.back()->utime >= kf.utime) map_is_sequence_ = false;
     // Inserted now unless the whole map is about to be rebuilt anyway.
-    if (!(rebuild_pending_ && may_rebuild)) integrate_keyframe(kf);
-    keyframes_.add(std::move(kf));
+    store(stored(g, *frame), !(rebuild_pending_ && may_rebuild));
     result.inserted.push_back(g.id);
   }
   if (rebuild_pending_ && may_rebuild) {
@@ -201,6 +195,24 @@ GraphResult Mapper::apply_graph(const std::vector<GraphKeyframe>& graph) {
     result.rebuild_keyframes = keyframes_.size();
   }
   return result;
+}
+
+void Mapper::store(StoredKeyframe kf, bool insert_now) {
+  // A keyframe older than a stored one breaks the live map's time order (a rebuild would
+  // insert it earlier), so the live map is no longer a checkpointable sequence.
+  const auto order = keyframes_.in_time_order();
+  if (!order.empty() && order.back()->utime >= kf.utime) map_is_sequence_ = false;
+  if (insert_now) integrate_keyframe(kf);
+  keyframes_.add(std::move(kf));
+}
+
+Mapper::Located Mapper::add_located(const GraphKeyframe& located) {
+  for (const StoredKeyframe* kf : keyframes_.in_time_order())
+    if (kf->utime == located.utime) return Located::kKeyframe;
+  const RgbdFrame* frame = buffered(located.utime);
+  if (frame == nullptr) return Located::kNotBuffered;
+  store(stored(located, *frame), true);
+  return Located::kInserted;
 }
 
 size_t Mapper::rebuild() { return rebuild_from(true); }

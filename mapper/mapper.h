@@ -84,6 +84,14 @@ class Mapper {
   void buffer_frame(const RgbdFrame& frame, const char* what = "frame");
   /// SLAM mode: one graph revision.
   GraphResult apply_graph(const std::vector<GraphKeyframe>& keyframes);
+  enum class Located { kInserted, kKeyframe, kNotBuffered };
+  /// SLAM mode: the buffered frame at `located.utime`, which SLAM located on its map without
+  /// making it a keyframe (a localisation-only flight makes none): stored under `located.id`,
+  /// which no graph names (so no graph moves it), and inserted. Nothing changes for a keyframe's
+  /// utime (the graph placed it) or a frame no longer buffered.
+  Located add_located(const GraphKeyframe& located);
+  /// SLAM mode: the buffered (decimated) frame at `utime`, if it still is.
+  const RgbdFrame* buffered(int64_t utime) const;
 
   /// A restarted mapper (map_node.h's journal): a keyframe stored before the restart, its frame
   /// as stored then. It goes into the store, not yet into the map: rebuild() after the last.
@@ -112,13 +120,15 @@ class Mapper {
  private:
   void integrate(const RgbdFrame& decimated, const Eigen::Isometry3d& T_world_camera, int64_t utime,
                  const char* what);
-  const RgbdFrame* buffered(int64_t utime) const;
   using Placed = std::pair<int64_t, Eigen::Isometry3d>;  // keyframe id, pose it was inserted at
   struct Checkpoint {
     std::vector<Placed> keyframes;  // what the map holds, in insertion (time) order
     VoxelMap map;
   };
   void integrate_keyframe(const StoredKeyframe& kf);
+  /// Stores a keyframe made from a buffered frame, inserting it into the map now unless a
+  /// rebuild is about to insert everything.
+  void store(StoredKeyframe kf, bool insert_now);
   // Moves the stored keyframes of `graph` that moved beyond the rebuild thresholds; the others
   // go to `fresh` when given. Returns the ids of those that moved.
   std::vector<int64_t> move_stored(const std::vector<GraphKeyframe>& graph,

@@ -253,7 +253,7 @@ int serve(const Options& o, const SlamOptions& options, std::shared_ptr<const Vo
     if (out.graph) node->publish(o.graph_channel, *out.graph);
     if (out.correction) node->publish(o.correction_channel, *out.correction);
     if (out.step && out.step->relocalised) report_relocalisation(adapter.slam().relocalisation(), true);
-    if (out.step && out.step->loop_closed) {
+    if (out.step && out.step->loop_closed && out.step->keyframe) {  // (a join is said with the relocalisation)
       spdlog::info("keyframe {} closes a loop with keyframe {} ({} inliers, {:.2f} px); chi2 {:.4g} -> {:.4g}",
                    published_id(adapter.slam(), out.step->keyframe_id),
                    published_id(adapter.slam(), out.step->loop_keyframe_id), out.step->loop.inliers,

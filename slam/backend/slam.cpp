@@ -248,8 +248,10 @@ void Slam::reset() {
 void Slam::rebin() {
   // The thinning bins follow the optimised poses, as the mapper's follow SLAM's graph: after a
   // loop corrects drift, views of one place share a bin again.
+  // Provisional keyframes are binned once joined: their poses are in a frame of their own,
+  // where they would share bins with the map's keyframes and have those thinned.
   for (const Keyframe& kf : keyframes_)
-    if (!kf.thinned) matchable_.insert(kf.id, graph_.poses[static_cast<size_t>(kf.id)]);
+    if (!kf.thinned && in_world(kf.id)) matchable_.insert(kf.id, graph_.poses[static_cast<size_t>(kf.id)]);
 }
 
 void Slam::keep_within_budget(std::optional<int64_t> newest) {
@@ -348,7 +350,7 @@ SlamStep Slam::add(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camer
   }
   if (!localized_) {
     FrameFeatures features = extractor_.extract(frame, motion);
-    SlamStep step = relocalise(frame, T_odom_camera, odometry_covariance, features, sensor);  // a break cleared the placements (above)
+    SlamStep step = relocalise(frame, T_odom_camera, link, odometry_covariance, features, sensor);  // a break cleared the placements (above)
     // Lost while localising only (not a camera that was never placed): the wait is short, and
     // the map is not to grow.
     if (step.relocalised || lost_since_utime_ >= 0) return step;
@@ -422,7 +424,7 @@ SlamStep Slam::add_keyframe(const RgbdFrame& frame, const Eigen::Isometry3d& T_o
   step = close_loop(std::move(step));
   const Keyframe& added = keyframes_.back();
   places_->add(added.features.descriptors);
-  matchable_.insert(added.id, graph_.poses.back());
+  if (in_world(added.id)) matchable_.insert(added.id, graph_.poses.back());
   feature_bytes_ += memory_of(added.features);
   keep_within_budget(added.id);
   return step;
@@ -516,13 +518,17 @@ bool Slam::accept_placement(const RgbdFrame& frame, const Eigen::Isometry3d& T_o
   return true;
 }
 
-SlamStep Slam::relocalise(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera,
+SlamStep Slam::relocalise(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera, OdometryLink link,
                           const std::optional<Matrix6d>& odometry_covariance, const FrameFeatures& features,
                           const sensors::SensorProfile& sensor) {
   const RelocalisationOptions& r = options_.relocalisation;
   SlamStep step;
   ++relocalisation_tries_;
   if (static_cast<int>(features.num_points()) < options_.verification.min_inliers) return step;
+  // Across a break nothing relates this frame to the provisional keyframes: placed now, the join
+  // would fix them where an assumed stillness puts them. It becomes a provisional keyframe (on a
+  // break edge, as in any flight) and the next frames are placed from it.
+  if (link == OdometryLink::kBroken && provisional_from_ >= 0) return step;
   const std::vector<BowMatch> candidates = places_->query(features.descriptors, r.max_candidates, [this](int entry) {
     return !keyframes_[static_cast<size_t>(entry)].thinned && in_world(entry);
   });
@@ -539,7 +545,7 @@ SlamStep Slam::relocalise(const RgbdFrame& frame, const Eigen::Isometry3d& T_odo
     int joined = 0;
     if (provisional_from_ >= 0) {
       joined = static_cast<int>(keyframes_.size()) - static_cast<int>(provisional_from_);
-      join_provisional(provisional, T_odom_camera, odometry_covariance, kf, located, step);
+      join_provisional(provisional, frame, T_odom_camera, link, odometry_covariance, kf, located, step);
     }
     localized_ = true;
     lost_since_utime_ = -1;
@@ -554,16 +560,20 @@ SlamStep Slam::relocalise(const RgbdFrame& frame, const Eigen::Isometry3d& T_odo
   return step;
 }
 
-void Slam::join_provisional(const OdometryReference& provisional, const Eigen::Isometry3d& T_odom_camera,
+void Slam::join_provisional(const OdometryReference& provisional, const RgbdFrame& frame,
+                            const Eigen::Isometry3d& T_odom_camera, OdometryLink link,
                             const std::optional<Matrix6d>& odometry_covariance, const Keyframe& kf,
                             const LoopConstraint& located, SlamStep& step) {
   // The placed frame in the provisional reference's keyframe r, through the odometry since the
-  // reference (and the reference's own uncertainty in r, when it was re-anchored or carried).
+  // reference (and the reference's own uncertainty in r, when it was re-anchored or carried),
+  // as an odometry edge from r to it would be (never across a break: relocalise()).
+  const OdometryLink weakest = weaker(link, provisional.link);
   const Eigen::Isometry3d T_ref_frame = provisional.T_odom_camera.inverse() * T_odom_camera;
   const Eigen::Isometry3d T_r_frame = provisional.T_keyframe_camera * T_ref_frame;
   const Matrix6d covariance_r_frame = right_covariance(composed_information(
       T_ref_frame, provisional.covariance,
-      odometry_edge_information(T_ref_frame, options_.odometry, OdometryLink::kContinuous, odometry_covariance)));
+      odometry_edge_information(T_ref_frame, options_.odometry, link,
+                                link == OdometryLink::kContinuous ? odometry_covariance : std::nullopt)));
   // Inverted: T Exp(d) inverse = T^-1 Exp(-Ad(T) d).
   const Eigen::Isometry3d T_frame_r = T_r_frame.inverse();
   const Matrix6d Ad = se3::adjoint(T_r_frame);
@@ -587,8 +597,11 @@ void Slam::join_provisional(const OdometryReference& provisional, const Eigen::I
   step.optimisation = optimize(graph_, options_.optimizer);
   rebin();
   ++revision_;
-  // The placed frame's reference (accept_placement) is in kf, whose marginal the join changed.
-  reference_marginal_ = marginal_covariance(graph_, static_cast<int>(k), options_.optimizer.kernel);
+  // The odometry goes on from r (not from kf, as accept_placement put it: the next keyframe's
+  // edge would use the placement a second time).
+  reference_ = OdometryReference{provisional.keyframe_id, frame.utime, T_odom_camera, frame.T_body_camera,
+                                 T_r_frame, covariance_r_frame, weakest};
+  reference_marginal_ = marginal_covariance(graph_, static_cast<int>(r), options_.optimizer.kernel);
 }
 
 bool Slam::reanchor(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera, OdometryLink link,
@@ -597,6 +610,9 @@ bool Slam::reanchor(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_came
   const CoverageOptions& c = options_.coverage;
   // After an odometry break the estimate is no guide to which keyframes are near.
   if (!gate_by_pose_) return false;
+  // Localising only keeps the map as it is; provisional keyframes are outside it (the vehicle
+  // started where the map never looked): they are mapped.
+  const bool localising = options_.localize_only && provisional_from_ < 0;
   const Eigen::Isometry3d T_world_frame = world_pose(T_odom_camera);
   std::vector<std::pair<double, size_t>> covering;  // (distance in units of the bounds, keyframe)
   // Not placed in the saved map yet: "world" here is the provisional keyframes' own frame.
@@ -604,7 +620,7 @@ bool Slam::reanchor(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_came
     const double d = se3::translation_distance(graph_.poses[k], T_world_frame);
     const double a = se3::rotation_distance(graph_.poses[k], T_world_frame);
     // Localisation only: a thinned keyframe still covers its view (the map is not to grow there).
-    if (d < c.max_translation_m && a < c.max_rotation_rad && (!keyframes_[k].thinned || options_.localize_only))
+    if (d < c.max_translation_m && a < c.max_rotation_rad && (!keyframes_[k].thinned || localising))
       covering.emplace_back(d / std::max(c.max_translation_m, 1e-9) + a / std::max(c.max_rotation_rad, 1e-9), k);
   }
   std::sort(covering.begin(), covering.end());
@@ -650,7 +666,7 @@ bool Slam::reanchor(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_came
         so3::angle(T_expected_located.linear()) > c.max_correction_rad) {
       step.loop = located;
       ++coverage_misses_.too_far;
-      if (!options_.localize_only) return false;  // a loop to close, through a new keyframe
+      if (!localising) return false;  // a loop to close, through a new keyframe
       // Localisation only: the map stays as it is. One view placing the frame far from its
       // estimate may be a wrong place, so the frame is carried at its prediction and the next
       // frames are relocalised (with confirmation; this placement is the first hypothesis) for
@@ -683,7 +699,7 @@ bool Slam::reanchor(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_came
   // mapping, none does while the prediction is certain and local (CoverageOptions).
   std::vector<size_t> covering_keyframes;
   for (const auto& entry : covering) covering_keyframes.push_back(entry.second);
-  if (!options_.localize_only && !carriable(covering_keyframes, predicted)) {
+  if (!localising && !carriable(covering_keyframes, predicted)) {
     ++coverage_misses_.not_verified;
     return false;
   }

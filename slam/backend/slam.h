@@ -237,7 +237,7 @@ class Slam {
   void restore(const SlamMap& map);
   /// Not localized: places the frame in the map, or keeps it as a hypothesis (RelocalisationOptions);
   /// a placement joins the provisional keyframes to the map (join_provisional).
-  SlamStep relocalise(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera,
+  SlamStep relocalise(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera, OdometryLink link,
                       const std::optional<Matrix6d>& odometry_covariance, const FrameFeatures& features,
                       const sensors::SensorProfile& sensor);
   /// Not placed yet, for long enough: the frame may be a provisional keyframe (or re-anchored on one).
@@ -246,8 +246,10 @@ class Slam {
                         const sensors::SensorProfile& sensor, FrameFeatures features, SlamStep step);
   /// The placement of a frame in keyframe `kf` (`located`), whose odometry went on from the
   /// provisional reference `provisional`: moves the provisional keyframes rigidly into the map's
-  /// world and joins them by one edge (kf to the reference's keyframe), then optimises.
-  void join_provisional(const OdometryReference& provisional, const Eigen::Isometry3d& T_odom_camera,
+  /// world and joins them by one edge (kf to the reference's keyframe r), then optimises; the
+  /// odometry goes on from r.
+  void join_provisional(const OdometryReference& provisional, const RgbdFrame& frame,
+                        const Eigen::Isometry3d& T_odom_camera, OdometryLink link,
                         const std::optional<Matrix6d>& odometry_covariance, const Keyframe& kf,
                         const LoopConstraint& located, SlamStep& step);
   /// Makes the frame a keyframe (features extracted), closes its loop if it has one.

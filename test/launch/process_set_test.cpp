@@ -164,12 +164,12 @@ TEST(ProcessSets, ASavedMapIsWiredIntoSlamTheMapperAndTheEstimator) {
     ADD_FAILURE() << name;
     return ProcessSpec{};
   };
-  const ProcessSet first = with_saved_map(shipped, "/maps/b1", false, 30.0);
+  const ProcessSet first = with_saved_map(shipped, "/maps/b1", false);
   EXPECT_EQ(args_of(first, "slam").argv, (std::vector<std::string>{"slam", "--save-map", "/maps/b1"}));
   EXPECT_EQ(args_of(first, "mapper").argv,
             (std::vector<std::string>{"mapper", "--journal", "/maps/b1/mapper.journal", "--journal-is-map"}));
   EXPECT_EQ(args_of(first, "estimator").argv, args_of(shipped, "estimator").argv) << "the first flight defines the world";
-  const ProcessSet again = with_saved_map(shipped, "/maps/b1", true, 30.0);
+  const ProcessSet again = with_saved_map(shipped, "/maps/b1", true);
   EXPECT_EQ(args_of(again, "slam").argv,
             (std::vector<std::string>{"slam", "--map", "/maps/b1", "--save-map", "/maps/b1"}));
   const ProcessSpec estimator = args_of(again, "estimator");
@@ -181,8 +181,20 @@ TEST(ProcessSets, ASavedMapIsWiredIntoSlamTheMapperAndTheEstimator) {
   ProcessSet named = shipped;
   for (auto& p : named)
     if (p.name == "slam") p.argv.insert(p.argv.end(), {"--map", "/old", "--save-map", "/old"});
-  EXPECT_EQ(args_of(with_saved_map(named, "/maps/b1", true, 30.0), "slam").argv,
+  EXPECT_EQ(args_of(with_saved_map(named, "/maps/b1", true), "slam").argv,
             (std::vector<std::string>{"slam", "--map", "/maps/b1", "--save-map", "/maps/b1"}));
+  // Localising only: SLAM adds no keyframes over the map, the mapper updates it from the frames
+  // SLAM locates (or keeps it as it is); on a first flight there is nothing to localise in.
+  const ProcessSet localising = with_saved_map(shipped, "/maps/b1", true, {30.0, true, true});
+  EXPECT_EQ(args_of(localising, "slam").argv,
+            (std::vector<std::string>{"slam", "--map", "/maps/b1", "--save-map", "/maps/b1", "--localize-only"}));
+  EXPECT_EQ(args_of(localising, "mapper").argv,
+            (std::vector<std::string>{"mapper", "--journal", "/maps/b1/mapper.journal", "--journal-is-map",
+                                      "--insert-located"}));
+  EXPECT_EQ(args_of(with_saved_map(shipped, "/maps/b1", true, {30.0, true, false}), "mapper").argv,
+            args_of(again, "mapper").argv);
+  EXPECT_EQ(args_of(with_saved_map(shipped, "/maps/b1", false, {30.0, true, true}), "slam").argv,
+            args_of(first, "slam").argv);
 }
 
 TEST(ResolveExecutable, PrefersKestrelToolsThenPath) {

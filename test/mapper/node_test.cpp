@@ -244,6 +244,82 @@ void expect_same_map(const VoxelMap& a, const VoxelMap& b) {
   a.for_each_cell([&](const Key& k, float v) { ASSERT_EQ(b.log_odds(k), v); });
 }
 
+// SLAM_CORRECTION for a frame SLAM located on its map without a keyframe (a localisation-only
+// flight): with insert_located, the frame goes into the map at the corrected pose. Here a box
+// has appeared in front of the camera since the keyframes were made (a door closed): the map
+// gets it, the journal keeps it, and a loop closure that moves the keyframes leaves it where
+// it was put. Corrections for a keyframe, or for a frame no longer buffered, add nothing;
+// without the option nothing at all.
+TEST(MapNode, AFrameSlamLocatedWithoutAKeyframeUpdatesTheMapWhenAsked) {
+  const test::Scene before = test::room_with_a_box();
+  test::Scene after = before;
+  after.add_box(Eigen::Vector3d(0.0, -0.2, 0.6), Eigen::Vector3d(0.3, 0.6, 1.3));
+  const Eigen::Vector3d box_face(0.02, 0.2, 1.0);  // on the new box's face towards the camera
+  kestrel::test::TempDir dir;
+  NodeOptions options;
+  options.mapper.rebuild_interval_s = 0.0;
+  options.insert_located = true;
+  options.journal_path = (dir / "mapper.journal").string();
+  MapNode node(options);
+  NodeOptions plain_options = options;
+  plain_options.insert_located = false;
+  plain_options.journal_path.clear();
+  MapNode plain(plain_options);
+  for (MapNode* n : {&node, &plain}) n->on_graph(feed_keyframes(*n, before, 0, 3, 1), "SLAM_GRAPH");
+  ASSERT_EQ(node.mapper().map().occupancy_at(box_face), Occupancy::kFree) << "the keyframes saw through it";
+  const auto correction = [](int64_t t) {
+    kestrel::slam_correction_t c{};
+    c.utime = t;
+    c.keyframe_id = 2;
+    c.graph_revision = 1;
+    c.T_world_body = transport::to_message(pose_at(1e-6 * t));
+    return c;
+  };
+  // Three located frames (one hit does not outweigh the four keyframes' misses: log-odds).
+  for (MapNode* n : {&node, &plain}) {
+    for (const int64_t t : {600000, 700000, 800000}) {
+      n->on_frame(frame_message(after, t), "CAMERA_RGBD");
+      n->on_correction(correction(t), "SLAM_CORRECTION");
+    }
+    n->on_correction(correction(300000), "SLAM_CORRECTION");  // keyframe 2's: the graph placed it
+    n->on_correction(correction(550000), "SLAM_CORRECTION");  // no such frame
+  }
+  EXPECT_EQ(node.stats().located, 3);
+  EXPECT_EQ(node.stats().located_missing, 1);
+  EXPECT_EQ(node.mapper().keyframes().size(), 7u);
+  ASSERT_NE(node.mapper().keyframes().find(-600000), nullptr);
+  EXPECT_EQ(node.mapper().map().occupancy_at(box_face), Occupancy::kOccupied);
+  EXPECT_EQ(plain.stats().located, 0);
+  EXPECT_EQ(plain.mapper().keyframes().size(), 4u);
+  EXPECT_EQ(plain.mapper().map().occupancy_at(box_face), Occupancy::kFree);
+
+  // A loop closure moves keyframe 1 (a rebuild): the located frame stays where it was put.
+  kestrel::slam_graph_t closed = feed_keyframes(node, before, 4, 3, 2);
+  closed.keyframes[1].T_world_camera.position[1] += 0.05;
+  node.on_graph(closed, "SLAM_GRAPH");
+  ASSERT_EQ(node.stats().rebuilds, 1);
+  EXPECT_TRUE(node.mapper().keyframes().find(-600000)->T_world_camera.isApprox(pose_at(0.6), 1e-12));
+  EXPECT_EQ(node.mapper().map().occupancy_at(box_face), Occupancy::kOccupied);
+  // A restarted mapper gets it back from the journal, with the same map.
+  MapNode restarted(options);
+  expect_same_keyframes(node.mapper(), restarted.mapper());
+  expect_same_map(node.mapper().map(), restarted.mapper().map());
+
+  // Bad corrections are refused naming the channel; nothing changes.
+  kestrel::slam_correction_t bad = correction(600000);
+  bad.T_world_body.orientation[0] = static_cast<double>(NAN);
+  EXPECT_THROW(node.on_correction(bad, "SLAM_CORRECTION"), InputError);
+  bad = correction(600000);
+  bad.utime = -5;
+  try {
+    node.on_correction(bad, "SLAM_CORRECTION");
+    FAIL() << "a correction at no time must be refused";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("SLAM_CORRECTION"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(node.mapper().keyframes().size(), 7u);
+}
+
 // A mapper killed in flight and started again on its journal: the keyframes it had, at the
 // poses a loop closure moved them to, and the same map, cell for cell; then it carries on.
 TEST(MapNode, ARestartedMapperRestoresItsKeyframesAndMapFromTheJournal) {

@@ -62,6 +62,8 @@ struct Options {
   bool list = false;
   std::string map;  // a building's saved map (slam.map, mapper.journal)
   double await_map_s = 30.0;
+  bool localize_only = false;
+  bool no_map_update = false;
 };
 
 // LCM 1.3 takes member functions, not lambdas.
@@ -114,7 +116,7 @@ int launch(const Options& o) {
     std::error_code ec;
     fs::create_directories(o.map, ec);  // the mapper's journal goes there from the start
     if (ec) throw kestrel::InputError(o.map + ": cannot make the map's folder (" + ec.message() + ")");
-    set = with_saved_map(std::move(set), o.map, exists, o.await_map_s);
+    set = with_saved_map(std::move(set), o.map, exists, {o.await_map_s, o.localize_only, !o.no_map_update});
     spdlog::info("{}: {}", o.map, exists ? "flying in its saved map (SLAM relocalises the vehicle in it), saved again on exit"
                                          : "no map yet: this flight's is saved there on exit");
   }
@@ -349,6 +351,10 @@ int main(int argc, char** argv) {
                  "--map: seconds the estimator's STATE waits for the map's world before flying on its own")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
+  app.add_flag("--localize-only", o.localize_only,
+               "--map: on an existing map, SLAM localises only (keyframes only where the vehicle leaves the map) and "
+               "the mapper updates the occupancy map from the frames SLAM locates in it");
+  app.add_flag("--no-map-update", o.no_map_update, "--localize-only: the mapper keeps the saved occupancy map as it is");
   app.add_flag("--list", o.list, "Print the processes the command would start, and exit");
   return app.run(argc, argv, [&] { return launch(o); });
 }

@@ -106,7 +106,8 @@ void drop_option(std::vector<std::string>& args, const std::string& option) {
 }  // namespace
 
 ProcessSet with_saved_map(ProcessSet set, const std::filesystem::path& map_dir, bool map_exists,
-                          double await_world_s) {
+                          const SavedMapUse& use) {
+  const bool localising = map_exists && use.localize_only;
   for (ProcessSpec& p : set) {
     const std::string& tool = p.argv.front();
     if (tool == "slam") {
@@ -114,15 +115,19 @@ ProcessSet with_saved_map(ProcessSet set, const std::filesystem::path& map_dir, 
       drop_option(p.argv, "--save-map");
       if (map_exists) p.argv.insert(p.argv.end(), {"--map", map_dir.string()});
       p.argv.insert(p.argv.end(), {"--save-map", map_dir.string()});
+      if (localising && std::find(p.argv.begin(), p.argv.end(), "--localize-only") == p.argv.end())
+        p.argv.push_back("--localize-only");
     } else if (tool == "mapper") {
       drop_option(p.argv, "--journal");
       p.argv.insert(p.argv.end(), {"--journal", (map_dir / "mapper.journal").string(), "--journal-is-map"});
+      if (localising && use.update_map && std::find(p.argv.begin(), p.argv.end(), "--insert-located") == p.argv.end())
+        p.argv.push_back("--insert-located");
     } else if (tool == "estimator" && map_exists) {
       // Every start awaits the map's world, the first one too (and for as long).
       drop_option(p.argv, "--await-world");
       drop_option(p.restart_args, "--await-world");
       char seconds[32];
-      std::snprintf(seconds, sizeof(seconds), "%g", await_world_s);
+      std::snprintf(seconds, sizeof(seconds), "%g", use.await_world_s);
       p.argv.insert(p.argv.end(), {"--await-world", seconds});
     }
   }

@@ -57,14 +57,24 @@ ProcessSet with_run_dir(ProcessSet set, const std::filesystem::path& run_dir);
 /// Whether an argument of `set` names `{run_dir}` (the launch makes the folder only then).
 bool names_run_dir(const ProcessSet& set);
 
+/// How a flight uses a building's saved map.
+struct SavedMapUse {
+  double await_world_s = 30.0;  ///< the estimator awaits the map's world this long
+  /// On an existing map, SLAM localises only (no keyframes over the map)...
+  bool localize_only = false;
+  /// ...and the mapper updates the occupancy map from the frames SLAM locates in it.
+  bool update_map = true;
+};
+
 /// `set` flying in a building's saved map (`kestrel launch --map DIR`, issue 41): SLAM saves its
 /// map in `map_dir` on exit and, when `map_exists`, starts from it (relocalising the vehicle);
 /// the mapper journals its keyframes in `map_dir`/mapper.journal, so its occupancy map follows
 /// from flight to flight; and, on an existing map, the estimator awaits the map's world for
-/// `await_world_s` (SLAM's first correction gives it) from its first start on. The processes
-/// are found by their tool (argv[0]: slam, mapper, estimator); others are unchanged.
+/// `use.await_world_s` (SLAM's first correction gives it) from its first start on. Localising
+/// only, SLAM gets --localize-only and the mapper --insert-located (unless not update_map). The
+/// processes are found by their tool (argv[0]: slam, mapper, estimator); others are unchanged.
 ProcessSet with_saved_map(ProcessSet set, const std::filesystem::path& map_dir, bool map_exists,
-                          double await_world_s);
+                          const SavedMapUse& use = {});
 
 /// Where argv[0] runs from: a path is used as given; a bare name `x` is `kestrel-x` in
 /// `tool_dir` if present there, else `x` itself looked up in `tool_dir` and then on PATH.
