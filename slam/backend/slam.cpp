@@ -242,6 +242,7 @@ void Slam::reset() {
   relocalisation_tries_ = 0;
   placements_.clear();
   provisional_from_ = -1;
+  break_pending_ = false;
   if (loaded_) restore(*loaded_);
 }
 
@@ -342,12 +343,16 @@ SlamStep Slam::add(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camer
   }
   // Placement hypotheses place the odometry frame: across a break that frame changes.
   if (odometry_broken) placements_.clear();
+  if (odometry_broken) break_pending_ = true;
   if (!localized_ && lost_since_utime_ >= 0 &&
       frame.utime - lost_since_utime_ > static_cast<int64_t>(std::llround(options_.relocalisation.max_span_s * 1e6))) {
     // Localisation only, not confirmed elsewhere in time: the estimate carries on from where it was.
     localized_ = true;
     lost_since_utime_ = -1;
   }
+  // The odometry broke at a frame that made no keyframe (lost, localising only) and nothing has
+  // placed it since: this frame's odometry is still unrelated to the reference's.
+  if (localized_ && break_pending_) link = OdometryLink::kBroken;
   if (!localized_) {
     FrameFeatures features = extractor_.extract(frame, motion);
     SlamStep step = relocalise(frame, T_odom_camera, link, odometry_covariance, features, sensor);  // a break cleared the placements (above)
@@ -416,6 +421,7 @@ SlamStep Slam::add_keyframe(const RgbdFrame& frame, const Eigen::Isometry3d& T_o
       first_of_frame ? T_odom_camera : (odometry_broken ? reference_world_pose() : world_pose(T_odom_camera));
   graph_.add_vertex(kf.id, T_world_camera, keyframes_.empty());
   if (!first_of_frame) add_odometry_edge(kf, link, odometry_covariance);
+  break_pending_ = false;  // the break is this keyframe's edge (or before its frame's start)
   reference_ = OdometryReference{kf.id, kf.utime, kf.T_odom_camera, kf.T_body_camera};
   reference_marginal_.reset();  // the previous reference's: a loop closure below gives this one's
   keyframes_.push_back(std::move(kf));
@@ -551,6 +557,7 @@ SlamStep Slam::relocalise(const RgbdFrame& frame, const Eigen::Isometry3d& T_odo
     lost_since_utime_ = -1;
     gate_by_pose_ = true;
     unplaced_from_ = -1;
+    break_pending_ = false;  // placed: the odometry since is in the map
     relocalisation_ = Relocalisation{frame.utime, relocalisation_tries_, kf.id, reference_world_pose(), joined};
     relocalisation_tries_ = 0;
     step.relocalised = true;

@@ -297,6 +297,7 @@ class Slam {
   };
   std::vector<Placement> placements_;  ///< hypotheses within max_span_s, oldest first
   int64_t provisional_from_ = -1;     ///< the first provisional keyframe (-1: none)
+  bool break_pending_ = false;        ///< the odometry broke since the last keyframe or placement
 };
 
 }  // namespace kestrel::slam

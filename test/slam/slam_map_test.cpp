@@ -554,6 +554,43 @@ TEST(LocalisationOnlyGlitch, AGlitchBeforeLeavingTheMapDoesNotStopMapping) {
   EXPECT_GE(keyframes, 1) << "the ceiling is not in the map: it is mapped once the wait is over";
 }
 
+// The same glitch, then the VO restarts (in a new odometry frame, 50 m away) while the vehicle
+// waits to be placed again: the first keyframe after the wait is across that break (a weak edge,
+// no motion assumed), not an odometry edge that composes the two unrelated frames.
+TEST(LocalisationOnlyGlitch, AVoRestartWhileLostIsABreakForTheFirstKeyframeAfter) {
+  SlamOptions options;
+  options.localize_only = true;
+  Slam slam(std::make_shared<const SlamMap>(saved()), options);
+  const auto lap = test::circle_path(48, 1.0, 1.0);
+  int64_t utime = 0;
+  for (int i = 0; i < 6; ++i) slam.add(room().render(lap[static_cast<size_t>(i)], test::test_camera(), utime += 100'000), lap[static_cast<size_t>(i)]);
+  Eigen::Isometry3d glitch = lap[7];
+  glitch.translation().x() += 0.10;
+  slam.add(room().render(lap[7], test::test_camera(), utime += 100'000), glitch);
+  ASSERT_FALSE(slam.localized());
+  Eigen::Isometry3d up = lap[7];
+  up.linear() = up.linear() * Eigen::AngleAxisd(-kPi / 2, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  const Eigen::Isometry3d T_odom2_world = se3::exp((Vector6d() << 50.0, -20.0, 3.0, 0.5, 0.2, 1.0).finished());
+  std::optional<Keyframe> first;
+  Eigen::Isometry3d truth_first = Eigen::Isometry3d::Identity();
+  for (int i = 0; i < 30 && !first; ++i) {
+    Eigen::Isometry3d T = up;
+    T.translation().y() += 0.02 * i;
+    const SlamStep step = slam.add(room().render(T, test::test_camera(), utime += 100'000), T_odom2_world * T,
+                                   i == 0 ? OdometryLink::kBroken : OdometryLink::kContinuous);
+    if (step.keyframe) {
+      first = slam.keyframes().back();
+      truth_first = T;
+    }
+  }
+  ASSERT_TRUE(first) << "the ceiling is not in the map: it is mapped once the wait is over";
+  EXPECT_EQ(first->link, OdometryLink::kBroken);
+  // No motion assumed across the break: where the reference was (the glitch, 10 cm off, and the
+  // 0.6 m drifted along at most), not 50 m away in the new odometry's frame.
+  const double off_m = (slam.graph().poses[static_cast<size_t>(first->id)].translation() - truth_first.translation()).norm();
+  EXPECT_LT(off_m, 1.0);
+}
+
 TEST(Relocalisation, AMapOfNothingMapsFromTheStart) {
   Slam empty_run(SlamOptions{}, builtin_vocabulary());
   Slam slam(std::make_shared<const SlamMap>(empty_run.map()), SlamOptions{});
