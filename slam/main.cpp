@@ -117,6 +117,9 @@ void add_options(cli::App& app, Options& o, SlamOptions& s) {
   app.add_option("--relocalisation-confirmations", s.relocalisation.confirmations,
                  "With --map: verified placements from different frames that must agree before the camera is placed")
       ->check(CLI::PositiveNumber)->capture_default_str();
+  app.add_option("--relocalisation-ratio", s.relocalisation.match_ratio,
+                 "With --map: the ratio test of a placement's feature matching (best / second-best distance)")
+      ->check(CLI::Range(0.0, 1.0))->capture_default_str();
   app.add_option("--map-unplaced-after", s.relocalisation.map_unplaced_after_s,
                  "With --map: seconds without a placement after which keyframes are made in a frame of their own, "
                  "joined to the map when the camera is placed (1e9: none before the placement)")

@@ -542,8 +542,9 @@ SlamStep Slam::relocalise(const RgbdFrame& frame, const Eigen::Isometry3d& T_odo
     ++step.candidates;
     const Keyframe& kf = keyframes_[static_cast<size_t>(candidate.entry)];
     const uint64_t seed = static_cast<uint64_t>(kf.id) * 1000003u + static_cast<uint64_t>(frame.utime);
-    const LoopConstraint located =
-        verify_loop(features, kf.features, loop_verification(options_.verification, kf.sensor, sensor), seed);
+    VerificationOptions verification = loop_verification(options_.verification, kf.sensor, sensor);
+    verification.ratio = r.match_ratio;
+    const LoopConstraint located = verify_loop(features, kf.features, verification, seed);
     step.loop = located;
     if (!located.accepted) continue;
     const OdometryReference provisional = reference_;  // accept_placement() replaces it

@@ -73,6 +73,10 @@ struct RelocalisationOptions {
   double max_disagreement_m = 0.05;
   double max_disagreement_rad = 2.0 * kPi / 180.0;
   double max_span_s = 2.0;         ///< placements of frames at most this far apart agree
+  /// The ratio test of a placement's matching (VerificationOptions::ratio). Looser than the
+  /// loops' 0.6 (Lowe's 0.8): brick and floor tiles repeat, and in a corridor of them 0.6 left 1-6
+  /// matches with the right keyframe; a placement, unlike a loop, must be confirmed by another.
+  double match_ratio = 0.8;
   /// Not placed this long after the first frame (a camera that starts where the map never
   /// looked): keyframes are made in a frame of their own (provisional, Slam::provisional_from()),
   /// and joined to the map, moved into its world, when a placement is confirmed. Infinite: the
