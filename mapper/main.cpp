@@ -84,17 +84,18 @@ int serve(Options& o) {
   node->subscribe<rgbd_frame_t>(channel::kCameraRgbd, [&](const rgbd_frame_t& m) {
     publish(map.on_frame(m, channel::kCameraRgbd));
   });
+  // Graphs and corrections may journal: a journal given up on the way is said at once. (Here,
+  // not in the block below: the handlers keep a reference to it for as long as the node spins.)
+  auto journalled = [&](auto&& handle) {
+    const bool journalling = !o.node.journal_path.empty() && map.journal_error().empty();
+    publish(handle());
+    if (journalling && !map.journal_error().empty()) {
+      spdlog::error("journal stopped (the map goes on without it): {}", map.journal_error());
+      report_health();
+    }
+  };
   if (o.node.pose_source == mapper::PoseSource::kSlamGraph) {
     // Graphs are rare and each may trigger a rebuild: never drop one.
-    // Both may journal: a journal given up on the way is said at once.
-    auto journalled = [&](auto&& handle) {
-      const bool journalling = !o.node.journal_path.empty() && map.journal_error().empty();
-      publish(handle());
-      if (journalling && !map.journal_error().empty()) {
-        spdlog::error("journal stopped (the map goes on without it): {}", map.journal_error());
-        report_health();
-      }
-    };
     node->subscribe<slam_graph_t>(channel::kSlamGraph, [&](const slam_graph_t& m) {
       journalled([&] { return map.on_graph(m, channel::kSlamGraph); });
     }, 0);

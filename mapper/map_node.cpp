@@ -220,17 +220,19 @@ std::optional<kestrel::octomap_t> MapNode::on_correction(const kestrel::slam_cor
   if (options_.pose_source != PoseSource::kSlamGraph || !options_.insert_located) return std::nullopt;
   const Eigen::Isometry3d T_world_body = transport::from_message(msg.T_world_body, channel);
   if (msg.utime <= 0) throw InputError(std::string(channel) + ": utime " + std::to_string(msg.utime) + " is not a time");
-  // As a graph keyframe of its own id, which no graph names (SLAM's are positive): no graph
-  // moves it. Stored as the journal will restore it (from this message).
+  // A keyframe's own correction (after an optimisation): the graph placed it. Told by id and
+  // time together: a simulator's flights all start at the same utime.
+  if (const StoredKeyframe* kf = mapper_.keyframes().find(msg.keyframe_id); kf != nullptr && kf->utime == msg.utime)
+    return std::nullopt;
+  // As a graph keyframe of an id no graph names: no graph moves it. Stored as the journal will
+  // restore it (from this message).
   const RgbdFrame* frame = mapper_.buffered(msg.utime);
   kestrel::slam_keyframe_t k{};
-  k.id = -msg.utime;
+  k.id = mapper_.next_located_id();
   k.utime = msg.utime;
   k.T_world_camera = transport::to_message(frame ? T_world_body * frame->T_body_camera : T_world_body);
   k.T_camera_depth = transport::to_message(Eigen::Isometry3d::Identity());
   switch (mapper_.add_located(to_graph_keyframe(k, channel))) {
-    case Mapper::Located::kKeyframe:
-      return std::nullopt;
     case Mapper::Located::kNotBuffered:
       ++stats_.located_missing;
       return std::nullopt;
@@ -241,7 +243,6 @@ std::optional<kestrel::octomap_t> MapNode::on_correction(const kestrel::slam_cor
   ++stats_.frames_inserted;
   if (journal_) {
     try {
-      // (Over the keyframe budget it may have gone at once.)
       if (const StoredKeyframe* kf = mapper_.keyframes().find(k.id)) journal_->keyframe(k, kf->frame);
     } catch (const std::exception& e) {
       journal_error_ = e.what();  // as write_journal(): the map goes on without its copy

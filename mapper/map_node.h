@@ -22,9 +22,10 @@
 // (its folder cannot be written), is given up, not the map: journal_error() says why, health()
 // is DEGRADED with it, and mapping goes on.
 //
-// Located frames (NodeOptions::insert_located, kSlamGraph): a frame SLAM located on its map
-// without making it a keyframe (SLAM_CORRECTION at its utime) goes into the map at the
-// corrected pose, and into the store and the journal as a keyframe of its own (id -utime) that no
+// Located frames (NodeOptions::insert_located, kSlamGraph): the frame of every SLAM_CORRECTION
+// that is not its keyframe's own (a frame SLAM located on its map without making it a keyframe,
+// or the one frame sent to a restarted estimator) goes into the map at the corrected pose, and
+// into the store and the journal as a keyframe of its own (Mapper::next_located_id) that no
 // graph moves: a localisation-only flight makes no keyframes, yet what changed in the building
 // (a door closed) reaches the map. Its pose is its colour time's (no depth-time correction).
 //

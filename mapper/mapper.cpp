@@ -206,9 +206,13 @@ void Mapper::store(StoredKeyframe kf, bool insert_now) {
   keyframes_.add(std::move(kf));
 }
 
+int64_t Mapper::next_located_id() const {
+  int64_t id = kFirstLocatedId;
+  for (const StoredKeyframe* kf : keyframes_.in_time_order()) id = std::max(id, kf->id + 1);
+  return id;
+}
+
 Mapper::Located Mapper::add_located(const GraphKeyframe& located) {
-  for (const StoredKeyframe* kf : keyframes_.in_time_order())
-    if (kf->utime == located.utime) return Located::kKeyframe;
   const RgbdFrame* frame = buffered(located.utime);
   if (frame == nullptr) return Located::kNotBuffered;
   store(stored(located, *frame), true);

@@ -84,12 +84,16 @@ class Mapper {
   void buffer_frame(const RgbdFrame& frame, const char* what = "frame");
   /// SLAM mode: one graph revision.
   GraphResult apply_graph(const std::vector<GraphKeyframe>& keyframes);
-  enum class Located { kInserted, kKeyframe, kNotBuffered };
+  enum class Located { kInserted, kNotBuffered };
   /// SLAM mode: the buffered frame at `located.utime`, which SLAM located on its map without
-  /// making it a keyframe (a localisation-only flight makes none): stored under `located.id`,
-  /// which no graph names (so no graph moves it), and inserted. Nothing changes for a keyframe's
-  /// utime (the graph placed it) or a frame no longer buffered.
+  /// making it a keyframe (a localisation-only flight makes none): stored under `located.id`
+  /// (next_located_id(): no graph names it, so no graph moves it) and inserted. Nothing changes
+  /// for a frame no longer buffered.
   Located add_located(const GraphKeyframe& located);
+  /// An id for a located frame: above every SLAM keyframe id (a utime in microseconds plus an
+  /// index) and every id stored, so that ids still grow with time (the budget's tie-break).
+  int64_t next_located_id() const;
+  static constexpr int64_t kFirstLocatedId = int64_t{1} << 62;
   /// SLAM mode: the buffered (decimated) frame at `utime`, if it still is.
   const RgbdFrame* buffered(int64_t utime) const;
 

@@ -208,6 +208,15 @@ TEST_F(LaunchTool, AProcessNameTheSetsDoNotHoldIsAUsageError) {
   }
 }
 
+TEST_F(LaunchTool, LocalisingOnlyWithoutAMapIsAUsageError) {
+  auto r = run({tool("launch"), "all", "--sets", sets.string(), "--localize-only", "--list"});
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("--localize-only requires --map"), std::string::npos) << r.err;
+  r = run({tool("launch"), "all", "--sets", sets.string(), "--map", (dir / "m").string(), "--no-map-update", "--list"});
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("--no-map-update requires --localize-only"), std::string::npos) << r.err;
+}
+
 TEST_F(LaunchTool, ListsTheSetWithoutStartingIt) {
   const auto r = run({tool("launch"), "onboard", "--sets", sets.string(), "--list"});
   EXPECT_EQ(r.exit_code, 0) << r.err;

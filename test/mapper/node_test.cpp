@@ -267,27 +267,33 @@ TEST(MapNode, AFrameSlamLocatedWithoutAKeyframeUpdatesTheMapWhenAsked) {
   MapNode plain(plain_options);
   for (MapNode* n : {&node, &plain}) n->on_graph(feed_keyframes(*n, before, 0, 3, 1), "SLAM_GRAPH");
   ASSERT_EQ(node.mapper().map().occupancy_at(box_face), Occupancy::kFree) << "the keyframes saw through it";
-  const auto correction = [](int64_t t) {
+  // These frames come from a camera mounted off the body (a correction is the body's pose).
+  const Eigen::Isometry3d T_body_camera = test::look_at({0.1, 0.0, -0.05}, {1.1, 0.0, -0.2});
+  const auto correction = [&](int64_t t, int64_t keyframe_id) {
     kestrel::slam_correction_t c{};
     c.utime = t;
-    c.keyframe_id = 2;
+    c.keyframe_id = keyframe_id;
     c.graph_revision = 1;
-    c.T_world_body = transport::to_message(pose_at(1e-6 * t));
+    c.T_world_body = transport::to_message(pose_at(1e-6 * t) * T_body_camera.inverse());
     return c;
   };
   // Three located frames (one hit does not outweigh the four keyframes' misses: log-odds).
   for (MapNode* n : {&node, &plain}) {
     for (const int64_t t : {600000, 700000, 800000}) {
-      n->on_frame(frame_message(after, t), "CAMERA_RGBD");
-      n->on_correction(correction(t), "SLAM_CORRECTION");
+      kestrel::rgbd_frame_t m = frame_message(after, t);
+      m.camera.T_body_camera = transport::to_message(T_body_camera);
+      n->on_frame(m, "CAMERA_RGBD");
+      n->on_correction(correction(t, 2), "SLAM_CORRECTION");  // located in keyframe 2
     }
-    n->on_correction(correction(300000), "SLAM_CORRECTION");  // keyframe 2's: the graph placed it
-    n->on_correction(correction(550000), "SLAM_CORRECTION");  // no such frame
+    n->on_correction(correction(300000, 2), "SLAM_CORRECTION");  // keyframe 2's own: the graph placed it
+    n->on_correction(correction(550000, 2), "SLAM_CORRECTION");  // no such frame
   }
   EXPECT_EQ(node.stats().located, 3);
   EXPECT_EQ(node.stats().located_missing, 1);
   EXPECT_EQ(node.mapper().keyframes().size(), 7u);
-  ASSERT_NE(node.mapper().keyframes().find(-600000), nullptr);
+  ASSERT_NE(node.mapper().keyframes().find(Mapper::kFirstLocatedId), nullptr);
+  EXPECT_TRUE(node.mapper().keyframes().find(Mapper::kFirstLocatedId)->T_world_camera.isApprox(pose_at(0.6), 1e-9))
+      << "the camera's pose is the corrected body's composed with its mounting";
   EXPECT_EQ(node.mapper().map().occupancy_at(box_face), Occupancy::kOccupied);
   EXPECT_EQ(plain.stats().located, 0);
   EXPECT_EQ(plain.mapper().keyframes().size(), 4u);
@@ -298,7 +304,7 @@ TEST(MapNode, AFrameSlamLocatedWithoutAKeyframeUpdatesTheMapWhenAsked) {
   closed.keyframes[1].T_world_camera.position[1] += 0.05;
   node.on_graph(closed, "SLAM_GRAPH");
   ASSERT_EQ(node.stats().rebuilds, 1);
-  EXPECT_TRUE(node.mapper().keyframes().find(-600000)->T_world_camera.isApprox(pose_at(0.6), 1e-12));
+  EXPECT_TRUE(node.mapper().keyframes().find(Mapper::kFirstLocatedId)->T_world_camera.isApprox(pose_at(0.6), 1e-9));
   EXPECT_EQ(node.mapper().map().occupancy_at(box_face), Occupancy::kOccupied);
   // A restarted mapper gets it back from the journal, with the same map.
   MapNode restarted(options);
@@ -306,10 +312,10 @@ TEST(MapNode, AFrameSlamLocatedWithoutAKeyframeUpdatesTheMapWhenAsked) {
   expect_same_map(node.mapper().map(), restarted.mapper().map());
 
   // Bad corrections are refused naming the channel; nothing changes.
-  kestrel::slam_correction_t bad = correction(600000);
+  kestrel::slam_correction_t bad = correction(600000, 2);
   bad.T_world_body.orientation[0] = static_cast<double>(NAN);
   EXPECT_THROW(node.on_correction(bad, "SLAM_CORRECTION"), InputError);
-  bad = correction(600000);
+  bad = correction(600000, 2);
   bad.utime = -5;
   try {
     node.on_correction(bad, "SLAM_CORRECTION");

@@ -343,7 +343,7 @@ int main(int argc, char** argv) {
   app.add_option("--status-period", o.status_period_s, "Seconds between health tables (0: none)")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
-  app.add_option("--map", o.map,
+  CLI::Option* map_option = app.add_option("--map", o.map,
                  "A building's map folder: SLAM starts from the map saved there (relocalising the vehicle; the "
                  "estimator awaits the map's world) and saves it there on exit; the mapper journals its keyframes "
                  "there, so the occupancy map follows. An empty or new folder: this flight's map is saved there");
@@ -353,8 +353,13 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_flag("--localize-only", o.localize_only,
                "--map: on an existing map, SLAM localises only (keyframes only where the vehicle leaves the map) and "
-               "the mapper updates the occupancy map from the frames SLAM locates in it");
-  app.add_flag("--no-map-update", o.no_map_update, "--localize-only: the mapper keeps the saved occupancy map as it is");
+               "the mapper updates the occupancy map from the frames SLAM locates in it")
+      ->needs(map_option);
+  CLI::Option* localize_option = app.get_option("--localize-only");
+  app.add_flag("--no-map-update", o.no_map_update,
+               "--localize-only: the mapper does not insert the frames SLAM locates (keyframes made where the vehicle "
+               "leaves the map still go in)")
+      ->needs(localize_option);
   app.add_flag("--list", o.list, "Print the processes the command would start, and exit");
   return app.run(argc, argv, [&] { return launch(o); });
 }
