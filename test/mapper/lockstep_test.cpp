@@ -13,6 +13,9 @@
 #include "common/transport/rgbd_codec.h"
 #include "kestrel/ground_truth_t.hpp"
 #include "kestrel/octomap_t.hpp"
+#include "kestrel/slam_correction_t.hpp"
+#include "kestrel/slam_graph_t.hpp"
+#include "mapper/keyframe_journal.h"
 #include "mapper/mapper.h"
 #include "mapper/voxel_map.h"
 #include "mapper/octree_io.h"
@@ -77,6 +80,65 @@ TEST(MapperProcess, LockStepReplayIsDeterministicAndResets) {
     upto.insert(scene.render(test::kinect_camera(160, 120), pose_at(t), t), pose_at(t));
   ASSERT_EQ(map.num_cells(), upto.map().num_cells());
   upto.map().for_each_cell([&](const Key& k, float v) { ASSERT_EQ(map.log_odds(k), v); });
+}
+
+// SLAM mode through the process, localising only: a graph of four keyframes, then corrections
+// for three later frames SLAM located without a keyframe (--insert-located). The journal holds
+// the four keyframes and the three located frames, and the mapper published a map after them.
+TEST(MapperProcess, FramesSlamLocatedReachTheJournalThroughTheProcess) {
+  if (!kestrel::test::can_isolate_network()) KESTREL_SKIP_ENVIRONMENT() << "no network namespace available";
+  kestrel::test::TempDir dir;
+  test::Scene scene(Eigen::Vector3d(-2.0, -2.0, 0.0), Eigen::Vector3d(3.0, 2.0, 2.5));
+  scene.add_box(Eigen::Vector3d(0.8, -0.4, 0.0), Eigen::Vector3d(1.4, 0.3, 0.9));
+  {
+    transport::LogWriter log((dir / "in.lcmlog").string());
+    kestrel::slam_graph_t graph{};
+    graph.revision = 1;
+    for (int64_t t = 100000; t <= 1000000; t += 100000) {
+      log.write_message(channel::kCameraRgbd, t, transport::encode_rgbd(scene.render(test::kinect_camera(160, 120), pose_at(t), t)));
+      if (t <= 400000) {
+        kestrel::slam_keyframe_t k{};
+        k.id = t / 100000;
+        k.utime = t;
+        k.T_world_camera = transport::to_message(pose_at(t));
+        k.T_camera_depth = transport::to_message(Eigen::Isometry3d::Identity());
+        graph.keyframes.push_back(k);
+        graph.num_keyframes = static_cast<int32_t>(graph.keyframes.size());
+        graph.utime = t;
+        log.write_message(channel::kSlamGraph, t, graph);
+      } else if (t >= 800000) {
+        kestrel::slam_correction_t c{};
+        c.utime = t;
+        c.keyframe_id = 4;
+        c.graph_revision = 1;
+        c.T_world_body = transport::to_message(pose_at(t));
+        log.write_message(channel::kSlamCorrection, t, c);
+      }
+    }
+  }
+  const std::string journal = (dir / "mapper.journal").string();
+  const std::string script = kestrel::test::tool("mapper").string() + " --insert-located --journal " + journal +
+                             " --publish-period 0.1 & P=$!; " + kestrel::test::tool("replay").string() + " " +
+                             (dir / "in.lcmlog").string() + " --expect mapper --record " + (dir / "out.lcmlog").string() +
+                             " || exit 11; kill -INT $P; wait $P";
+  const auto r = kestrel::test::run_isolated(script, 240.0);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const JournalContents written = read_journal(journal);
+  int keyframes = 0, located = 0;
+  for (const JournalRecord& record : written.records) {
+    if (record.kind != JournalRecord::Kind::kKeyframe) continue;
+    (record.keyframe.id >= Mapper::kFirstLocatedId ? located : keyframes) += 1;
+  }
+  EXPECT_EQ(keyframes, 4);
+  EXPECT_EQ(located, 3);
+  transport::LogReader recorded((dir / "out.lcmlog").string());
+  int64_t newest_map_utime = 0;
+  while (auto event = recorded.next()) {
+    if (event->channel != channel::kMapOctomap) continue;
+    const auto m = transport::decode_message<kestrel::octomap_t>(event->data.data(), event->data.size(), "MAP_OCTOMAP");
+    newest_map_utime = std::max(newest_map_utime, m.utime);
+  }
+  EXPECT_GE(newest_map_utime, 800000) << "no map after the located frames";
 }
 
 }  // namespace
