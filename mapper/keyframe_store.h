@@ -15,6 +15,7 @@
 #include <Eigen/Geometry>
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <vector>
 
 #include "common/geometry/view_bins.h"
@@ -52,6 +53,10 @@ class KeyframeStore {
   bool set_pose(int64_t id, const Eigen::Isometry3d& T_world_camera);
   const StoredKeyframe* find(int64_t id) const;
   bool contains(int64_t id) const { return keyframes_.count(id) != 0; }
+  /// The largest id stored (none when empty).
+  std::optional<int64_t> max_id() const {
+    return keyframes_.empty() ? std::nullopt : std::optional<int64_t>(keyframes_.rbegin()->first);
+  }
   /// Stored keyframes, ordered by sensor time (the order to rebuild in).
   std::vector<const StoredKeyframe*> in_time_order() const;
 

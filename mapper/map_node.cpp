@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <stdexcept>
 #include <string>
 
@@ -51,8 +52,20 @@ MapNode::MapNode(const NodeOptions& options)
   }
 }
 
-void MapNode::write_journal(const kestrel::slam_graph_t& msg, const GraphResult& result) {
+void MapNode::journal(const std::function<void(JournalWriter&)>& write) {
+  if (!journal_) return;
   try {
+    write(*journal_);
+  } catch (const std::exception& e) {
+    // The map matters more than its copy: stop journalling (a later record after a lost one
+    // would restore a different map) and map on.
+    journal_error_ = e.what();
+    journal_.reset();
+  }
+}
+
+void MapNode::write_journal(const kestrel::slam_graph_t& msg, const GraphResult& result) {
+  journal([&](JournalWriter& writer) {
     // In apply_graph's order: the keyframes the graph moved, if any (the others kept their
     // stored poses, and a restore moves a keyframe only where its pose differs by more than the
     // thresholds, as apply_graph did), then the new keyframes as the message gave them, so a
@@ -67,20 +80,15 @@ void MapNode::write_journal(const kestrel::slam_graph_t& msg, const GraphResult&
       }
       poses.num_keyframes = static_cast<int32_t>(poses.keyframes.size());
       poses.num_edges = 0;
-      journal_->graph(poses);
+      writer.graph(poses);
     }
     for (const int64_t id : result.inserted) {
       const auto k = std::find_if(msg.keyframes.begin(), msg.keyframes.end(),
                                   [&](const kestrel::slam_keyframe_t& m) { return m.id == id; });
       // (Over the keyframe budget, one stored by this graph may have gone already.)
-      if (const StoredKeyframe* stored = mapper_.keyframes().find(id)) journal_->keyframe(*k, stored->frame);
+      if (const StoredKeyframe* stored = mapper_.keyframes().find(id)) writer.keyframe(*k, stored->frame);
     }
-  } catch (const std::exception& e) {
-    // The map matters more than its copy: stop journalling (a later record after a lost one
-    // would restore a different map) and map on.
-    journal_error_ = e.what();
-    journal_.reset();
-  }
+  });
 }
 
 void MapNode::reset() {
@@ -89,17 +97,12 @@ void MapNode::reset() {
   mapper_.reset();
   journal_kept_aside_.clear();
   journal_pruned_ = {};
-  if (journal_) {
-    // The journal starts again with the map; the one it ends is kept, never emptied in place.
-    try {
-      journal_->restart();
-      journal_kept_aside_ = journal_->kept_aside();
-      journal_pruned_ = journal_->pruned();
-    } catch (const std::exception& e) {
-      journal_error_ = e.what();
-      journal_.reset();
-    }
-  }
+  // The journal starts again with the map; the one it ends is kept, never emptied in place.
+  journal([&](JournalWriter& writer) {
+    writer.restart();
+    journal_kept_aside_ = writer.kept_aside();
+    journal_pruned_ = writer.pruned();
+  });
   stats_ = {};
   last_frame_utime_ = 0;
   last_published_utime_ = -1;
@@ -241,14 +244,9 @@ std::optional<kestrel::octomap_t> MapNode::on_correction(const kestrel::slam_cor
   }
   ++stats_.located;
   ++stats_.frames_inserted;
-  if (journal_) {
-    try {
-      if (const StoredKeyframe* kf = mapper_.keyframes().find(k.id)) journal_->keyframe(k, kf->frame);
-    } catch (const std::exception& e) {
-      journal_error_ = e.what();  // as write_journal(): the map goes on without its copy
-      journal_.reset();
-    }
-  }
+  journal([&](JournalWriter& writer) {
+    if (const StoredKeyframe* kf = mapper_.keyframes().find(k.id)) writer.keyframe(k, kf->frame);
+  });
   return maybe_publish(false);
 }
 
@@ -270,7 +268,7 @@ std::optional<kestrel::octomap_t> MapNode::on_graph(const kestrel::slam_graph_t&
   const GraphResult result = mapper_.apply_graph(keyframes);
   // keyframes: the frames a SLAM map is made of
   stats_.frames_inserted += static_cast<int64_t>(result.inserted.size());
-  if (journal_) write_journal(msg, result);
+  write_journal(msg, result);
   if (result.rebuilt) {
     ++stats_.rebuilds;
     stats_.last_rebuild_keyframes = static_cast<double>(result.rebuild_keyframes);

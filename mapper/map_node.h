@@ -39,6 +39,7 @@
 
 #include <cstdint>
 #include <deque>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -136,6 +137,8 @@ class MapNode {
   std::optional<kestrel::octomap_t> maybe_publish(bool now);
   std::optional<kestrel::octomap_t> repeat_map(int64_t frame_utime);
   void insert_pending();
+  /// Runs `write` on the journal, if there is one; a failure gives the journal up (journal_error()).
+  void journal(const std::function<void(JournalWriter&)>& write);
   void write_journal(const kestrel::slam_graph_t& msg, const GraphResult& result);
 
   NodeOptions options_;

@@ -207,9 +207,8 @@ void Mapper::store(StoredKeyframe kf, bool insert_now) {
 }
 
 int64_t Mapper::next_located_id() const {
-  int64_t id = kFirstLocatedId;
-  for (const StoredKeyframe* kf : keyframes_.in_time_order()) id = std::max(id, kf->id + 1);
-  return id;
+  const std::optional<int64_t> newest = keyframes_.max_id();
+  return newest && *newest >= kFirstLocatedId ? *newest + 1 : kFirstLocatedId;
 }
 
 Mapper::Located Mapper::add_located(const GraphKeyframe& located) {

@@ -33,8 +33,7 @@ Eigen::Isometry3d pose_at(int64_t utime) {
 TEST(MapperProcess, LockStepReplayIsDeterministicAndResets) {
   if (!kestrel::test::can_isolate_network()) KESTREL_SKIP_ENVIRONMENT() << "no network namespace available";
   kestrel::test::TempDir dir;
-  test::Scene scene(Eigen::Vector3d(-2.0, -2.0, 0.0), Eigen::Vector3d(3.0, 2.0, 2.5));
-  scene.add_box(Eigen::Vector3d(0.8, -0.4, 0.0), Eigen::Vector3d(1.4, 0.3, 0.9));
+  const test::Scene scene = test::room_with_a_box();
   {
     transport::LogWriter log((dir / "in.lcmlog").string());
     for (int64_t t = 0; t <= 1500000; t += 20000) {
@@ -88,8 +87,7 @@ TEST(MapperProcess, LockStepReplayIsDeterministicAndResets) {
 TEST(MapperProcess, FramesSlamLocatedReachTheJournalThroughTheProcess) {
   if (!kestrel::test::can_isolate_network()) KESTREL_SKIP_ENVIRONMENT() << "no network namespace available";
   kestrel::test::TempDir dir;
-  test::Scene scene(Eigen::Vector3d(-2.0, -2.0, 0.0), Eigen::Vector3d(3.0, 2.0, 2.5));
-  scene.add_box(Eigen::Vector3d(0.8, -0.4, 0.0), Eigen::Vector3d(1.4, 0.3, 0.9));
+  const test::Scene scene = test::room_with_a_box();
   {
     transport::LogWriter log((dir / "in.lcmlog").string());
     kestrel::slam_graph_t graph{};

@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <iostream>
 #include <vector>
 
@@ -74,6 +75,18 @@ Sweep sweep(const sim::World& world, const std::vector<Eigen::Isometry3d>& start
   return s;
 }
 
+// A map of `flight` in `world`: its camera every 0.1 s for `seconds`, at the true poses.
+std::shared_ptr<const SlamMap> map_of_flight(const sim::World& world, const sim::Flight& flight, double seconds) {
+  sim::CameraOptions camera;
+  sim::Renderer renderer(world, camera, 3);
+  Slam mapping(SlamOptions{}, builtin_vocabulary());
+  for (int k = 0; k <= static_cast<int>(std::lround(seconds * 10.0)); ++k) {
+    const Eigen::Isometry3d T_world_camera = flight.state(0.1 * k).T_world_body * camera.T_body_camera;
+    mapping.add(renderer.render(T_world_camera, 1'000'000 + 100'000 * k, k), T_world_camera);
+  }
+  return std::make_shared<const SlamMap>(mapping.map());
+}
+
 double median(std::vector<double> v) {
   if (v.empty()) return 0.0;
   std::sort(v.begin(), v.end());
@@ -83,16 +96,7 @@ double median(std::vector<double> v) {
 TEST(RelocalisationSweep, StartsOverTheMappedRoomArePlacedRightAndNoneElsewhere) {
   const sim::World room = sim::load_world("room");
   // The map: the figure-eight's camera every 0.1 s for 20 s, at the true poses.
-  const auto flight = sim::make_flight("figure8", room);
-  sim::CameraOptions camera;
-  sim::Renderer renderer(room, camera, 3);
-  Slam mapping(SlamOptions{}, builtin_vocabulary());
-  for (int k = 0; k <= 200; ++k) {
-    const double t = 0.1 * k;
-    const Eigen::Isometry3d T_world_camera = flight->state(t).T_world_body * camera.T_body_camera;
-    mapping.add(renderer.render(T_world_camera, 1'000'000 + 100'000 * k, k), T_world_camera);
-  }
-  const auto map = std::make_shared<const SlamMap>(mapping.map());
+  const auto map = map_of_flight(room, *sim::make_flight("figure8", room), 20.0);
 
   // Start poses: a 3 x 3 grid over the take-off area, 1.3 m up, eight headings each.
   const Eigen::Vector4d takeoff = room.start();
@@ -129,14 +133,7 @@ TEST(RelocalisationSweep, StartsOverTheMappedRoomArePlacedRightAndNoneElsewhere)
 TEST(RelocalisationSweep, StartsInACorridorOfRepeatingTilesArePlacedRightAndSooner) {
   const sim::World floor = sim::load_world("floor");
   const auto flight = sim::make_flight("loop", floor);
-  sim::CameraOptions camera;
-  sim::Renderer renderer(floor, camera, 3);
-  Slam mapping(SlamOptions{}, builtin_vocabulary());
-  for (int k = 0; k <= 120; ++k) {
-    const Eigen::Isometry3d T_world_camera = flight->state(0.1 * k).T_world_body * camera.T_body_camera;
-    mapping.add(renderer.render(T_world_camera, 1'000'000 + 100'000 * k, k), T_world_camera);
-  }
-  const auto map = std::make_shared<const SlamMap>(mapping.map());
+  const auto map = map_of_flight(floor, *flight, 12.0);
   std::vector<Eigen::Isometry3d> starts;
   for (double t : {1.5, 4.5, 7.5, 10.5}) {
     const Eigen::Isometry3d on_path = flight->state(t).T_world_body;

@@ -47,6 +47,12 @@ const SlamMap& saved() {
   return *m;
 }
 
+// The same camera turned to look straight up (at the ceiling, which the lap never saw).
+Eigen::Isometry3d looking_up(Eigen::Isometry3d T) {
+  T.linear() = T.linear() * Eigen::AngleAxisd(-kPi / 2, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  return T;
+}
+
 struct TempDir {
   fs::path path = fs::temp_directory_path() / ("kestrel_map_test_" + std::to_string(::getpid()) + "_" +
                                                ::testing::UnitTest::GetInstance()->current_test_info()->name());
@@ -247,7 +253,6 @@ struct CeilingFirst {
   explicit CeilingFirst(bool revisit = false) {
     const Eigen::Isometry3d wall = test::circle_path(48, 1.0, 1.0)[10];  // a view the lap saw
     const Eigen::Vector3d outward(wall.translation().x(), wall.translation().y(), 0.0);
-    const Eigen::AngleAxisd up(-kPi / 2, Eigen::Vector3d::UnitX());
     std::vector<int> steps;  // 3 s under the ceiling, from 0.4 m to 1 m from the room's axis
     for (int i = 0; i <= 30; ++i) steps.push_back(i);
     if (revisit) {
@@ -256,9 +261,8 @@ struct CeilingFirst {
       for (int i = 0; i < 25; ++i) steps.push_back(30);  // and hovers there 2.5 s
     }
     for (const int i : steps) {
-      Eigen::Isometry3d T = wall;
+      Eigen::Isometry3d T = looking_up(wall);
       T.translation() -= (0.6 - 0.02 * i) * outward;
-      T.linear() = wall.linear() * up.toRotationMatrix();
       truth.push_back(T);
     }
     for (int i = 1; i <= 12; ++i) {  // then down to the wall
@@ -517,8 +521,7 @@ TEST_P(LocalisationOnly, LapsOverTheMapAddNothingAndStayOnIt) {
   // Looking up at the ceiling, which the lap never saw: the vehicle left the map, keyframes again
   // (once localised: with the larger drift the last frame may be waiting for its confirmation).
   if (!slam.localized()) return;
-  Eigen::Isometry3d up = laps.back();
-  up.linear() = up.linear() * Eigen::AngleAxisd(-kPi / 2, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  const Eigen::Isometry3d up = looking_up(laps.back());
   const Eigen::Isometry3d T_odom_up = T_odom_camera * laps.back().inverse() * up;
   EXPECT_TRUE(slam.add(room().render(up, test::test_camera(), utime += 100'000), T_odom_up).keyframe);
 }
@@ -528,23 +531,38 @@ INSTANTIATE_TEST_SUITE_P(Drift, LocalisationOnly, ::testing::Values(0.3, 1.5));
 // Localisation only: one frame located far off (a VO glitch) just before the vehicle turns to
 // what the map never saw (the ceiling) must not leave it waiting for a placement for ever: after
 // max_span_s without one, the estimate carries on and the new view is mapped.
-TEST(LocalisationOnlyGlitch, AGlitchBeforeLeavingTheMapDoesNotStopMapping) {
-  SlamOptions options;
-  options.localize_only = true;
-  Slam slam(std::make_shared<const SlamMap>(saved()), options);
-  const auto lap = test::circle_path(48, 1.0, 1.0);
-  int64_t utime = 0;
-  for (int i = 0; i < 6; ++i) slam.add(room().render(lap[static_cast<size_t>(i)], test::test_camera(), utime += 100'000), lap[static_cast<size_t>(i)]);
-  ASSERT_TRUE(slam.localized());
-  Eigen::Isometry3d glitch = lap[7];
-  glitch.translation().x() += 0.10;  // the odometry jumps 10 cm: located beyond the correction bound
-  const SlamStep off = slam.add(room().render(lap[7], test::test_camera(), utime += 100'000), glitch);
-  EXPECT_FALSE(off.keyframe);
-  EXPECT_FALSE(slam.localized()) << "one far placement is not taken, and relocalisation begins";
+// Localising only on the lap's map: six frames on the lap, then lap[7] with the odometry 10 cm
+// off (located beyond the correction bound). Returns that odometry pose of lap[7].
+class LocalisationOnlyGlitch : public ::testing::Test {
+ protected:
+  LocalisationOnlyGlitch() : slam_(std::make_shared<const SlamMap>(saved()), localising()) {}
+  static SlamOptions localising() {
+    SlamOptions options;
+    options.localize_only = true;
+    return options;
+  }
+  Eigen::Isometry3d glitch() {
+    for (size_t i = 0; i < 6; ++i) slam_.add(room().render(lap_[i], test::test_camera(), utime_ += 100'000), lap_[i]);
+    EXPECT_TRUE(slam_.localized());
+    Eigen::Isometry3d glitched = lap_[7];
+    glitched.translation().x() += 0.10;
+    const SlamStep off = slam_.add(room().render(lap_[7], test::test_camera(), utime_ += 100'000), glitched);
+    EXPECT_FALSE(off.keyframe);
+    EXPECT_FALSE(slam_.localized()) << "one far placement is not taken, and relocalisation begins";
+    return glitched;
+  }
+  Slam slam_;
+  const std::vector<Eigen::Isometry3d> lap_ = test::circle_path(48, 1.0, 1.0);
+  int64_t utime_ = 0;
+};
+
+TEST_F(LocalisationOnlyGlitch, AGlitchBeforeLeavingTheMapDoesNotStopMapping) {
+  Slam& slam = slam_;
+  int64_t& utime = utime_;
+  const Eigen::Isometry3d glitch_pose = glitch();
   int keyframes = 0;
-  Eigen::Isometry3d up = lap[7];
-  up.linear() = up.linear() * Eigen::AngleAxisd(-kPi / 2, Eigen::Vector3d::UnitX()).toRotationMatrix();
-  const Eigen::Isometry3d T_odom_up = glitch * lap[7].inverse() * up;
+  const Eigen::Isometry3d up = looking_up(lap_[7]);
+  const Eigen::Isometry3d T_odom_up = glitch_pose * lap_[7].inverse() * up;
   for (int i = 0; i < 30; ++i) {
     Eigen::Isometry3d T = up;
     T.translation().y() += 0.02 * i;  // drifting along under the ceiling
@@ -557,19 +575,12 @@ TEST(LocalisationOnlyGlitch, AGlitchBeforeLeavingTheMapDoesNotStopMapping) {
 // The same glitch, then the VO restarts (in a new odometry frame, 50 m away) while the vehicle
 // waits to be placed again: the first keyframe after the wait is across that break (a weak edge,
 // no motion assumed), not an odometry edge that composes the two unrelated frames.
-TEST(LocalisationOnlyGlitch, AVoRestartWhileLostIsABreakForTheFirstKeyframeAfter) {
-  SlamOptions options;
-  options.localize_only = true;
-  Slam slam(std::make_shared<const SlamMap>(saved()), options);
-  const auto lap = test::circle_path(48, 1.0, 1.0);
-  int64_t utime = 0;
-  for (int i = 0; i < 6; ++i) slam.add(room().render(lap[static_cast<size_t>(i)], test::test_camera(), utime += 100'000), lap[static_cast<size_t>(i)]);
-  Eigen::Isometry3d glitch = lap[7];
-  glitch.translation().x() += 0.10;
-  slam.add(room().render(lap[7], test::test_camera(), utime += 100'000), glitch);
+TEST_F(LocalisationOnlyGlitch, AVoRestartWhileLostIsABreakForTheFirstKeyframeAfter) {
+  Slam& slam = slam_;
+  int64_t& utime = utime_;
+  glitch();
   ASSERT_FALSE(slam.localized());
-  Eigen::Isometry3d up = lap[7];
-  up.linear() = up.linear() * Eigen::AngleAxisd(-kPi / 2, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  const Eigen::Isometry3d up = looking_up(lap_[7]);
   const Eigen::Isometry3d T_odom2_world = se3::exp((Vector6d() << 50.0, -20.0, 3.0, 0.5, 0.2, 1.0).finished());
   std::optional<Keyframe> first;
   Eigen::Isometry3d truth_first = Eigen::Isometry3d::Identity();
