@@ -253,6 +253,9 @@ int serve(const Options& o, const SlamOptions& options, std::shared_ptr<const Vo
   auto publish = [&](const AdapterOutputs& out) {
     if (out.anchored) spdlog::info("map anchored in the estimator's world at keyframe {}",
                                  published_id(adapter.slam(), adapter.slam().keyframes().back().id));
+    if (out.levelled_rad > 0.0)
+      spdlog::info("map turned level by {:.2f} deg about keyframe {}: the estimator's gravity says it was tilted",
+                   out.levelled_rad * 180.0 / kPi, published_id(adapter.slam(), adapter.slam().keyframes().back().id));
     if (out.graph) node->publish(o.graph_channel, *out.graph);
     if (out.correction) node->publish(o.correction_channel, *out.correction);
     if (out.step && out.step->relocalised) report_relocalisation(adapter.slam().relocalisation(), true);
@@ -306,12 +309,12 @@ int serve(const Options& o, const SlamOptions& options, std::shared_ptr<const Vo
   spdlog::info("{} keyframes ({} thinned, features {:.1f} MB), {} loop closures, {} frames re-anchored on a "
                "covering keyframe (keyframes instead: {} with none near, {} none verified, {} located too far; carried "
                "instead: {} too featureless to locate, {} none verified), {} VO restarts "
-               "bridged by the estimator, {} estimator restarts, {} messages rejected",
+               "bridged by the estimator, {} estimator restarts, {} levellings, {} messages rejected",
                adapter.slam().keyframes().size(), adapter.slam().num_thinned(), adapter.slam().feature_bytes() / 1e6,
                adapter.slam().num_loop_closures(), adapter.slam().num_reanchors(),
                misses.none_near, misses.not_verified, misses.too_far, misses.featureless, misses.unverified_carried,
                adapter.bridges(),
-               adapter.estimator_restarts(), node->counters().messages_rejected);
+               adapter.estimator_restarts(), adapter.levellings(), node->counters().messages_rejected);
   return status;
 }
 

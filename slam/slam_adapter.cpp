@@ -44,6 +44,8 @@ void SlamAdapter::reset() {
   last_state_seq_ = -1;
   restart_correction_due_ = false;
   estimator_restarts_ = 0;
+  keyframe_up_.clear();
+  levellings_ = 0;
 }
 
 void SlamAdapter::trim_frames() {
@@ -137,6 +139,7 @@ AdapterOutputs SlamAdapter::on_state(const kestrel::state_t& state) {
   // its start (the accelerometer levels the start only, by default), so its world is the one
   // its first states show, however uncertain their tilt.
   const bool visual_only = state.filter == kestrel::state_t::FILTER_VISUAL_ONLY;
+  if (!visual_only && std::isfinite(tilt_variance) && tilt_variance > 0.0) sample.tilt_sigma_rad = std::sqrt(tilt_variance);
   sample.ok = ok && std::isfinite(tilt_variance) &&
               (visual_only ||
                tilt_variance <= options_.anchor_max_tilt_sigma_rad * options_.anchor_max_tilt_sigma_rad);
@@ -265,6 +268,7 @@ AdapterOutputs SlamAdapter::process(const kestrel::rgbd_frame_t& message, const 
     try_anchor(out);
     return out;
   }
+  const bool levelled = level(step, message.utime, T_body_camera, out);
   // Placed in a saved map: the map's graph goes out too, so that the mapper (restored from its
   // journal) publishes the map the planner flies in before this flight makes a keyframe.
   // Not before: provisional keyframes (made before the placement) are in a frame of their own.
@@ -279,13 +283,66 @@ AdapterOutputs SlamAdapter::process(const kestrel::rgbd_frame_t& message, const 
   // in the gap, and a new estimator would take it as the map's world whatever its error.
   const bool new_estimator_waits =
       restart_correction_due_ && message.utime > restart_state_utime_ && slam_.odometry_placed();
-  if ((step.optimisation || step.reanchored || step.relocalised || new_estimator_waits) && anchored_ &&
+  if ((step.optimisation || step.reanchored || step.relocalised || levelled || new_estimator_waits) && anchored_ &&
       slam_.localized()) {
     out.correction =
         correction_message(slam_, options_.correction_sigma_m, options_.correction_sigma_rad, std::nullopt, anchor_);
     if (new_estimator_waits) restart_correction_due_ = false;
   }
   return out;
+}
+
+bool SlamAdapter::level(const SlamStep& step, int64_t utime, const Eigen::Isometry3d& T_body_camera,
+                        AdapterOutputs& out) {
+  if (!step.keyframe || step.keyframe_id < 0) return false;
+  // The estimator's up at this keyframe: from a settled OK state with a gravity-measured tilt.
+  // Any estimator's world is level, so a restarted one's up is as good as the first's; a pose
+  // across an unplaced odometry break is not the keyframe's.
+  if (slam_.odometry_placed()) {
+    const auto after = std::lower_bound(states_.begin(), states_.end(), utime,
+                                        [](const StateSample& s, int64_t t) { return s.utime < t; });
+    double sigma = 0.0;
+    if (after != states_.end()) sigma = after->tilt_sigma_rad;
+    if (after != states_.begin()) {
+      const double before = std::prev(after)->tilt_sigma_rad;
+      sigma = after == states_.end() ? before : (before > 0.0 && sigma > 0.0 ? std::max(before, sigma) : 0.0);
+    }
+    const auto state = sigma > 0.0 ? state_at(utime, true) : std::nullopt;
+    if (state) {
+      keyframe_up_[step.keyframe_id] =
+          KeyframeUp{(state->T_world_body * T_body_camera).linear().transpose() * Eigen::Vector3d::UnitZ(), sigma};
+    }
+  }
+  // Only a graph anchored here on the estimator's states: a saved map's world is fixed.
+  if (!anchored_ || !anchor_ || !slam_.localized() || !slam_.odometry_placed() ||
+      static_cast<int>(keyframe_up_.size()) < options_.level_min_keyframes)
+    return false;
+  const auto& poses = slam_.graph().poses;
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  double weights = 0.0;
+  int n = 0;
+  for (const auto& [id, kf] : keyframe_up_) {
+    if (id >= static_cast<int64_t>(poses.size())) continue;
+    const double w = 1.0 / (kf.sigma_rad * kf.sigma_rad);
+    sum += w * (poses[static_cast<size_t>(id)].linear() * kf.up_camera);
+    weights += w;
+    ++n;
+  }
+  if (n < options_.level_min_keyframes || !(sum.norm() > 0.0)) return false;
+  const Eigen::Vector3d up = sum.normalized();
+  const double rms_sigma = std::sqrt(n / weights);
+  const double tilt = std::acos(std::clamp(up.z(), -1.0, 1.0));
+  if (!(tilt > options_.level_min_tilt_rad && tilt > options_.level_sigmas * rms_sigma)) return false;
+  // The smallest rotation taking the estimators' up to the graph's: about a horizontal axis,
+  // so heading stays; about the newest keyframe, so where the vehicle is now stays.
+  Eigen::Isometry3d T_level = Eigen::Isometry3d::Identity();
+  T_level.linear() = Eigen::Quaterniond::FromTwoVectors(up, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const Eigen::Vector3d pivot = poses[static_cast<size_t>(step.keyframe_id)].translation();
+  T_level.translation() = pivot - T_level.linear() * pivot;
+  slam_.change_world(T_level);
+  ++levellings_;
+  out.levelled_rad = tilt;
+  return true;
 }
 
 void SlamAdapter::correct_new_estimator(int64_t utime, const ChainedPose& chained, OdometryLink link,

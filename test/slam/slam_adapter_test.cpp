@@ -7,9 +7,12 @@
 
 #include <array>
 #include <cmath>
+#include <optional>
+#include <vector>
 
 #include "common/error.h"
 #include "common/geometry/se3.h"
+#include "common/geometry/so3.h"
 #include "common/numbers.h"
 #include "common/transport/convert.h"
 #include "common/transport/rgbd_codec.h"
@@ -746,6 +749,79 @@ TEST_F(AdapterTest, OnASavedMapKeyframesMadeBeforeThePlacementGoOutOnlyJoinedInT
     EXPECT_LT(E.translation().norm(), 0.02) << "keyframe of frame " << frame;
     EXPECT_LT(so3::angle(E.linear()), 1.0 * kPi / 180.0) << "keyframe of frame " << frame;
   }
+}
+
+// Levelling (slam_adapter.h): anchored on a filter whose tilt was 1.5 degrees off (sigma 5 mrad,
+// "settled"), the graph is turned level once five keyframes have the later states' up
+// (gravity-measured, sigma `later_sigma`): by the anchor's tilt exactly, about the newest
+// keyframe, with a graph and a correction, and once. A tilt within 3 sigma of the states' is
+// left alone, and so are states without a tilt sigma (the tests above: cov_dim 0).
+class LevellingTest : public AdapterTest {
+ protected:
+  struct Flown {
+    std::vector<AdapterOutputs> levelled;  ///< the outputs that turned the graph
+    std::optional<kestrel::slam_graph_t> graph;  ///< the last one published
+  };
+  Flown fly(const Eigen::Isometry3d& anchor_world, const Eigen::Isometry3d& world, double later_sigma) {
+    int64_t seq = 0;
+    Matrix6d P = Matrix6d::Identity() * 1e-6;
+    P.diagonal().segment<2>(3).setConstant(0.005 * 0.005);
+    fly_anchored(adapter_, anchor_world, seq, P);
+    EXPECT_TRUE(adapter_.anchored());
+    P.diagonal().segment<2>(3).setConstant(later_sigma * later_sigma);
+    Flown flown;
+    for (int k = 4; k <= 24; ++k) {
+      for (const double at : {k - 0.5, static_cast<double>(k)}) {  // a state at the frame itself
+        kestrel::state_t m = state(at, world);
+        m.seq = seq++;
+        set_pose_covariance(m, P);
+        adapter_.on_state(m);
+      }
+      adapter_.on_frame(frame(k));
+      const AdapterOutputs out = adapter_.on_vo_update(noisy_update(k));
+      if (out.levelled_rad > 0.0) flown.levelled.push_back(out);
+      if (out.graph) flown.graph = out.graph;
+    }
+    return flown;
+  }
+};
+
+TEST_F(LevellingTest, AGraphAnchoredOnATiltedStateIsTurnedLevelByTheLaterStates) {
+  const Eigen::Isometry3d X = estimator_world();
+  const double tilt = 0.026;
+  const Eigen::Isometry3d tilted = Eigen::AngleAxisd(tilt, Eigen::Vector3d::UnitY()) * X;
+  const Flown flown = fly(tilted, X, 0.002);
+  ASSERT_EQ(flown.levelled.size(), 1u);
+  EXPECT_EQ(adapter_.levellings(), 1);
+  const AdapterOutputs& out = flown.levelled.front();
+  EXPECT_NEAR(out.levelled_rad, tilt, 1e-6);
+  ASSERT_TRUE(out.graph);
+  ASSERT_TRUE(out.correction) << "the estimator is told at once";
+  // Every keyframe's attitude is the level world's (the odometry is exact in rotation); the
+  // newest keyframe then (the pivot) stays where the tilted graph had it.
+  const auto& g = *out.graph;
+  const int newest = g.num_keyframes - 1;
+  const Eigen::Isometry3d pivot_before = tilted * pose(0).inverse() * pose(3 * newest);
+  EXPECT_LT((keyframe_pose(g, newest).translation() - pivot_before.translation()).norm(), 1e-6);
+  for (int i = 0; i < g.num_keyframes; ++i) {
+    const Eigen::Matrix3d expected = (X * pose(0).inverse() * pose(3 * i)).linear();
+    EXPECT_LT(so3::angle(expected.transpose() * keyframe_pose(g, i).linear()), 1e-6) << "keyframe " << i;
+  }
+  // Level now: the keyframes after it change nothing.
+  ASSERT_TRUE(flown.graph);
+  EXPECT_GT(flown.graph->num_keyframes, g.num_keyframes);
+}
+
+TEST_F(LevellingTest, ATiltWithinThreeSigmasOfTheStatesIsLeft) {
+  const Eigen::Isometry3d X = estimator_world();
+  const Eigen::Isometry3d tilted = Eigen::AngleAxisd(0.026, Eigen::Vector3d::UnitY()) * X;
+  EXPECT_TRUE(fly(tilted, X, 0.009).levelled.empty()) << "3 x 9 mrad > 26 mrad";
+  EXPECT_EQ(adapter_.levellings(), 0);
+}
+
+TEST_F(LevellingTest, AGraphTheStatesAgreeWithIsLeft) {
+  const Eigen::Isometry3d X = estimator_world();
+  EXPECT_TRUE(fly(X, X, 0.002).levelled.empty());
 }
 
 // The graph is moved rigidly onto the state it is anchored on, so it shares that state's error:
