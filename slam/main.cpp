@@ -309,12 +309,13 @@ int serve(const Options& o, const SlamOptions& options, std::shared_ptr<const Vo
   spdlog::info("{} keyframes ({} thinned, features {:.1f} MB), {} loop closures, {} frames re-anchored on a "
                "covering keyframe (keyframes instead: {} with none near, {} none verified, {} located too far; carried "
                "instead: {} too featureless to locate, {} none verified), {} VO restarts "
-               "bridged by the estimator, {} estimator restarts, {} levellings, {} messages rejected",
+               "bridged by the estimator, {} estimator restarts, {} levellings ({} tilts refused as too large), {} messages rejected",
                adapter.slam().keyframes().size(), adapter.slam().num_thinned(), adapter.slam().feature_bytes() / 1e6,
                adapter.slam().num_loop_closures(), adapter.slam().num_reanchors(),
                misses.none_near, misses.not_verified, misses.too_far, misses.featureless, misses.unverified_carried,
                adapter.bridges(),
-               adapter.estimator_restarts(), adapter.levellings(), node->counters().messages_rejected);
+               adapter.estimator_restarts(), adapter.levellings(), adapter.levels_refused(),
+               node->counters().messages_rejected);
   return status;
 }
 

@@ -45,7 +45,7 @@ void SlamAdapter::reset() {
   restart_correction_due_ = false;
   estimator_restarts_ = 0;
   keyframe_up_.clear();
-  levellings_ = 0;
+  levellings_ = levels_refused_ = 0;
 }
 
 void SlamAdapter::trim_frames() {
@@ -132,9 +132,17 @@ AdapterOutputs SlamAdapter::on_state(const kestrel::state_t& state) {
   // The map's world is fixed once: only by a state whose tilt is settled (a filter that started
   // on the move knows its roll and pitch to a few degrees at first, and a map anchored then
   // stays tilted against the filter's later world).
+  // dtheta is in the body frame (state_t): roll and pitch are the world's x and y of it.
+  sample.T_world_body = transport::from_message(state.T_world_body, options_.state_channel.c_str());
   double tilt_variance = 0.0;
-  if (state.cov_dim >= 9 && static_cast<int>(state.covariance.size()) >= 9)
-    tilt_variance = std::max(state.covariance[6][6], state.covariance[7][7]);
+  if (state.cov_dim >= 9 && static_cast<int>(state.covariance.size()) >= 9) {
+    Eigen::Matrix3d rotation_body;
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) rotation_body(r, c) = state.covariance[static_cast<size_t>(6 + r)][static_cast<size_t>(6 + c)];
+    const Eigen::Matrix3d R = sample.T_world_body.linear();
+    const Eigen::Matrix3d rotation_world = R * rotation_body * R.transpose();
+    tilt_variance = std::max(rotation_world(0, 0), rotation_world(1, 1));
+  }
   // The visual-only estimator (no gyro) is the exception: nothing re-measures its tilt after
   // its start (the accelerometer levels the start only, by default), so its world is the one
   // its first states show, however uncertain their tilt.
@@ -143,7 +151,6 @@ AdapterOutputs SlamAdapter::on_state(const kestrel::state_t& state) {
   sample.ok = ok && std::isfinite(tilt_variance) &&
               (visual_only ||
                tilt_variance <= options_.anchor_max_tilt_sigma_rad * options_.anchor_max_tilt_sigma_rad);
-  sample.T_world_body = transport::from_message(state.T_world_body, options_.state_channel.c_str());
   // The pose's covariance, which the graph inherits where it is anchored on this state.
   sample.pose_covariance = transport::pose_covariance_from(state);
   if (!sample.pose_covariance.allFinite()) sample.ok = false;  // not to anchor on; a bridge needs only the pose
@@ -295,17 +302,21 @@ AdapterOutputs SlamAdapter::process(const kestrel::rgbd_frame_t& message, const 
 bool SlamAdapter::level(const SlamStep& step, int64_t utime, const Eigen::Isometry3d& T_body_camera,
                         AdapterOutputs& out) {
   if (!step.keyframe || step.keyframe_id < 0) return false;
-  // The estimator's up at this keyframe: from a settled OK state with a gravity-measured tilt.
-  // Any estimator's world is level, so a restarted one's up is as good as the first's; a pose
-  // across an unplaced odometry break is not the keyframe's.
-  if (slam_.odometry_placed()) {
+  // The estimator's up at this keyframe, in its camera frame: from a settled OK state with a
+  // gravity-measured tilt (the sigma of the states state_at() takes). Any estimator's world is
+  // level, so a restarted one's up is as good as the first's, and a camera-frame direction
+  // needs no odometry (a keyframe after a break not yet placed is used once it is).
+  {
     const auto after = std::lower_bound(states_.begin(), states_.end(), utime,
                                         [](const StateSample& s, int64_t t) { return s.utime < t; });
     double sigma = 0.0;
-    if (after != states_.end()) sigma = after->tilt_sigma_rad;
-    if (after != states_.begin()) {
+    if (after != states_.end() && after->utime == utime) {
+      sigma = after->tilt_sigma_rad;
+    } else if (after == states_.end()) {
+      if (!states_.empty()) sigma = states_.back().tilt_sigma_rad;  // carried on from the newest
+    } else if (after != states_.begin()) {
       const double before = std::prev(after)->tilt_sigma_rad;
-      sigma = after == states_.end() ? before : (before > 0.0 && sigma > 0.0 ? std::max(before, sigma) : 0.0);
+      sigma = before > 0.0 && after->tilt_sigma_rad > 0.0 ? std::max(before, after->tilt_sigma_rad) : 0.0;
     }
     const auto state = sigma > 0.0 ? state_at(utime, true) : std::nullopt;
     if (state) {
@@ -330,9 +341,15 @@ bool SlamAdapter::level(const SlamStep& step, int64_t utime, const Eigen::Isomet
   }
   if (n < options_.level_min_keyframes || !(sum.norm() > 0.0)) return false;
   const Eigen::Vector3d up = sum.normalized();
-  const double rms_sigma = std::sqrt(n / weights);
+  const double sigma = std::sqrt(n / weights);  // root of the harmonic mean of the variances
   const double tilt = std::acos(std::clamp(up.z(), -1.0, 1.0));
-  if (!(tilt > options_.level_min_tilt_rad && tilt > options_.level_sigmas * rms_sigma)) return false;
+  if (!(tilt > options_.level_min_tilt_rad && tilt > options_.level_sigmas * sigma)) return false;
+  // No estimator's error tilts a map this far: a camera mounting that disagrees with the
+  // frames (T_body_camera) would. Refused, and counted for the operator.
+  if (tilt > options_.level_max_tilt_rad) {
+    ++levels_refused_;
+    return false;
+  }
   // The smallest rotation taking the estimators' up to the graph's: about a horizontal axis,
   // so heading stays; about the newest keyframe, so where the vehicle is now stays.
   Eigen::Isometry3d T_level = Eigen::Isometry3d::Identity();
@@ -340,6 +357,12 @@ bool SlamAdapter::level(const SlamStep& step, int64_t utime, const Eigen::Isomet
   const Eigen::Vector3d pivot = poses[static_cast<size_t>(step.keyframe_id)].translation();
   T_level.translation() = pivot - T_level.linear() * pivot;
   slam_.change_world(T_level);
+  // The anchoring state's pose turns with the graph: its covariance is carried about it
+  // (correction_message's lever arm).
+  anchor_->T_world_body = T_level * anchor_->T_world_body;
+  Matrix6d turn = Matrix6d::Identity();  // dp is in the world, dtheta in the body (pose_t)
+  turn.topLeftCorner<3, 3>() = T_level.linear();
+  anchor_->covariance = turn * anchor_->covariance * turn.transpose();
   ++levellings_;
   out.levelled_rad = tilt;
   return true;

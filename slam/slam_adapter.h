@@ -46,11 +46,16 @@
 // 17 m away, out of a planner's height band. So, once anchored on the estimator's states (not
 // on a saved map, whose world is fixed), each keyframe keeps the world's up as the estimator
 // had it then (a state with a gravity-measured tilt and its sigma: not the visual-only
-// filter's); when their weighted mean, in the graph's current frame, is tilted from the
-// graph's up by more than level_min_tilt_rad and level_sigmas of their RMS sigma (not divided
-// by their number: a filter's tilt errors last for seconds), the graph is turned rigidly about
-// the newest keyframe by the smallest rotation that levels it (heading and that keyframe's
-// position unchanged), and a SLAM_GRAPH and a SLAM_CORRECTION go out as after an optimisation.
+// filter's); when their 1/sigma^2-weighted mean, in the graph's current frame, is tilted from
+// the graph's up by more than level_min_tilt_rad and level_sigmas of sqrt(n / sum sigma^-2)
+// (the sigma of one typical sample, not of the mean: a filter's tilt errors last for seconds,
+// so neighbouring keyframes do not measure them independently), the graph is turned rigidly
+// about the newest keyframe by the smallest rotation that levels it (heading and that
+// keyframe's position unchanged), the anchoring state with it, and a SLAM_GRAPH and a
+// SLAM_CORRECTION go out as after an optimisation. Known limits: the estimator fuses SLAM's
+// corrections, roll and pitch included (at 0.02 rad, far looser than gravity), so its up
+// leans a little towards the graph's; and an overconfident filter's early ups weigh as much
+// as later ones (docs/decisions/2026-12-06-slam-levelling.md).
 //
 // A frame and its VO update are paired by utime. Frames wait (encoded) in a bounded buffer and
 // are decoded only when their pose makes them a keyframe; an update whose frame has not come
@@ -95,6 +100,7 @@ struct AdapterOptions {
   double level_min_tilt_rad = 0.005;
   double level_sigmas = 3.0;
   int level_min_keyframes = 5;
+  double level_max_tilt_rad = 0.1;  ///< a larger tilt is refused (levels_refused()), not corrected
   /// The camera's profile, whose timing (depth offset, rolling shutter) the keyframes'
   /// features are corrected with as the VO corrects them (kestrel-slam --sensor); unset: each
   /// frame's sensor model names it (sensors::profile_of_sensor).
@@ -103,7 +109,7 @@ struct AdapterOptions {
 
 struct AdapterOutputs {
   std::optional<kestrel::slam_graph_t> graph;            ///< after a new keyframe or optimisation
-  std::optional<kestrel::slam_correction_t> correction;  ///< after an optimisation or a re-anchoring, or for a new estimator
+  std::optional<kestrel::slam_correction_t> correction;  ///< after an optimisation, a re-anchoring or a levelling, or for a new estimator
   std::optional<SlamStep> step;                          ///< what SLAM did (a keyframe was made or a frame re-anchored)
   bool anchored = false;  ///< the graph was just moved into the estimator's world
   double levelled_rad = 0.0;  ///< the graph was just turned level by this angle (0: not)
@@ -134,8 +140,10 @@ class SlamAdapter {
   int bridges() const { return bridges_; }
   /// New estimators seen on STATE (its seq started again): a restarted process.
   int estimator_restarts() const { return estimator_restarts_; }
-  /// Times the graph was turned level (levelling, above).
+  /// Times the graph was turned level (levelling, above), and tilts beyond level_max_tilt_rad
+  /// that were not.
   int levellings() const { return levellings_; }
+  int levels_refused() const { return levels_refused_; }
 
   const Slam& slam() const { return slam_; }
 
@@ -204,6 +212,7 @@ class SlamAdapter {
   };
   std::map<int64_t, KeyframeUp> keyframe_up_;  ///< keyframe index -> the estimator's up there
   int levellings_ = 0;
+  int levels_refused_ = 0;
 };
 
 }  // namespace kestrel::slam

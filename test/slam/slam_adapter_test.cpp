@@ -762,7 +762,10 @@ class LevellingTest : public AdapterTest {
     std::vector<AdapterOutputs> levelled;  ///< the outputs that turned the graph
     std::optional<kestrel::slam_graph_t> graph;  ///< the last one published
   };
-  Flown fly(const Eigen::Isometry3d& anchor_world, const Eigen::Isometry3d& world, double later_sigma) {
+  // The later states: at each frame and half a frame before (`between`: 40 ms after the frame
+  // instead of at it, so the keyframe's up is interpolated), from `filter`.
+  Flown fly(const Eigen::Isometry3d& anchor_world, const Eigen::Isometry3d& world, double later_sigma,
+            bool between = false, int8_t filter = kestrel::state_t::FILTER_EKF) {
     int64_t seq = 0;
     Matrix6d P = Matrix6d::Identity() * 1e-6;
     P.diagonal().segment<2>(3).setConstant(0.005 * 0.005);
@@ -771,9 +774,10 @@ class LevellingTest : public AdapterTest {
     P.diagonal().segment<2>(3).setConstant(later_sigma * later_sigma);
     Flown flown;
     for (int k = 4; k <= 24; ++k) {
-      for (const double at : {k - 0.5, static_cast<double>(k)}) {  // a state at the frame itself
+      for (const double at : {k - 0.5, between ? k + 0.4 : static_cast<double>(k)}) {
         kestrel::state_t m = state(at, world);
         m.seq = seq++;
+        m.filter = filter;
         set_pose_covariance(m, P);
         adapter_.on_state(m);
       }
@@ -817,6 +821,26 @@ TEST_F(LevellingTest, ATiltWithinThreeSigmasOfTheStatesIsLeft) {
   const Eigen::Isometry3d tilted = Eigen::AngleAxisd(0.026, Eigen::Vector3d::UnitY()) * X;
   EXPECT_TRUE(fly(tilted, X, 0.009).levelled.empty()) << "3 x 9 mrad > 26 mrad";
   EXPECT_EQ(adapter_.levellings(), 0);
+}
+
+TEST_F(LevellingTest, ATiltAboutAnyHorizontalAxisIsTakenOutWithInterpolatedStates) {
+  const Eigen::Isometry3d X = estimator_world();
+  const Eigen::Isometry3d tilted =
+      Eigen::AngleAxisd(0.02, Eigen::Vector3d(1.0, -2.0, 0.0).normalized()) * X;
+  const Flown flown = fly(tilted, X, 0.002, true);
+  ASSERT_EQ(flown.levelled.size(), 1u);
+  EXPECT_NEAR(flown.levelled.front().levelled_rad, 0.02, 1e-6);
+  const auto& g = *flown.levelled.front().graph;
+  for (int i = 0; i < g.num_keyframes; ++i) {
+    const Eigen::Matrix3d expected = (X * pose(0).inverse() * pose(3 * i)).linear();
+    EXPECT_LT(so3::angle(expected.transpose() * keyframe_pose(g, i).linear()), 1e-6) << "keyframe " << i;
+  }
+}
+
+TEST_F(LevellingTest, TheVisualOnlyFiltersTiltIsNoMeasureOfGravity) {
+  const Eigen::Isometry3d X = estimator_world();
+  const Eigen::Isometry3d tilted = Eigen::AngleAxisd(0.026, Eigen::Vector3d::UnitY()) * X;
+  EXPECT_TRUE(fly(tilted, X, 0.002, false, kestrel::state_t::FILTER_VISUAL_ONLY).levelled.empty());
 }
 
 TEST_F(LevellingTest, AGraphTheStatesAgreeWithIsLeft) {
