@@ -50,18 +50,23 @@ std::vector<Waypoint> read_waypoints(const std::string& path) {
   return out;
 }
 
-FollowerNode::FollowerNode(const FollowerNodeOptions& options) : options_(options), follower_(options.follower) {
+FollowerNode::FollowerNode(const FollowerNodeOptions& options)
+    : options_(options), follower_(options.follower), smoother_(options.smoothing) {
   if (!(options.command_period_s >= 0.0)) throw std::invalid_argument("follower: command period must be >= 0");
 }
 
 void FollowerNode::reset() {
   follower_.clear();
+  smoother_.reset();
   active_ = hold_pending_ = commanded_ = false;
   last_command_utime_ = 0;
 }
 
 void FollowerNode::set_path(const std::vector<Waypoint>& waypoints) {
   follower_.set_path(waypoints);
+  // A new path (planned from STATE as it is) starts from STATE as it is: an offset left from an
+  // earlier jump would shift the whole of it.
+  smoother_.clear_offset();
   active_ = true;
   hold_pending_ = false;
 }
@@ -91,20 +96,29 @@ void FollowerNode::on_plan(const kestrel::plan_t& plan) {
 
 std::optional<kestrel::vehicle_command_t> FollowerNode::on_state(const kestrel::state_t& state) {
   if (!active_ && !hold_pending_) return std::nullopt;
+  const bool usable = state.status == kestrel::state_t::STATUS_OK || state.status == kestrel::state_t::STATUS_DEGRADED;
+  // Every usable state while following, due or not, feeds the smoother: a jump is a step
+  // between two states, whichever of them is commanded on.
+  std::optional<Eigen::Isometry3d> T;
+  Eigen::Vector3d offset = Eigen::Vector3d::Zero();
+  if (usable) {
+    T = transport::from_message(state.T_world_body, options_.state_channel.c_str());
+    const Eigen::Vector3d velocity(state.velocity[0], state.velocity[1], state.velocity[2]);
+    offset = smoother_.update(state.utime, T->translation(), velocity);
+  }
   const bool due = !commanded_ || hold_pending_ ||
                    state.utime - last_command_utime_ >= std::llround(options_.command_period_s * 1e6);
   if (!due) return std::nullopt;
-  const bool usable = state.status == kestrel::state_t::STATUS_OK || state.status == kestrel::state_t::STATUS_DEGRADED;
   VehicleState s;
-  if (usable) {
-    const Eigen::Isometry3d T = transport::from_message(state.T_world_body, options_.state_channel.c_str());
-    s.position = T.translation();
-    s.yaw = std::atan2(T.linear()(1, 0), T.linear()(0, 0));
+  if (T) {
+    s.position = T->translation() - offset;
+    s.yaw = std::atan2(T->linear()(1, 0), T->linear()(0, 0));
   }
   FollowerCommand c;  // kHold unless the follower says otherwise: the vehicle stops where it is
   c.position = s.position;
   c.yaw = s.yaw;
   if (usable) c = follower_.command(s);
+  c.position += offset;  // back into the estimator's world, which the vehicle's controller uses
   hold_pending_ = false;
   active_ = follower_.status() != FollowStatus::kIdle;
   commanded_ = true;

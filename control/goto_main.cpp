@@ -89,6 +89,8 @@ int run(const Options& o) {
   progress_options.follower.arrive_radius_m = o.arrive_radius_m;
   progress_options.follower.max_deviation_m = std::numeric_limits<double>::infinity();
   progress_options.command_period_s = 0.0;
+  // The progress of the vehicle as STATE has it (arrival is judged on STATE): no jump smoothing.
+  progress_options.smoothing.min_jump_m = std::numeric_limits<double>::infinity();
   control::FollowerNode progress(progress_options);
   node.subscribe<kestrel::state_t>(channel::kState, [&](const kestrel::state_t& m) {
     if (m.status != kestrel::state_t::STATUS_OK && m.status != kestrel::state_t::STATUS_DEGRADED) return;

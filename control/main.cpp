@@ -30,8 +30,10 @@ int run(const Options& o) {
   }
   transport::Node node("follow", o.lcm_url);  // UnavailableError: exit 4
   node.advertise(o.command_channel);
+  int jumps_said = 0;
   node.on_reset([&] {
     follower.reset();
+    jumps_said = 0;
     if (!given.empty()) follower.set_path(given);
   });
   auto health = [&] {
@@ -53,6 +55,11 @@ int run(const Options& o) {
   FollowStatus last = follower.follower().status();
   node.subscribe<kestrel::state_t>(o.node.state_channel, [&](const kestrel::state_t& m) {
     if (const auto command = follower.on_state(m)) node.publish(o.command_channel, *command);
+    if (follower.smoother().jumps() > jumps_said) {
+      jumps_said = follower.smoother().jumps();
+      spdlog::info("STATE jumped {:.3f} m: taken out of the control (up to {:.2f} m), let go at {:.2f} m/s",
+                   follower.smoother().last_jump_m(), o.node.smoothing.max_offset_m, o.node.smoothing.release_speed_m_s);
+    }
     const FollowStatus now = follower.follower().status();
     if (now != last) {
       spdlog::info("{} at {:.2f} of {:.2f} m (deviation {:.2f} m)", to_string(now), follower.follower().progress_m(),
@@ -61,7 +68,10 @@ int run(const Options& o) {
       health();
     }
   }, 400);
-  return node.spin();
+  const int status = node.spin();
+  spdlog::info("{} STATE jumps taken out of the control, the largest {:.3f} m", follower.smoother().jumps(),
+               follower.smoother().largest_jump_m());
+  return status;
 }
 
 }  // namespace
@@ -77,6 +87,14 @@ int main(int argc, char** argv) {
   app.add_option("--lookahead", f.lookahead_m, "Where the velocity aims, ahead along the path (m)")->check(cli::Positive)->capture_default_str();
   app.add_option("--arrive-radius", f.arrive_radius_m, "Arrived within this of the last waypoint (m)")->check(cli::Positive)->capture_default_str();
   app.add_option("--max-deviation", f.max_deviation_m, "Farther than this from the path: hold and wait for a new plan (m)")->check(cli::Positive)->capture_default_str();
+  app.add_option("--jump-min", o.node.smoothing.min_jump_m,
+                 "A step of STATE its velocity does not explain, beyond this, is taken out of the control and let go slowly (m; 100: never)")
+      ->check(CLI::NonNegativeNumber)->capture_default_str();
+  app.add_option("--jump-release-speed", o.node.smoothing.release_speed_m_s, "How fast a jump taken out is let go (m/s)")
+      ->check(cli::Positive)->capture_default_str();
+  app.add_option("--jump-max", o.node.smoothing.max_offset_m,
+                 "At most this much of jumps is held out of the control; the rest passes, so the off-path hold sees it (m)")
+      ->check(cli::Positive)->capture_default_str();
   app.add_option("--period", o.node.command_period_s, "At most one command per this much sensor time (s)")->check(CLI::NonNegativeNumber)->capture_default_str();
   app.add_option("--plan-channel", o.node.plan_channel, "Channel of plan_t")->capture_default_str();
   app.add_option("--state-channel", o.node.state_channel, "Channel of state_t")->capture_default_str();

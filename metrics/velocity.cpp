@@ -14,6 +14,8 @@ VelocityResult compute_velocity(const Association& association, const EvalOption
   const std::vector<FramePoses>& frames = association.frames;
   result.gross.frames = frames.size();
   result.verdicts.reserve(frames.size());
+  std::vector<double> steps;
+  size_t largest = 0;
   for (size_t k = 0; k < frames.size(); ++k) {
     const FramePoses& cur = frames[k];
     const FramePoses* prev = k > 0 ? &frames[k - 1] : nullptr;
@@ -31,7 +33,10 @@ VelocityResult compute_velocity(const Association& association, const EvalOption
     } else {
       const Eigen::Vector3d t_est = (prev->T_world_est->inverse() * *cur.T_world_est).translation();
       const Eigen::Vector3d t_gt = (prev->T_world_gt->inverse() * *cur.T_world_gt).translation();
-      const double error = (t_est - t_gt).norm() / to_seconds(cur.utime - prev->utime);
+      const double step = (t_est - t_gt).norm();
+      const double error = step / to_seconds(cur.utime - prev->utime);
+      if (steps.empty() || step > steps[largest]) largest = steps.size();
+      steps.push_back(step);
       result.utimes.push_back(cur.utime);
       result.errors_mps.push_back(error);
       verdict = Verdict::kChecked;
@@ -43,6 +48,8 @@ VelocityResult compute_velocity(const Association& association, const EvalOption
     result.verdicts.push_back(verdict);
   }
   result.error_mps = summarize(result.errors_mps);
+  result.step_error_m = summarize(steps);
+  if (!steps.empty()) result.largest_step_utime = result.utimes[largest];
   return result;
 }
 

@@ -7,6 +7,8 @@
 // k-1's coordinates, t_est = trans(P_{k-1}^-1 P_k), t_gt = trans(G_{k-1}^-1 G_k), gives
 //   e_k = |t_est - t_gt| / (t_k - t_{k-1})   (m/s).
 // It needs no alignment, but both trajectories must be of the same frame (camera or body).
+// Its step error |t_est - t_gt| (m) is the same without the division: for an estimate that jumps
+// (a late correction applied at once) its largest value is the jump a controller sees.
 //
 // Gross failures are counted over the whole frame list (the denominator). Frame k is one when
 //  * the estimator gave no pose for it (no estimate), or
@@ -53,6 +55,8 @@ struct GrossFailures {
 
 struct VelocityResult {
   Summary error_mps;
+  Summary step_error_m;              ///< |t_est - t_gt| per checked frame
+  int64_t largest_step_utime = 0;    ///< the frame of step_error_m.max (0: none)
   std::vector<int64_t> utimes;     ///< frame k of each error below
   std::vector<double> errors_mps;  ///< e_k
   std::vector<Verdict> verdicts;   ///< one per frame of the association

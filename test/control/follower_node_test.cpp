@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <optional>
 
 #include "common/error.h"
 #include "common/transport/convert.h"
@@ -75,6 +76,62 @@ TEST(FollowerNode, AStateWithoutAPoseGivesAHold) {
   const auto again = node.on_state(state(1'100'000, 1, 0));
   ASSERT_TRUE(again);
   EXPECT_EQ(again->mode, kestrel::vehicle_command_t::MODE_POSITION) << "the path is kept";
+}
+
+// A late SLAM correction moves STATE 0.45 m sideways within one 5 ms step while the vehicle
+// follows the path at 0.5 m/s: the set point moves with it, so the controller's error (set point
+// less state) does not step; then it goes back onto the path at the release speed.
+TEST(FollowerNode, AJumpOfTheStateMovesTheSetPointWithItAndIsLetGoSlowly) {
+  FollowerNodeOptions o;
+  o.command_period_s = 0.0;  // a command on every state
+  FollowerNode node(o);
+  node.on_plan(plan());
+  const auto moving = [](int64_t utime, double x, double y) {
+    kestrel::state_t m = state(utime, x, y);
+    m.velocity[0] = 0.5;
+    return m;
+  };
+  const auto before = node.on_state(moving(1'000'000, 1.0, 0.0));
+  ASSERT_TRUE(before);
+  EXPECT_NEAR(before->position[1], 0.0, 1e-12);
+  const auto after = node.on_state(moving(1'005'000, 1.0025, 0.45));
+  ASSERT_TRUE(after);
+  EXPECT_NEAR(after->position[1] - 0.45, before->position[1] - 0.0, 1e-9) << "set point less state: no step";
+  EXPECT_NEAR(node.smoother().largest_jump_m(), 0.45, 1e-9);
+  EXPECT_NEAR(node.follower().deviation_m(), 0.0, 1e-9) << "the follower sees the state less the jump";
+  // One second on, 0.1 m of it let go: the set point is 0.35 m off the path, towards the state.
+  std::optional<kestrel::vehicle_command_t> later;
+  for (int k = 2; k <= 201; ++k) later = node.on_state(moving(1'000'000 + 5'000 * k, 1.0 + 0.0025 * k, 0.45));
+  ASSERT_TRUE(later);
+  EXPECT_NEAR(later->position[1], 0.35, 1e-6);
+}
+
+// The smoother sees every state while following, not only those a command is due on; a jump
+// beyond the largest offset still takes the vehicle off the path (hold); a new plan starts from
+// the state as it is.
+TEST(FollowerNode, JumpsBetweenCommandsCountBeyondTheLargestOffsetTheVehicleHoldsAndANewPlanStartsAfresh) {
+  FollowerNodeOptions o;
+  o.command_period_s = 0.02;
+  FollowerNode node(o);
+  node.on_plan(plan());
+  const auto moving = [](int64_t utime, double x, double y) {
+    kestrel::state_t m = state(utime, x, y);
+    m.velocity[0] = 0.5;
+    return m;
+  };
+  ASSERT_TRUE(node.on_state(moving(1'000'000, 1.0, 0.0)));
+  EXPECT_FALSE(node.on_state(moving(1'005'000, 1.0025, 0.3))) << "no command due: the jump is taken all the same";
+  EXPECT_NEAR(node.smoother().offset().y(), 0.3, 1e-9);
+  const auto next = node.on_state(moving(1'020'000, 1.01, 0.3));
+  ASSERT_TRUE(next);
+  EXPECT_NEAR(next->position[1], 0.3 - 0.1 * 0.015, 1e-9) << "the set point moved with it, 15 ms of it let go";
+  // 1.5 m more: 0.5 m is held, the rest passes; 1.2 m off a path whose limit is 1 m: hold.
+  const auto off = node.on_state(moving(1'040'000, 1.02, 1.8));
+  ASSERT_TRUE(off);
+  EXPECT_EQ(node.follower().status(), FollowStatus::kOffPath);
+  // A new plan from the state as it is: no offset left to shift it.
+  node.on_plan(plan());
+  EXPECT_EQ(node.smoother().offset().norm(), 0.0);
 }
 
 TEST(FollowerNode, RefusesBadPlansAndStatesNamingTheChannel) {

@@ -149,7 +149,7 @@ TEST(EvalCli, TextReportNamesWhatWasCompared) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   for (const char* s : {"ground truth", "estimate", "compared", "ATE, not aligned (m)",
                         "RPE translation, 1 s (m/s)", "RPE rotation, 1 s (deg/s)",
-                        "velocity error (m/s)", "gross failures", "0 of 90 frames (0.00 %)"})
+                        "velocity error (m/s)", "step error (m)", "gross failures", "0 of 90 frames (0.00 %)"})
     EXPECT_NE(r.out.find(s), std::string::npos) << s << "\n" << r.out;
 }
 

@@ -176,6 +176,10 @@ TEST(EvalMetrics, MissingFramesAndJumpsAreGrossFailures) {
   // 99 transitions minus the 9 that touch a missed frame: 90 velocity errors.
   EXPECT_EQ(e.velocity.error_mps.count, 90u);
   EXPECT_NEAR(e.velocity.error_mps.max, 0.1 / (1e-6 * kFrame_us), 1e-6);
+  // The jump itself, in metres, and when: what a controller fed the estimate would see.
+  EXPECT_EQ(e.velocity.step_error_m.count, 90u);
+  EXPECT_NEAR(e.velocity.step_error_m.max, 0.1, 1e-9);
+  EXPECT_EQ(e.velocity.largest_step_utime, times[jump]);
 }
 
 // Ground truth with a 0.11 s hole (as fr1_xyz has): frames with no sample within 20 ms on a

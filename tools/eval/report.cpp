@@ -74,6 +74,7 @@ std::string text_report(const ReportInputs& in, const metrics::Evaluation& e, co
   s += row(fmt::format("RPE translation, {:g} s (m/s)", o.rpe_delta_s), e.rpe.translation_mps);
   s += row(fmt::format("RPE rotation, {:g} s (deg/s)", o.rpe_delta_s), e.rpe.rotation_degps);
   s += row("velocity error (m/s)", e.velocity.error_mps);
+  s += row("step error (m)", e.velocity.step_error_m);
   s += fmt::format(
       "{:<30} {} of {} frames ({:.2f} %): {} without an estimate, {} with velocity "
       "error > {:g} m/s",
@@ -120,6 +121,9 @@ nlohmann::json json_report(const ReportInputs& in, const metrics::Evaluation& e,
         {"translation_mps", to_json(e.rpe.translation_mps)},
         {"rotation_degps", to_json(e.rpe.rotation_degps)}}},
       {"velocity_error_mps", to_json(e.velocity.error_mps)},
+      {"step_error_m", to_json(e.velocity.step_error_m)},
+      {"largest_step_s", e.velocity.step_error_m.count == 0 ? nlohmann::json(nullptr)
+                                                           : nlohmann::json(to_seconds(e.velocity.largest_step_utime))},
       {"gross_failures",
        {{"frames", g.frames},
         {"no_estimate", g.no_estimate},
