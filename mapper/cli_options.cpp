@@ -43,6 +43,10 @@ void add_mapper_options(CLI::App& app, MapperOptions& o) {
       ->group("Map");
   opt("--checkpoint-megabytes", o.checkpoint_megabytes, "Memory budget of the rebuild checkpoints, MB");
   opt("--frame-buffer", o.frame_buffer_s, "Frames kept for SLAM keyframes to refer to, s");
+  app.add_option("--max-pinned-frames", o.max_pinned_frames,
+                 "Frames kept past the buffer for keyframes SLAM made before placing the camera in its saved map")
+      ->capture_default_str()
+      ->group("Map");
 }
 
 namespace {

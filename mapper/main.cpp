@@ -99,6 +99,9 @@ int serve(Options& o) {
     node->subscribe<slam_graph_t>(channel::kSlamGraph, [&](const slam_graph_t& m) {
       journalled([&] { return map.on_graph(m, channel::kSlamGraph); });
     }, 0);
+    node->subscribe<slam_graph_t>(channel::kSlamGraphUnplaced, [&](const slam_graph_t& m) {
+      map.on_unplaced_graph(m, channel::kSlamGraphUnplaced);
+    }, 0);
     if (o.node.insert_located) {
       node->subscribe<slam_correction_t>(channel::kSlamCorrection, [&](const slam_correction_t& m) {
         journalled([&] { return map.on_correction(m, channel::kSlamCorrection); });
@@ -122,6 +125,9 @@ int serve(Options& o) {
                node->counters().messages_rejected);
   if (o.node.insert_located)
     spdlog::info("{} frames SLAM located inserted, {} no longer buffered", s.located, s.located_missing);
+  if (s.unplaced_pinned > 0)
+    spdlog::info("{} frames of keyframes SLAM made before placing the camera kept past the buffer, {} of them joined the map",
+                 s.unplaced_pinned, s.unplaced_joined);
   // Where the memory is (the soak's question): the map, the keyframes kept for rebuilds and the
   // rebuild checkpoints, each within its budget (--keyframe-megabytes, checkpoints' 128 MB).
   const mapper::Mapper& m = map.mapper();

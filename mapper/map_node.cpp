@@ -1,5 +1,7 @@
 #include "mapper/map_node.h"
 
+#include <set>
+
 #include <algorithm>
 #include <cmath>
 #include <functional>
@@ -250,6 +252,21 @@ std::optional<kestrel::octomap_t> MapNode::on_correction(const kestrel::slam_cor
   return maybe_publish(false);
 }
 
+void MapNode::on_unplaced_graph(const kestrel::slam_graph_t& msg, const char* channel) {
+  input_since_start_ = true;
+  if (options_.pose_source != PoseSource::kSlamGraph) return;
+  if (msg.num_keyframes != static_cast<int32_t>(msg.keyframes.size())) {
+    throw InputError(std::string(channel) + ": num_keyframes does not match the keyframes sent");
+  }
+  std::set<int64_t> listed;
+  for (const auto& k : msg.keyframes) listed.insert(k.utime);
+  mapper_.keep_pinned(listed);  // a keyframe no longer listed will not join (a SLAM restarted)
+  for (const auto& k : msg.keyframes) {
+    if (mapper_.keyframes().find(k.id) != nullptr) continue;  // already in the map
+    if (mapper_.pin(k.utime) == Mapper::Pin::kPinned) ++stats_.unplaced_pinned;
+  }
+}
+
 std::optional<kestrel::octomap_t> MapNode::on_graph(const kestrel::slam_graph_t& msg, const char* channel) {
   input_since_start_ = true;
   if (options_.pose_source != PoseSource::kSlamGraph) return std::nullopt;
@@ -266,6 +283,8 @@ std::optional<kestrel::octomap_t> MapNode::on_graph(const kestrel::slam_graph_t&
   last_graph_revision_ = msg.revision;
   ++stats_.graphs;
   const GraphResult result = mapper_.apply_graph(keyframes);
+  mapper_.keep_pinned({});  // placed: SLAM sends no unplaced keyframes any more
+  stats_.unplaced_joined += static_cast<int64_t>(result.from_pinned);
   // keyframes: the frames a SLAM map is made of
   stats_.frames_inserted += static_cast<int64_t>(result.inserted.size());
   write_journal(msg, result);

@@ -90,6 +90,8 @@ struct NodeStats {
   int64_t keyframes_restored = 0;  ///< from the journal at start
   int64_t located = 0;             ///< located frames inserted (insert_located)
   int64_t located_missing = 0;     ///< located frames no longer buffered
+  int64_t unplaced_pinned = 0;     ///< frames of unplaced keyframes pinned (kept past the buffer)
+  int64_t unplaced_joined = 0;     ///< of them, inserted when a graph joined their keyframes
 };
 
 class MapNode {
@@ -104,6 +106,13 @@ class MapNode {
   std::optional<kestrel::octomap_t> on_graph(const kestrel::slam_graph_t& msg, const char* channel);
   std::optional<kestrel::octomap_t> on_ground_truth(const kestrel::ground_truth_t& msg,
                                                     const char* channel);
+  /// kSlamGraph: SLAM_GRAPH_UNPLACED, the keyframes SLAM made before it placed the camera in
+  /// its saved map (in a frame of their own, not in the map): their frames are kept past the
+  /// buffer (Mapper::pin) until the placement joins them and a SLAM_GRAPH names them; frames
+  /// pinned for keyframes a later list leaves out, and all once a SLAM_GRAPH comes (SLAM sends
+  /// whole graphs only once placed), are let go. Nothing goes into the map. Throws InputError
+  /// naming the channel for a count that disagrees.
+  void on_unplaced_graph(const kestrel::slam_graph_t& msg, const char* channel);
   /// insert_located: the frame the correction is for, if SLAM located it without a keyframe.
   std::optional<kestrel::octomap_t> on_correction(const kestrel::slam_correction_t& msg, const char* channel);
   /// The map as a message now, regardless of the rate limit (e.g. at shutdown).

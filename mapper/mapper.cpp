@@ -46,6 +46,7 @@ void MapperOptions::validate() const {
   non_negative(rebuild_rotation_deg, "rebuild-rotation");
   non_negative(rebuild_interval_s, "rebuild-interval");
   positive(frame_buffer_s, "frame-buffer");
+  if (max_pinned_frames < 0) throw std::invalid_argument("max-pinned-frames: must be >= 0");
   if (checkpoint_every < 0) throw std::invalid_argument("checkpoint-every: must be >= 0");
   non_negative(checkpoint_megabytes, "checkpoint-megabytes");
 }
@@ -135,7 +136,22 @@ void Mapper::buffer_frame(const RgbdFrame& frame, const char* what) {
 const RgbdFrame* Mapper::buffered(int64_t utime) const {
   auto it = std::lower_bound(buffer_.begin(), buffer_.end(), utime,
                              [](const RgbdFrame& f, int64_t t) { return f.utime < t; });
-  return it != buffer_.end() && it->utime == utime ? &*it : nullptr;
+  if (it != buffer_.end() && it->utime == utime) return &*it;
+  const auto pinned = pinned_.find(utime);
+  return pinned != pinned_.end() ? &pinned->second : nullptr;
+}
+
+Mapper::Pin Mapper::pin(int64_t utime) {
+  if (pinned_.count(utime) != 0) return Pin::kAlready;
+  const RgbdFrame* frame = buffered(utime);
+  if (frame == nullptr) return Pin::kGone;
+  pinned_.emplace(utime, *frame);
+  while (static_cast<int>(pinned_.size()) > options_.max_pinned_frames) pinned_.erase(pinned_.begin());
+  return pinned_.count(utime) != 0 ? Pin::kPinned : Pin::kGone;  // the oldest itself may go
+}
+
+void Mapper::keep_pinned(const std::set<int64_t>& utimes) {
+  for (auto it = pinned_.begin(); it != pinned_.end();) it = utimes.count(it->first) != 0 ? std::next(it) : pinned_.erase(it);
 }
 
 std::vector<int64_t> Mapper::move_stored(const std::vector<GraphKeyframe>& graph,
@@ -184,8 +200,13 @@ GraphResult Mapper::apply_graph(const std::vector<GraphKeyframe>& graph) {
       ++result.missing;
       continue;
     }
+    const bool was_pinned = pinned_.count(g.utime) != 0;
     // Inserted now unless the whole map is about to be rebuilt anyway.
     store(stored(g, *frame), !(rebuild_pending_ && may_rebuild));
+    if (was_pinned) {  // stored (a copy): no longer needed; `frame` is not used after this
+      pinned_.erase(g.utime);
+      ++result.from_pinned;
+    }
     result.inserted.push_back(g.id);
   }
   if (rebuild_pending_ && may_rebuild) {
@@ -261,6 +282,7 @@ void Mapper::reset() {
   map_is_sequence_ = true;
   keyframes_.clear();
   buffer_.clear();
+  pinned_.clear();
   have_last_keyframe_ = false;
   next_keyframe_id_ = 0;
   last_rebuild_utime_ = -1;

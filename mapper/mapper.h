@@ -25,6 +25,8 @@
 #include <Eigen/Geometry>
 #include <cstdint>
 #include <deque>
+#include <map>
+#include <set>
 #include <vector>
 
 #include "common/rgbd_frame.h"
@@ -46,6 +48,7 @@ struct MapperOptions {
   double rebuild_rotation_deg = 0.5;
   double rebuild_interval_s = 1.0;       ///< at most one rebuild per this much sensor time
   double frame_buffer_s = 5.0;           ///< frames kept for SLAM keyframes to refer to
+  int max_pinned_frames = 300;           ///< frames kept past the buffer for keyframes SLAM has not placed yet (pin())
   /// Rebuild checkpoints: a copy of the map after every this many keyframes (in time order),
   /// so a rebuild starts from the last one whose keyframes did not move (0 = none).
   int checkpoint_every = 8;
@@ -65,6 +68,7 @@ struct GraphResult {
   std::vector<int64_t> inserted;  ///< ids of the new keyframes stored and put into the map
   std::vector<int64_t> moved;  ///< ids of the stored keyframes that moved beyond the threshold
   size_t missing = 0;    ///< new keyframes whose frame was not (or no longer) buffered
+  size_t from_pinned = 0;  ///< new keyframes whose frame was pinned (Mapper::pin)
   bool rebuilt = false;  ///< the map was rebuilt from the stored keyframes
   size_t rebuild_keyframes = 0;
   size_t reinserted = 0;  ///< keyframes the rebuild inserted (the rest came from a checkpoint)
@@ -94,8 +98,20 @@ class Mapper {
   /// index) and every id stored, so that ids still grow with time (the budget's tie-break).
   int64_t next_located_id() const;
   static constexpr int64_t kFirstLocatedId = int64_t{1} << 62;
-  /// SLAM mode: the buffered (decimated) frame at `utime`, if it still is.
+  /// SLAM mode: the buffered (decimated) frame at `utime`, if it still is (in the buffer or
+  /// pinned).
   const RgbdFrame* buffered(int64_t utime) const;
+  /// SLAM mode: keeps the buffered frame at `utime` past the buffer's time until a graph names
+  /// it: a keyframe SLAM made before it placed the camera in its saved map, which joins the map
+  /// only when the placement comes, maybe long after (SLAM_GRAPH_UNPLACED). At most
+  /// max_pinned_frames are kept, the oldest let go first. kGone: the frame is no longer
+  /// buffered (nothing to keep).
+  enum class Pin { kPinned, kAlready, kGone };
+  Pin pin(int64_t utime);
+  /// Lets go of every pinned frame but those at `utimes` (SLAM's current unplaced keyframes;
+  /// empty: all, once SLAM placed the camera and sends whole graphs).
+  void keep_pinned(const std::set<int64_t>& utimes);
+  size_t pinned() const { return pinned_.size(); }
 
   /// A restarted mapper (map_node.h's journal): a keyframe stored before the restart, its frame
   /// as stored then. It goes into the store, not yet into the map: rebuild() after the last.
@@ -147,6 +163,7 @@ class Mapper {
   ScanUpdate update_;
   Scan scan_;                      // reused: a fresh one per frame cost page faults
   std::deque<RgbdFrame> buffer_;   // decimated, by increasing utime
+  std::map<int64_t, RgbdFrame> pinned_;  // utime -> frame kept past the buffer (pin())
   bool have_last_keyframe_ = false;
   Eigen::Isometry3d last_keyframe_pose_ = Eigen::Isometry3d::Identity();
   int64_t next_keyframe_id_ = 0;

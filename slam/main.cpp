@@ -1,7 +1,8 @@
 // kestrel-slam: keyframes, loop closure and pose-graph optimisation (PAPER.md section 3).
 // As a process (default) it reads CAMERA_RGBD and VO_UPDATE and publishes SLAM_GRAPH after every
-// new keyframe and SLAM_CORRECTION after every optimisation, with heartbeats and lock-step
-// replay. With --tum DIR it runs VO and SLAM in process over a TUM RGB-D folder and writes the
+// new keyframe and SLAM_CORRECTION after every optimisation (on a saved map, before the camera is
+// placed, SLAM_GRAPH_UNPLACED instead: the keyframes waiting to join), with heartbeats and
+// lock-step replay. With --tum DIR it runs VO and SLAM in process over a TUM RGB-D folder and writes the
 // optimised trajectory (TUM format). See slam/README.md.
 
 #include <spdlog/spdlog.h>
@@ -249,6 +250,9 @@ int serve(const Options& o, const SlamOptions& options, std::shared_ptr<const Vo
   node = std::make_unique<transport::Node>(o.name, o.lcm_url);  // UnavailableError: exit 4
   node->advertise(o.graph_channel);
   node->advertise(o.correction_channel);
+  // The unplaced keyframes go out beside the graph: SLAM_GRAPH_UNPLACED by default.
+  const std::string unplaced_channel = o.graph_channel + "_UNPLACED";
+  node->advertise(unplaced_channel);
   node->on_reset([&] { adapter.reset(); });
   auto publish = [&](const AdapterOutputs& out) {
     if (out.anchored) spdlog::info("map anchored in the estimator's world at keyframe {}",
@@ -257,6 +261,7 @@ int serve(const Options& o, const SlamOptions& options, std::shared_ptr<const Vo
       spdlog::info("map turned level by {:.2f} deg about keyframe {}: the estimator's gravity says it was tilted",
                    out.levelled_rad * 180.0 / kPi, published_id(adapter.slam(), adapter.slam().keyframes().back().id));
     if (out.graph) node->publish(o.graph_channel, *out.graph);
+    if (out.unplaced) node->publish(unplaced_channel, *out.unplaced);
     if (out.correction) node->publish(o.correction_channel, *out.correction);
     if (out.step && out.step->relocalised) report_relocalisation(adapter.slam().relocalisation(), true);
     if (out.step && out.step->loop_closed && out.step->keyframe) {  // (a join is said with the relocalisation)

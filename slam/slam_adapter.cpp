@@ -280,6 +280,12 @@ AdapterOutputs SlamAdapter::process(const kestrel::rgbd_frame_t& message, const 
   // journal) publishes the map the planner flies in before this flight makes a keyframe.
   // Not before: provisional keyframes (made before the placement) are in a frame of their own.
   if ((step.keyframe || step.relocalised) && slam_.localized()) out.graph = graph_message(slam_);
+  // Not placed yet: the keyframes waiting to join go out on their own, so that the mapper
+  // keeps their frames until the placement brings them into the map.
+  if (step.keyframe && !slam_.localized()) {
+    kestrel::slam_graph_t unplaced = unplaced_graph_message(slam_);
+    if (unplaced.num_keyframes > 0) out.unplaced = std::move(unplaced);
+  }
   out.step = step;
   try_anchor(out);
   // A correction is a pose in the estimator's world: none before the graph is anchored in it

@@ -1,6 +1,7 @@
 #pragma once
 // The message side of kestrel-slam, without LCM: CAMERA_RGBD and VO_UPDATE messages in (in
-// any interleaving), SLAM_GRAPH and SLAM_CORRECTION messages out. main.cpp wires it to a Node;
+// any interleaving), SLAM_GRAPH and SLAM_CORRECTION messages out (and SLAM_GRAPH_UNPLACED on a
+// saved map before the placement). main.cpp wires it to a Node;
 // tests feed it directly.
 //
 // World frame: SLAM's graph starts in the odometry frame (slam.h), which is not the state
@@ -109,6 +110,9 @@ struct AdapterOptions {
 
 struct AdapterOutputs {
   std::optional<kestrel::slam_graph_t> graph;            ///< after a new keyframe or optimisation
+  /// On a saved map, after a keyframe made before the camera is placed: those keyframes
+  /// (unplaced_graph_message), for SLAM_GRAPH_UNPLACED.
+  std::optional<kestrel::slam_graph_t> unplaced;
   std::optional<kestrel::slam_correction_t> correction;  ///< after an optimisation, a re-anchoring or a levelling, or for a new estimator
   std::optional<SlamStep> step;                          ///< what SLAM did (a keyframe was made or a frame re-anchored)
   bool anchored = false;  ///< the graph was just moved into the estimator's world

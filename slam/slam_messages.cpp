@@ -64,6 +64,27 @@ kestrel::slam_graph_t graph_message(const Slam& slam) {
   return m;
 }
 
+kestrel::slam_graph_t unplaced_graph_message(const Slam& slam, size_t max_keyframes) {
+  kestrel::slam_graph_t m{};
+  m.revision = published_revision(slam);
+  const auto& keyframes = slam.keyframes();
+  const PoseGraph3d& graph = slam.graph();
+  const size_t first = keyframes.size() > max_keyframes ? keyframes.size() - max_keyframes : 0;
+  for (size_t k = first; k < keyframes.size(); ++k) {
+    if (slam.in_world(keyframes[k].id)) continue;
+    kestrel::slam_keyframe_t kf{};
+    kf.id = published_id(slam, keyframes[k].id);
+    kf.utime = keyframes[k].utime;
+    kf.T_world_camera = transport::to_message(graph.poses[k]);
+    kf.T_camera_depth = transport::to_message(keyframes[k].T_camera_depth);
+    m.keyframes.push_back(kf);
+    m.utime = kf.utime;
+  }
+  m.num_keyframes = static_cast<int32_t>(m.keyframes.size());
+  m.num_edges = 0;
+  return m;
+}
+
 Matrix6d body_covariance(const Eigen::Isometry3d& T_world_body, const Eigen::Isometry3d& T_body_camera,
                          const Matrix6d& camera_covariance) {
   // A right perturbation xi of T_world_camera moves T_world_body by Ad(T_body_camera) xi on the

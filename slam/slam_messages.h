@@ -35,6 +35,12 @@ VoMotion motion_from_message(const kestrel::vo_update_t& m, const char* channel)
 int64_t published_id(const Slam& slam, int64_t keyframe_index);
 int64_t published_revision(const Slam& slam);
 
+/// The keyframes made while the camera is not yet placed in a saved map (ids from
+/// Slam::provisional_from(), poses in their own frame, no edges), for SLAM_GRAPH_UNPLACED: the
+/// mapper keeps their frames until the placement joins them to the map: the newest
+/// `max_keyframes` (the mapper keeps no more). Empty when none.
+kestrel::slam_graph_t unplaced_graph_message(const Slam& slam, size_t max_keyframes = 300);
+
 kestrel::slam_graph_t graph_message(const Slam& slam);
 
 /// The covariance of T_world_body in pose_t's convention ([dp in world; dtheta in body]) from

@@ -10,6 +10,7 @@ inline constexpr const char* kVoUpdate = "VO_UPDATE";           // vo_update_t
 inline constexpr const char* kState = "STATE";                  // state_t
 inline constexpr const char* kSlamCorrection = "SLAM_CORRECTION";  // slam_correction_t
 inline constexpr const char* kSlamGraph = "SLAM_GRAPH";         // slam_graph_t
+inline constexpr const char* kSlamGraphUnplaced = "SLAM_GRAPH_UNPLACED";  // slam_graph_t
 inline constexpr const char* kSlamSaveMap = "SLAM_SAVE_MAP";    // map_save_request_t
 inline constexpr const char* kMapOctomap = "MAP_OCTOMAP";       // octomap_t
 inline constexpr const char* kPlanRequest = "PLAN_REQUEST";     // plan_request_t

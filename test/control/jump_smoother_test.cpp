@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 #include "control/jump_smoother.h"
@@ -62,7 +63,7 @@ TEST(JumpSmoother, ASteadyTurnSmallStepsAndStepsAcrossAGapPass) {
   // again) starts afresh.
   steps.update(kStepUs + 505'000, Eigen::Vector3d(1.3, 0.0, 0.0), still);
   ASSERT_NEAR(steps.offset().x(), 0.3, 1e-12);
-  EXPECT_NEAR(steps.update(kStepUs + 510'000, Eigen::Vector3d(NAN, 0.0, 0.0), still).x(), 0.3, 1e-12);
+  EXPECT_NEAR(steps.update(kStepUs + 510'000, Eigen::Vector3d(std::numeric_limits<double>::quiet_NaN(), 0.0, 0.0), still).x(), 0.3, 1e-12);
   EXPECT_NEAR(steps.update(kStepUs + 505'000, Eigen::Vector3d(9.0, 0.0, 0.0), still).x(), 0.3, 1e-12);
   EXPECT_EQ(steps.update(kStepUs, Eigen::Vector3d(5.0, 0.0, 0.0), still).norm(), 0.0);
   EXPECT_EQ(steps.update(2 * kStepUs, Eigen::Vector3d(5.0, 0.0, 0.0), still).norm(), 0.0) << "from 5 m on";
@@ -87,7 +88,7 @@ TEST(JumpSmoother, HoldsAtMostTheLargestOffsetAndClearsOnRequest) {
 TEST(JumpSmoother, RefusesOptionsThatCannotWork) {
   EXPECT_THROW(JumpSmoother(JumpSmoothingOptions{-0.01, 0.1, 0.1}), std::invalid_argument);
   EXPECT_THROW(JumpSmoother(JumpSmoothingOptions{0.02, 0.0, 0.1}), std::invalid_argument);
-  EXPECT_THROW(JumpSmoother(JumpSmoothingOptions{0.02, 0.1, NAN}), std::invalid_argument);
+  EXPECT_THROW(JumpSmoother(JumpSmoothingOptions{0.02, 0.1, std::numeric_limits<double>::quiet_NaN()}), std::invalid_argument);
   EXPECT_THROW(JumpSmoother(JumpSmoothingOptions{0.02, 0.1, 0.1, 0.0}), std::invalid_argument);
 }
 

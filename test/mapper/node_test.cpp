@@ -244,6 +244,78 @@ void expect_same_map(const VoxelMap& a, const VoxelMap& b) {
   a.for_each_cell([&](const Key& k, float v) { ASSERT_EQ(b.log_odds(k), v); });
 }
 
+// Keyframes SLAM made before it placed the camera in its saved map join the map only at the
+// placement, maybe long after their frames left the buffer: announced on SLAM_GRAPH_UNPLACED,
+// their frames are kept (up to max_pinned_frames, the oldest let go), and the graph that joins
+// them puts them in. Announced again with the next one, nothing is counted twice; a list that
+// leaves one out, a whole graph and a reset let the pins go.
+TEST(MapNode, KeyframesSlamHasNotPlacedYetKeepTheirFramesUntilTheyJoin) {
+  const test::Scene scene = test::room_with_a_box();
+  const auto fly = [&](bool announce, int max_pinned) {
+    NodeOptions options;
+    options.mapper.frame_buffer_s = 0.5;
+    options.mapper.max_pinned_frames = max_pinned;
+    auto node = std::make_unique<MapNode>(options);
+    kestrel::slam_graph_t unplaced{};
+    for (int i = 0; i < 20; ++i) {  // frames every 0.1 s; keyframes at the first three
+      const int64_t t = 100000 * (i + 1);
+      node->on_frame(frame_message(scene, t), "CAMERA_RGBD");
+      if (i < 3 && announce) {
+        unplaced.keyframes.push_back(keyframe_message(i, t));
+        unplaced.num_keyframes = static_cast<int32_t>(unplaced.keyframes.size());
+        node->on_unplaced_graph(unplaced, "SLAM_GRAPH_UNPLACED");
+      }
+    }
+    // 1.7 s after the last of them, far beyond the 0.5 s buffer: the placement joins them.
+    kestrel::slam_graph_t joined{};
+    for (int i = 0; i < 3; ++i) joined.keyframes.push_back(keyframe_message(i, 100000 * (i + 1)));
+    joined.keyframes.push_back(keyframe_message(19, 2000000));
+    joined.num_keyframes = 4;
+    joined.revision = 1;
+    node->on_graph(joined, "SLAM_GRAPH");
+    return node;
+  };
+  const auto kept = fly(true, 300);
+  EXPECT_EQ(kept->stats().frames_inserted, 4);
+  EXPECT_EQ(kept->stats().unplaced_pinned, 3);
+  EXPECT_EQ(kept->stats().unplaced_joined, 3);
+  EXPECT_EQ(kept->mapper().pinned(), 0u) << "inserted: no longer kept";
+  const auto lost = fly(false, 300);
+  EXPECT_EQ(lost->stats().frames_inserted, 1) << "without the announcement their frames are gone";
+  const auto bounded = fly(true, 2);
+  EXPECT_EQ(bounded->stats().frames_inserted, 3);
+  EXPECT_EQ(bounded->mapper().keyframes().find(0), nullptr) << "the oldest is let go beyond the bound";
+  EXPECT_NE(bounded->mapper().keyframes().find(2), nullptr);
+
+  // A list that leaves a keyframe out lets its frame go (that SLAM will not join it); a whole
+  // graph lets all go (SLAM sends one only once placed); so does a reset. A bad count is refused.
+  MapNode node{NodeOptions{}};
+  for (int i = 0; i < 3; ++i) node.on_frame(frame_message(scene, 100000 * (i + 1)), "CAMERA_RGBD");
+  kestrel::slam_graph_t list{};
+  list.keyframes = {keyframe_message(0, 100000), keyframe_message(1, 200000)};
+  list.num_keyframes = 2;
+  node.on_unplaced_graph(list, "SLAM_GRAPH_UNPLACED");
+  node.on_unplaced_graph(list, "SLAM_GRAPH_UNPLACED");
+  EXPECT_EQ(node.stats().unplaced_pinned, 2) << "announced twice, pinned once";
+  list.keyframes = {keyframe_message(1, 200000)};
+  list.num_keyframes = 1;
+  node.on_unplaced_graph(list, "SLAM_GRAPH_UNPLACED");
+  EXPECT_EQ(node.mapper().pinned(), 1u);
+  list.num_keyframes = 2;
+  EXPECT_THROW(node.on_unplaced_graph(list, "SLAM_GRAPH_UNPLACED"), InputError);
+  kestrel::slam_graph_t other{};
+  other.keyframes = {keyframe_message(7, 300000)};
+  other.num_keyframes = 1;
+  other.revision = 1;
+  node.on_graph(other, "SLAM_GRAPH");
+  EXPECT_EQ(node.mapper().pinned(), 0u) << "a whole graph: placed";
+  list.num_keyframes = 1;
+  node.on_unplaced_graph(list, "SLAM_GRAPH_UNPLACED");
+  ASSERT_EQ(node.mapper().pinned(), 1u);
+  node.reset();
+  EXPECT_EQ(node.mapper().pinned(), 0u);
+}
+
 // SLAM_CORRECTION for a frame SLAM located on its map without a keyframe (a localisation-only
 // flight): with insert_located, the frame goes into the map at the corrected pose. Here a box
 // has appeared in front of the camera since the keyframes were made (a door closed): the map

@@ -722,6 +722,7 @@ TEST_F(AdapterTest, OnASavedMapKeyframesMadeBeforeThePlacementGoOutOnlyJoinedInT
     truth.push_back(T);
   }
   std::optional<AdapterOutputs> placed;
+  std::optional<kestrel::slam_graph_t> unplaced;  // the last SLAM_GRAPH_UNPLACED
   size_t k = 0;
   for (; k < truth.size() && !placed; ++k) {
     adapter.on_frame(transport::encode_rgbd(room_.render(truth[k], test::test_camera(), utime(static_cast<int>(k)))));
@@ -734,6 +735,13 @@ TEST_F(AdapterTest, OnASavedMapKeyframesMadeBeforeThePlacementGoOutOnlyJoinedInT
     }
     EXPECT_FALSE(out.graph) << "frame " << k << ": a graph with provisional keyframes went out";
     EXPECT_FALSE(out.correction) << "frame " << k << ": a correction before the placement";
+    // Each provisional keyframe is announced, with all those before it, for the mapper to keep
+    // their frames until they join.
+    EXPECT_EQ(static_cast<bool>(out.unplaced), out.step && out.step->keyframe) << "frame " << k;
+    if (out.unplaced) {
+      EXPECT_EQ(out.unplaced->keyframes.back().utime, utime(static_cast<int>(k)));
+      unplaced = std::move(out.unplaced);
+    }
   }
   ASSERT_TRUE(placed) << "never relocalised";
   EXPECT_GE(k, 12u) << "placed under the ceiling, which the map never saw";
@@ -742,6 +750,13 @@ TEST_F(AdapterTest, OnASavedMapKeyframesMadeBeforeThePlacementGoOutOnlyJoinedInT
   ASSERT_TRUE(placed->graph);
   ASSERT_TRUE(placed->correction);
   ASSERT_EQ(placed->graph->keyframes.size(), mapped + static_cast<size_t>(joined));
+  EXPECT_FALSE(placed->unplaced) << "joined: nothing is unplaced any more";
+  ASSERT_TRUE(unplaced);
+  ASSERT_EQ(unplaced->keyframes.size(), static_cast<size_t>(joined)) << "the last announcement named them all";
+  for (size_t i = 0; i < unplaced->keyframes.size(); ++i) {
+    EXPECT_EQ(unplaced->keyframes[i].id, placed->graph->keyframes[mapped + i].id) << "the same keyframes join";
+    EXPECT_EQ(unplaced->keyframes[i].utime, placed->graph->keyframes[mapped + i].utime);
+  }
   for (size_t i = mapped; i < placed->graph->keyframes.size(); ++i) {
     const auto& kf = placed->graph->keyframes[i];
     const size_t frame = static_cast<size_t>((kf.utime - utime(0)) / 100'000);

@@ -92,6 +92,7 @@ std::map<std::string, const MessageType*> default_channel_types() {
       {ch::kGroundTruth, "ground_truth_t"},       {ch::kVoUpdate, "vo_update_t"},
       {ch::kState, "state_t"},                    {ch::kSlamCorrection, "slam_correction_t"},
       {ch::kSlamGraph, "slam_graph_t"},           {ch::kMapOctomap, "octomap_t"},
+      {ch::kSlamGraphUnplaced, "slam_graph_t"},
       {ch::kPlanRequest, "plan_request_t"},       {ch::kPlan, "plan_t"},
       {ch::kPlanCovariance, "plan_covariance_t"},
       {ch::kVehicleCommand, "vehicle_command_t"}, {ch::kProcessStatus, "process_status_t"},
