@@ -1,7 +1,8 @@
 // kestrel-mapper under lock-step replay, in a private network namespace: a log of synthetic
 // frames and ground truth replayed twice through one running mapper (RESET between) gives
 // byte-identical MAP_OCTOMAP recordings, and the last map is the library's map of the same
-// frames. This is the whole process path: LCM decode, MapNode, rate limit, acks, RESET.
+// frames. This is the whole process path: LCM decode, MapNode, rate limit, acks, RESET. In SLAM
+// mode: frames SLAM located, and keyframes announced before a placement, reach the journal.
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -137,6 +138,56 @@ TEST(MapperProcess, FramesSlamLocatedReachTheJournalThroughTheProcess) {
     newest_map_utime = std::max(newest_map_utime, m.utime);
   }
   EXPECT_GE(newest_map_utime, 800000) << "no map after the located frames";
+}
+
+// SLAM on a saved map, through the process: three keyframes made before the placement are
+// announced on SLAM_GRAPH_UNPLACED as they come; the graph that joins them comes 1.7 s later,
+// far past the mapper's 0.5 s frame buffer. The journal holds all four keyframes (the three
+// frames kept, and the newest), not only the newest.
+TEST(MapperProcess, KeyframesAnnouncedBeforeThePlacementJoinThroughTheProcess) {
+  if (!kestrel::test::can_isolate_network()) KESTREL_SKIP_ENVIRONMENT() << "no network namespace available";
+  kestrel::test::TempDir dir;
+  const test::Scene scene = test::room_with_a_box();
+  const auto keyframe = [](int64_t t) {
+    kestrel::slam_keyframe_t k{};
+    k.id = t / 100000;
+    k.utime = t;
+    k.T_world_camera = transport::to_message(pose_at(t));
+    k.T_camera_depth = transport::to_message(Eigen::Isometry3d::Identity());
+    return k;
+  };
+  {
+    transport::LogWriter log((dir / "in.lcmlog").string());
+    kestrel::slam_graph_t unplaced{};
+    for (int64_t t = 100000; t <= 2000000; t += 100000) {
+      log.write_message(channel::kCameraRgbd, t, transport::encode_rgbd(scene.render(test::kinect_camera(160, 120), pose_at(t), t)));
+      if (t <= 300000) {
+        unplaced.keyframes.push_back(keyframe(t));
+        unplaced.num_keyframes = static_cast<int32_t>(unplaced.keyframes.size());
+        unplaced.utime = t;
+        log.write_message(channel::kSlamGraphUnplaced, t, unplaced);
+      }
+    }
+    kestrel::slam_graph_t joined = unplaced;
+    joined.keyframes.push_back(keyframe(2000000));
+    joined.num_keyframes = 4;
+    joined.utime = 2000000;
+    joined.revision = 1;
+    log.write_message(channel::kSlamGraph, 2000000, joined);
+  }
+  const std::string journal = (dir / "mapper.journal").string();
+  const std::string script = kestrel::test::tool("mapper").string() + " --frame-buffer 0.5 --journal " + journal +
+                             " & P=$!; " + kestrel::test::tool("replay").string() + " " + (dir / "in.lcmlog").string() +
+                             " --expect mapper || exit 11; kill -INT $P; wait $P";
+  const auto r = kestrel::test::run_isolated(script, 240.0);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  int keyframes = 0;
+  for (const JournalRecord& record : read_journal(journal).records)
+    keyframes += record.kind == JournalRecord::Kind::kKeyframe;
+  EXPECT_EQ(keyframes, 4) << r.err;
+  EXPECT_NE(r.err.find("3 frames of keyframes SLAM made before placing the camera kept past the buffer, 3 of them joined"),
+            std::string::npos)
+      << r.err;
 }
 
 }  // namespace

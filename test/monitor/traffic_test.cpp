@@ -46,7 +46,8 @@ TEST(MessageTypes, DefaultTableCoversTheReadmeChannels) {
   EXPECT_EQ(table.at("PLAYBACK_COMMAND"), find_type("playback_command_t"));
   EXPECT_EQ(table.at("PLAYBACK_STATUS"), find_type("playback_status_t"));
   EXPECT_EQ(table.at("PLAN_COVARIANCE"), find_type("plan_covariance_t"));
-  EXPECT_EQ(table.size(), 19u);
+  EXPECT_EQ(table.at("SLAM_GRAPH_UNPLACED"), find_type("slam_graph_t"));
+  EXPECT_EQ(table.size(), 20u);
   for (const auto& [channel, type] : table) EXPECT_NE(type, nullptr) << channel;
 }
 
