@@ -36,20 +36,26 @@ int64_t published_revision(const Slam& slam) {
   return base + slam.revision();
 }
 
+namespace {
+// Keyframe k (its index in Slam::keyframes(), and vertex k of the graph) as published.
+kestrel::slam_keyframe_t keyframe_message(const Slam& slam, size_t k) {
+  const Keyframe& keyframe = slam.keyframes()[k];
+  kestrel::slam_keyframe_t kf{};
+  kf.id = published_id(slam, keyframe.id);
+  kf.utime = keyframe.utime;
+  kf.T_world_camera = transport::to_message(slam.graph().poses[k]);
+  kf.T_camera_depth = transport::to_message(keyframe.T_camera_depth);
+  return kf;
+}
+}  // namespace
+
 kestrel::slam_graph_t graph_message(const Slam& slam) {
   kestrel::slam_graph_t m{};
   const auto& keyframes = slam.keyframes();
   const PoseGraph3d& graph = slam.graph();
   m.utime = keyframes.empty() ? 0 : keyframes.back().utime;
   m.revision = published_revision(slam);
-  for (size_t k = 0; k < keyframes.size(); ++k) {
-    kestrel::slam_keyframe_t kf{};
-    kf.id = published_id(slam, keyframes[k].id);
-    kf.utime = keyframes[k].utime;
-    kf.T_world_camera = transport::to_message(graph.poses[k]);
-    kf.T_camera_depth = transport::to_message(keyframes[k].T_camera_depth);
-    m.keyframes.push_back(kf);
-  }
+  for (size_t k = 0; k < keyframes.size(); ++k) m.keyframes.push_back(keyframe_message(slam, k));
   m.num_keyframes = static_cast<int32_t>(m.keyframes.size());
   for (const auto& e : graph.edges) {
     kestrel::slam_edge_t edge{};
@@ -68,17 +74,11 @@ kestrel::slam_graph_t unplaced_graph_message(const Slam& slam, size_t max_keyfra
   kestrel::slam_graph_t m{};
   m.revision = published_revision(slam);
   const auto& keyframes = slam.keyframes();
-  const PoseGraph3d& graph = slam.graph();
   const size_t first = keyframes.size() > max_keyframes ? keyframes.size() - max_keyframes : 0;
   for (size_t k = first; k < keyframes.size(); ++k) {
     if (slam.in_world(keyframes[k].id)) continue;
-    kestrel::slam_keyframe_t kf{};
-    kf.id = published_id(slam, keyframes[k].id);
-    kf.utime = keyframes[k].utime;
-    kf.T_world_camera = transport::to_message(graph.poses[k]);
-    kf.T_camera_depth = transport::to_message(keyframes[k].T_camera_depth);
-    m.keyframes.push_back(kf);
-    m.utime = kf.utime;
+    m.keyframes.push_back(keyframe_message(slam, k));
+    m.utime = m.keyframes.back().utime;
   }
   m.num_keyframes = static_cast<int32_t>(m.keyframes.size());
   m.num_edges = 0;

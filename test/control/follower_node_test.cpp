@@ -26,6 +26,13 @@ kestrel::state_t state(int64_t utime, double x, double y, int8_t status = kestre
   return m;
 }
 
+// A state of a vehicle flying along x at 0.5 m/s (what the jump smoother predicts steps from).
+kestrel::state_t moving(int64_t utime, double x, double y) {
+  kestrel::state_t m = state(utime, x, y);
+  m.velocity[0] = 0.5;
+  return m;
+}
+
 kestrel::plan_t plan(int8_t status = kestrel::plan_t::STATUS_OK) {
   kestrel::plan_t p{};
   p.request_id = 7;
@@ -86,11 +93,6 @@ TEST(FollowerNode, AJumpOfTheStateMovesTheSetPointWithItAndIsLetGoSlowly) {
   o.command_period_s = 0.0;  // a command on every state
   FollowerNode node(o);
   node.on_plan(plan());
-  const auto moving = [](int64_t utime, double x, double y) {
-    kestrel::state_t m = state(utime, x, y);
-    m.velocity[0] = 0.5;
-    return m;
-  };
   const auto before = node.on_state(moving(1'000'000, 1.0, 0.0));
   ASSERT_TRUE(before);
   EXPECT_NEAR(before->position[1], 0.0, 1e-12);
@@ -114,11 +116,6 @@ TEST(FollowerNode, JumpsBetweenCommandsCountBeyondTheLargestOffsetTheVehicleHold
   o.command_period_s = 0.02;
   FollowerNode node(o);
   node.on_plan(plan());
-  const auto moving = [](int64_t utime, double x, double y) {
-    kestrel::state_t m = state(utime, x, y);
-    m.velocity[0] = 0.5;
-    return m;
-  };
   ASSERT_TRUE(node.on_state(moving(1'000'000, 1.0, 0.0)));
   EXPECT_FALSE(node.on_state(moving(1'005'000, 1.0025, 0.3))) << "no command due: the jump is taken all the same";
   EXPECT_NEAR(node.smoother().offset().y(), 0.3, 1e-9);
