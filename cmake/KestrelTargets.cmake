@@ -289,19 +289,22 @@ endfunction()
 # The tests' precompiled header: GoogleTest, Eigen and OpenCV's core are most of a small test
 # file's compile time.
 set(_KESTREL_TEST_PCH_DEPS GTest::gtest GTest::gmock Eigen3::Eigen opencv_core)
-function(_kestrel_test_pch)
-  if(TARGET kestrel_test_pch)
+# _kestrel_test_pch(pch optimized): the header for the tests compiled at -O0 in the sanitizer
+# builds, or for those that stay at -O1 (OPTIMIZED; KestrelWarnings.cmake): a precompiled
+# header is only used at the -O level it was made with.
+function(_kestrel_test_pch pch optimized)
+  if(TARGET ${pch})
     return()
   endif()
-  _kestrel_shared_pch(kestrel_test_pch DEPS ${_KESTREL_TEST_PCH_DEPS}
+  _kestrel_shared_pch(${pch} DEPS ${_KESTREL_TEST_PCH_DEPS}
     HEADERS <gtest/gtest.h> <gmock/gmock.h> <Eigen/Core> <Eigen/Geometry> <opencv2/core.hpp>
             <filesystem> <fstream> <map> <random> <sstream> ${_KESTREL_STD_HEADERS})
-  _kestrel_test_definitions(kestrel_test_pch)
-  set_target_properties(kestrel_test_pch PROPERTIES KESTREL_TEST_CODE ON)  # as its users
+  _kestrel_test_definitions(${pch})
+  set_target_properties(${pch} PROPERTIES KESTREL_TEST_CODE ON KESTREL_TEST_OPTIMIZED ${optimized})  # as its users
 endfunction()
 
 # kestrel_test(name SOURCES ... [DEPS ...] LABELS unit|integration|data
-#              [SANITIZED [SANITIZED_CASES regex]] [THREADS] [TIMEOUT s])
+#              [SANITIZED [SANITIZED_CASES regex]] [THREADS] [OPTIMIZED] [TIMEOUT s])
 # A GoogleTest executable registered with ctest. Label `unit`: fast, in-process, no files
 # outside the repository. `integration`: several processes or tools, in a private network
 # namespace. `data`: needs ../shared/data and skips with a message without it.
@@ -312,9 +315,11 @@ endfunction()
 # slower (README.md, Tests). SANITIZED_CASES: only the cases ("Suite.Name") the regex matches.
 # THREADS: the test exercises code that runs on more than one thread; its cases also get the
 # label `threads`, and the executable joins `threads_tests`, which the ThreadSanitizer build
-# (build/tsan) builds and runs.
+# (build/tsan) builds and runs. OPTIMIZED: the test's own code stays at -O1 in the sanitizer
+# builds, where the others' is at -O0 (KestrelWarnings.cmake): for a test whose time goes to
+# templates it instantiates itself.
 function(kestrel_test name)
-  cmake_parse_arguments(ARG "SANITIZED;THREADS" "TIMEOUT;SANITIZED_CASES" "SOURCES;DEPS;LABELS" ${ARGN})
+  cmake_parse_arguments(ARG "SANITIZED;THREADS;OPTIMIZED" "TIMEOUT;SANITIZED_CASES" "SOURCES;DEPS;LABELS" ${ARGN})
   if(NOT ARG_TIMEOUT)
     set(ARG_TIMEOUT 300)
   endif()
@@ -346,10 +351,18 @@ function(kestrel_test name)
   target_link_libraries(${name} PRIVATE ${ARG_DEPS} GTest::gtest GTest::gtest_main GTest::gmock
                         kestrel_options)
   _kestrel_test_definitions(${name})
-  _kestrel_test_pch()
-  _kestrel_use_pch(${name} kestrel_test_pch "${_KESTREL_TEST_PCH_DEPS}")
+  # Outside the sanitizer builds every test's code is at -O1, and one header serves them all.
+  if(ARG_OPTIMIZED AND (KESTREL_SANITIZE OR KESTREL_TSAN))
+    _kestrel_test_pch(kestrel_test_pch_optimized ON)
+    set(pch kestrel_test_pch_optimized)
+  else()
+    _kestrel_test_pch(kestrel_test_pch OFF)
+    set(pch kestrel_test_pch)
+  endif()
+  _kestrel_use_pch(${name} ${pch} "${_KESTREL_TEST_PCH_DEPS}")
   set_target_properties(${name} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/test
-                                           KESTREL_TEST_CODE ON)  # -O1 (KestrelWarnings.cmake)
+                                           KESTREL_TEST_CODE ON  # -O1 or -O0 (KestrelWarnings.cmake)
+                                           KESTREL_TEST_OPTIMIZED "${ARG_OPTIMIZED}")
   gtest_discover_tests(${name}
     PROPERTIES LABELS ${ARG_LABELS} TIMEOUT ${ARG_TIMEOUT}
     DISCOVERY_TIMEOUT 60)

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <limits>
 #include <map>
 #include <sstream>
 #include <string>
@@ -349,7 +350,7 @@ TEST(Cli, IntrinsicsOptionGivesACameraOrNamesTheOption) {
   EXPECT_EQ(c->cx, 319.5);
   EXPECT_EQ(c->cy, 239.5);
   for (const std::vector<double>& bad : std::vector<std::vector<double>>{
-           {0, 500, 1, 1}, {500, -1, 1, 1}, {500, 500, std::nan(""), 1}, {500, 500, 1, INFINITY}, {500, 500, 1}}) {
+           {0, 500, 1, 1}, {500, -1, 1, 1}, {500, 500, std::nan(""), 1}, {500, 500, 1, std::numeric_limits<double>::infinity()}, {500, 500, 1}}) {
     try {
       intrinsics_option(bad);
       ADD_FAILURE() << "accepted " << bad.size() << " values";

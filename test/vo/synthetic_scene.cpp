@@ -108,7 +108,7 @@ RgbdFrame SyntheticScene::render(const Eigen::Isometry3d& T_world_camera, const 
   for (int y = 0; y < z.rows; ++y) {
     for (int x = 0; x < z.cols; ++x) {
       const float m = z.at<float>(y, x);
-      f.depth_mm.at<uint16_t>(y, x) = m > 0.0f && m < 65.0f ? static_cast<uint16_t>(std::lround(1000.0 * m)) : 0;
+      f.depth_mm.at<uint16_t>(y, x) = m > 0.0f && m < 65.0f ? static_cast<uint16_t>(std::lround(1000.0 * static_cast<double>(m))) : 0;
     }
   }
   f.camera = camera;

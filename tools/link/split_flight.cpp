@@ -17,6 +17,7 @@
 #include "common/transport/message.h"
 #include "kestrel/ground_truth_t.hpp"
 #include "kestrel/plan_t.hpp"
+#include "kestrel/vo_update_t.hpp"
 
 namespace kestrel::link {
 namespace {
@@ -85,7 +86,7 @@ SplitFlightResult fly_split(const SplitFlightOptions& o) {
             "  - {name: vo, command: vo, side: onboard}\n"
             "  - {name: estimator, command: \"estimator --await-world 1 --init-position 8,3.5,1.3\", side: onboard}\n"
             "  - {name: follow, command: follow, side: onboard}\n"
-            "  - {name: recorder, command: \"lcm-logger -q -c GROUND_TRUTH|STATE|PLAN|SLAM_CORRECTION "
+            "  - {name: recorder, command: \"lcm-logger -q -c GROUND_TRUTH|STATE|PLAN|SLAM_CORRECTION|VO_UPDATE "
          << (out / "onboard.lcmlog").string() << "\", side: onboard}\n"
             "  - {name: slam, command: slam, side: offboard}\n"
             "  - {name: mapper, command: \"mapper --publish-period 1\", side: offboard}\n"
@@ -151,6 +152,10 @@ SplitFlightResult fly_split(const SplitFlightOptions& o) {
         last_state = e->timestamp;
       } else if (e->channel == channel::kSlamCorrection) {
         ++r.corrections_received;
+      } else if (e->channel == channel::kVoUpdate) {
+        const auto m = transport::decode_message<kestrel::vo_update_t>(data.data(), data.size(), "VO_UPDATE");
+        if (m.status != kestrel::vo_update_t::STATUS_OK && m.status != kestrel::vo_update_t::STATUS_NO_REFERENCE)
+          r.vo_failures.push_back({m.utime, m.status, m.num_features, m.num_matches, m.num_inliers});
       } else if (e->channel == channel::kPlan) {
         ++r.plans_received;
         r.plans_answered +=
@@ -165,7 +170,7 @@ SplitFlightResult fly_split(const SplitFlightOptions& o) {
   const fs::path logs = out / "logs";
   r.corrections_applied = last_match(read_text(logs / "estimator.log"), R"(corrections (\d+) applied)");
   r.mapper_keyframes = last_match(read_text(logs / "mapper.log"), R"(\d+ frames \((\d+) inserted)");
-  r.slam_keyframes = last_match(read_text(logs / "slam.log"), R"((\d+) keyframes, \d+ loop closures)");
+  r.slam_keyframes = last_match(read_text(logs / "slam.log"), R"((\d+) keyframes \(\d+ thinned)");
   const std::string vo = read_text(logs / "vo.log");
   r.vo_frames = last_match(vo, R"((\d+) frames, \d+ with a motion)");
   r.vo_motions = last_match(vo, R"(\d+ frames, (\d+) with a motion)");

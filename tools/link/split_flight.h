@@ -11,7 +11,8 @@
 // start lies behind the first camera, and half a metre ahead is inside its shortest range:
 // the planner never learns they are free); then it holds there until the end. The source
 // sends raw frames, as a Kinect does, and rgbd-codec compresses those that cross. Onboard,
-// an lcm-logger records GROUND_TRUTH, STATE, PLAN and SLAM_CORRECTION as they arrive there.
+// an lcm-logger records GROUND_TRUTH, STATE, PLAN, SLAM_CORRECTION and VO_UPDATE as they
+// arrive there.
 //
 // What is measured: the true deviation while holding (from 3 s after the first truth until
 // the first request, and from 2 s after the return until the end): the distance of the
@@ -29,6 +30,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 namespace kestrel::link {
 
@@ -40,6 +42,14 @@ struct SplitFlightOptions {
   uint64_t seed = 1;
   double duration_s = 55;  ///< of the simulator's flight
   double hover_s = 8;      ///< wall seconds from the start until the first request
+};
+
+/// A frame VO read but could not measure a motion on (not the first frame: that one has no
+/// reference), as VO_UPDATE said it.
+struct VoFailure {
+  int64_t utime = 0;
+  int status = 0;  ///< vo_update_t::STATUS_*
+  int features = 0, matches = 0, inliers = 0;
 };
 
 struct SplitFlightResult {
@@ -55,6 +65,7 @@ struct SplitFlightResult {
   int mapper_keyframes = -1;      ///< frames the mapper inserted (-1: not found)
   int slam_keyframes = -1;        ///< (-1: not found)
   int vo_frames = -1, vo_motions = -1;  ///< frames VO read and those it measured (-1: not found)
+  std::vector<VoFailure> vo_failures;  ///< from the onboard log, in order
   int states = 0;                 ///< STATE messages logged onboard
   double state_max_gap_s = 0;     ///< the longest wall time between two of them (onboard never waits)
   int64_t datagrams_offered = 0, datagrams_lost = 0, datagrams_queue_full = 0;  ///< both ways
