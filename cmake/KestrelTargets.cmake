@@ -211,6 +211,9 @@ function(kestrel_add_tools_executable)
     HEADERS <CLI/CLI.hpp> <spdlog/spdlog.h> <Eigen/Core> <Eigen/Geometry> <opencv2/core.hpp>
             <chrono> <filesystem> <fstream> <iostream> ${_KESTREL_STD_HEADERS})
   _kestrel_use_pch(kestrel-tools kestrel_tool_pch "${_KESTREL_TOOL_PCH_DEPS}")
+  # The mains parse options and wire callbacks; the work is in the libraries (-O0 in the
+  # sanitizer build: KestrelWarnings.cmake).
+  set_target_properties(kestrel-tools kestrel_tool_pch PROPERTIES KESTREL_MAIN_CODE ON)
 endfunction()
 
 # kestrel_write_layering_manifest(FILE): what the layering test checks, as JSON — every
@@ -290,7 +293,7 @@ endfunction()
 # file's compile time.
 set(_KESTREL_TEST_PCH_DEPS GTest::gtest GTest::gmock Eigen3::Eigen opencv_core)
 # _kestrel_test_pch(pch optimized): the header for the tests compiled at -O0 in the sanitizer
-# builds, or for those that stay at -O1 (OPTIMIZED; KestrelWarnings.cmake): a precompiled
+# build, or for those that stay at -O1 (OPTIMIZED; KestrelWarnings.cmake): a precompiled
 # header is only used at the -O level it was made with.
 function(_kestrel_test_pch pch optimized)
   if(TARGET ${pch})
@@ -316,7 +319,7 @@ endfunction()
 # THREADS: the test exercises code that runs on more than one thread; its cases also get the
 # label `threads`, and the executable joins `threads_tests`, which the ThreadSanitizer build
 # (build/tsan) builds and runs. OPTIMIZED: the test's own code stays at -O1 in the sanitizer
-# builds, where the others' is at -O0 (KestrelWarnings.cmake): for a test whose time goes to
+# build, where the others' is at -O0 (KestrelWarnings.cmake): for a test whose time goes to
 # templates it instantiates itself.
 function(kestrel_test name)
   cmake_parse_arguments(ARG "SANITIZED;THREADS;OPTIMIZED" "TIMEOUT;SANITIZED_CASES" "SOURCES;DEPS;LABELS" ${ARGN})
@@ -351,8 +354,8 @@ function(kestrel_test name)
   target_link_libraries(${name} PRIVATE ${ARG_DEPS} GTest::gtest GTest::gtest_main GTest::gmock
                         kestrel_options)
   _kestrel_test_definitions(${name})
-  # Outside the sanitizer builds every test's code is at -O1, and one header serves them all.
-  if(ARG_OPTIMIZED AND (KESTREL_SANITIZE OR KESTREL_TSAN))
+  # Outside the sanitizer build all test code shares one -O level, and one header serves it.
+  if(ARG_OPTIMIZED AND KESTREL_SANITIZE)
     _kestrel_test_pch(kestrel_test_pch_optimized ON)
     set(pch kestrel_test_pch_optimized)
   else()

@@ -67,16 +67,17 @@ if(KESTREL_TSAN)
   target_link_options(kestrel_options INTERFACE -fsanitize=thread)
 endif()
 
-# In the sanitizer builds the tests' own code (KESTREL_TEST_CODE) is compiled at -O0: it drives
-# the libraries, which keep -O1, and with the sanitizers' instrumentation -O1 was 40-65 % of a
-# test file's compile time; the test files are the largest part of the sanitizer build. A test
-# whose own code does heavy work (OctoMap's and Eigen's templates instantiated in the test,
-# images drawn there) is marked OPTIMIZED (kestrel_test) and stays at -O1, with a precompiled
-# header of its own. The tools' mains stay at -O1: some do heavy work themselves (kestrel map).
+# In the ASan/UBSan build the code that only drives the libraries is compiled at -O0: the
+# tests' own code (KESTREL_TEST_CODE) and the tools' mains (KESTREL_MAIN_CODE). The libraries
+# keep -O1. With the sanitizers' instrumentation, -O1 was 38-63 % of such a file's compile time,
+# and the test files are the largest part of that build. A test whose own code does heavy work
+# (the mapper's, OctoMap's and Eigen's templates instantiated in the test, images drawn there)
+# is marked OPTIMIZED (kestrel_test) and stays at -O1, with a precompiled header of its own.
+# Not in the ThreadSanitizer build, whose tests are about timing between threads.
 # docs/decisions/2026-12-06-ci-time-test-code-at-O0.md.
-if(KESTREL_SANITIZE OR KESTREL_TSAN)
-  target_compile_options(kestrel_options INTERFACE
-    "$<$<AND:$<BOOL:$<TARGET_PROPERTY:KESTREL_TEST_CODE>>,$<NOT:$<BOOL:$<TARGET_PROPERTY:KESTREL_TEST_OPTIMIZED>>>>:-O0>")
+if(KESTREL_SANITIZE)
+  set(_kestrel_driving_code "$<OR:$<BOOL:$<TARGET_PROPERTY:KESTREL_MAIN_CODE>>,$<AND:$<BOOL:$<TARGET_PROPERTY:KESTREL_TEST_CODE>>,$<NOT:$<BOOL:$<TARGET_PROPERTY:KESTREL_TEST_OPTIMIZED>>>>>")
+  target_compile_options(kestrel_options INTERFACE "$<${_kestrel_driving_code}:-O0>")
 endif()
 
 # The fuzz build (`./kestrel fuzz`, fuzz/README.md): every library is compiled with libFuzzer's

@@ -11,6 +11,8 @@
 #include <filesystem>
 #include <map>
 #include <optional>
+#include <regex>
+#include <set>
 #include <string>
 #include <tuple>
 #include <utility>
@@ -21,6 +23,7 @@
 #include "common/transport/log_file.h"
 #include "common/transport/message.h"
 #include "kestrel/ground_truth_t.hpp"
+#include "kestrel/slam_graph_t.hpp"
 #include "kestrel/state_t.hpp"
 #include "metrics/alignment.h"
 #include "test/support/test_support.h"
@@ -68,8 +71,12 @@ TEST(System, ASecondFlightStartedElsewhereIsPlacedInTheSavedMapAndFliesToAGoalIn
   // Mapped: the room's figure-eight from (8, 3.5, 1.3). Then: start at (8.5, 3.3, 1.3), yaw 0.3,
   // and fly to a goal 40 degrees off the camera's axis (its half field of view is 31): out of view
   // at the start, known from the first flight's map only.
+  // SLAM makes keyframes from the first frame of the second flight on, before it has placed the
+  // camera in the map (--map-unplaced-after 0): it announces them on SLAM_GRAPH_UNPLACED, the
+  // mapper keeps their frames, and they join the map when the placement comes.
   const Eigen::Vector3d start(8.5, 3.3, 1.3), goal(9.2, 4.4, 1.3);
-  const auto r = test::run({"bash", (test::source_dir() / "tools/demo/fly_again").string(),
+  const auto r = test::run({"env", "SLAM2_OPTIONS=--map-unplaced-after 0", "bash",
+                            (test::source_dir() / "tools/demo/fly_again").string(),
                             test::tool("sim").parent_path().string(), dir.path().string(), "room", "8,3.5,1.3",
                             "figure8", "20", "8.5,3.3,1.3,0.3", "9.2 4.4 1.3 0", "20"},
                            400.0);
@@ -85,6 +92,32 @@ TEST(System, ASecondFlightStartedElsewhereIsPlacedInTheSavedMapAndFliesToAGoalIn
   const std::string slam = test::read_file(two / "slam.txt");
   EXPECT_NE(slam.find("relocalised at frame"), std::string::npos) << slam;
   EXPECT_NE(test::read_file(two / "sim.txt").find("contacts: 0\n"), std::string::npos);
+
+  // The keyframes made before the placement: announced, then each in a placed graph, and the
+  // mapper kept the frames of those it had and inserted every one of them.
+  std::set<int64_t> announced, placed;
+  {
+    transport::LogReader log((two / "flight.lcmlog").string());
+    while (auto e = log.next()) {
+      if (e->channel == channel::kSlamGraphUnplaced) {
+        const auto m = transport::decode_message<kestrel::slam_graph_t>(e->data.data(), e->data.size(), "unplaced");
+        for (const auto& k : m.keyframes) announced.insert(k.utime);
+      } else if (e->channel == channel::kSlamGraph) {
+        const auto m = transport::decode_message<kestrel::slam_graph_t>(e->data.data(), e->data.size(), "graph");
+        for (const auto& k : m.keyframes) placed.insert(k.utime);
+      }
+    }
+  }
+  const std::string mapper = test::read_file(two / "mapper.txt");
+  std::cout << "second flight: " << announced.size() << " keyframes announced before the placement\n";
+  EXPECT_FALSE(announced.empty()) << slam;
+  for (const int64_t utime : announced) EXPECT_TRUE(placed.count(utime)) << "keyframe " << utime << " never joined";
+  std::smatch kept;
+  const std::regex kept_line(
+      R"((\d+) frames of keyframes SLAM made before placing the camera kept past the buffer, (\d+) of them joined)");
+  ASSERT_TRUE(std::regex_search(mapper, kept, kept_line)) << mapper;
+  EXPECT_GE(std::stoi(kept[1]), 1) << mapper;
+  EXPECT_EQ(kept[1], kept[2]) << mapper;
 
   // The map's world is the first flight's estimator's (started at the take-off pose, which the
   // figure-eight does not start at exactly): its STATE against the truth gives the truth in it,

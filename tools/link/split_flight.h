@@ -44,8 +44,8 @@ struct SplitFlightOptions {
   double hover_s = 8;      ///< wall seconds from the start until the first request
 };
 
-/// A frame VO read but could not measure a motion on (not the first frame: that one has no
-/// reference), as VO_UPDATE said it.
+/// A frame VO read but could not measure a motion on (not one without a reference: the first,
+/// or the first after a reset), as VO_UPDATE said it.
 struct VoFailure {
   int64_t utime = 0;
   int status = 0;  ///< vo_update_t::STATUS_*
