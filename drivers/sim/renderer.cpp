@@ -163,8 +163,11 @@ void Renderer::shade(bool ir, bool accumulate) {
         tm = z * (vs.t_a * static_cast<float>(x) + t_row) + vs.t_0;
       };
       // Chunks of up to kChunk pixels: exact (perspective) surface coordinates and light at
-      // the first and last pixel, linear in between (the perspective error over 16 px is a
-      // small fraction of a texel at these depths); one mip level (or one blend) per chunk.
+      // the first and last pixel, linear in between; one mip level (or one blend) per chunk.
+      // The perspective error over 16 px is a small fraction of a texel on surfaces seen face
+      // on, but not on walls seen at grazing angles, where it moves the texture a little with
+      // the camera: in stata's corridor that is a third to a half of the VO's rotation drift
+      // (docs/decisions/2026-12-06-stata-flights-rotation-drift.md; adaptive spans are the fix).
       // A chunk's work; full chunks (the common case) with a compile-time count, so their
       // loops need no remainder handling.
       auto chunk = [&](auto count) {
