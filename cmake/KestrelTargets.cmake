@@ -211,7 +211,7 @@ function(kestrel_add_tools_executable)
     HEADERS <CLI/CLI.hpp> <spdlog/spdlog.h> <Eigen/Core> <Eigen/Geometry> <opencv2/core.hpp>
             <chrono> <filesystem> <fstream> <iostream> ${_KESTREL_STD_HEADERS})
   _kestrel_use_pch(kestrel-tools kestrel_tool_pch "${_KESTREL_TOOL_PCH_DEPS}")
-  # The mains parse options and wire callbacks; the work is in the libraries (-O0 in the
+  # The mains mostly parse options and wire callbacks; the work is in the libraries (-O0 in the
   # sanitizer build: KestrelWarnings.cmake).
   set_target_properties(kestrel-tools kestrel_tool_pch PROPERTIES KESTREL_MAIN_CODE ON)
 endfunction()

@@ -86,7 +86,7 @@ SplitFlightResult fly_split(const SplitFlightOptions& o) {
             "  - {name: vo, command: vo, side: onboard}\n"
             "  - {name: estimator, command: \"estimator --await-world 1 --init-position 8,3.5,1.3\", side: onboard}\n"
             "  - {name: follow, command: follow, side: onboard}\n"
-            "  - {name: recorder, command: \"lcm-logger -q -c GROUND_TRUTH|STATE|PLAN|SLAM_CORRECTION|VO_UPDATE "
+            "  - {name: recorder, command: \"lcm-logger -q -c (GROUND_TRUTH|STATE|PLAN|SLAM_CORRECTION|VO_UPDATE) "
          << (out / "onboard.lcmlog").string() << "\", side: onboard}\n"
             "  - {name: slam, command: slam, side: offboard}\n"
             "  - {name: mapper, command: \"mapper --publish-period 1\", side: offboard}\n"
