@@ -25,8 +25,10 @@ inline float fast_log2(float x) {
   return exponent + f * (1.3465557f - 0.34655573f * f);
 }
 
-// Pixels per shading chunk (see Renderer::shade).
+// Pixels per shading chunk, and the largest error of a chunk's linear light, relative (1e-3:
+// about a tenth of a grey level); see Renderer::shade.
 constexpr int kChunk = 16;
+constexpr float kMaxLightError = 1e-3f;
 
 // What a pixel of one visible surface needs, hoisted out of the pixel loop.
 struct Shader {
@@ -130,6 +132,7 @@ void Renderer::shade(bool ir, bool accumulate) {
   const int w = cam.width;
   const int wear_top = wear.levels() - 1;
   uint32_t texels[kChunk], texels_next[kChunk], greys[kChunk];
+  float lights[kChunk];
   for (int v = 0; v < cam.height; ++v) {
     const uint16_t* ids = raster_.ids(v);
     const float* inv = raster_.inverse_depth(v);
@@ -162,12 +165,18 @@ void Renderer::shade(bool ir, bool accumulate) {
         sm = z * (vs.s_a * static_cast<float>(x) + s_row) + vs.s_0;
         tm = z * (vs.t_a * static_cast<float>(x) + t_row) + vs.t_0;
       };
-      // Chunks of up to kChunk pixels: exact (perspective) surface coordinates and light at
-      // the first and last pixel, linear in between; one mip level (or one blend) per chunk.
-      // The perspective error over 16 px is a small fraction of a texel on surfaces seen face
-      // on, but not on walls seen at grazing angles, where it moves the texture a little with
-      // the camera: in stata's corridor that is a third to a half of the VO's rotation drift
-      // (docs/decisions/2026-12-06-stata-flights-rotation-drift.md; adaptive spans are the fix).
+      // Chunks of up to kChunk pixels: exact (perspective) surface coordinates at the first
+      // and last pixel, linear in between; one mip level (or one blend) per chunk. A chunk is
+      // fixed in the image while the surface moves, so whatever its linear steps get wrong
+      // moves with the camera, and the VO reads it as motion
+      // (docs/decisions/2026-12-06-stata-flights-rotation-drift.md, where both were measured):
+      // - Light. A line over the chunk cuts off the light map's shadow edges and lamp pools.
+      //   Always linear (this renderer until 2026-12-06), it was most of the VO's rotation
+      //   drift in stata's corridor: 2.00° in 18 s on exact images, 0.87° with the rule below.
+      // - Surface coordinates, off by (w1-w0)/(2(w0+w1)) of the chunk's extent at its middle,
+      //   w the inverse depth: a small fraction of a texel face on, several texels on a wall
+      //   at a grazing angle. Shorter chunks there (under 1/8 texel) changed that drift by less
+      //   than a run's spread and cost floor's frames a few ms, so the chunks stay 16 px.
       // A chunk's work; full chunks (the common case) with a compile-time count, so their
       // loops need no remainder handling.
       auto chunk = [&](auto count) {
@@ -204,8 +213,21 @@ void Renderer::shade(bool ir, bool accumulate) {
         const int wl = std::clamp(static_cast<int>(lz + s.wear_lod_c + 0.5f), 0, wear_top);
         wear.grey_span(wl, wear.fixed_coordinate(wl, wx0), wear.fixed_coordinate(wl, wy0),
                            wear.fixed_step(wl, wdx), wear.fixed_step(wl, wdy), n, greys);
+        // Light: linear over the chunk where the light map is (its middle within
+        // kMaxLightError of the line), else at every pixel. The map is bilinear between nodes;
+        // a chunk spans one node line at most in all but the farthest views, and then the
+        // error at the middle is at least half the largest.
         const float light0 = s.shade->at(s0, t0) * exposure;
-        const float dlight = (s.shade->at(s1, t1) * exposure - light0) * step;
+        const float light1 = s.shade->at(s1, t1) * exposure;
+        const float light_mid = s.shade->at(0.5f * (s0 + s1), 0.5f * (t0 + t1)) * exposure;
+        if (std::abs(light_mid - 0.5f * (light0 + light1)) <= kMaxLightError * std::max(light0, light1)) {
+          const float dlight = (light1 - light0) * step;
+          for (int i = 0; i < n; ++i) lights[i] = light0 + dlight * static_cast<float>(i);
+        } else {
+          const float ds = (s1 - s0) * step, dt = (t1 - t0) * step;
+          for (int i = 0; i < n; ++i)
+            lights[i] = s.shade->at(s0 + ds * static_cast<float>(i), t0 + dt * static_cast<float>(i)) * exposure;
+        }
         float* r = R + u;
         float* g = G + u;
         float* b = B + u;
@@ -214,7 +236,7 @@ void Renderer::shade(bool ir, bool accumulate) {
           for (int i = 0; i < n; ++i) {
             const uint32_t texel = texels[i];
             const float wear_factor = 1.0f + s.wear_k * (static_cast<float>(greys[i] & 255u) - 127.5f);
-            const float light = (light0 + dlight * static_cast<float>(i)) * wear_factor;
+            const float light = lights[i] * wear_factor;
             const float vr = (s.base[0] + s.detail * static_cast<float>(texel & 255u)) * light;
             const float vg = (s.base[1] + s.detail * static_cast<float>((texel >> 8) & 255u)) * light;
             const float vb = (s.base[2] + s.detail * static_cast<float>((texel >> 16) & 255u)) * light;

@@ -111,7 +111,7 @@ TEST(RosBridgeData, Fr1XyzPlayedIntoTheBridgeGivesImportsFramesAndTheStateOnBoth
     ASSERT_EQ(sub.getNumPublishers(), 1u) << "/kestrel/odom not connected to the bridge";
 
     // The camera's topics and the mocap's /tf (--wait-for-subscribers waits on each).
-    ASSERT_EQ(system.run("play", {"rosbag", "play", "-q", "--wait-for-subscribers", bag.string(), "--topics",
+    ASSERT_EQ(system.run("play", {"rosbag", "play", "-q", "--wait-for-subscribers", "-d", "1", bag.string(), "--topics",
                                   "/camera/rgb/image_color", "/camera/depth/image", "/camera/rgb/camera_info", "/imu",
                                   "/tf"},
                          40.0),

@@ -62,7 +62,7 @@ Refusal bridge_on(const std::string& depth_encoding, double fx) {
   if (!test::start_roscore(system)) return r;
   system.start("bridge", {test::tool("ros-bridge").string()});
   system.wait_running("ros-bridge");
-  system.start("play", {"rosbag", "play", "-q", "--wait-for-subscribers", (dir / "bad.bag").string()});
+  system.start("play", {"rosbag", "play", "-q", "--wait-for-subscribers", "-d", "1", (dir / "bad.bag").string()});
   r.exit_code = system.exit_status("bridge", 30.0);
   r.log = system.output("bridge");
   r.frames = system.messages(channel::kCameraRgbd).size();
@@ -145,7 +145,7 @@ TEST(RosBridge, TheSameBagWellFormedGivesItsFrames) {
   ASSERT_TRUE(test::start_roscore(system));
   system.start("bridge", {test::tool("ros-bridge").string()});
   ASSERT_NE(system.wait_running("ros-bridge"), 0);
-  ASSERT_EQ(system.run("play", {"rosbag", "play", "-q", "--wait-for-subscribers", (dir / "good.bag").string()}, 30.0), 0);
+  ASSERT_EQ(system.run("play", {"rosbag", "play", "-q", "--wait-for-subscribers", "-d", "1", (dir / "good.bag").string()}, 30.0), 0);
   // The last colour image is decided by its own depth image (same stamp): all three go out.
   ASSERT_TRUE(system.wait_for<kestrel::rgbd_frame_t>(
       channel::kCameraRgbd, [](const kestrel::rgbd_frame_t& f) { return f.seq == 2; }, 20.0, "the third frame"));

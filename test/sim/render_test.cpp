@@ -1,10 +1,12 @@
 // The renderer against geometry known in closed form: depth of a plane and of a box equals
 // the analytic depth within the Kinect's disparity quantisation; every pixel back-projects
 // onto the surface it shows; textured walls give FAST corners at several pyramid levels and
-// the blank wall few; the texture span loops equal per-texel lookups in the unpadded levels.
+// the blank wall few; the texture span loops equal per-texel lookups in the unpadded levels;
+// where the shading chunks fall does not change the image.
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
@@ -180,6 +182,39 @@ TEST(RenderTest, TextureSpansEqualPerTexelBilinearLookups) {
         y += static_cast<uint32_t>(dy);
       }
     }
+  }
+}
+
+
+// Where the renderer's 16-pixel shading chunks fall must not change what a pixel shows: the
+// same rays, moved 5 px along the rows by the principal point, give the same image. Linear
+// light over a chunk broke this near the lamps and shadow edges, at places fixed in the
+// image, and the VO read it as motion (docs/decisions/2026-12-06-stata-flights-rotation-drift.md).
+TEST(RenderTest, WhatAPixelShowsDoesNotDependOnWhereTheShadingChunksFall) {
+  const World& world = test::builtin("room");
+  CameraOptions options = exact_camera();
+  options.rgb.vignetting = 0.0;  // the only sensor effect that sees the principal point
+  options.rgb.optics_blur = false;
+  CameraOptions shifted = options;
+  constexpr int kShift = 5;
+  shifted.camera.cx += kShift;
+  Renderer a(world, options, 1), b(world, shifted, 1);
+  for (const Eigen::Isometry3d& T : {look({8.0, 3.5, 1.3}, 0.0, -1.2), look({3.0, 4.5, 1.0}, -2.0, 0.35),
+                                     look({5.5, 2.0, 2.0}, 1.7, -0.9)}) {
+    const cv::Mat ia = a.render(T, 0, 0).rgb, ib = b.render(T, 0, 0).rgb;
+    std::vector<int> diffs;
+    for (int v = 0; v < ia.rows; ++v)
+      for (int u = 0; u + kShift < ia.cols; ++u)
+        for (int ch = 0; ch < 3; ++ch)
+          diffs.push_back(std::abs(ia.at<cv::Vec3b>(v, u)[ch] - ib.at<cv::Vec3b>(v, u + kShift)[ch]));
+    std::sort(diffs.begin(), diffs.end());
+    double mean = 0;
+    for (int d : diffs) mean += d;
+    mean /= static_cast<double>(diffs.size());
+    // What remains is the texture's mip level, chosen per chunk. Linear light gave 0.12 and 4
+    // grey levels on the two views up at the lamps; the light map sampled as it is, 0.03 and 1.
+    EXPECT_LT(mean, 0.05) << "mean difference, grey levels";
+    EXPECT_LE(diffs[diffs.size() - diffs.size() / 1000], 1) << "99.9th percentile difference, grey levels";
   }
 }
 
