@@ -214,6 +214,13 @@ JournalWriter::JournalWriter(std::string path, const JournalContents& contents, 
     pruned_ = prune_kept_journals(path_, "damaged", keep_, kept_aside_);
   }
   open_for_append();
+  for (const JournalRecord& r : contents.records) {
+    if (r.kind == JournalRecord::Kind::kKeyframe) {
+      place(r.keyframe);
+    } else {
+      for (const auto& k : r.graph.keyframes) place(k);
+    }
+  }
 }
 
 void JournalWriter::start_fresh(const std::string& source, const std::vector<std::pair<uint64_t, uint64_t>>& spans) {
@@ -241,20 +248,17 @@ void JournalWriter::open_for_append() {
   bytes_ = std::filesystem::file_size(path_, ec);
 }
 
-void JournalWriter::append(char kind, const std::vector<uint8_t>& payload) {
-  std::vector<uint8_t> head{static_cast<uint8_t>(kind)};
-  journal::put_u32(head, static_cast<uint32_t>(payload.size()));
-  std::vector<uint8_t> tail;
-  journal::put_u32(tail, journal::crc32(payload.data(), payload.size(), journal::crc32(head.data(), head.size())));
-  out_.write(reinterpret_cast<const char*>(head.data()), static_cast<std::streamsize>(head.size()));
-  out_.write(reinterpret_cast<const char*>(payload.data()), static_cast<std::streamsize>(payload.size()));
-  out_.write(reinterpret_cast<const char*>(tail.data()), static_cast<std::streamsize>(tail.size()));
-  out_.flush();  // to the kernel: a killed process loses nothing written before
-  if (!out_) throw std::runtime_error(path_ + ": writing the mapper journal failed: " + std::strerror(errno));
-  bytes_ += head.size() + payload.size() + tail.size();
+std::vector<uint8_t> JournalWriter::record(char kind, const std::vector<uint8_t>& payload) {
+  std::vector<uint8_t> bytes{static_cast<uint8_t>(kind)};
+  journal::put_u32(bytes, static_cast<uint32_t>(payload.size()));
+  const uint32_t crc = journal::crc32(payload.data(), payload.size(), journal::crc32(bytes.data(), bytes.size()));
+  bytes.reserve(bytes.size() + payload.size() + 4);
+  bytes.insert(bytes.end(), payload.begin(), payload.end());
+  journal::put_u32(bytes, crc);
+  return bytes;
 }
 
-void JournalWriter::keyframe(const kestrel::slam_keyframe_t& keyframe, const RgbdFrame& frame) {
+std::vector<uint8_t> JournalWriter::keyframe_payload(const kestrel::slam_keyframe_t& keyframe, const RgbdFrame& frame) {
   const std::vector<uint8_t> k = transport::encode_message(keyframe);
   const std::vector<uint8_t> f = transport::encode_message(transport::encode_rgbd(frame, lossless()));
   std::vector<uint8_t> payload;
@@ -262,11 +266,55 @@ void JournalWriter::keyframe(const kestrel::slam_keyframe_t& keyframe, const Rgb
   journal::put_u32(payload, static_cast<uint32_t>(k.size()));
   payload.insert(payload.end(), k.begin(), k.end());
   payload.insert(payload.end(), f.begin(), f.end());
-  append(journal::kKeyframe, payload);
+  return payload;
+}
+
+void JournalWriter::append(char kind, const std::vector<uint8_t>& payload) {
+  const std::vector<uint8_t> bytes = record(kind, payload);
+  out_.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  out_.flush();  // to the kernel: a killed process loses nothing written before
+  if (!out_) throw std::runtime_error(path_ + ": writing the mapper journal failed: " + std::strerror(errno));
+  bytes_ += bytes.size();
+}
+
+void JournalWriter::keyframe(const kestrel::slam_keyframe_t& keyframe, const RgbdFrame& frame) {
+  append(journal::kKeyframe, keyframe_payload(keyframe, frame));
+  place(keyframe);
 }
 
 void JournalWriter::graph(const kestrel::slam_graph_t& graph) {
   append(journal::kGraph, transport::encode_message(graph));
+  for (const auto& k : graph.keyframes) place(k);
+}
+
+void JournalWriter::compact(const std::vector<LiveKeyframe>& keyframes, int64_t graph_revision) {
+  {
+    AtomicFile file(path_);  // the old journal stays whole (and open for append) until commit
+    const auto put = [&](char kind, const std::vector<uint8_t>& payload) {
+      const std::vector<uint8_t> bytes = record(kind, payload);
+      file.stream().write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+    };
+    file.stream().write(journal::kHeader, static_cast<std::streamsize>(journal::kHeaderSize));
+    for (const LiveKeyframe& k : keyframes) {
+      const auto placed = placed_.find(k.id);
+      if (placed == placed_.end() || k.frame == nullptr)
+        throw std::invalid_argument(path_ + ": compacting: keyframe " + std::to_string(k.id) +
+                                    (k.frame == nullptr ? " has no frame" : " was never in this journal"));
+      put(journal::kKeyframe, keyframe_payload(placed->second, *k.frame));
+    }
+    if (graph_revision >= 0) {
+      kestrel::slam_graph_t graph{};
+      graph.revision = graph_revision;
+      put(journal::kGraph, transport::encode_message(graph));
+    }
+    file.commit();
+  }
+  out_.close();
+  open_for_append();
+  ++compactions_;
+  std::map<int64_t, kestrel::slam_keyframe_t> live;  // the others are gone with the old file
+  for (const LiveKeyframe& k : keyframes) live.insert(placed_.extract(k.id));
+  placed_ = std::move(live);
 }
 
 void JournalWriter::restart() {
@@ -278,6 +326,7 @@ void JournalWriter::restart() {
   kept_aside_ = keep_aside(path_, "reset");
   start_fresh("", {});
   open_for_append();
+  placed_.clear();
   pruned_ = prune_kept_journals(path_, "reset", keep_, kept_aside_);
 }
 

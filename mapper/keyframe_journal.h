@@ -32,6 +32,13 @@
 //    copied byte for byte, which the writer then appends to.
 //  * A reset (lock-step replay's RESET) keeps the journal it ends as "<file>.reset-<utime>" and
 //    starts "<file>" again empty; a journal without records is simply kept.
+//  * Compaction (JournalWriter::compact): the file is replaced, by one rename, with a journal
+//    that restores the same store: one record per stored keyframe at its current pose, and a
+//    graph record of the last revision. The records it drops are of keyframes the store itself
+//    has dropped (over its budget) and of poses since superseded, so a mapper restored from
+//    either file holds the same keyframes at the same poses, bit for bit; until the rename
+//    the old file is whole. So the journal stays within a bound of the store instead of
+//    growing with the flight.
 //  * The only deletion: so that repeated resets (or damage) cannot fill the disk, each time a
 //    journal is set aside the oldest of that kind ("reset" or "damaged") beyond the `keep` most
 //    recent are deleted, and each deletion is reported (JournalWriter::pruned()) for the
@@ -40,6 +47,7 @@
 
 #include <cstdint>
 #include <fstream>
+#include <map>
 #include <string>
 #include <utility>
 #include <vector>
@@ -108,6 +116,12 @@ struct PrunedJournals {
 PrunedJournals prune_kept_journals(const std::string& path, const std::string& tag, int keep,
                                    const std::string& just_kept);
 
+/// A stored keyframe, for compaction: its id and its stored frame.
+struct LiveKeyframe {
+  int64_t id = 0;
+  const RgbdFrame* frame = nullptr;
+};
+
 class JournalWriter {
  public:
   /// Journals to `path`, whose read_journal() is `contents` (default: a missing or empty file,
@@ -126,6 +140,16 @@ class JournalWriter {
   /// "<path>.reset-<utime>" (if it holds a record). Throws InputError (nothing changed) if the
   /// old one cannot be kept.
   void restart();
+  /// Replaces the journal by one of `keyframes` (in that order), each as its last record in
+  /// this journal placed it (its keyframe record, or the last graph record that moved it: the
+  /// pose exactly as SLAM sent it, so a restore is bit for bit), and, when `graph_revision`
+  /// >= 0, a graph record of that revision that moves nothing (a restored mapper then still
+  /// refuses older graphs); see the top of this file. Atomic: on any failure (InputError
+  /// naming the file; std::invalid_argument for a keyframe this journal never held) the old
+  /// journal is still whole and still appended to.
+  void compact(const std::vector<LiveKeyframe>& keyframes, int64_t graph_revision);
+  /// How many times compact() replaced the journal.
+  int compactions() const { return compactions_; }
 
   const std::string& path() const { return path_; }
   uint64_t bytes() const { return bytes_; }
@@ -140,6 +164,9 @@ class JournalWriter {
   void start_fresh(const std::string& source, const std::vector<std::pair<uint64_t, uint64_t>>& spans);
   void open_for_append();
   void append(char kind, const std::vector<uint8_t>& payload);
+  // A record's bytes as they go into the file.
+  static std::vector<uint8_t> record(char kind, const std::vector<uint8_t>& payload);
+  static std::vector<uint8_t> keyframe_payload(const kestrel::slam_keyframe_t& keyframe, const RgbdFrame& frame);
 
   std::string path_;
   int keep_;
@@ -147,6 +174,11 @@ class JournalWriter {
   uint64_t bytes_ = 0;
   std::string kept_aside_;
   PrunedJournals pruned_;
+  int compactions_ = 0;
+  // Each keyframe's last entry in the journal (its keyframe record's, or the last graph
+  // record's that moved it): what compact() writes for it.
+  std::map<int64_t, kestrel::slam_keyframe_t> placed_;
+  void place(const kestrel::slam_keyframe_t& keyframe) { placed_[keyframe.id] = keyframe; }
 };
 
 }  // namespace kestrel::mapper

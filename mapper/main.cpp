@@ -88,7 +88,11 @@ int serve(Options& o) {
   // not in the block below: the handlers keep a reference to it for as long as the node spins.)
   auto journalled = [&](auto&& handle) {
     const bool journalling = !o.node.journal_path.empty() && map.journal_error().empty();
+    const int compactions = map.journal_compactions();
     publish(handle());
+    if (map.journal_compactions() > compactions)
+      spdlog::info("journal {} compacted to the {} stored keyframes", o.node.journal_path,
+                   map.mapper().keyframes().size());
     if (journalling && !map.journal_error().empty()) {
       spdlog::error("journal stopped (the map goes on without it): {}", map.journal_error());
       report_health();
@@ -179,6 +183,11 @@ int main(int argc, char** argv) {
                  "Journals set aside kept of each kind (FILE.reset-*, FILE.damaged-*): the newest; each older one "
                  "is deleted, and logged, when another is set aside")
       ->check(CLI::Range(1, 1000000))
+      ->capture_default_str();
+  app.add_option("--journal-compact-mb", o.node.journal_compact_mb,
+                 "The journal is compacted (replaced at once by the stored keyframes' records) when it is larger "
+                 "than twice the stored keyframes plus this many MB")
+      ->check(CLI::PositiveNumber)
       ->capture_default_str();
   mapper::add_mapper_options(app, o.node.mapper);
   return app.run(argc, argv, [&] { return serve(o); });

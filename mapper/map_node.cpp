@@ -30,6 +30,8 @@ void NodeOptions::validate() const {
   if (max_pending_frames < 1) throw std::invalid_argument("max-pending-frames: must be >= 1");
   // 0 would delete the journal a reset has just set aside: keeping none is not offered.
   if (journal_keep < 1) throw std::invalid_argument("journal-keep: must be >= 1");
+  if (!(std::isfinite(journal_compact_mb) && journal_compact_mb > 0.0))
+    throw std::invalid_argument("journal-compact-mb: must be > 0");
   if (!journal_path.empty() && pose_source != PoseSource::kSlamGraph)
     throw std::invalid_argument("journal: only with the slam pose source");
 }
@@ -90,6 +92,19 @@ void MapNode::write_journal(const kestrel::slam_graph_t& msg, const GraphResult&
       // (Over the keyframe budget, one stored by this graph may have gone already.)
       if (const StoredKeyframe* stored = mapper_.keyframes().find(id)) writer.keyframe(*k, stored->frame);
     }
+  });
+}
+
+void MapNode::compact_journal_if_due() {
+  journal([&](JournalWriter& writer) {
+    const KeyframeStore& store = mapper_.keyframes();
+    const double due = 2.0 * static_cast<double>(store.bytes()) + options_.journal_compact_mb * 1e6;
+    if (static_cast<double>(writer.bytes()) <= due) return;
+    // In sensor time, the order they were stored in, so a restore bins them as they were.
+    std::vector<LiveKeyframe> live;
+    live.reserve(store.size());
+    for (const StoredKeyframe* k : store.in_time_order()) live.push_back({k->id, &k->frame});
+    writer.compact(live, last_graph_revision_);
   });
 }
 
@@ -249,6 +264,7 @@ std::optional<kestrel::octomap_t> MapNode::on_correction(const kestrel::slam_cor
   journal([&](JournalWriter& writer) {
     if (const StoredKeyframe* kf = mapper_.keyframes().find(k.id)) writer.keyframe(k, kf->frame);
   });
+  compact_journal_if_due();
   return maybe_publish(false);
 }
 
@@ -288,6 +304,7 @@ std::optional<kestrel::octomap_t> MapNode::on_graph(const kestrel::slam_graph_t&
   // keyframes: the frames a SLAM map is made of
   stats_.frames_inserted += static_cast<int64_t>(result.inserted.size());
   write_journal(msg, result);
+  compact_journal_if_due();
   if (result.rebuilt) {
     ++stats_.rebuilds;
     stats_.last_rebuild_keyframes = static_cast<double>(result.rebuild_keyframes);

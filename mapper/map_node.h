@@ -17,7 +17,9 @@
 // past the damage, kept aside whole and continued as a fresh copy; RESET starts the journal
 // again empty and keeps the old one aside (keyframe_journal.h): no journal is ever cut. Of the
 // journals set aside, NodeOptions::journal_keep of each kind are kept; the older ones deleted
-// are in journal_pruned(), for the process to log.
+// are in journal_pruned(), for the process to log. A journal that has grown past twice the
+// store (keyframes the store dropped, poses since moved) is compacted: replaced at once by the
+// same store's records (NodeOptions::journal_compact_mb; journal_compactions()).
 // A journal that cannot be written mid-flight (a full disk), or cannot be continued at start
 // (its folder cannot be written), is given up, not the map: journal_error() says why, health()
 // is DEGRADED with it, and mapping goes on.
@@ -73,6 +75,10 @@ struct NodeOptions {
   bool journal_is_map = false;
   /// Journals set aside kept of each kind (reset, damaged), the newest; >= 1.
   int journal_keep = kDefaultKeptJournals;
+  /// The journal is compacted (JournalWriter::compact) once it is larger than twice the
+  /// stored keyframes' bytes plus this many MB, so it stays within about twice the store
+  /// while each compaction writes at most what the journal grew by since the last; > 0.
+  double journal_compact_mb = 64.0;
   /// kSlamGraph: also insert the frames SLAM located on its map (above).
   bool insert_located = false;
   void validate() const;
@@ -130,6 +136,8 @@ class MapNode {
   const std::string& journal_kept_aside() const { return journal_kept_aside_; }
   /// Why journalling stopped ("" = it did not).
   const std::string& journal_error() const { return journal_error_; }
+  /// How many times the journal was compacted since the start.
+  int journal_compactions() const { return journal_ ? journal_->compactions() : 0; }
   /// The older journals deleted (or that could not be) when the last one was set aside, so
   /// that at most journal_keep of its kind stay.
   const PrunedJournals& journal_pruned() const { return journal_pruned_; }
@@ -149,6 +157,7 @@ class MapNode {
   /// Runs `write` on the journal, if there is one; a failure gives the journal up (journal_error()).
   void journal(const std::function<void(JournalWriter&)>& write);
   void write_journal(const kestrel::slam_graph_t& msg, const GraphResult& result);
+  void compact_journal_if_due();
 
   NodeOptions options_;
   Mapper mapper_;

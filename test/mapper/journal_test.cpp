@@ -4,7 +4,8 @@
 // bytes) and goes on in a fresh journal made of exactly the intact records' bytes; nothing is
 // ever cut in place, and a file that is no journal, or not as it was read, is never written.
 // Of the journals set aside only the newest of each kind stay, and only files the writer set
-// aside are ever deleted.
+// aside are ever deleted. Compaction keeps each keyframe as placed, in one rename, or changes
+// nothing.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -333,6 +334,44 @@ TEST(KeyframeJournal, AWriterKeepsOnlyTheNewestJournalsSetAsideOfEachKind) {
   EXPECT_EQ(kept_journals(path, "damaged"), std::vector<std::string>{damaged[1]});
   EXPECT_EQ(kept_journals(path, "reset"), (std::vector<std::string>{resets[1], resets[2]})) << "another kind";
   EXPECT_THROW(JournalWriter(path, read_journal(path), 0), std::invalid_argument);
+}
+
+// Compaction replaces the file by one rename: keyframes as their last records placed them
+// (keyframe 0 where the graph moved it), a graph record of the revision, and appends go on in
+// the new file. Asked for a keyframe the journal never held, it changes nothing and the old
+// file is still appended to.
+TEST(KeyframeJournal, CompactionKeepsTheKeyframesAsPlacedOrChangesNothing) {
+  kestrel::test::TempDir dir;
+  const Written w = write_journal(dir.path());
+  const JournalContents read = read_journal(w.path);
+  const auto frame_of = [&](int64_t id) {
+    for (const JournalRecord& r : read.records)
+      if (r.kind == JournalRecord::Kind::kKeyframe && r.keyframe.id == id) return &r.frame;
+    return static_cast<const RgbdFrame*>(nullptr);
+  };
+  JournalWriter writer(w.path, read);
+  EXPECT_THROW(writer.compact({{0, frame_of(0)}, {7, frame_of(1)}}, 2), std::invalid_argument);
+  EXPECT_TRUE(kestrel::test::read_file(w.path) == w.bytes) << "nothing changed";
+  kestrel::slam_graph_t later{};
+  later.revision = 3;
+  writer.graph(later);
+  EXPECT_EQ(summary(read_journal(w.path)), "K0 K1 G K2 K3 G");
+
+  writer.compact({{0, frame_of(0)}, {2, frame_of(2)}, {3, frame_of(3)}}, 3);
+  EXPECT_EQ(writer.compactions(), 1);
+  const JournalContents compacted = read_journal(w.path);
+  EXPECT_EQ(compacted.damage, "");
+  EXPECT_EQ(summary(compacted), "K0 K2 K3 G");
+  EXPECT_EQ(writer.bytes(), compacted.file_bytes);
+  const auto& moved = compacted.records[0].keyframe.T_world_camera;
+  const auto expected = keyframe(0, 100000, 0.05).T_world_camera;  // as the graph record moved it
+  EXPECT_EQ(std::vector<double>(moved.position, moved.position + 3),
+            std::vector<double>(expected.position, expected.position + 3));
+  EXPECT_EQ(compacted.records.back().graph.revision, 3);
+  EXPECT_EQ(compacted.records.back().graph.keyframes.size(), 0u);
+  writer.graph(later);
+  EXPECT_EQ(summary(read_journal(w.path)), "K0 K2 K3 G G");
+  EXPECT_TRUE(kept_journals(w.path, "reset").empty() && kept_journals(w.path, "damaged").empty());
 }
 
 }  // namespace

@@ -3,8 +3,8 @@
 // rebuild published at once, RESET, bad messages rejected with the channel named, and the
 // journal a restarted mapper gets its map back from (whole, after a full disk, not a journal;
 // damaged journals: journal_test.cpp), which a RESET starts again without destroying it, keeping
-// only the newest journals set aside; a journal that cannot be continued at start is given up
-// (DEGRADED, with why), never the map.
+// only the newest journals set aside, and which is compacted past twice the store; a journal
+// that cannot be continued at start is given up (DEGRADED, with why), never the map.
 #include <gtest/gtest.h>
 
 #include <sys/resource.h>
@@ -449,6 +449,58 @@ TEST(MapNode, ARestartedMapperRestoresItsKeyframesAndMapFromTheJournal) {
   forgetful.on_graph(next, "SLAM_GRAPH");
   EXPECT_EQ(forgetful.mapper().keyframes().size(), 0u);
 
+}
+
+// A journal grows with every keyframe stored and every pose moved, the store only to its
+// budget. Past twice the store (plus journal_compact_mb) the journal is replaced by the store's
+// own records: after every graph it is within that bound, and a mapper restarted on it holds
+// what one restarted on the whole journal holds (the same keyframes at the same poses, the same
+// map) and still refuses an older graph.
+TEST(MapNode, AJournalPastTwiceTheStoreIsCompactedAndRestoresTheSameMapper) {
+  const test::Scene scene = test::room_with_a_box();
+  kestrel::test::TempDir dir;
+  NodeOptions options;
+  options.mapper.rebuild_interval_s = 0.0;
+  options.mapper.keyframes.max_megabytes = 0.02;  // about five keyframes
+  options.journal_compact_mb = 1e-6;
+  options.journal_path = (dir / "compacted.journal").string();
+  NodeOptions whole = options;
+  whole.journal_compact_mb = 1e6;
+  whole.journal_path = (dir / "whole.journal").string();
+  const auto fly = [&](const NodeOptions& o) {
+    auto node = std::make_unique<MapNode>(o);
+    kestrel::slam_graph_t graph;
+    for (int i = 0; i < 24; ++i) {
+      graph = feed_keyframes(*node, scene, i, i, i + 1);
+      if (i % 6 == 5) {  // a loop closure every sixth keyframe: the stored ones move 3 cm
+        for (auto& k : graph.keyframes) k.T_world_camera.position[2] += 0.03 * (i / 6 + 1);
+      }
+      node->on_graph(graph, "SLAM_GRAPH");
+      const uint64_t bytes = std::filesystem::file_size(o.journal_path);
+      if (o.journal_compact_mb < 1.0) {
+        EXPECT_LE(bytes, 2 * node->mapper().keyframes().bytes() + 1) << "after keyframe " << i;
+      }
+    }
+    EXPECT_EQ(node->journal_error(), "");
+    return node;
+  };
+  const auto flown = fly(options);
+  const auto reference = fly(whole);
+  EXPECT_GT(flown->mapper().keyframes().dropped(), 0u) << "the store's budget is what makes compaction pay";
+  EXPECT_GT(flown->journal_compactions(), 1);
+  EXPECT_EQ(reference->journal_compactions(), 0);
+  EXPECT_LT(std::filesystem::file_size(options.journal_path), std::filesystem::file_size(whole.journal_path) / 2);
+  expect_same_keyframes(flown->mapper(), reference->mapper());
+
+  MapNode restarted(options), restarted_whole(whole);
+  EXPECT_EQ(restarted.journal_damage(), "");
+  EXPECT_EQ(restarted.stats().keyframes_restored, static_cast<int64_t>(flown->mapper().keyframes().size()));
+  expect_same_keyframes(flown->mapper(), restarted.mapper());
+  expect_same_keyframes(restarted_whole.mapper(), restarted.mapper());
+  expect_same_map(restarted_whole.mapper().map(), restarted.mapper().map());
+  // The compacted journal kept the last graph's revision.
+  kestrel::slam_graph_t older = feed_keyframes(restarted, scene, 24, 24, 3);
+  EXPECT_THROW(restarted.on_graph(older, "SLAM_GRAPH"), InputError);
 }
 
 // RESET (a lock-step replay starting again) starts the journal again with the map, and keeps
