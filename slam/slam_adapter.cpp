@@ -275,7 +275,7 @@ AdapterOutputs SlamAdapter::process(const kestrel::rgbd_frame_t& message, const 
     try_anchor(out);
     return out;
   }
-  const bool levelled = level(step, message.utime, T_body_camera, out);
+  level(step, message.utime, T_body_camera, out);
   // Placed in a saved map: the map's graph goes out too, so that the mapper (restored from its
   // journal) publishes the map the planner flies in before this flight makes a keyframe.
   // Not before: provisional keyframes (made before the placement) are in a frame of their own.
@@ -294,9 +294,14 @@ AdapterOutputs SlamAdapter::process(const kestrel::rgbd_frame_t& message, const 
   // Strictly after: the filter takes a correction only after its oldest state (estimator.cpp).
   // Never from a pose across an odometry break that no loop has placed yet: it assumes no motion
   // in the gap, and a new estimator would take it as the map's world whatever its error.
+  // Not for a levelling alone: it turns the graph towards the estimator's own gravity, about
+  // where the vehicle is, so the estimator's world is level already; a correction would only
+  // pull the state to the odometry chain's position, which no loop has made better than its
+  // own (stata, no loops: three levellings moved STATE 3-10 cm each, the wrong way;
+  // docs/decisions/2026-12-06-stata-flights-rotation-drift.md).
   const bool new_estimator_waits =
       restart_correction_due_ && message.utime > restart_state_utime_ && slam_.odometry_placed();
-  if ((step.optimisation || step.reanchored || step.relocalised || levelled || new_estimator_waits) && anchored_ &&
+  if ((step.optimisation || step.reanchored || step.relocalised || new_estimator_waits) && anchored_ &&
       slam_.localized()) {
     out.correction =
         correction_message(slam_, options_.correction_sigma_m, options_.correction_sigma_rad, std::nullopt, anchor_);

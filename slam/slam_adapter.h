@@ -52,11 +52,10 @@
 // (the sigma of one typical sample, not of the mean: a filter's tilt errors last for seconds,
 // so neighbouring keyframes do not measure them independently), the graph is turned rigidly
 // about the newest keyframe by the smallest rotation that levels it (heading and that
-// keyframe's position unchanged), the anchoring state with it, and a SLAM_GRAPH and a
-// SLAM_CORRECTION go out as after an optimisation. Known limits: the estimator fuses SLAM's
-// corrections, roll and pitch included (at 0.02 rad, far looser than gravity), so its up
-// leans a little towards the graph's; and an overconfident filter's early ups weigh as much
-// as later ones (docs/decisions/2026-12-06-slam-levelling.md).
+// keyframe's position unchanged), the anchoring state with it, and a SLAM_GRAPH goes out. No
+// SLAM_CORRECTION: the estimator's world is level already, and the correction would only pull
+// its state to the odometry chain's position. Known limit: an overconfident filter's early
+// ups weigh as much as later ones (docs/decisions/2026-12-06-slam-levelling.md).
 //
 // A frame and its VO update are paired by utime. Frames wait (encoded) in a bounded buffer and
 // are decoded only when their pose makes them a keyframe; an update whose frame has not come
@@ -113,7 +112,7 @@ struct AdapterOutputs {
   /// On a saved map, after a keyframe made before the camera is placed: those keyframes
   /// (unplaced_graph_message), for SLAM_GRAPH_UNPLACED.
   std::optional<kestrel::slam_graph_t> unplaced;
-  std::optional<kestrel::slam_correction_t> correction;  ///< after an optimisation, a re-anchoring or a levelling, or for a new estimator
+  std::optional<kestrel::slam_correction_t> correction;  ///< after an optimisation or a re-anchoring, or for a new estimator
   std::optional<SlamStep> step;                          ///< what SLAM did (a keyframe was made or a frame re-anchored)
   bool anchored = false;  ///< the graph was just moved into the estimator's world
   double levelled_rad = 0.0;  ///< the graph was just turned level by this angle (0: not)
