@@ -89,10 +89,13 @@ int serve(Options& o) {
   auto journalled = [&](auto&& handle) {
     const bool journalling = !o.node.journal_path.empty() && map.journal_error().empty();
     const int compactions = map.journal_compactions();
+    const std::string compaction_error = map.journal_compaction_error();
     publish(handle());
     if (map.journal_compactions() > compactions)
       spdlog::info("journal {} compacted to the {} stored keyframes", o.node.journal_path,
                    map.mapper().keyframes().size());
+    if (!map.journal_compaction_error().empty() && map.journal_compaction_error() != compaction_error)
+      spdlog::warn("journal not compacted (it is kept as it was and appended to): {}", map.journal_compaction_error());
     if (journalling && !map.journal_error().empty()) {
       spdlog::error("journal stopped (the map goes on without it): {}", map.journal_error());
       report_health();

@@ -96,16 +96,25 @@ void MapNode::write_journal(const kestrel::slam_graph_t& msg, const GraphResult&
 }
 
 void MapNode::compact_journal_if_due() {
-  journal([&](JournalWriter& writer) {
-    const KeyframeStore& store = mapper_.keyframes();
-    const double due = 2.0 * static_cast<double>(store.bytes()) + options_.journal_compact_mb * 1e6;
-    if (static_cast<double>(writer.bytes()) <= due) return;
-    // In sensor time, the order they were stored in, so a restore bins them as they were.
-    std::vector<LiveKeyframe> live;
-    live.reserve(store.size());
-    for (const StoredKeyframe* k : store.in_time_order()) live.push_back({k->id, &k->frame});
-    writer.compact(live, last_graph_revision_);
-  });
+  if (!journal_) return;
+  const KeyframeStore& store = mapper_.keyframes();
+  const double margin = options_.journal_compact_mb * 1e6;
+  const double due = std::max(2.0 * static_cast<double>(store.bytes()) + margin, compact_retry_bytes_);
+  if (static_cast<double>(journal_->bytes()) <= due) return;
+  // In sensor time, about the order they were stored in (a restore bins them in this order).
+  std::vector<LiveKeyframe> live;
+  live.reserve(store.size());
+  for (const StoredKeyframe* k : store.in_time_order()) live.push_back({k->id, &k->frame});
+  try {
+    journal_->compact(live, last_graph_revision_);
+    journal_compaction_error_.clear();
+  } catch (const std::exception& e) {
+    // compact() is atomic: the old journal is whole and still appended to, so journalling goes
+    // on (a full disk stops it at the next append, as always); tried again once the journal
+    // has grown by another margin.
+    journal_compaction_error_ = e.what();
+    compact_retry_bytes_ = static_cast<double>(journal_->bytes()) + margin;
+  }
 }
 
 void MapNode::reset() {
@@ -114,6 +123,8 @@ void MapNode::reset() {
   mapper_.reset();
   journal_kept_aside_.clear();
   journal_pruned_ = {};
+  journal_compaction_error_.clear();
+  compact_retry_bytes_ = 0.0;
   // The journal starts again with the map; the one it ends is kept, never emptied in place.
   journal([&](JournalWriter& writer) {
     writer.restart();

@@ -138,6 +138,9 @@ class MapNode {
   const std::string& journal_error() const { return journal_error_; }
   /// How many times the journal was compacted since the start.
   int journal_compactions() const { return journal_ ? journal_->compactions() : 0; }
+  /// Why the last compaction failed ("" = it did not): the journal is then kept as it was and
+  /// appended to, and compaction is tried again once it has grown by journal_compact_mb.
+  const std::string& journal_compaction_error() const { return journal_compaction_error_; }
   /// The older journals deleted (or that could not be) when the last one was set aside, so
   /// that at most journal_keep of its kind stay.
   const PrunedJournals& journal_pruned() const { return journal_pruned_; }
@@ -174,6 +177,8 @@ class MapNode {
   std::string journal_damage_;
   std::string journal_kept_aside_;
   std::string journal_error_;
+  std::string journal_compaction_error_;
+  double compact_retry_bytes_ = 0.0;  // no compaction below this journal size (after a failure)
   bool input_since_start_ = false;  ///< a frame, graph or pose handled since the start or reset()
   PrunedJournals journal_pruned_;
 };

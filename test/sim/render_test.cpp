@@ -187,9 +187,11 @@ TEST(RenderTest, TextureSpansEqualPerTexelBilinearLookups) {
 
 
 // Where the renderer's 16-pixel shading chunks fall must not change what a pixel shows: the
-// same rays, moved 5 px along the rows by the principal point, give the same image. Linear
-// light over a chunk broke this near the lamps and shadow edges, at places fixed in the
-// image, and the VO read it as motion (docs/decisions/2026-12-06-stata-flights-rotation-drift.md).
+// same rays, moved 5 px along the rows by the principal point, give the same image. A row's
+// chunks start where each surface's run starts, so the shift moves them on the surfaces the
+// image's left edge cuts (here the ceiling and the walls up to the lamps). Linear light over a
+// chunk broke this near the lamps and shadow edges, at places that moved with the camera, and
+// the VO read it as motion (docs/decisions/2026-12-06-stata-flights-rotation-drift.md).
 TEST(RenderTest, WhatAPixelShowsDoesNotDependOnWhereTheShadingChunksFall) {
   const World& world = test::builtin("room");
   CameraOptions options = exact_camera();
@@ -212,9 +214,10 @@ TEST(RenderTest, WhatAPixelShowsDoesNotDependOnWhereTheShadingChunksFall) {
     for (int d : diffs) mean += d;
     mean /= static_cast<double>(diffs.size());
     // What remains is the texture's mip level, chosen per chunk. Linear light gave 0.12 and 4
-    // grey levels on the two views up at the lamps; the light map sampled as it is, 0.03 and 1.
-    EXPECT_LT(mean, 0.05) << "mean difference, grey levels";
-    EXPECT_LE(diffs[diffs.size() - diffs.size() / 1000], 1) << "99.9th percentile difference, grey levels";
+    // grey levels on the two views up at the lamps; the light map sampled as it is, 0.03 and 1
+    // (bounds with room for another compiler's rounding).
+    EXPECT_LT(mean, 0.06) << "mean difference, grey levels";
+    EXPECT_LE(diffs[diffs.size() - diffs.size() / 1000], 2) << "99.9th percentile difference, grey levels";
   }
 }
 
