@@ -248,14 +248,15 @@ void JournalWriter::open_for_append() {
   bytes_ = std::filesystem::file_size(path_, ec);
 }
 
-std::vector<uint8_t> JournalWriter::record(char kind, const std::vector<uint8_t>& payload) {
+uint64_t JournalWriter::write_record(std::ostream& out, char kind, const std::vector<uint8_t>& payload) {
   std::vector<uint8_t> bytes{static_cast<uint8_t>(kind)};
   journal::put_u32(bytes, static_cast<uint32_t>(payload.size()));
   const uint32_t crc = journal::crc32(payload.data(), payload.size(), journal::crc32(bytes.data(), bytes.size()));
   bytes.reserve(bytes.size() + payload.size() + 4);
   bytes.insert(bytes.end(), payload.begin(), payload.end());
   journal::put_u32(bytes, crc);
-  return bytes;
+  out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  return bytes.size();
 }
 
 std::vector<uint8_t> JournalWriter::keyframe_payload(const kestrel::slam_keyframe_t& keyframe, const RgbdFrame& frame) {
@@ -270,11 +271,10 @@ std::vector<uint8_t> JournalWriter::keyframe_payload(const kestrel::slam_keyfram
 }
 
 void JournalWriter::append(char kind, const std::vector<uint8_t>& payload) {
-  const std::vector<uint8_t> bytes = record(kind, payload);
-  out_.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  const uint64_t written = write_record(out_, kind, payload);
   out_.flush();  // to the kernel: a killed process loses nothing written before
   if (!out_) throw std::runtime_error(path_ + ": writing the mapper journal failed: " + std::strerror(errno));
-  bytes_ += bytes.size();
+  bytes_ += written;
 }
 
 void JournalWriter::keyframe(const kestrel::slam_keyframe_t& keyframe, const RgbdFrame& frame) {
@@ -290,22 +290,18 @@ void JournalWriter::graph(const kestrel::slam_graph_t& graph) {
 void JournalWriter::compact(const std::vector<LiveKeyframe>& keyframes, int64_t graph_revision) {
   {
     AtomicFile file(path_);  // the old journal stays whole (and open for append) until commit
-    const auto put = [&](char kind, const std::vector<uint8_t>& payload) {
-      const std::vector<uint8_t> bytes = record(kind, payload);
-      file.stream().write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
-    };
     file.stream().write(journal::kHeader, static_cast<std::streamsize>(journal::kHeaderSize));
     for (const LiveKeyframe& k : keyframes) {
       const auto placed = placed_.find(k.id);
       if (placed == placed_.end() || k.frame == nullptr)
         throw std::invalid_argument(path_ + ": compacting: keyframe " + std::to_string(k.id) +
                                     (k.frame == nullptr ? " has no frame" : " was never in this journal"));
-      put(journal::kKeyframe, keyframe_payload(placed->second, *k.frame));
+      write_record(file.stream(), journal::kKeyframe, keyframe_payload(placed->second, *k.frame));
     }
     if (graph_revision >= 0) {
       kestrel::slam_graph_t graph{};
       graph.revision = graph_revision;
-      put(journal::kGraph, transport::encode_message(graph));
+      write_record(file.stream(), journal::kGraph, transport::encode_message(graph));
     }
     file.commit();
   }

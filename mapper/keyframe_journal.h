@@ -164,8 +164,9 @@ class JournalWriter {
   void start_fresh(const std::string& source, const std::vector<std::pair<uint64_t, uint64_t>>& spans);
   void open_for_append();
   void append(char kind, const std::vector<uint8_t>& payload);
-  // A record's bytes as they go into the file.
-  static std::vector<uint8_t> record(char kind, const std::vector<uint8_t>& payload);
+  // Writes one record (kind, size, payload, CRC) to `out`; returns the bytes written. The one
+  // place a record's layout is written, for appends and for compaction alike.
+  static uint64_t write_record(std::ostream& out, char kind, const std::vector<uint8_t>& payload);
   static std::vector<uint8_t> keyframe_payload(const kestrel::slam_keyframe_t& keyframe, const RgbdFrame& frame);
 
   std::string path_;
