@@ -88,7 +88,7 @@ SensorProfile parse_sensor_profile(const std::string& yaml_text, const std::stri
   }
   if (const YAML::Node v = root["vo"]) {
     check_keys(v, {"translation_floor_m", "rotation_floor_rad", "translation_per_rad_m", "rotation_per_rad",
-                   "dense_weight", "min_inliers_to_keep_near"},
+                   "dense_weight", "min_inliers_to_keep_near", "floor_cap_fraction"},
                source, "vo.");
     p.vo.translation_floor_m = number(v, "translation_floor_m", 0.0, 1.0, source, "vo.");
     p.vo.rotation_floor_rad = number(v, "rotation_floor_rad", 0.0, 1.0, source, "vo.");
@@ -99,6 +99,7 @@ SensorProfile parse_sensor_profile(const std::string& yaml_text, const std::stri
       if (*n != std::floor(*n)) fail(source, "'vo.min_inliers_to_keep_near' must be a whole number");
       p.vo.min_inliers_to_keep_near = static_cast<int>(*n);
     }
+    p.vo.floor_cap_fraction = number(v, "floor_cap_fraction", 0.0, 1.0, source, "vo.");
   }
   if (const YAML::Node s = root["slam"]) {
     check_keys(s, {"loop_rotation_floor_deg"}, source, "slam.");

@@ -38,6 +38,7 @@ struct SensorProfile {
     std::optional<double> rotation_per_rad;
     std::optional<double> dense_weight;
     std::optional<int> min_inliers_to_keep_near;
+    std::optional<double> floor_cap_fraction;  ///< keyframe floors' cap, share of the first match
   } vo;
 
   struct Slam {

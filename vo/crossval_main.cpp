@@ -42,6 +42,7 @@ std::vector<Parameter> kinect_parameters() {
       {"dense.weight", {"0.4", "1", "2", "3", "4"}, Objective::kAte},
       {"dense.weight", {"0.4", "1", "2", "3", "4"}, Objective::kVelocity},
       {"keyframe.min_inliers_to_keep_near", {"0", "75", "150", "225", "300"}, Objective::kAte},
+      {"keyframe.floor_cap_fraction", {"0", "0.3", "0.5", "0.7"}, Objective::kAte},
       {"covariance.translation_floor_m", {"0.0005", "0.001", "0.002", "0.004"}, Objective::kNees},
       {"covariance.rotation_floor_rad", {"0.001", "0.002", "0.004", "0.008"}, Objective::kNees},
       {"covariance.translation_per_rad_m", {"0.05", "0.1", "0.2", "0.4"}, Objective::kNees},

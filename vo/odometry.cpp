@@ -313,8 +313,10 @@ VoResult VisualOdometry::Pipeline::process(const RgbdFrame& input) {
   const bool near_keyframe = against_keyframe && k.min_inliers_to_keep_near > 0 &&
                              e.T_ref_cur.translation().norm() <= k.near_translation_m &&
                              so3::angle(e.T_ref_cur.linear()) <= k.near_rotation_rad;
-  const int absolute_floor = near_keyframe ? std::min(k.min_inliers_to_keep_near, k.min_inliers_to_keep)
-                                           : k.min_inliers_to_keep;
+  double absolute_floor = near_keyframe ? std::min(k.min_inliers_to_keep_near, k.min_inliers_to_keep)
+                                        : k.min_inliers_to_keep;
+  if (k.floor_cap_fraction > 0.0 && keyframe_first_inliers_ > 0)
+    absolute_floor = std::min(absolute_floor, k.floor_cap_fraction * keyframe_first_inliers_);
   if (result.fell_back_to_previous || e.num_reprojection_inliers < absolute_floor ||
       e.num_reprojection_inliers < relative_floor) {
     keyframe_ = &cur;

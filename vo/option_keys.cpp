@@ -79,6 +79,7 @@ std::vector<std::pair<std::string, Field>> fields(VoOptions& o) {
       {"keyframe.min_inliers_to_keep_near", &o.keyframe.min_inliers_to_keep_near},
       {"keyframe.near_translation_m", &o.keyframe.near_translation_m},
       {"keyframe.near_rotation_rad", &o.keyframe.near_rotation_rad},
+      {"keyframe.floor_cap_fraction", &o.keyframe.floor_cap_fraction},
       {"keyframe.fall_back_to_previous", &o.keyframe.fall_back_to_previous},
       {"min_features", &o.min_features},
       {"min_features_with_depth", &o.min_features_with_depth},

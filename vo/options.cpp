@@ -70,6 +70,8 @@ void VoOptions::validate() const {
   require(keyframe.min_inlier_fraction_to_keep >= 0.0 && keyframe.min_inlier_fraction_to_keep <= 1.0,
           "keyframe.min_inlier_fraction_to_keep", "must be in [0, 1]");
   require(keyframe.min_inliers_to_keep_near >= 0, "keyframe.min_inliers_to_keep_near", "must be >= 0");
+  require(keyframe.floor_cap_fraction >= 0.0 && keyframe.floor_cap_fraction <= 1.0, "keyframe.floor_cap_fraction",
+          "must be in [0, 1]");
   require(keyframe.near_translation_m >= 0.0 && keyframe.near_rotation_rad >= 0.0,
           "keyframe.near_translation_m/near_rotation_rad", "must be >= 0");
   require(min_features >= 0 && min_features_with_depth >= 3 && min_matches >= 3,

@@ -158,6 +158,17 @@ struct KeyframeOptions {
   int min_inliers_to_keep_near = 150;
   double near_translation_m = 0.03;
   double near_rotation_rad = 0.03;
+  /// Poor-scene cap (0 = off): the floors above never exceed this fraction of the keyframe's
+  /// inliers at its first match. Where a scene offers fewer inliers than the floors (a bare
+  /// corridor: 80-110), they would re-key at every frame and the pose becomes a random walk of
+  /// frame-to-frame errors; capped, the keyframe is kept while it still holds this share of
+  /// what it first matched. In a scene rich enough (first match >= floor / fraction) the
+  /// floors apply unchanged. On the simulator's camera 0.7 makes the VO alone 2-6x more
+  /// accurate in stata's corridors; fr1 (Kinect) is best without it. Off by default because
+  /// the estimator fuses every update against one keyframe as independent of the others,
+  /// which a held keyframe makes 4-5x overconfident in closed-loop flights
+  /// (docs/decisions/2026-12-06-vo-keyframe-cap.md).
+  double floor_cap_fraction = 0.0;
   bool fall_back_to_previous = true;
 };
 

@@ -17,6 +17,7 @@ VoOptions with_sensor(const sensors::SensorProfile& profile, VoOptions options) 
   if (v.rotation_per_rad) options.covariance.rotation_per_rad = *v.rotation_per_rad;
   if (v.dense_weight) options.dense.weight = *v.dense_weight;
   if (v.min_inliers_to_keep_near) options.keyframe.min_inliers_to_keep_near = *v.min_inliers_to_keep_near;
+  if (v.floor_cap_fraction) options.keyframe.floor_cap_fraction = *v.floor_cap_fraction;
   options.validate();
   return options;
 }

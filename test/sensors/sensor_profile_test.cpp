@@ -21,7 +21,7 @@ TEST(BuiltinProfiles, EveryShippedFileParsesAndTheSimulatorSetsNothing) {
   const SensorProfile& sim = builtin_profile("simulator");
   EXPECT_FALSE(sim.timing.rolling_shutter_readout_s || sim.timing.depth_time_from_stamps ||
                sim.timing.depth_extra_latency_s || sim.vo.translation_floor_m || sim.vo.dense_weight ||
-               sim.vo.min_inliers_to_keep_near || sim.slam.loop_rotation_floor_rad);
+               sim.vo.min_inliers_to_keep_near || sim.vo.floor_cap_fraction || sim.slam.loop_rotation_floor_rad);
   const SensorProfile& kinect = builtin_profile("kinect1");
   EXPECT_EQ(kinect.timing.rolling_shutter_readout_s, 0.015);
   EXPECT_EQ(kinect.timing.depth_time_from_stamps, true);
@@ -45,7 +45,8 @@ TEST(ParseSensorProfile, AMinimalAndAFullProfile) {
   const SensorProfile full = parse_sensor_profile(
       "name: my-cam\ndescription: a test\ntiming: {rolling_shutter_readout_s: 0.03, depth_time_from_stamps: false, "
       "depth_extra_latency_s: -0.002}\nvo: {translation_floor_m: 0.002, rotation_floor_rad: 0.001, "
-      "translation_per_rad_m: 0.2, rotation_per_rad: 0.05, dense_weight: 1, min_inliers_to_keep_near: 80}\n"
+      "translation_per_rad_m: 0.2, rotation_per_rad: 0.05, dense_weight: 1, min_inliers_to_keep_near: 80, "
+      "floor_cap_fraction: 0.5}\n"
       "slam: {loop_rotation_floor_deg: 2}\n",
       "t");
   EXPECT_EQ(full.description, "a test");
@@ -54,6 +55,7 @@ TEST(ParseSensorProfile, AMinimalAndAFullProfile) {
   EXPECT_EQ(full.timing.depth_extra_latency_s, -0.002);
   EXPECT_EQ(full.vo.rotation_per_rad, 0.05);
   EXPECT_EQ(full.vo.min_inliers_to_keep_near, 80);
+  EXPECT_EQ(full.vo.floor_cap_fraction, 0.5);
   EXPECT_DOUBLE_EQ(*full.slam.loop_rotation_floor_rad, 2.0 * kPi / 180.0);
 }
 
@@ -77,6 +79,7 @@ TEST(ParseSensorProfile, EveryKindOfBadFileIsRefusedNamingTheField) {
       {"name: a\ntiming: {depth_time_from_stamps: maybe}\n", "not true or false"},
       {"name: a\nvo: {translation_floor_m: -1}\n", "vo.translation_floor_m"},
       {"name: a\nvo: {min_inliers_to_keep_near: 1.5}\n", "whole number"},
+      {"name: a\nvo: {floor_cap_fraction: 1.5}\n", "vo.floor_cap_fraction"},
       {"name: a\nslam: {loop_rotation_floor_deg: 90}\n", "slam.loop_rotation_floor_deg"},
       {"name: {x: 1}\n", "'name' is not a word"},
       {"name:\n", "'name' is not a word"},  // YAML's null, not a profile called "null"
