@@ -163,8 +163,10 @@ struct KeyframeOptions {
   /// corridor: 80-110), they would re-key at every frame and the pose becomes a random walk of
   /// frame-to-frame errors; capped, the keyframe is kept while it still holds this share of
   /// what it first matched. In a scene rich enough (first match >= floor / fraction) the
-  /// floors apply unchanged. On the simulator's camera 0.7 makes the VO alone 2-6x more
-  /// accurate in stata's corridors; fr1 (Kinect) is best without it. Off by default because
+  /// floors apply unchanged. A keyframe's first match is never below the cap, so a frame that
+  /// becomes the reference with few inliers is held all the same. On the simulator's camera
+  /// 0.7 makes the VO alone 3-6x more accurate on stata's survey flights (1.1x on its loops);
+  /// fr1 (Kinect) is best without it. Off by default because
   /// the estimator fuses every update against one keyframe as independent of the others,
   /// which a held keyframe makes 4-5x overconfident in closed-loop flights
   /// (docs/decisions/2026-12-06-vo-keyframe-cap.md).

@@ -80,6 +80,7 @@ TEST(ParseSensorProfile, EveryKindOfBadFileIsRefusedNamingTheField) {
       {"name: a\nvo: {translation_floor_m: -1}\n", "vo.translation_floor_m"},
       {"name: a\nvo: {min_inliers_to_keep_near: 1.5}\n", "whole number"},
       {"name: a\nvo: {floor_cap_fraction: 1.5}\n", "vo.floor_cap_fraction"},
+      {"name: a\nvo: {floor_cap_fraction: -0.5}\n", "vo.floor_cap_fraction"},
       {"name: a\nslam: {loop_rotation_floor_deg: 90}\n", "slam.loop_rotation_floor_deg"},
       {"name: {x: 1}\n", "'name' is not a word"},
       {"name:\n", "'name' is not a word"},  // YAML's null, not a profile called "null"

@@ -164,9 +164,11 @@ TEST(Options, SetByNameAndRejectedByName) {
   set_option(o, "keyframe.min_inliers_to_keep_near", "0");
   EXPECT_EQ(o.keyframe.min_inliers_to_keep_near, 0);
   EXPECT_THROW(set_option(o, "keyframe.near_translation_m", "-0.01"), std::invalid_argument);
-  set_option(o, "keyframe.floor_cap_fraction", "0");
-  EXPECT_EQ(o.keyframe.floor_cap_fraction, 0.0);
+  set_option(o, "keyframe.floor_cap_fraction", "0.7");
+  EXPECT_EQ(o.keyframe.floor_cap_fraction, 0.7);
   EXPECT_THROW(set_option(o, "keyframe.floor_cap_fraction", "-0.1"), std::invalid_argument);
+  EXPECT_THROW(set_option(o, "keyframe.floor_cap_fraction", "1.5"), std::invalid_argument);
+  EXPECT_EQ(o.keyframe.floor_cap_fraction, 0.7) << "a rejected value changes nothing";
   EXPECT_EQ(describe_options(o).size(), 73u);
 }
 

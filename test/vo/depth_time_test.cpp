@@ -154,6 +154,13 @@ TEST(SensorProfiles, AppliedToTheOptions) {
   EXPECT_EQ(l.depth.time_offset_from_stamps, given.depth.time_offset_from_stamps);
   EXPECT_DOUBLE_EQ(l.depth.time_offset_s, -0.004);
   EXPECT_DOUBLE_EQ(l.depth.rolling_shutter_readout_s, given.depth.rolling_shutter_readout_s);
+  EXPECT_DOUBLE_EQ(l.keyframe.floor_cap_fraction, given.keyframe.floor_cap_fraction);
+
+  // A profile's keyframe cap reaches the options.
+  sensors::SensorProfile capped;
+  capped.name = "y";
+  capped.vo.floor_cap_fraction = 0.7;
+  EXPECT_DOUBLE_EQ(with_sensor(capped, given).keyframe.floor_cap_fraction, 0.7);
 }
 
 }  // namespace
