@@ -112,7 +112,11 @@ LiveSystem::LiveSystem(std::filesystem::path dir, Options options)
     listener_->recording.emplace(options_.record.string());
     listener_->recorded = options_.recorded.empty() ? options_.channels : options_.recorded;
   }
-  for (const auto& c : channels) listener_->lcm.subscribe(c, &Listener::handle, listener_.get());
+  // No queue limit: LCM drops the oldest messages of a subscription whose queue holds its
+  // capacity (30 by default), which a listener starved of CPU reaches within a third of a
+  // second of IMU (a CI run lost 170 of 1002 IMU samples so while a build ran beside it), and
+  // a test's recording must hold every message that arrived.
+  for (const auto& c : channels) listener_->lcm.subscribe(c, &Listener::handle, listener_.get())->setQueueCapacity(0);
   listener_->thread = std::thread([this] { listen(); });
 }
 
