@@ -55,6 +55,10 @@ void add_estimator_options(CLI::App& app, EstimatorOptions& o) {
       ->default_str("reported");
   app.add_option("--vo-scale", o.vo_noise.reported_scale, "Multiplies the reported VO covariance")
       ->check(positive)->capture_default_str();
+  app.add_option("--vo-keyframe-share", o.vo_noise.keyframe_share,
+                 "Share of each VO update's noise that is its keyframe's own error, common to every "
+                 "update against that keyframe: fused once per keyframe, not once per update")
+      ->check(CLI::Range(0.0, 0.99))->capture_default_str();
   app.add_option_function<std::vector<double>>(
          "--vo-sigma",
          [&o](const std::vector<double>& v) {

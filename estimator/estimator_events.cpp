@@ -10,9 +10,13 @@
 namespace kestrel::estimator {
 namespace {
 
-// Covariance of A^-1 z from those of an anchor A = T_ref_anchor and z = T_ref_cur, treated
-// as independent (conservative: both share the reference frame's errors).
-Matrix6d anchored_covariance(const Eigen::Isometry3d& A, const Matrix6d& cov_A,
+// The error of A^-1 z from those of an anchor A = T_ref_anchor and z = T_ref_cur: the
+// anchor's part (common to every update through that anchor) and the update's own part.
+struct AnchoredNoise {
+  Matrix6d from_anchor;
+  Matrix6d from_update;
+};
+AnchoredNoise anchored_noise(const Eigen::Isometry3d& A, const Matrix6d& cov_A,
                              const Eigen::Isometry3d& z, const Matrix6d& cov_z) {
   const Eigen::Isometry3d rel = A.inverse() * z;
   const Eigen::Matrix3d Rt = A.linear().transpose();
@@ -23,7 +27,7 @@ Matrix6d anchored_covariance(const Eigen::Isometry3d& A, const Matrix6d& cov_A,
   JA.topLeftCorner<3, 3>() = -Rt;
   JA.topRightCorner<3, 3>() = so3::hat(rel.translation());
   JA.bottomRightCorner<3, 3>() = -rel.linear().transpose();
-  return Jz * cov_z * Jz.transpose() + JA * cov_A * JA.transpose();
+  return {JA * cov_A * JA.transpose(), Jz * cov_z * Jz.transpose()};
 }
 
 }  // namespace
@@ -41,13 +45,29 @@ void Estimator::apply(Event& e, FilterState& s) {
         e.outcome = Outcome::kUnreferenced;
         return;
       }
+      // The update's noise is its keyframe's error, common to every update against that
+      // keyframe, plus its own. The common part is added once, to the clone, so that a
+      // keyframe held for many frames is not believed once per frame (docs/estimator.md §4).
+      const double share = options_.vo_noise.keyframe_share;
       Eigen::Isometry3d z = e.vo.T_refcam_curcam;
-      Matrix6d Q = vo_noise(options_.vo_noise, e.vo);
+      const Matrix6d Q = vo_noise(options_.vo_noise, e.vo);
+      Matrix6d Q_common = share * Q, Q_own = (1.0 - share) * Q;
       if (spec->second.anchored) {
-        Q = anchored_covariance(spec->second.anchor, spec->second.anchor_covariance, z, Q);
+        // Every update through an anchor shares the anchor's error too.
+        const AnchoredNoise a =
+            anchored_noise(spec->second.anchor, spec->second.anchor_covariance, z, Q);
+        Q_common = a.from_anchor + share * a.from_update;
+        Q_own = (1.0 - share) * a.from_update;
         z = spec->second.anchor.inverse() * z;
       }
-      const RelativePoseMeasurement m(clone, z, Q, e.vo.T_body_camera);
+      Clone& reference = s.mean.clones[static_cast<size_t>(clone)];
+      if (!reference.keyframe_error_added) {
+        const RelativePoseMeasurement first(clone, z, Q_own, e.vo.T_body_camera);
+        const int o = FilterMean::clone_offset(clone);
+        s.P.block<6, 6>(o, o) += first.reference_covariance(s.mean, Q_common);
+        reference.keyframe_error_added = true;
+      }
+      const RelativePoseMeasurement m(clone, z, Q_own, e.vo.T_body_camera);
       const int max_in_row = options_.vo_max_gated_in_row;
       const bool force = max_in_row > 0 && s.vo_gated_in_row >= max_in_row;
       const UpdateResult r = filter_->update(s, m, force ? 0.0 : options_.vo_gate_chi2);

@@ -33,6 +33,10 @@ struct Clone {
   int64_t utime = 0;
   Eigen::Vector3d p_world_body = Eigen::Vector3d::Zero();
   Eigen::Matrix3d R_world_body = Eigen::Matrix3d::Identity();
+  /// The keyframe's own VO error (shared by every update against it) has been added to this
+  /// clone's covariance (estimator_events.cpp): the clone then stands for the pose the VO
+  /// believes the keyframe at, which is what every update against it measures from.
+  bool keyframe_error_added = false;
 };
 
 struct FilterMean {

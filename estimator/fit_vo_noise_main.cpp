@@ -51,6 +51,8 @@ int run(const Options& o) {
             << "mean keyframe-to-frame interval: " << fit.mean_interval_s << " s\n"
             << "error mean  [dx dy dz m, rx ry rz rad]: " << row(fit.mean, " ") << "\n"
             << "error sigma [dx dy dz m, rx ry rz rad]: " << row(fit.sigma, " ") << "\n"
+            << "keyframe share of the error: " << fit.keyframe_share << " (over "
+            << fit.keyframes_with_pairs << " keyframes with two updates or more)\n"
             << "estimator options: --vo-noise constant --vo-sigma " << row(fit.sigma, ",") << "\n";
   return kExitOk;
 }

@@ -1,5 +1,6 @@
 #include "estimator/measurements.h"
 
+#include <Eigen/LU>
 #include <limits>
 
 #include "common/geometry/so3.h"
@@ -53,6 +54,14 @@ MeasurementJacobian RelativePoseMeasurement::jacobian(const FilterMean& x) const
   H.block<3, 3>(3, idx::kTheta) = Jr_inv * R_bc.transpose();
   H.block<3, 3>(3, o + 3) = -Jr_inv * R_bc.transpose() * Rc.transpose() * Rr;
   return H;
+}
+
+Matrix6d RelativePoseMeasurement::reference_covariance(const FilterMean& x,
+                                                       const Matrix6d& Q_ref) const {
+  const Matrix6d H_ref = jacobian(x).block<6, 6>(0, FilterMean::clone_offset(clone_));
+  const Matrix6d H_inv = H_ref.partialPivLu().inverse();
+  const Matrix6d C = H_inv * Q_ref * H_inv.transpose();
+  return 0.5 * (C + C.transpose());
 }
 
 AbsolutePoseMeasurement::AbsolutePoseMeasurement(const Eigen::Isometry3d& T_world_body,

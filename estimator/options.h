@@ -18,6 +18,10 @@ struct VoNoiseOptions {
   };
   Source source = Source::kReported;
   double reported_scale = 1.0;  ///< multiplies the reported covariance
+  /// Share of each update's noise that is its keyframe's own error, common to every update
+  /// against that keyframe (the keyframe's feature positions and depths): that share is added
+  /// once to the keyframe's clone, the rest is fused per update. 0 = every update independent.
+  double keyframe_share = 0.0;
   /// Standard deviations of [dp (reference camera frame, m); dtheta (current camera, rad)].
   Eigen::Matrix<double, 6, 1> constant_sigma =
       (Eigen::Matrix<double, 6, 1>() << 0.005, 0.005, 0.008, 0.004, 0.004, 0.003).finished();

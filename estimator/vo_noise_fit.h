@@ -25,6 +25,14 @@ struct VoNoiseFit {
   /// Mean over updates of the keyframe-to-frame interval, s: the model is per update, so it
   /// only transfers to a VO with similar keyframe spacing.
   double mean_interval_s = 0.0;
+  /// Share of the error common to the updates against one keyframe (the estimator's
+  /// --vo-keyframe-share): over every pair of updates against the same keyframe, the mean
+  /// product of their whitened errors over the mean squared whitened error. Errors are
+  /// whitened by each update's reported covariance (by `sigma` where it reports none), so
+  /// the share is independent of how well that covariance is scaled. 0 when no keyframe has
+  /// two usable updates.
+  double keyframe_share = 0.0;
+  int64_t keyframes_with_pairs = 0;  ///< keyframes that contributed to keyframe_share
   int64_t used = 0;
   int64_t failed = 0;     ///< VO failures (nothing to fit)
   int64_t uncovered = 0;  ///< no ground truth at one of the two times

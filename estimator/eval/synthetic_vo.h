@@ -23,6 +23,10 @@ struct SyntheticVoOptions {
   double keyframe_distance_m = 0.25;
   double keyframe_angle_rad = 10.0 * kPi / 180.0;
   double failure_probability = 0.0;  ///< per frame: a failed update, as the VO reports it
+  /// Share of the noise (of sigma^2) that is the keyframe's own error: drawn once when a frame
+  /// becomes the keyframe and common to every update against it, as the real VO's keyframe
+  /// features and depths are. The reported covariance stays sigma^2 (the update's whole noise).
+  double keyframe_share = 0.0;
   /// Frames for which this returns true see nothing to track (a blank wall): failed updates
   /// that keep the keyframe, as the real VO keeps it. The first frame that sees again is
   /// matched against that keyframe if the camera is still within max_match_distance_m and
@@ -45,6 +49,9 @@ class SyntheticVo {
   bool has_keyframe_ = false;
   int64_t keyframe_utime_ = 0;
   Eigen::Isometry3d T_world_keycam_ = Eigen::Isometry3d::Identity();
+  Vector6d keyframe_error_ = Vector6d::Zero();
+
+  void set_keyframe(int64_t utime, const Eigen::Isometry3d& T_world_cam);
 };
 
 }  // namespace kestrel::estimator

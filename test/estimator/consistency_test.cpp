@@ -65,29 +65,37 @@ int nees_runs() {
   return v ? std::max(2, std::atoi(v)) : 12;
 }
 
+// Mean NEES of [p; v; theta] every 0.1 s over `runs` seeded runs of the aggressive motion with
+// small constant biases, for the filter and VO that `options` and `scenario` set.
+NeesAccumulator::Summary nees_over_runs(int runs, const EstimatorOptions& options,
+                                        const test::ScenarioOptions& scenario) {
+  NeesAccumulator pose_velocity(9);
+  for (int run = 0; run < runs; ++run) {
+    Estimator e(options);
+    test::ScenarioOptions o = scenario;
+    o.seed = 100 + static_cast<uint64_t>(run);
+    o.imu.gyro_bias = {0.003, -0.002, 0.001};
+    o.imu.accel_bias = {0.03, 0.05, -0.04};
+    const auto steps = test::run_scenario(e, test::AnalyticMotion::aggressive(), o);
+    for (size_t i = 0; i < steps.size(); i += 20) {  // every 0.1 s
+      const auto& s = steps[i];
+      pose_velocity.add(i / 20, nees(pose_velocity_error(s.truth, s.output.nav),
+                                     s.output.covariance.topLeftCorner<9, 9>()));
+    }
+  }
+  return pose_velocity.summary();
+}
+
 TEST(Consistency, FilterNeesIsInTheBandOverSeededRuns) {
   const int runs = nees_runs();
   std::vector<FilterKind> kinds{FilterKind::kEkf};
   if (std::getenv("KESTREL_NEES_UKF")) kinds.push_back(FilterKind::kUkf);
   for (FilterKind kind : kinds) {
-    NeesAccumulator pose_velocity(9);
-    for (int run = 0; run < runs; ++run) {
-      EstimatorOptions options;
-      options.filter = kind;
-      Estimator e(options);
-      test::ScenarioOptions o;
-      o.duration_s = 10.0;
-      o.seed = 100 + static_cast<uint64_t>(run);
-      o.imu.gyro_bias = {0.003, -0.002, 0.001};
-      o.imu.accel_bias = {0.03, 0.05, -0.04};
-      const auto steps = test::run_scenario(e, test::AnalyticMotion::aggressive(), o);
-      for (size_t i = 0; i < steps.size(); i += 20) {  // every 0.1 s
-        const auto& s = steps[i];
-        pose_velocity.add(i / 20, nees(pose_velocity_error(s.truth, s.output.nav),
-                                       s.output.covariance.topLeftCorner<9, 9>()));
-      }
-    }
-    const auto s = pose_velocity.summary();
+    EstimatorOptions options;
+    options.filter = kind;
+    test::ScenarioOptions o;
+    o.duration_s = 10.0;
+    const auto s = nees_over_runs(runs, options, o);
     // The checkpoints of one run are correlated, so the pooled band (all samples as if
     // independent) is far too narrow to test against; the band of one checkpoint's mean over
     // the runs is the honest one for the overall mean, and the fraction of checkpoints inside
@@ -101,6 +109,35 @@ TEST(Consistency, FilterNeesIsInTheBandOverSeededRuns) {
               << s.mean << " band [" << per_checkpoint.low << ", " << per_checkpoint.high
               << "], checkpoints in their band " << s.fraction_in_band << "\n";
   }
+}
+
+// A VO that holds its keyframes for tens of frames, whose updates share their keyframe's error
+// (as the real VO's keyframe features and depths are shared): fused as independent
+// measurements, the filter believes the keyframe once per update and is overconfident; with
+// the common share added once to the keyframe's clone it is consistent.
+TEST(Consistency, AKeyframeErrorSharedByItsUpdatesIsCountedOnce) {
+  const int runs = nees_runs();
+  test::ScenarioOptions o;
+  o.duration_s = 10.0;
+  o.vo.keyframe_distance_m = 1.0;
+  o.vo.keyframe_angle_rad = 0.6;
+  o.vo.keyframe_share = 0.6;
+  const Band band = mean_nees_band(9, runs);
+  EstimatorOptions options;
+  options.vo_noise.keyframe_share = 0.6;
+  NeesAccumulator::Summary once;
+  for (FilterKind kind : {FilterKind::kUkf, FilterKind::kEkf}) {
+    options.filter = kind;
+    once = nees_over_runs(runs, options, o);
+    EXPECT_TRUE(band.contains(once.mean)) << "fused once: mean NEES " << once.mean << " band ["
+                                          << band.low << ", " << band.high << "]";
+    EXPECT_GT(once.fraction_in_band, 0.8) << "fused once: mean NEES " << once.mean;
+  }
+  options.vo_noise.keyframe_share = 0.0;
+  const auto every_update = nees_over_runs(runs, options, o);
+  EXPECT_GT(every_update.mean, band.high) << "fused per update";
+  std::cout << "keyframes shared 0.6: mean NEES fused once " << once.mean << ", per update "
+            << every_update.mean << " (band [" << band.low << ", " << band.high << "])\n";
 }
 
 }  // namespace

@@ -52,6 +52,23 @@ TEST(VoNoiseFit, RecoversTheSyntheticVoSigmas) {
   EXPECT_GT(fit.mean_interval_s, 0.03);
 }
 
+TEST(VoNoiseFit, MeasuresTheShareOfTheErrorCommonToAKeyframe) {
+  // Keyframes held for tens of frames, so that each gives many pairs of updates.
+  SyntheticVoOptions o;
+  o.keyframe_distance_m = 1.0;
+  o.keyframe_angle_rad = 0.6;
+  for (const double share : {0.0, 0.3, 0.6}) {
+    o.keyframe_share = share;
+    const VoRun r = synthetic_run(o, 120.0);
+    const VoNoiseFit fit = fit_vo_noise(r.updates, r.truth, 20000);
+    ASSERT_GT(fit.keyframes_with_pairs, 50) << "share " << share;
+    // ~100 keyframes of ~30 updates: the estimate's spread is a few hundredths.
+    EXPECT_NEAR(fit.keyframe_share, share, 0.08) << "share " << share;
+    // The whole error is still what each update reports.
+    for (int i = 0; i < 6; ++i) EXPECT_NEAR(fit.sigma[i], o.sigma[i], 0.15 * o.sigma[i]);
+  }
+}
+
 TEST(VoNoiseFit, ErrorFollowsTheFilterResidualConvention) {
   // A known perturbation true = measured ⊞ e comes back as e.
   VoUpdate u;
