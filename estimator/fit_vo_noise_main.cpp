@@ -2,6 +2,7 @@
 // VO_UPDATE and GROUND_TRUTH (or a separate TUM ground truth), and prints it in the form the
 // estimator takes (--vo-noise constant --vo-sigma ...). See README.md.
 
+#include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
 #include <cstdio>
@@ -34,6 +35,19 @@ std::string row(const Eigen::Matrix<double, 6, 1>& v, const char* separator) {
   return s;
 }
 
+std::string share_by_lag(const VoNoiseFit& fit) {
+  std::string s = "  by lag (frames apart):";
+  for (size_t b = 0; b < fit.share_by_lag.size(); ++b) {
+    if (fit.share_by_lag[b].pairs == 0) continue;
+    const size_t low = size_t{1} << b, high = (size_t{2} << b) - 1;
+    const std::string lags = b + 1 == fit.share_by_lag.size() ? fmt::format("{}+", low)
+                             : low == high                    ? fmt::format("{}", low)
+                                                              : fmt::format("{}-{}", low, high);
+    s += fmt::format(" {} {:.2f}", lags, fit.share_by_lag[b].share);
+  }
+  return s + "\n";
+}
+
 int run(const Options& o) {
   VoAndTruth input = read_vo_and_truth(o.log, o.channels);
   if (!input.skips.damage.empty()) spdlog::warn("{}", input.skips.damage);
@@ -51,8 +65,10 @@ int run(const Options& o) {
             << "mean keyframe-to-frame interval: " << fit.mean_interval_s << " s\n"
             << "error mean  [dx dy dz m, rx ry rz rad]: " << row(fit.mean, " ") << "\n"
             << "error sigma [dx dy dz m, rx ry rz rad]: " << row(fit.sigma, " ") << "\n"
+            << "reported covariance: mean e^T C^-1 e / 6 = " << fit.reported_nees << "\n"
             << "keyframe share of the error: " << fit.keyframe_share << " (over "
             << fit.keyframes_with_pairs << " keyframes with two updates or more)\n"
+            << share_by_lag(fit)
             << "estimator options: --vo-noise constant --vo-sigma " << row(fit.sigma, ",") << "\n";
   return kExitOk;
 }

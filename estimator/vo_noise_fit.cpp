@@ -2,6 +2,7 @@
 
 #include <Eigen/Cholesky>
 #include <map>
+#include <vector>
 
 #include "common/error.h"
 #include "common/geometry/so3.h"
@@ -21,37 +22,49 @@ Vector6d vo_error(const VoUpdate& u, const Eigen::Isometry3d& T_world_refbody,
 namespace {
 
 // With w_i = b + n_i for the updates of one keyframe (b common, n_i own, whitened so that
-// E|w|^2 = 6): E[w_i . w_j] = 6 s for i != j, s the common share. Over a keyframe's n updates,
-// sum_{i<j} w_i . w_j = (|sum w|^2 - sum |w|^2) / 2 and the matching sum of the pairs' mean
-// squares is (n - 1) sum |w|^2 / 2: the ratio of their totals over all keyframes estimates s.
+// E|w|^2 = 6): E[w_i . w_j] = 6 s for i != j, s the common share. The ratio of the pairs'
+// summed products to their summed mean squares estimates s, over all pairs and by lag.
 template <typename UsedUpdates>
 void fit_keyframe_share(const UsedUpdates& usable, VoNoiseFit& fit) {
-  struct Group {
-    Vector6d sum = Vector6d::Zero();
-    double sum_sq = 0.0;
-    int64_t n = 0;
-  };
-  std::map<int64_t, Group> groups;
+  std::map<int64_t, std::vector<Vector6d>> groups;  // whitened errors by keyframe, in order
+  double sum_sq = 0.0;
+  int64_t whitened = 0;
   for (const auto& x : usable) {
     Vector6d w;
     const Eigen::LLT<Matrix6d> llt(x.update->covariance);
-    if (llt.info() == Eigen::Success && x.update->covariance.diagonal().minCoeff() > 0.0)
+    if (llt.info() == Eigen::Success && x.update->covariance.diagonal().minCoeff() > 0.0) {
       w = llt.matrixL().solve(x.error);
-    else
+      sum_sq += w.squaredNorm();
+      ++whitened;
+    } else {
       w = x.error.cwiseQuotient(fit.sigma.cwiseMax(1e-12));
-    Group& g = groups[x.update->reference_utime];
-    g.sum += w;
-    g.sum_sq += w.squaredNorm();
-    ++g.n;
+    }
+    groups[x.update->reference_utime].push_back(w);
   }
-  double common = 0.0, total = 0.0;
+  fit.reported_nees = whitened > 0 ? sum_sq / (6.0 * static_cast<double>(whitened)) : 0.0;
+  const size_t buckets = fit.share_by_lag.size();
+  std::vector<double> common(buckets, 0.0), total(buckets, 0.0);
+  double all_common = 0.0, all_total = 0.0;
   for (const auto& [reference, g] : groups) {
-    if (g.n < 2) continue;
-    common += g.sum.squaredNorm() - g.sum_sq;
-    total += static_cast<double>(g.n - 1) * g.sum_sq;
+    if (g.size() < 2) continue;
     ++fit.keyframes_with_pairs;
+    for (size_t i = 0; i < g.size(); ++i) {
+      for (size_t j = i + 1; j < g.size(); ++j) {
+        const double product = g[i].dot(g[j]);
+        const double square = 0.5 * (g[i].squaredNorm() + g[j].squaredNorm());
+        all_common += product;
+        all_total += square;
+        size_t b = 0;  // lag 1, 2-3, 4-7, ...: bucket floor(log2(lag)), the last open
+        for (size_t lag = j - i; lag > 1 && b + 1 < buckets; lag >>= 1) ++b;
+        common[b] += product;
+        total[b] += square;
+        ++fit.share_by_lag[b].pairs;
+      }
+    }
   }
-  fit.keyframe_share = total > 0.0 ? common / total : 0.0;
+  fit.keyframe_share = all_total > 0.0 ? all_common / all_total : 0.0;
+  for (size_t b = 0; b < buckets; ++b)
+    fit.share_by_lag[b].share = total[b] > 0.0 ? common[b] / total[b] : 0.0;
 }
 
 }  // namespace

@@ -11,6 +11,7 @@
 // Updates whose times the truth does not cover (outside it, or in a gap wider than
 // max_gap_us) are skipped and counted.
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -26,13 +27,23 @@ struct VoNoiseFit {
   /// only transfers to a VO with similar keyframe spacing.
   double mean_interval_s = 0.0;
   /// Share of the error common to the updates against one keyframe (the estimator's
-  /// --vo-keyframe-share): over every pair of updates against the same keyframe, the mean
-  /// product of their whitened errors over the mean squared whitened error. Errors are
-  /// whitened by each update's reported covariance (by `sigma` where it reports none), so
-  /// the share is independent of how well that covariance is scaled. 0 when no keyframe has
-  /// two usable updates.
+  /// --vo-keyframe-share): over every pair of updates against the same keyframe, the summed
+  /// product of their whitened errors over the summed mean squared whitened error. Errors are
+  /// whitened by each update's reported covariance (by `sigma` where it reports none), so the
+  /// share does not depend on how well that covariance is scaled. 0 when no keyframe has two
+  /// usable updates.
   double keyframe_share = 0.0;
   int64_t keyframes_with_pairs = 0;  ///< keyframes that contributed to keyframe_share
+  /// The same share from the pairs `lag` frames apart only: lag 1, 2-3, 4-7, ..., 128 and more
+  /// (the common error fades as the view moves away from the keyframe's).
+  struct LagShare {
+    double share = 0.0;
+    int64_t pairs = 0;
+  };
+  std::array<LagShare, 8> share_by_lag{};
+  /// Mean of e^T C^-1 e / 6 under each update's reported covariance C: 1 when C is right on
+  /// average (a --vo-scale to try); 0 when no update reports one.
+  double reported_nees = 0.0;
   int64_t used = 0;
   int64_t failed = 0;     ///< VO failures (nothing to fit)
   int64_t uncovered = 0;  ///< no ground truth at one of the two times

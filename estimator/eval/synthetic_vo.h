@@ -26,7 +26,9 @@ struct SyntheticVoOptions {
   /// Share of the noise (of sigma^2) that is the keyframe's own error: drawn once when a frame
   /// becomes the keyframe and common to every update against it, as the real VO's keyframe
   /// features and depths are. The reported covariance stays sigma^2 (the update's whole noise).
-  double keyframe_share = 0.0;
+  /// 0.4: kestrel-vo's share between updates one frame apart on the simulator's stata flights
+  /// (`kestrel fit-vo-noise`), the estimator's default.
+  double keyframe_share = 0.4;
   /// Frames for which this returns true see nothing to track (a blank wall): failed updates
   /// that keep the keyframe, as the real VO keeps it. The first frame that sees again is
   /// matched against that keyframe if the camera is still within max_match_distance_m and

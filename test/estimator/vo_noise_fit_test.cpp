@@ -64,6 +64,12 @@ TEST(VoNoiseFit, MeasuresTheShareOfTheErrorCommonToAKeyframe) {
     ASSERT_GT(fit.keyframes_with_pairs, 50) << "share " << share;
     // ~100 keyframes of ~30 updates: the estimate's spread is a few hundredths.
     EXPECT_NEAR(fit.keyframe_share, share, 0.08) << "share " << share;
+    // The synthetic keyframe error does not fade: the same share at every lag.
+    EXPECT_NEAR(fit.share_by_lag[0].share, share, 0.1) << "share " << share;
+    EXPECT_NEAR(fit.share_by_lag[4].share, share, 0.1) << "share " << share;
+    EXPECT_GT(fit.share_by_lag[4].pairs, 1000);
+    // The reported covariance is the whole noise.
+    EXPECT_NEAR(fit.reported_nees, 1.0, 0.1) << "share " << share;
     // The whole error is still what each update reports.
     for (int i = 0; i < 6; ++i) EXPECT_NEAR(fit.sigma[i], o.sigma[i], 0.15 * o.sigma[i]);
   }
