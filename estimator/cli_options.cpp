@@ -57,7 +57,8 @@ void add_estimator_options(CLI::App& app, EstimatorOptions& o) {
       ->check(positive)->capture_default_str();
   app.add_option("--vo-keyframe-share", o.vo_noise.keyframe_share,
                  "Share of each VO update's noise that is its keyframe's own error, common to every "
-                 "update against that keyframe: fused once per keyframe, not once per update")
+                 "update against that keyframe: fused once per keyframe, not once per update (the IMU "
+                 "filter; the visual-only mode does not model it)")
       ->check(CLI::Range(0.0, 0.99))->capture_default_str();
   app.add_option_function<std::vector<double>>(
          "--vo-sigma",

@@ -11,7 +11,9 @@ namespace kestrel::estimator {
 namespace {
 
 // The error of A^-1 z from those of an anchor A = T_ref_anchor and z = T_ref_cur: the
-// anchor's part (common to every update through that anchor) and the update's own part.
+// anchor's part (common to every update through that anchor) and the update's own part,
+// treated as independent (conservative: A and z are both measured from the same old frame,
+// whose error partly cancels in A^-1 z).
 struct AnchoredNoise {
   Matrix6d from_anchor;
   Matrix6d from_update;
@@ -61,11 +63,11 @@ void Estimator::apply(Event& e, FilterState& s) {
         z = spec->second.anchor.inverse() * z;
       }
       Clone& reference = s.mean.clones[static_cast<size_t>(clone)];
-      if (!reference.keyframe_error_added) {
+      if (reference.keyframe_error_of != e.vo.reference_utime) {
         const RelativePoseMeasurement first(clone, z, Q_own, e.vo.T_body_camera);
         const int o = FilterMean::clone_offset(clone);
         s.P.block<6, 6>(o, o) += first.reference_covariance(s.mean, Q_common);
-        reference.keyframe_error_added = true;
+        reference.keyframe_error_of = e.vo.reference_utime;
       }
       const RelativePoseMeasurement m(clone, z, Q_own, e.vo.T_body_camera);
       const int max_in_row = options_.vo_max_gated_in_row;

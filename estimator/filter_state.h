@@ -33,10 +33,11 @@ struct Clone {
   int64_t utime = 0;
   Eigen::Vector3d p_world_body = Eigen::Vector3d::Zero();
   Eigen::Matrix3d R_world_body = Eigen::Matrix3d::Identity();
-  /// The keyframe's own VO error (shared by every update against it) has been added to this
-  /// clone's covariance (estimator_events.cpp): the clone then stands for the pose the VO
-  /// believes the keyframe at, which is what every update against it measures from.
-  bool keyframe_error_added = false;
+  /// The VO reference frame whose own error (common to every update against it) has been
+  /// added to this clone's covariance (estimator_events.cpp), -1 none: the clone then stands
+  /// for the pose the VO believes that keyframe at, which is what its updates measure from.
+  /// A reference, not a flag: an anchor's clone may also become a later reference's.
+  int64_t keyframe_error_of = -1;
 };
 
 struct FilterMean {

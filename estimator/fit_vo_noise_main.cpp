@@ -35,8 +35,13 @@ std::string row(const Eigen::Matrix<double, 6, 1>& v, const char* separator) {
   return s;
 }
 
-std::string share_by_lag(const VoNoiseFit& fit) {
-  std::string s = "  by lag (frames apart):";
+// The keyframe share, by lag and against its control; "n/a" where nothing measured it.
+std::string keyframe_share(const VoNoiseFit& fit) {
+  if (fit.keyframes_with_pairs == 0)
+    return "keyframe share of the error: n/a (no keyframe with two usable updates)\n";
+  std::string s = fmt::format("keyframe share of the error: {:.3f} (over {} keyframes with two updates or more)\n",
+                              fit.keyframe_share, fit.keyframes_with_pairs);
+  s += "  by lag (usable updates apart):";
   for (size_t b = 0; b < fit.share_by_lag.size(); ++b) {
     if (fit.share_by_lag[b].pairs == 0) continue;
     const size_t low = size_t{1} << b, high = (size_t{2} << b) - 1;
@@ -45,7 +50,11 @@ std::string share_by_lag(const VoNoiseFit& fit) {
                                                               : fmt::format("{}-{}", low, high);
     s += fmt::format(" {} {:.2f}", lags, fit.share_by_lag[b].share);
   }
-  return s + "\n";
+  s += "\n";
+  if (fit.rekey_pairs > 0)
+    s += fmt::format("  consecutive updates across a re-key (negative: the frame's error changes sides): {:.3f} ({} pairs)\n",
+                     fit.share_across_rekey, fit.rekey_pairs);
+  return s;
 }
 
 int run(const Options& o) {
@@ -66,9 +75,7 @@ int run(const Options& o) {
             << "error mean  [dx dy dz m, rx ry rz rad]: " << row(fit.mean, " ") << "\n"
             << "error sigma [dx dy dz m, rx ry rz rad]: " << row(fit.sigma, " ") << "\n"
             << "reported covariance: mean e^T C^-1 e / 6 = " << fit.reported_nees << "\n"
-            << "keyframe share of the error: " << fit.keyframe_share << " (over "
-            << fit.keyframes_with_pairs << " keyframes with two updates or more)\n"
-            << share_by_lag(fit)
+            << keyframe_share(fit)
             << "estimator options: --vo-noise constant --vo-sigma " << row(fit.sigma, ",") << "\n";
   return kExitOk;
 }

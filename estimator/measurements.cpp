@@ -58,7 +58,18 @@ MeasurementJacobian RelativePoseMeasurement::jacobian(const FilterMean& x) const
 
 Matrix6d RelativePoseMeasurement::reference_covariance(const FilterMean& x,
                                                        const Matrix6d& Q_ref) const {
-  const Matrix6d H_ref = jacobian(x).block<6, 6>(0, FilterMean::clone_offset(clone_));
+  // The clone block of jacobian(x) with J_r^-1 = I: the keyframe's error must not depend on
+  // how far this one update (perhaps a gross one the gate refuses) lies from the state.
+  const Clone& c = x.clones[static_cast<size_t>(clone_)];
+  const Eigen::Matrix3d& Rr = c.R_world_body;
+  const Eigen::Matrix3d& Rc = x.nav.R_world_body;
+  const Eigen::Matrix3d R_bc = T_body_camera_.linear();
+  const Eigen::Vector3d d =
+      Rr.transpose() * (x.nav.p_world_body + Rc * T_body_camera_.translation() - c.p_world_body);
+  Matrix6d H_ref = Matrix6d::Zero();
+  H_ref.topLeftCorner<3, 3>() = -R_bc.transpose() * Rr.transpose();
+  H_ref.topRightCorner<3, 3>() = R_bc.transpose() * so3::hat(d);
+  H_ref.bottomRightCorner<3, 3>() = -R_bc.transpose() * Rc.transpose() * Rr;
   const Matrix6d H_inv = H_ref.partialPivLu().inverse();
   const Matrix6d C = H_inv * Q_ref * H_inv.transpose();
   return 0.5 * (C + C.transpose());

@@ -44,8 +44,8 @@ class RelativePoseMeasurement final : public Measurement {
   /// The camera motion the state x predicts.
   Eigen::Isometry3d predict(const FilterMean& x) const;
   /// The error of the reference clone that moves the prediction by an error of covariance
-  /// Q_ref: H_r^-1 Q_ref H_r^-T, H_r the Jacobian's clone block at x (always invertible: block
-  /// triangular with rotations and J_r^-1 on the diagonal).
+  /// Q_ref: H_r^-1 Q_ref H_r^-T, H_r the Jacobian's clone block at x with J_r^-1 taken as I
+  /// (block triangular with rotations on the diagonal: always invertible).
   Matrix6d reference_covariance(const FilterMean& x, const Matrix6d& Q_ref) const;
 
  private:

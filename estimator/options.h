@@ -20,7 +20,9 @@ struct VoNoiseOptions {
   double reported_scale = 1.0;  ///< multiplies the reported covariance
   /// Share of each update's noise that is its keyframe's own error, common to every update
   /// against that keyframe (the keyframe's feature positions and depths): that share is added
-  /// once to the keyframe's clone, the rest is fused per update. 0 = every update independent.
+  /// once to the keyframe's clone, the rest is fused per update. 0 = every update independent
+  /// (an anchor's own error is still common to the updates through it). The IMU filters only:
+  /// the visual-only estimator does not model it.
   /// 0.4: kestrel-vo's share between updates one frame apart on the simulator's stata flights
   /// (`kestrel fit-vo-noise`; it fades to 0.04-0.27 over a hundred frames; on the two TUM
   /// clips 0.61 and 0.63).

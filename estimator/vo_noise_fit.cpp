@@ -23,25 +23,43 @@ namespace {
 
 // With w_i = b + n_i for the updates of one keyframe (b common, n_i own, whitened so that
 // E|w|^2 = 6): E[w_i . w_j] = 6 s for i != j, s the common share. The ratio of the pairs'
-// summed products to their summed mean squares estimates s, over all pairs and by lag.
+// summed products to their summed mean squares estimates s, over all pairs and by lag. The
+// errors' mean is removed first (a bias is not a keyframe's). The same ratio for consecutive
+// updates either side of a re-key is the check on that reading: the new keyframe is the frame
+// of the update before, whose own error then enters the next update as its keyframe's with the
+// opposite sign, so it is negative where the keyframe's part is real; error that drifts slowly
+// (a timing offset, the truth's own) would make it positive instead.
 template <typename UsedUpdates>
 void fit_keyframe_share(const UsedUpdates& usable, VoNoiseFit& fit) {
   std::map<int64_t, std::vector<Vector6d>> groups;  // whitened errors by keyframe, in order
-  double sum_sq = 0.0;
+  double sum_sq = 0.0, across_common = 0.0, across_total = 0.0;
   int64_t whitened = 0;
+  Vector6d previous = Vector6d::Zero();
+  int64_t previous_reference = 0;
+  bool has_previous = false;
   for (const auto& x : usable) {
     Vector6d w;
+    const Vector6d e = x.error - fit.mean;
     const Eigen::LLT<Matrix6d> llt(x.update->covariance);
     if (llt.info() == Eigen::Success && x.update->covariance.diagonal().minCoeff() > 0.0) {
-      w = llt.matrixL().solve(x.error);
+      w = llt.matrixL().solve(e);
       sum_sq += w.squaredNorm();
       ++whitened;
     } else {
-      w = x.error.cwiseQuotient(fit.sigma.cwiseMax(1e-12));
+      w = e.cwiseQuotient(fit.sigma.cwiseMax(1e-12));
     }
     groups[x.update->reference_utime].push_back(w);
+    if (has_previous && previous_reference != x.update->reference_utime) {
+      across_common += previous.dot(w);
+      across_total += 0.5 * (previous.squaredNorm() + w.squaredNorm());
+      ++fit.rekey_pairs;
+    }
+    previous = w;
+    previous_reference = x.update->reference_utime;
+    has_previous = true;
   }
   fit.reported_nees = whitened > 0 ? sum_sq / (6.0 * static_cast<double>(whitened)) : 0.0;
+  fit.share_across_rekey = across_total > 0.0 ? across_common / across_total : 0.0;
   const size_t buckets = fit.share_by_lag.size();
   std::vector<double> common(buckets, 0.0), total(buckets, 0.0);
   double all_common = 0.0, all_total = 0.0;

@@ -28,19 +28,26 @@ struct VoNoiseFit {
   double mean_interval_s = 0.0;
   /// Share of the error common to the updates against one keyframe (the estimator's
   /// --vo-keyframe-share): over every pair of updates against the same keyframe, the summed
-  /// product of their whitened errors over the summed mean squared whitened error. Errors are
+  /// product of their whitened errors (mean removed) over the summed mean squared whitened
+  /// error. Errors are
   /// whitened by each update's reported covariance (by `sigma` where it reports none), so the
   /// share does not depend on how well that covariance is scaled. 0 when no keyframe has two
   /// usable updates.
   double keyframe_share = 0.0;
   int64_t keyframes_with_pairs = 0;  ///< keyframes that contributed to keyframe_share
-  /// The same share from the pairs `lag` frames apart only: lag 1, 2-3, 4-7, ..., 128 and more
-  /// (the common error fades as the view moves away from the keyframe's).
+  /// The same share from the pairs `lag` usable updates apart only: lag 1, 2-3, 4-7, ..., 128
+  /// and more (the common error fades as the view moves away from the keyframe's).
   struct LagShare {
     double share = 0.0;
     int64_t pairs = 0;
   };
   std::array<LagShare, 8> share_by_lag{};
+  /// The check: the same ratio for consecutive updates either side of a re-key. The new
+  /// keyframe is the frame of the update before, whose error enters the next update with the
+  /// opposite sign: negative where the keyframe's part is real, positive if the common error
+  /// were slow drift of another kind (a timing offset, the truth's own error).
+  double share_across_rekey = 0.0;
+  int64_t rekey_pairs = 0;
   /// Mean of e^T C^-1 e / 6 under each update's reported covariance C: 1 when C is right on
   /// average (a --vo-scale to try); 0 when no update reports one.
   double reported_nees = 0.0;

@@ -237,6 +237,35 @@ TEST(Estimator, OneKeyframeForAMinuteKeepsThePositionOfTheKeyframe) {
   EXPECT_EQ(e.counters().vo_anchors, 0);
 }
 
+TEST(Estimator, AKeyframeWithOneUpdateIsFusedAsWithoutAShare) {
+  // A VO that re-keys at every frame: each keyframe has one update, whose common and own
+  // parts add up to its whole noise (the clone is never used again), so the navigation state
+  // and its covariance are those of share 0 — to first order: the common part is mapped with
+  // J_r^-1 taken as I, the update with J_r^-1 at its ~1e-3 rad residual, so they differ by
+  // ~1e-6 relative. With keyframes held they differ by percents.
+  for (const double keyframe_m : {0.0, 10.0}) {
+    ScenarioOptions o = scenario(5.0);
+    o.vo.keyframe_distance_m = keyframe_m;
+    o.vo.keyframe_angle_rad = keyframe_m > 0.0 ? 3.0 : 0.0;
+    std::vector<EstimatorOutput> outputs;
+    for (const double share : {0.0, 0.4}) {
+      EstimatorOptions options;
+      options.vo_noise.keyframe_share = share;
+      Estimator e(options);
+      outputs.push_back(test::run_scenario(e, AnalyticMotion::gentle(), o).back().output);
+      EXPECT_GT(e.counters().vo_applied, 140);
+    }
+    const double dp = (outputs[0].nav.p_world_body - outputs[1].nav.p_world_body).norm();
+    const double dP = (outputs[0].covariance - outputs[1].covariance).norm() / outputs[0].covariance.norm();
+    if (keyframe_m == 0.0) {
+      EXPECT_LT(dp, 1e-5);
+      EXPECT_LT(dP, 1e-4);
+    } else {
+      EXPECT_GT(dP, 0.01);  // held keyframes: the share makes the state less certain
+    }
+  }
+}
+
 TEST(Estimator, KeyframeOlderThanTheEstimatorBecomesAnAnchor) {
   // The VO picked its keyframe before the estimator started (or before a reset): the first
   // update against it becomes an anchor, and the ones after it are fused through it.

@@ -36,6 +36,7 @@ VoRun synthetic_run(const SyntheticVoOptions& vo_options, double duration_s) {
 
 TEST(VoNoiseFit, RecoversTheSyntheticVoSigmas) {
   SyntheticVoOptions o;
+  o.keyframe_share = 0.0;  // independent errors: the standard error below holds
   o.T_body_camera.translation() << 0.1, 0.0, -0.05;
   o.T_body_camera.linear() << 0, 0, 1, -1, 0, 0, 0, -1, 0;  // optical frame on a body x-forward
   const VoRun r = synthetic_run(o, 60.0);
@@ -70,6 +71,10 @@ TEST(VoNoiseFit, MeasuresTheShareOfTheErrorCommonToAKeyframe) {
     EXPECT_GT(fit.share_by_lag[4].pairs, 1000);
     // The reported covariance is the whole noise.
     EXPECT_NEAR(fit.reported_nees, 1.0, 0.1) << "share " << share;
+    // Updates either side of a re-key share nothing here (the synthetic VO's error is drawn
+    // per update and per keyframe, not per frame).
+    EXPECT_GT(fit.rekey_pairs, 50);
+    EXPECT_NEAR(fit.share_across_rekey, 0.0, 0.15) << "share " << share;
     // The whole error is still what each update reports.
     for (int i = 0; i < 6; ++i) EXPECT_NEAR(fit.sigma[i], o.sigma[i], 0.15 * o.sigma[i]);
   }
