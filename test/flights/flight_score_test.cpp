@@ -6,6 +6,12 @@
 
 #include <cmath>
 
+#include "common/transport/channels.h"
+#include "common/transport/log_file.h"
+#include "kestrel/ground_truth_t.hpp"
+#include "kestrel/slam_graph_t.hpp"
+#include "test/support/test_support.h"
+#include "tools/flights/flight_log.h"
 #include "tools/flights/flight_score.h"
 
 namespace kestrel::flights {
@@ -72,6 +78,33 @@ TEST(FlightScore, FlownCovarianceIsTakenWhereTheTruthPassedEachNode) {
   EXPECT_NEAR(s.flown_trace[0], 0.0, 1e-12);
   EXPECT_NEAR(s.flown_trace[1], 3.0 * 20, 1e-12);  // x = 2.0 is the 21st sample
   EXPECT_NEAR(s.flown_trace[2], 3.0 * 50, 1e-12);
+}
+
+TEST(FlightLog, TheLastGraphCountsEvenWhenOnlyKeyframesWereAdded) {
+  // SLAM's revision counts optimisations: keyframes added between two keep the revision, and
+  // the flight's keyframes are the latest graph's, not the first of its revision.
+  test::TempDir dir;
+  const std::string path = (dir / "flight.lcmlog").string();
+  {
+    transport::LogWriter log(path);
+    kestrel::ground_truth_t truth{};
+    truth.utime = 1'000'000;
+    truth.T_world_frame.orientation[0] = 1.0;
+    log.write_message(channel::kGroundTruth, truth.utime, truth);
+    const std::vector<std::pair<int64_t, int>> graphs = {{0, 1}, {0, 2}, {1, 5}, {1, 8}, {0, 3}};
+    int64_t utime = 1'000'000;
+    for (const auto& [revision, keyframes] : graphs) {
+      kestrel::slam_graph_t g{};
+      g.utime = utime += 100'000;
+      g.revision = revision;
+      g.num_keyframes = keyframes;
+      g.keyframes.resize(static_cast<size_t>(keyframes));
+      log.write_message(channel::kSlamGraph, g.utime, g);
+    }
+    log.close();
+  }
+  // The stale revision-0 graph at the end is a duplicate from before the optimisation.
+  EXPECT_EQ(read_flight_log(path).keyframes, 8);
 }
 
 }  // namespace

@@ -21,7 +21,8 @@ TEST(FlyPlans, ABrmPlanInTheRoomIsFlownToItsGoalOnTheEstimatorsState) {
   if (!test::can_isolate_network()) KESTREL_SKIP_ENVIRONMENT() << "no network namespace available";
   test::TempDir dir;
   const auto r = test::run({test::tool("fly-plans").string(), "--world", "room", "--start", "8,3.5,1.3,0", "--goal",
-                            "10,3.5,1.3,0", "--planners", "brm:su", "--seeds", "1", "--out", dir.path().string()},
+                            "10,3.5,1.3,0", "--planners", "brm:su", "--seeds", "1", "--out", dir.path().string(),
+                            "--vo-set", "keyframe.floor_cap_fraction=0"},  // the default, passed through
                            500.0);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const nlohmann::json flights = nlohmann::json::parse(test::read_file(dir / "flights.json"));
@@ -44,6 +45,8 @@ TEST(FlyPlans, ABrmPlanInTheRoomIsFlownToItsGoalOnTheEstimatorsState) {
   // What a person reads: the table and the picture, and each process's log beside the recording.
   EXPECT_NE(test::read_file(dir / "report.md").find("| 1 | brm-su | 1 | 100 % (1/1) |"), std::string::npos)
       << test::read_file(dir / "report.md");
+  EXPECT_NE(test::read_file(dir / "report.md").find("The VO with `--set keyframe.floor_cap_fraction=0`"),
+            std::string::npos);
   EXPECT_TRUE(fs::exists(dir / "room_pair1.png"));
   const fs::path flight = dir / "room" / "pair1" / "brm-su" / "seed1";
   for (const char* file : {"flight.lcmlog", "waypoints.txt", "vo.log", "estimator.log", "follow.log", "slam.log",
@@ -66,6 +69,12 @@ TEST(FlyPlans, UsageErrorsExitTwoNamingTheOption) {
                                "--out", dir.path().string()});
   EXPECT_EQ(wall.exit_code, 2) << wall.err;
   EXPECT_NE(wall.err.find("not free"), std::string::npos) << wall.err;
+  // A VO setting is checked before anything flies, not by the first flight's VO dying.
+  for (const char* bad : {"nope=1", "keyframe.floor_cap_fraction=2", "keyframe.floor_cap_fraction"}) {
+    const auto r = test::run({tool, "--vo-set", bad, "--out", dir.path().string()});
+    EXPECT_EQ(r.exit_code, 2) << bad << ": " << r.err;
+    EXPECT_NE(r.err.find("--vo-set"), std::string::npos) << r.err;
+  }
 }
 
 }  // namespace

@@ -62,8 +62,10 @@ FlightRun fly(const FlightSetup& s, const fs::path& tool_dir, const std::string&
   run.recording = s.dir / "flight.lcmlog";
   fs::remove(run.recording, ec);  // a recording of an earlier run must not pass for this one's
   const std::string start = csv(s.start[0], s.start[1], s.start[2]);
+  std::vector<std::string> vo = {"vo"};
+  for (const std::string& kv : s.vo_settings) vo.insert(vo.end(), {"--set", kv});
   launch::ProcessSet set = {
-      {"vo", {"vo"}, "onboard"},
+      {"vo", vo, "onboard"},
       {"estimator", {"estimator", "--init-position", start, "--init-yaw", fmt::format("{:.6f}", s.start[3])}, "onboard"},
       {"follow", {"follow", "--waypoints", waypoints.string(), "--speed", fmt::format("{}", s.speed_m_s)}, "onboard"},
       {"slam", {"slam"}, "offboard"},

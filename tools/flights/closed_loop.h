@@ -32,6 +32,8 @@ struct FlightSetup {
   double duration_s = 60.0;    ///< of simulated flight
   double speed_m_s = 0.5;      ///< the follower's cruise speed
   double ack_timeout_s = 60.0;  ///< lock-step: longest wait for a process
+  /// kestrel-vo's --set KEY=VALUE settings (kestrel-vo --print-config keys), checked by the caller.
+  std::vector<std::string> vo_settings;
   std::filesystem::path dir;    ///< made if absent
   /// Write flight.lcmlog; a long flight goes without (STATE alone is ~0.4 MB per second).
   bool record = true;

@@ -43,7 +43,9 @@ FlightRecord read_flight_log(const std::string& path) {
         r.vo_failures += m.status != kestrel::vo_update_t::STATUS_OK;
       } else if (e->channel == channel::kSlamGraph) {
         const auto m = transport::decode_message<kestrel::slam_graph_t>(d.data(), d.size(), e->channel);
-        if (m.revision <= graph_revision) continue;
+        // A newer graph has a later revision, or the same one with keyframes added since (the
+        // revision counts optimisations only); an older revision is a stale duplicate.
+        if (m.revision < graph_revision) continue;
         graph_revision = m.revision;
         r.keyframes = m.num_keyframes;
         r.loop_closures = 0;

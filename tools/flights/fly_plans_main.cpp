@@ -6,6 +6,7 @@
 // picture per pair: the map, the planned paths with the belief model's 1-sigma ellipses, and
 // the flown tracks coloured by the estimator's true error. See README.md.
 
+#include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
 
 #include <csignal>
@@ -28,6 +29,7 @@
 #include "tools/flights/flight_log.h"
 #include "tools/flights/flight_report.h"
 #include "drivers/sim/world_catalog.h"
+#include "vo/option_keys.h"
 
 #ifndef KESTREL_DEFAULT_STATA_MAP
 #define KESTREL_DEFAULT_STATA_MAP "../shared/data/maps/stata_basement.yaml"
@@ -56,6 +58,7 @@ struct Options {
   std::string out = "fly-plans-output";
   bool plan_only = false;
   std::string lcm_url;
+  std::vector<std::string> vo_settings;  // kestrel-vo --set KEY=VALUE
 };
 
 struct PlannedFlight {
@@ -123,6 +126,7 @@ int run(const Options& o) {
   report += fmt::format("{} seed(s) per plan from seed {}, {} samples per roadmap, the {} sensor model, cruise {} m/s, "
                         "arrived within {} m of the goal by the truth.\n\n",
                         o.seeds, o.first_seed, o.samples, o.sensor, o.speed, o.arrive_radius);
+  if (!o.vo_settings.empty()) report += fmt::format("The VO with `--set {}`.\n\n", fmt::join(o.vo_settings, " --set "));
   bool failures = false;
   for (const planner::ExperimentWorld& w : worlds) {
     const planner::ExperimentWorld* world = &w;
@@ -187,6 +191,7 @@ int run(const Options& o) {
           setup.speed_m_s = o.speed;
           setup.duration_s = flights::flight_duration_s(setup.waypoints, o.speed);
           setup.ack_timeout_s = o.ack_timeout;
+          setup.vo_settings = o.vo_settings;
           setup.dir = out / world_name / fmt::format("pair{}", pair) / plan.name / fmt::format("seed{}", row.seed);
           spdlog::info("{} pair {}: flying {} ({:.1f} m, {:.0f} s of flight), seed {}", world_name, pair, plan.name,
                        row.path_length_m, setup.duration_s, row.seed);
@@ -308,6 +313,19 @@ int main(int argc, char** argv) {
   app.add_option("--ack-timeout", o.ack_timeout, "Lock-step: the longest wait for a process (s)")->check(cli::Positive)->capture_default_str();
   app.add_option("--out", o.out, "Folder for report.md, flights.json, the pictures and each flight's logs")->capture_default_str();
   app.add_flag("--plan-only", o.plan_only, "Plan and draw each pair's plans, fly nothing");
+  app.add_option("--vo-set", o.vo_settings,
+                 "KEY=VALUE: a kestrel-vo option for every flight (repeatable; keys: kestrel-vo --print-config)")
+      ->each([](const std::string& kv) {
+        // Checked here, not by the first flight's VO dying: a bad key or value is a usage error.
+        const size_t eq = kv.find('=');
+        if (eq == std::string::npos) throw CLI::ValidationError("'" + kv + "' is not KEY=VALUE");
+        vo::VoOptions check;
+        try {
+          vo::set_option(check, kv.substr(0, eq), kv.substr(eq + 1));
+        } catch (const std::invalid_argument& e) {
+          throw CLI::ValidationError(e.what());
+        }
+      });
   app.add_option("--lcm-url", o.lcm_url, "LCM URL inside the private network (default: $LCM_DEFAULT_URL or kestrel's)");
   return app.run(argc, argv, [&] { return run(o); });
 }
