@@ -166,10 +166,11 @@ struct KeyframeOptions {
   /// floors apply unchanged. A keyframe's first match is never below the cap, so a frame that
   /// becomes the reference with few inliers is held all the same. On the simulator's camera
   /// 0.7 makes the VO alone 3-6x more accurate on stata's survey flights (1.1x on its loops);
-  /// fr1 (Kinect) is best without it. Off by default because
-  /// the estimator fuses every update against one keyframe as independent of the others,
-  /// which a held keyframe makes 4-5x overconfident in closed-loop flights
-  /// (docs/decisions/2026-12-06-vo-keyframe-cap.md).
+  /// fr1 (Kinect) is best without it. With the estimator's keyframe share (7 Dec) the stata
+  /// BRM flights stay within 0.3 m on 11 of 12 with it, 7 of 12 without (`kestrel fly-plans
+  /// --vo-set`). Off by default: a frame without a known sensor gets the simulator's profile,
+  /// so a default for the simulator would also be one for an unknown real camera, which fr1
+  /// says is better without (docs/decisions/2026-12-07-estimator-keyframe-share.md).
   double floor_cap_fraction = 0.0;
   bool fall_back_to_previous = true;
 };
