@@ -62,14 +62,13 @@ void Estimator::apply(Event& e, FilterState& s) {
         Q_own = (1.0 - share) * a.from_update;
         z = spec->second.anchor.inverse() * z;
       }
+      const RelativePoseMeasurement m(clone, z, Q_own, e.vo.T_body_camera);
       Clone& reference = s.mean.clones[static_cast<size_t>(clone)];
       if (reference.keyframe_error_of != e.vo.reference_utime) {
-        const RelativePoseMeasurement first(clone, z, Q_own, e.vo.T_body_camera);
         const int o = FilterMean::clone_offset(clone);
-        s.P.block<6, 6>(o, o) += first.reference_covariance(s.mean, Q_common);
+        s.P.block<6, 6>(o, o) += m.reference_covariance(s.mean, Q_common);
         reference.keyframe_error_of = e.vo.reference_utime;
       }
-      const RelativePoseMeasurement m(clone, z, Q_own, e.vo.T_body_camera);
       const int max_in_row = options_.vo_max_gated_in_row;
       const bool force = max_in_row > 0 && s.vo_gated_in_row >= max_in_row;
       const UpdateResult r = filter_->update(s, m, force ? 0.0 : options_.vo_gate_chi2);

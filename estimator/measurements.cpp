@@ -34,43 +34,42 @@ Residual RelativePoseMeasurement::residual(const FilterMean& x) const {
   return pose_residual(predict(x), z_);
 }
 
-MeasurementJacobian RelativePoseMeasurement::jacobian(const FilterMean& x) const {
+Matrix6d RelativePoseMeasurement::reference_block(const FilterMean& x, const Eigen::Matrix3d& Jr_inv) const {
   const Clone& c = x.clones[static_cast<size_t>(clone_)];
   const Eigen::Matrix3d& Rr = c.R_world_body;
   const Eigen::Matrix3d& Rc = x.nav.R_world_body;
   const Eigen::Matrix3d R_bc = T_body_camera_.linear();
-  const Eigen::Vector3d t_bc = T_body_camera_.translation();
   // Camera centre now, seen from the reference body frame.
-  const Eigen::Vector3d d = Rr.transpose() * (x.nav.p_world_body + Rc * t_bc - c.p_world_body);
-  const Eigen::Matrix3d A = R_bc.transpose() * Rr.transpose();
+  const Eigen::Vector3d d =
+      Rr.transpose() * (x.nav.p_world_body + Rc * T_body_camera_.translation() - c.p_world_body);
+  Matrix6d H_ref = Matrix6d::Zero();
+  H_ref.topLeftCorner<3, 3>() = -(R_bc.transpose() * Rr.transpose());
+  H_ref.topRightCorner<3, 3>() = R_bc.transpose() * so3::hat(d);
+  H_ref.bottomRightCorner<3, 3>() = -Jr_inv * R_bc.transpose() * Rc.transpose() * Rr;
+  return H_ref;
+}
+
+MeasurementJacobian RelativePoseMeasurement::jacobian(const FilterMean& x) const {
+  const Clone& c = x.clones[static_cast<size_t>(clone_)];
+  const Eigen::Matrix3d& Rc = x.nav.R_world_body;
+  const Eigen::Matrix3d R_bc = T_body_camera_.linear();
+  const Eigen::Vector3d t_bc = T_body_camera_.translation();
+  const Eigen::Matrix3d A = R_bc.transpose() * c.R_world_body.transpose();
   const Eigen::Matrix3d Jr_inv = so3::right_jacobian_inverse(residual(x).tail<3>());
-  const int o = FilterMean::clone_offset(clone_);
 
   MeasurementJacobian H = MeasurementJacobian::Zero(6, x.dim());
   H.block<3, 3>(0, idx::kP) = A;
   H.block<3, 3>(0, idx::kTheta) = -A * Rc * so3::hat(t_bc);
-  H.block<3, 3>(0, o) = -A;
-  H.block<3, 3>(0, o + 3) = R_bc.transpose() * so3::hat(d);
   H.block<3, 3>(3, idx::kTheta) = Jr_inv * R_bc.transpose();
-  H.block<3, 3>(3, o + 3) = -Jr_inv * R_bc.transpose() * Rc.transpose() * Rr;
+  H.block<6, 6>(0, FilterMean::clone_offset(clone_)) = reference_block(x, Jr_inv);
   return H;
 }
 
 Matrix6d RelativePoseMeasurement::reference_covariance(const FilterMean& x,
                                                        const Matrix6d& Q_ref) const {
-  // The clone block of jacobian(x) with J_r^-1 = I: the keyframe's error must not depend on
-  // how far this one update (perhaps a gross one the gate refuses) lies from the state.
-  const Clone& c = x.clones[static_cast<size_t>(clone_)];
-  const Eigen::Matrix3d& Rr = c.R_world_body;
-  const Eigen::Matrix3d& Rc = x.nav.R_world_body;
-  const Eigen::Matrix3d R_bc = T_body_camera_.linear();
-  const Eigen::Vector3d d =
-      Rr.transpose() * (x.nav.p_world_body + Rc * T_body_camera_.translation() - c.p_world_body);
-  Matrix6d H_ref = Matrix6d::Zero();
-  H_ref.topLeftCorner<3, 3>() = -R_bc.transpose() * Rr.transpose();
-  H_ref.topRightCorner<3, 3>() = R_bc.transpose() * so3::hat(d);
-  H_ref.bottomRightCorner<3, 3>() = -R_bc.transpose() * Rc.transpose() * Rr;
-  const Matrix6d H_inv = H_ref.partialPivLu().inverse();
+  // With J_r^-1 = I: the keyframe's error must not depend on how far this one update (perhaps
+  // a gross one the gate refuses) lies from the state.
+  const Matrix6d H_inv = reference_block(x, Eigen::Matrix3d::Identity()).partialPivLu().inverse();
   const Matrix6d C = H_inv * Q_ref * H_inv.transpose();
   return 0.5 * (C + C.transpose());
 }

@@ -49,6 +49,9 @@ class RelativePoseMeasurement final : public Measurement {
   Matrix6d reference_covariance(const FilterMean& x, const Matrix6d& Q_ref) const;
 
  private:
+  /// The Jacobian's block of the reference clone, with J_r^-1 given.
+  Matrix6d reference_block(const FilterMean& x, const Eigen::Matrix3d& Jr_inv) const;
+
   int clone_;
   Eigen::Isometry3d z_;
   MeasurementNoise Q_;

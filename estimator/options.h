@@ -24,8 +24,8 @@ struct VoNoiseOptions {
   /// (an anchor's own error is still common to the updates through it). The IMU filters only:
   /// the visual-only estimator does not model it.
   /// 0.4: kestrel-vo's share between updates one frame apart on the simulator's stata flights
-  /// (`kestrel fit-vo-noise`; it fades to 0.04-0.27 over a hundred frames; on the two TUM
-  /// clips 0.61 and 0.63).
+  /// (`kestrel fit-vo-noise`; it fades to 0.02-0.17 over a hundred updates; on the two TUM
+  /// clips 0.62 and 0.62).
   double keyframe_share = 0.4;
   /// Standard deviations of [dp (reference camera frame, m); dtheta (current camera, rad)].
   Eigen::Matrix<double, 6, 1> constant_sigma =

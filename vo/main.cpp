@@ -66,10 +66,8 @@ vo::VoOptions configured(const Options& o, const sensors::SensorProfile& sensor)
     throw CLI::ValidationError("--sensor", "profile '" + sensor.name + "': " + e.what());
   }
   for (const std::string& kv : o.settings) {
-    const auto eq = kv.find('=');
-    if (eq == std::string::npos) throw CLI::ValidationError("--set", "'" + kv + "' is not KEY=VALUE");
     try {
-      vo::set_option(options, kv.substr(0, eq), kv.substr(eq + 1));
+      vo::set_option_assignment(options, kv);
     } catch (const std::invalid_argument& e) {
       throw CLI::ValidationError("--set", e.what());
     }

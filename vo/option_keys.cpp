@@ -144,6 +144,12 @@ void set_option(VoOptions& options, const std::string& key, const std::string& v
   throw std::invalid_argument("unknown vo option '" + key + "'");
 }
 
+void set_option_assignment(VoOptions& options, const std::string& kv) {
+  const size_t eq = kv.find('=');
+  if (eq == std::string::npos) throw std::invalid_argument("'" + kv + "' is not KEY=VALUE");
+  set_option(options, kv.substr(0, eq), kv.substr(eq + 1));
+}
+
 std::vector<std::string> describe_options(const VoOptions& options) {
   VoOptions copy = options;
   std::vector<std::string> out;

@@ -16,6 +16,10 @@ namespace kestrel::vo {
 /// Sets the field called `key` from `value`.
 void set_option(VoOptions& options, const std::string& key, const std::string& value);
 
+/// Sets a field from "KEY=VALUE" (a --set argument); throws std::invalid_argument when the
+/// text has no '=' or set_option refuses it.
+void set_option_assignment(VoOptions& options, const std::string& key_equals_value);
+
 /// "key = value" for every field, in declaration order (for --print-config and READMEs).
 std::vector<std::string> describe_options(const VoOptions& options);
 

@@ -317,11 +317,9 @@ int main(int argc, char** argv) {
                  "KEY=VALUE: a kestrel-vo option for every flight (repeatable; keys: kestrel-vo --print-config)")
       ->each([](const std::string& kv) {
         // Checked here, not by the first flight's VO dying: a bad key or value is a usage error.
-        const size_t eq = kv.find('=');
-        if (eq == std::string::npos) throw CLI::ValidationError("'" + kv + "' is not KEY=VALUE");
         vo::VoOptions check;
         try {
-          vo::set_option(check, kv.substr(0, eq), kv.substr(eq + 1));
+          vo::set_option_assignment(check, kv);
         } catch (const std::invalid_argument& e) {
           throw CLI::ValidationError(e.what());
         }
