@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <stdexcept>
+#include <string>
 #include <utility>
 
 namespace kestrel::sensors {
@@ -23,9 +24,9 @@ const std::vector<SensorProfile>& builtin_profiles() {
         throw std::logic_error("sensors/profiles/" + file + " names its profile '" + out.back().name + "'");
     }
     std::sort(out.begin(), out.end(), [](const SensorProfile& a, const SensorProfile& b) { return a.name < b.name; });
-    const bool has_simulator =
-        std::any_of(out.begin(), out.end(), [](const SensorProfile& p) { return p.name == "simulator"; });
-    if (!has_simulator) throw std::logic_error("sensors/profiles/ has no simulator.yaml");
+    for (const char* required : {"default", "simulator"})
+      if (std::none_of(out.begin(), out.end(), [&](const SensorProfile& p) { return p.name == required; }))
+        throw std::logic_error(std::string("sensors/profiles/ has no ") + required + ".yaml");
     return out;
   }();
   return profiles;
@@ -58,7 +59,7 @@ const SensorProfile& builtin_profile(const std::string& name) {
 const SensorProfile& profile_of_sensor(const std::string& sensor_model) {
   for (const auto& p : builtin_profiles())
     if (p.name == sensor_model) return p;
-  return builtin_profile("simulator");
+  return builtin_profile("default");
 }
 
 }  // namespace kestrel::sensors

@@ -3,7 +3,8 @@
 // every tool has them wherever it runs (one source, the files; nothing typed twice).
 //
 // Invariants: every built-in file parses (a test checks it, and the first use throws
-// std::logic_error otherwise); names are unique; "simulator" is one of them.
+// std::logic_error otherwise); names are unique; "default" (what a camera without a profile
+// gets: it sets nothing) and "simulator" are among them.
 
 #include <optional>
 #include <string>
@@ -17,7 +18,7 @@ namespace kestrel::sensors {
 const std::vector<SensorProfile>& builtin_profiles();
 /// Their names, for help texts and errors.
 std::vector<std::string> builtin_profile_names();
-/// The same as one list, "kinect1, simulator".
+/// The same as one list, "default, kinect1, simulator".
 std::string builtin_profile_list();
 /// The built-in profile called `name`, or nothing.
 std::optional<SensorProfile> find_builtin_profile(const std::string& name);
@@ -25,7 +26,8 @@ std::optional<SensorProfile> find_builtin_profile(const std::string& name);
 const SensorProfile& builtin_profile(const std::string& name);
 
 /// The profile for frames whose sensor model is `sensor_model` (RgbdFrame::sensor): the
-/// built-in one of that name, the simulator's for any other name, "" (unknown) included.
+/// built-in one of that name, "default" (the built-in defaults) for any other name, "" (unknown)
+/// included.
 const SensorProfile& profile_of_sensor(const std::string& sensor_model);
 
 }  // namespace kestrel::sensors

@@ -6,8 +6,8 @@
 // (`kestrel vo --sensor my_camera.yaml`), so a new camera is a new file, not code.
 //
 // Every frame names its camera's model (RgbdFrame::sensor, set by the source and kept in logs);
-// the profile of that name applies. A field the file leaves out leaves the consumer's default
-// as it is: the simulator's profile sets nothing, the defaults having been fitted on its frames.
+// the profile of that name applies, "default" (which sets nothing) for a model without one. A
+// field the file leaves out leaves the consumer's default as it is.
 //
 // Invariants of a parsed profile: the name is lower-case letters, digits, '_' or '-'; every
 // number is finite and in its field's range (parse_sensor_profile says which).

@@ -179,10 +179,10 @@ int main(int argc, char** argv) {
                  "Change one option of the variant, KEY=VALUE (repeatable; --list-options shows them)");
   bool list = false;
   app.add_option("--sensor", o.sensor,
-                 "Camera profile: a built-in one (simulator: global shutter; kinect1: rolling shutter, depth "
-                 "before colour, larger covariance floors) or a profile file of your own (sensors/README.md); "
-                 "by default the one each frame's sensor model names (with --tum the folder's: kinect1 for "
-                 "freiburg1)")
+                 "Camera profile: a built-in one (simulator: global shutter, keyframe floors capped; kinect1: "
+                 "rolling shutter, depth before colour, larger covariance floors; default: nothing changed) or a "
+                 "profile file of your own (sensors/README.md); by default the one each frame's sensor model "
+                 "names, or default (with --tum the folder's: kinect1 for freiburg1)")
       ->check(CLI::Validator([](std::string& name) { return sensors::check_sensor_profile_name(name); }, "PROFILE"));
   app.add_flag("--list-options", list, "Print every pipeline option of the variant with its value and exit");
   app.add_option("--tum", o.tum, "Offline: TUM RGB-D sequence folder to run over");
@@ -206,7 +206,9 @@ int main(int argc, char** argv) {
     } else {
       for (const sensors::SensorProfile& p : sensors::builtin_profiles()) configured(o, p);
     }
-    const vo::VoOptions options = configured(o, forced ? *forced : sensors::builtin_profile("simulator"));
+    // Live without --sensor, each frame's profile applies (serve()); --list-options shows the
+    // options before any camera's: the built-in defaults.
+    const vo::VoOptions options = configured(o, forced ? *forced : sensors::builtin_profile("default"));
     if (list) {
       for (const std::string& line : vo::describe_options(options)) std::cout << line << "\n";
       return kExitOk;

@@ -167,10 +167,10 @@ struct KeyframeOptions {
   /// becomes the reference with few inliers is held all the same. On the simulator's camera
   /// 0.7 makes the VO alone 3-6x more accurate on stata's survey flights (1.1x on its loops);
   /// fr1 (Kinect) is best without it. With the estimator's keyframe share (7 Dec) the stata
-  /// BRM flights stay within 0.3 m on 11 of 12 with it, 7 of 12 without (`kestrel fly-plans
-  /// --vo-set`). Off by default: a frame without a known sensor gets the simulator's profile,
-  /// so a default for the simulator would also be one for an unknown real camera, which fr1
-  /// says is better without (docs/decisions/2026-12-07-estimator-keyframe-share.md).
+  /// BRM flights stay within 0.3 m on 11 of 12 with it, 7 of 12 without. Off here, on in the
+  /// simulator's profile (sensors/profiles/simulator.yaml): a camera without a profile keeps
+  /// the default, which fr1 says is better for a Kinect
+  /// (docs/decisions/2026-12-07-estimator-keyframe-share.md).
   double floor_cap_fraction = 0.0;
   bool fall_back_to_previous = true;
 };

@@ -67,8 +67,9 @@ struct LoadedSequence {
 LoadedSequence load_tum_sequence(const std::string& folder);
 
 /// The sensor profile of the recording in `folder`: kinect1's for a freiburg1 recording (named
-/// as TUM names them, tum::detect_camera); the simulator's for any other -- freiburg2/3, whose
-/// timing was not measured, and the simulator's TUM-format exports.
+/// as TUM names them, tum::detect_camera); "default" (the built-in defaults) for any other --
+/// freiburg2/3, whose timing was not measured, and the simulator's TUM-format exports too (run
+/// those with `--sensor simulator` to get the simulator's profile).
 const sensors::SensorProfile& tum_sensor(const std::string& folder);
 
 /// `options` with the profile of the recording in `folder` (tum_sensor()). Every offline run

@@ -16,12 +16,21 @@
 namespace kestrel::sensors {
 namespace {
 
-TEST(BuiltinProfiles, EveryShippedFileParsesAndTheSimulatorSetsNothing) {
-  ASSERT_EQ(builtin_profile_names(), (std::vector<std::string>{"kinect1", "simulator"}));
-  const SensorProfile& sim = builtin_profile("simulator");
-  EXPECT_FALSE(sim.timing.rolling_shutter_readout_s || sim.timing.depth_time_from_stamps ||
-               sim.timing.depth_extra_latency_s || sim.vo.translation_floor_m || sim.vo.dense_weight ||
-               sim.vo.min_inliers_to_keep_near || sim.vo.floor_cap_fraction || sim.slam.loop_rotation_floor_rad);
+TEST(BuiltinProfiles, EveryShippedFileParsesAndTheDefaultSetsNothing) {
+  ASSERT_EQ(builtin_profile_names(), (std::vector<std::string>{"default", "kinect1", "simulator"}));
+  const auto sets_anything = [](const SensorProfile& p) {
+    return p.timing.rolling_shutter_readout_s || p.timing.depth_time_from_stamps || p.timing.depth_extra_latency_s ||
+           p.vo.translation_floor_m || p.vo.rotation_floor_rad || p.vo.translation_per_rad_m ||
+           p.vo.rotation_per_rad || p.vo.dense_weight || p.vo.min_inliers_to_keep_near || p.vo.floor_cap_fraction ||
+           p.slam.loop_rotation_floor_rad;
+  };
+  EXPECT_FALSE(sets_anything(builtin_profile("default")));
+  // The simulator's camera: a global shutter (no timing), the defaults fitted on its frames,
+  // and the keyframe floors' cap measured on its bare corridors.
+  SensorProfile sim = builtin_profile("simulator");
+  EXPECT_EQ(sim.vo.floor_cap_fraction, 0.7);
+  sim.vo.floor_cap_fraction.reset();
+  EXPECT_FALSE(sets_anything(sim)) << "the simulator's profile sets only the cap";
   const SensorProfile& kinect = builtin_profile("kinect1");
   EXPECT_EQ(kinect.timing.rolling_shutter_readout_s, 0.015);
   EXPECT_EQ(kinect.timing.depth_time_from_stamps, true);
@@ -34,8 +43,8 @@ TEST(BuiltinProfiles, EveryShippedFileParsesAndTheSimulatorSetsNothing) {
 TEST(BuiltinProfiles, AFramesSensorModelNamesItsProfile) {
   EXPECT_EQ(profile_of_sensor("kinect1").name, "kinect1");
   EXPECT_EQ(profile_of_sensor("simulator").name, "simulator");
-  EXPECT_EQ(profile_of_sensor("").name, "simulator");  // unknown: the simulator's, which sets nothing
-  EXPECT_EQ(profile_of_sensor("realsense_d435").name, "simulator");
+  EXPECT_EQ(profile_of_sensor("").name, "default");  // unknown: the built-in defaults
+  EXPECT_EQ(profile_of_sensor("realsense_d435").name, "default");
 }
 
 TEST(ParseSensorProfile, AMinimalAndAFullProfile) {

@@ -546,7 +546,7 @@ TEST_F(AdapterTest, PairsFramesAndUpdatesInEitherOrderAndPublishesTheGraph) {
 // updates give from the frame before it (frame 2 -> 3: 1 m/s along the optical axis), here with
 // frame 2's update in and its frame never decoded; the first keyframe, with no frame before
 // it, gets none. The timing is the one the frames' sensor model names, or the adapter's own
-// profile when it has one; frames that name no model get the simulator's, which corrects nothing.
+// profile when it has one; frames that name no model get the default one, which corrects nothing.
 TEST_F(AdapterTest, KeyframeFeaturesTakeTheCamerasTimingAndTheOdometrysMotion) {
   AdapterOptions kinect;
   kinect.sensor = sensors::builtin_profile("kinect1");

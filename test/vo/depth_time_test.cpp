@@ -120,7 +120,7 @@ TEST(DepthTimeOffset, TheKinectTimingIsForFreiburg1RecordingsOnly) {
   EXPECT_DOUBLE_EQ(fr1.covariance.rotation_per_rad, 0.085);
   EXPECT_DOUBLE_EQ(fr1.dense.weight, 2.0);
   for (const char* other : {"/tmp/sim_room_export", "rgbd_dataset_freiburg2_desk", "rgbd_dataset_freiburg3_office"}) {
-    EXPECT_EQ(tum_sensor(other).name, "simulator") << other;
+    EXPECT_EQ(tum_sensor(other).name, "default") << other;
     const VoOptions o = with_tum_sensor(other, given);
     EXPECT_FALSE(o.depth.compensate_time_offset) << other;
     EXPECT_DOUBLE_EQ(o.depth.rolling_shutter_readout_s, 0.0) << other;
@@ -128,8 +128,8 @@ TEST(DepthTimeOffset, TheKinectTimingIsForFreiburg1RecordingsOnly) {
   }
 }
 
-// The built-in profiles applied: the simulator's changes nothing, the Kinect's what its file
-// says; a field a profile leaves out keeps the options' value.
+// The built-in profiles applied: the simulator's changes only the keyframe floors' cap, the
+// Kinect's what its file says; a field a profile leaves out keeps the options' value.
 TEST(SensorProfiles, AppliedToTheOptions) {
   VoOptions given;
   given.dense.weight = 0.7;
@@ -137,6 +137,9 @@ TEST(SensorProfiles, AppliedToTheOptions) {
   EXPECT_DOUBLE_EQ(sim.covariance.translation_floor_m, given.covariance.translation_floor_m);
   EXPECT_DOUBLE_EQ(sim.dense.weight, 0.7);
   EXPECT_FALSE(sim.depth.compensate_time_offset);
+  EXPECT_DOUBLE_EQ(sim.keyframe.floor_cap_fraction, 0.7);
+  EXPECT_DOUBLE_EQ(with_sensor(sensors::builtin_profile("default"), given).keyframe.floor_cap_fraction,
+                   given.keyframe.floor_cap_fraction);
   const VoOptions kinect = with_sensor(sensors::builtin_profile("kinect1"), given);
   EXPECT_GT(kinect.covariance.translation_floor_m, given.covariance.translation_floor_m);
   EXPECT_GT(kinect.covariance.rotation_floor_rad, given.covariance.rotation_floor_rad);

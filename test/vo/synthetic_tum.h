@@ -34,7 +34,7 @@ struct TumFolderSpec {
 
 /// Writes parent/rgbd_dataset_synthetic and returns it: frame k rendered from line_pose(k)
 /// with the ROS default intrinsics (the name names no freiburg camera, so a run takes the
-/// simulator's profile, which the synthetic room matches), rgb.txt, depth.txt and
+/// default profile, the built-in defaults fitted on synthetic frames), rgb.txt, depth.txt and
 /// groundtruth.txt (line_ground_truth). Throws std::runtime_error if a file cannot be written.
 std::filesystem::path write_tum_folder(const std::filesystem::path& parent, const TumFolderSpec& spec = {});
 

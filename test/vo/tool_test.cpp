@@ -115,7 +115,7 @@ TEST(VoTool, TheCameraProfileComesFromAFileOfTheUsersOwn) {
   EXPECT_FALSE(fs::exists(dir / "c.txt"));
   const RunResult unknown = run_vo(folder, dir / "d.txt", {"--sensor", "kinect2"});
   EXPECT_EQ(unknown.exit_code, kExitUsage) << unknown.err;
-  EXPECT_NE(unknown.err.find("neither a built-in sensor profile (kinect1, simulator)"), std::string::npos) << unknown.err;
+  EXPECT_NE(unknown.err.find("neither a built-in sensor profile (default, kinect1, simulator)"), std::string::npos) << unknown.err;
 }
 
 TEST(VoTool, UnreadableListsAndImagesExitThreeNamingTheFileAndLine) {
@@ -169,7 +169,7 @@ TEST(VoCrossvalTool, TwoFoldsOverTwoFoldersAndEveryValueOnEach) {
   // The two folders share a name: they are told apart by the paths given.
   EXPECT_NE(r.out.find("| fitted on " + a.string() + ": value, held-out score (best there) | fitted on " + b.string()),
             std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("| `dense.weight` | ATE cm | 0.4 | "), std::string::npos) << "the simulator's profile value: " << r.out;
+  EXPECT_NE(r.out.find("| `dense.weight` | ATE cm | 0.4 | "), std::string::npos) << "the default profile's value: " << r.out;
   EXPECT_NE(r.out.find("| `covariance.translation_floor_m` | ATE cm | "), std::string::npos) << r.out;
   EXPECT_EQ(r.out.find("n/a"), std::string::npos) << "every value measured on both: " << r.out;
   EXPECT_NE(r.out.find("| 2 | "), std::string::npos) << "the grid of every value: " << r.out;
