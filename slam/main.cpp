@@ -101,9 +101,9 @@ void add_options(cli::App& app, Options& o, SlamOptions& s) {
   app.add_option("--sensor", o.sensor,
                  "Camera profile, as kestrel-vo's (its timing corrects the keyframes' features, its noise "
                  "floors the loops'): a built-in one (simulator: global shutter; kinect1: rolling shutter, "
-                 "depth before colour, loops 1 degree uncertain) or a profile file of your own "
-                 "(sensors/README.md); by default the one each frame's sensor model names (with --tum the "
-                 "folder's: kinect1 for freiburg1)")
+                 "depth before colour, loops 1 degree uncertain; default: nothing changed) or a profile file "
+                 "of your own (sensors/README.md); by default the one each frame's sensor model names, or "
+                 "default (with --tum the folder's: kinect1 for freiburg1)")
       ->check(CLI::Validator([](std::string& name) { return sensors::check_sensor_profile_name(name); }, "PROFILE"));
   app.add_option("--map", o.map,
                  "Start from the SLAM map saved in this folder: frames are relocalised in it (no pose prior), then "

@@ -167,7 +167,7 @@ struct KeyframeOptions {
   /// becomes the reference with few inliers is held all the same. On the simulator's camera
   /// 0.7 makes the VO alone 3-6x more accurate on stata's survey flights (1.1x on its loops);
   /// fr1 (Kinect) is best without it. With the estimator's keyframe share (7 Dec) the stata
-  /// BRM flights stay within 0.3 m on 11 of 12 with it, 7 of 12 without. Off here, on in the
+  /// BRM flights stay within 0.3 m on 10 of 12 with it (11 at 95ea46f), 7 of 12 without. Off here, on in the
   /// simulator's profile (sensors/profiles/simulator.yaml): a camera without a profile keeps
   /// the default, which fr1 says is better for a Kinect
   /// (docs/decisions/2026-12-07-estimator-keyframe-share.md).

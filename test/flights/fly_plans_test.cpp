@@ -22,7 +22,7 @@ TEST(FlyPlans, ABrmPlanInTheRoomIsFlownToItsGoalOnTheEstimatorsState) {
   test::TempDir dir;
   const auto r = test::run({test::tool("fly-plans").string(), "--world", "room", "--start", "8,3.5,1.3,0", "--goal",
                             "10,3.5,1.3,0", "--planners", "brm:su", "--seeds", "1", "--out", dir.path().string(),
-                            "--vo-set", "keyframe.floor_cap_fraction=0"},  // the default, passed through
+                            "--vo-set", "keyframe.floor_cap_fraction=0.7"},  // the simulator profile's, passed through
                            500.0);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const nlohmann::json flights = nlohmann::json::parse(test::read_file(dir / "flights.json"));
@@ -45,7 +45,7 @@ TEST(FlyPlans, ABrmPlanInTheRoomIsFlownToItsGoalOnTheEstimatorsState) {
   // What a person reads: the table and the picture, and each process's log beside the recording.
   EXPECT_NE(test::read_file(dir / "report.md").find("| 1 | brm-su | 1 | 100 % (1/1) |"), std::string::npos)
       << test::read_file(dir / "report.md");
-  EXPECT_NE(test::read_file(dir / "report.md").find("The VO with `--set keyframe.floor_cap_fraction=0`"),
+  EXPECT_NE(test::read_file(dir / "report.md").find("The VO with `--set keyframe.floor_cap_fraction=0.7`"),
             std::string::npos);
   EXPECT_TRUE(fs::exists(dir / "room_pair1.png"));
   const fs::path flight = dir / "room" / "pair1" / "brm-su" / "seed1";

@@ -34,7 +34,7 @@ TEST(SlamTool, BadOptionsAreExitCode2) {
   EXPECT_EQ(run({tool("slam"), "--kernel", "tukey"}).exit_code, kExitUsage);
   EXPECT_EQ(run({tool("slam"), "--keyframe-distance", "-1"}).exit_code, kExitUsage);
   EXPECT_EQ(run({tool("slam"), "--candidates", "0"}).exit_code, kExitUsage);
-  EXPECT_EQ(run({tool("slam"), "--sensor", "kinect2"}).exit_code, kExitUsage) << "simulator or kinect1";
+  EXPECT_EQ(run({tool("slam"), "--sensor", "kinect2"}).exit_code, kExitUsage) << "default, kinect1 or simulator";
   EXPECT_EQ(run({tool("slam"), "--out", "x.txt"}).exit_code, kExitUsage) << "--out only with --tum";
   EXPECT_EQ(run({tool("slam"), "--tum", "somewhere"}).exit_code, kExitUsage) << "--tum needs --out";
 }

@@ -4,7 +4,7 @@
 //
 // The frames name their sensor (kinect1), so the odometry runs with the Kinect's profile: its
 // chained VO_UPDATEs are the offline `kestrel vo --tum` trajectory of the same folder, pose for
-// pose. (Before the frames carried the model, a replayed log ran with the simulator's profile:
+// pose. (Before the frames carried the model, a replayed log ran with the built-in defaults:
 // ATE 1.68 cm against 1.13.) SLAM closes the recording's loop, the mapper rebuilds its map from
 // the moved keyframes, and that map is the map of the same frames at their true poses.
 //
@@ -130,7 +130,7 @@ TEST(System, ReplayedTumRecordingRunsWithItsCamerasProfileAndMapsTheScene) {
   std::cout << "VO ATE " << scored.ate.error_m.rmse << " m over " << scored.ate.error_m.count << " frames (offline run's trajectory to "
             << worst_m << " m)\n";
   EXPECT_TRUE(test::no_worse_than(scored.ate.error_m.rmse, test::figure("vo.fr1_xyz.ate_rmse")))
-      << "the Kinect's profile gives vo/README.md's figure, the simulator's 1.68 cm";
+      << "the Kinect's profile gives vo/README.md's figure, the built-in defaults 1.68 cm";
 
   const test::Recording rec = test::read_recording(recorded);
   expect_visual_only_state(recorded, truth, replayed);

@@ -122,7 +122,8 @@ TEST(VoProcess, TakesTheCameraProfileTheFramesName) {
       kestrel::test::run_isolated(script, 120.0);
   ASSERT_EQ(r.exit_code, 0) << r.err;
 
-  const VoOptions simulator, kinect = with_sensor(sensors::builtin_profile("kinect1"), VoOptions{});
+  const VoOptions simulator = with_sensor(sensors::builtin_profile("simulator"), VoOptions{}),
+                  kinect = with_sensor(sensors::builtin_profile("kinect1"), VoOptions{});
   ASSERT_NE(simulator.covariance.translation_floor_m, kinect.covariance.translation_floor_m);
   const auto named = updates((dir / "named.lcmlog").string()), told = updates((dir / "told.lcmlog").string());
   ASSERT_EQ(named.size(), 6u);
