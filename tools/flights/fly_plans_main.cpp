@@ -251,7 +251,7 @@ int run(const Options& o) {
                                                             *sc.env, shown, 3.0, ppm));
       spdlog::info("wrote {}", png.string());
     }
-    report += "## " + world_name + "\n\n" + flights::markdown_table(rows, world_name) + "\n";
+    report += "## " + world_name + "\n\n" + flights::markdown_table(rows, world_name, o.arrive_radius) + "\n";
     write_file_atomically((out / "report.md").string(), report);
     write_file_atomically((out / "flights.json").string(), flights::to_json(rows).dump(2) + "\n");
   }
