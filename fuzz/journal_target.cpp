@@ -19,14 +19,15 @@ bool run_journal(const uint8_t* data, size_t size) {
     }
     mapper::Mapper mapper;
     const mapper::Restored restored = mapper::restore_journal(journal, mapper, "mapper.journal");
-    if (restored.keyframes > static_cast<int64_t>(journal.records.size())) {
-      defect("mapper-journal", "more keyframes restored than records read");
+    if (restored.keyframes + restored.pinned > static_cast<int64_t>(journal.records.size())) {
+      defect("mapper-journal", "more keyframes and pinned frames restored than records read");
     }
   });
 }
 
 // A journal as a mapper writes it: two keyframes (a wall 1.5 m ahead, seen from two places),
-// a graph that moves the first, a third keyframe.
+// a graph that moves the first, a third keyframe, then two frames pinned for keyframes SLAM
+// has not placed yet, the first of which joins.
 std::vector<Bytes> journal_seeds() {
   const PinholeCamera camera = small_camera(32, 24);
   const auto frame = [&](int64_t utime) {
@@ -51,6 +52,9 @@ std::vector<Bytes> journal_seeds() {
     moved.num_keyframes = 1;
     journal.graph(moved);
     journal.keyframe(keyframe(3000000, 0.6), frame(3000000));
+    journal.pinned(frame(4000000));
+    journal.pinned(frame(5000000));
+    journal.keyframe(keyframe(4000000, 0.9), frame(4000000));
   }
   return {file_bytes(path)};
 }

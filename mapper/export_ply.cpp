@@ -19,7 +19,7 @@ struct Point {
 size_t write_ply(const KeyframeStore& keyframes, const std::string& path, double max_range_m) {
   std::vector<Point> points;
   const double max_mm = max_range_m * 1000.0;
-  for (const StoredKeyframe* kf : keyframes.in_time_order()) {
+  for (const StoredKeyframe* kf : keyframes.in_stored_order()) {
     const RgbdFrame& f = kf->frame;
     const Eigen::Isometry3d T_world_depth = kf->T_world_depth();
     const PinholeCamera& c = f.camera;

@@ -59,6 +59,12 @@ JournalRecord decode_record(char kind, const std::vector<uint8_t>& payload, cons
     r.graph = transport::decode_message<kestrel::slam_graph_t>(payload.data(), payload.size(), what);
     return r;
   }
+  if (kind == kPinned) {
+    r.kind = JournalRecord::Kind::kPinned;
+    const auto frame = transport::decode_message<kestrel::rgbd_frame_t>(payload.data(), payload.size(), what);
+    r.frame = transport::decode_rgbd(frame, what.c_str());
+    return r;
+  }
   if (kind != kKeyframe) throw InputError(what + ": unknown record kind " + std::to_string(kind));
   if (payload.size() < 4) throw InputError(what + ": keyframe record too short");
   const uint32_t size = get_u32(payload.data());
@@ -124,6 +130,10 @@ std::optional<uint64_t> next_record(const JournalBytes& file, uint64_t from, con
     const std::vector<uint8_t> m = transport::encode_message(kestrel::slam_keyframe_t{});
     return std::vector<uint8_t>(m.begin(), m.begin() + kFingerprint);
   }();
+  static const std::vector<uint8_t> frame_hash = [] {
+    const std::vector<uint8_t> m = transport::encode_message(kestrel::rgbd_frame_t{});
+    return std::vector<uint8_t>(m.begin(), m.begin() + kFingerprint);
+  }();
   // Windows overlap by what a candidate needs to be looked at: its head and the fingerprint
   // (after a keyframe's u32).
   constexpr size_t kLook = kRecordHead + 4 + kFingerprint;
@@ -138,13 +148,13 @@ std::optional<uint64_t> next_record(const JournalBytes& file, uint64_t from, con
       const uint8_t* p = window.data() + i;
       const size_t left = n - i;
       if (left < kRecordHead + kFingerprint + kRecordTail) break;  // no record is smaller
-      if (p[0] != kKeyframe && p[0] != kGraph) continue;
+      if (p[0] != kKeyframe && p[0] != kGraph && p[0] != kPinned) continue;
       const uint32_t size = get_u32(p + 1);
       if (size > kMaxPayload || base + i + kRecordHead + size + kRecordTail > file.size()) continue;
-      const bool graph = p[0] == kGraph;
-      const size_t hash_at = kRecordHead + (graph ? 0 : 4);
+      const bool keyframe = p[0] == kKeyframe;  // the only kind with a u32 before its message
+      const size_t hash_at = kRecordHead + (keyframe ? 4 : 0);
       if (size < hash_at - kRecordHead + kFingerprint || left < hash_at + kFingerprint) continue;
-      const std::vector<uint8_t>& hash = graph ? graph_hash : keyframe_hash;
+      const std::vector<uint8_t>& hash = keyframe ? keyframe_hash : p[0] == kGraph ? graph_hash : frame_hash;
       if (!std::equal(hash.begin(), hash.end(), p + hash_at)) continue;
       if (size > crc_budget) return std::nullopt;
       crc_budget -= size;

@@ -115,7 +115,8 @@ JournalContents read_journal(const std::string& path) {
   contents.file_bytes = file.size();
   std::string header(journal::kHeaderSize, '\0');
   uint64_t at = 0;
-  const bool header_ok = file.read(0, header.data(), journal::kHeaderSize) && header == journal::kHeader;
+  const bool header_ok = file.read(0, header.data(), journal::kHeaderSize) &&
+                         (header == journal::kHeader || header == journal::kHeaderVersion1);
   if (header_ok) {
     at = journal::kHeaderSize;
   } else {
@@ -175,9 +176,15 @@ GraphKeyframe to_graph_keyframe(const kestrel::slam_keyframe_t& keyframe, const 
 
 Restored restore_journal(const JournalContents& journal, Mapper& mapper, const std::string& what) {
   Restored restored;
+  // Pinned frames by utime, oldest first; a keyframe record of the same time after a pin is
+  // its keyframe joining (Mapper::apply_graph took the pinned frame then).
+  std::map<int64_t, const RgbdFrame*> pinned;
   for (const JournalRecord& r : journal.records) {
-    if (r.kind == JournalRecord::Kind::kKeyframe) {
+    if (r.kind == JournalRecord::Kind::kPinned) {
+      pinned[r.frame.utime] = &r.frame;
+    } else if (r.kind == JournalRecord::Kind::kKeyframe) {
       mapper.restore_keyframe(to_graph_keyframe(r.keyframe, what.c_str()), r.frame);
+      pinned.erase(r.keyframe.utime);
       ++restored.keyframes;
     } else {
       std::vector<GraphKeyframe> keyframes;
@@ -188,6 +195,9 @@ Restored restore_journal(const JournalContents& journal, Mapper& mapper, const s
     }
   }
   if (restored.keyframes > 0) mapper.rebuild_from_scratch();
+  const size_t pinned_before = mapper.pinned();
+  for (const auto& [utime, frame] : pinned) mapper.restore_pinned(*frame);  // the oldest go past the bound
+  restored.pinned = static_cast<int64_t>(mapper.pinned() - pinned_before);
   return restored;
 }
 
@@ -217,7 +227,7 @@ JournalWriter::JournalWriter(std::string path, const JournalContents& contents, 
   for (const JournalRecord& r : contents.records) {
     if (r.kind == JournalRecord::Kind::kKeyframe) {
       place(r.keyframe);
-    } else {
+    } else if (r.kind == JournalRecord::Kind::kGraph) {
       for (const auto& k : r.graph.keyframes) place(k);
     }
   }
@@ -259,9 +269,13 @@ uint64_t JournalWriter::write_record(std::ostream& out, char kind, const std::ve
   return bytes.size();
 }
 
+std::vector<uint8_t> JournalWriter::frame_payload(const RgbdFrame& frame) {
+  return transport::encode_message(transport::encode_rgbd(frame, lossless()));
+}
+
 std::vector<uint8_t> JournalWriter::keyframe_payload(const kestrel::slam_keyframe_t& keyframe, const RgbdFrame& frame) {
   const std::vector<uint8_t> k = transport::encode_message(keyframe);
-  const std::vector<uint8_t> f = transport::encode_message(transport::encode_rgbd(frame, lossless()));
+  const std::vector<uint8_t> f = frame_payload(frame);
   std::vector<uint8_t> payload;
   payload.reserve(4 + k.size() + f.size());
   journal::put_u32(payload, static_cast<uint32_t>(k.size()));
@@ -287,7 +301,10 @@ void JournalWriter::graph(const kestrel::slam_graph_t& graph) {
   for (const auto& k : graph.keyframes) place(k);
 }
 
-void JournalWriter::compact(const std::vector<LiveKeyframe>& keyframes, int64_t graph_revision) {
+void JournalWriter::pinned(const RgbdFrame& frame) { append(journal::kPinned, frame_payload(frame)); }
+
+void JournalWriter::compact(const std::vector<LiveKeyframe>& keyframes, int64_t graph_revision,
+                            const std::vector<const RgbdFrame*>& pinned) {
   {
     AtomicFile file(path_);  // the old journal stays whole (and open for append) until commit
     file.stream().write(journal::kHeader, static_cast<std::streamsize>(journal::kHeaderSize));
@@ -303,6 +320,7 @@ void JournalWriter::compact(const std::vector<LiveKeyframe>& keyframes, int64_t 
       graph.revision = graph_revision;
       write_record(file.stream(), journal::kGraph, transport::encode_message(graph));
     }
+    for (const RgbdFrame* frame : pinned) write_record(file.stream(), journal::kPinned, frame_payload(*frame));
     file.commit();
   }
   out_.close();

@@ -4,14 +4,18 @@
 // --restart`) rebuilds the map it had instead of starting from nothing. Once a keyframe's
 // frame has left the bus, the mapper's copy is the only one; the journal keeps it on disk.
 //
-// File: the header "kestrel mapper journal 1\n", then records, each
-//   kind (1 byte: 'K' keyframe, 'G' graph) | payload size (u32, little-endian) | payload |
-//   CRC-32 of kind, size and payload (u32, little-endian).
+// File: the header "kestrel mapper journal 2\n" (version 1, without pinned records, still
+// reads), then records, each
+//   kind (1 byte: 'K' keyframe, 'G' graph, 'P' pinned frame) | payload size (u32,
+//   little-endian) | payload | CRC-32 of kind, size and payload (u32, little-endian).
 // A keyframe's payload is the keyframe as SLAM_GRAPH gave it and the frame the mapper stored
 // (decimated; raw colour and zstd depth, so lossless), both LCM-encoded, the first with its
 // size (u32) in front. A graph's payload is a SLAM_GRAPH message holding only the stored
 // keyframes that graph moved (their new poses; no edges), so the journal grows with what moved,
-// not with the whole graph at each loop closure.
+// not with the whole graph at each loop closure. A pinned frame's payload is a frame the mapper
+// keeps for a keyframe SLAM has not placed in its saved map yet (Mapper::pin; LCM-encoded as a
+// keyframe's): a mapper restarted before the placement pins it again, unless a keyframe record
+// after it shows that its keyframe joined.
 // Records are written whole and flushed to the kernel at once, so a process killed at any
 // point leaves every earlier record intact.
 //
@@ -60,10 +64,10 @@
 namespace kestrel::mapper {
 
 struct JournalRecord {
-  enum class Kind { kKeyframe, kGraph };
+  enum class Kind { kKeyframe, kGraph, kPinned };
   Kind kind = Kind::kKeyframe;
   kestrel::slam_keyframe_t keyframe;  ///< kKeyframe
-  RgbdFrame frame;                    ///< kKeyframe: as the mapper stored it (decimated)
+  RgbdFrame frame;                    ///< kKeyframe: as the mapper stored it; kPinned: as it pinned it (decimated)
   kestrel::slam_graph_t graph;        ///< kGraph
 };
 
@@ -87,12 +91,14 @@ GraphKeyframe to_graph_keyframe(const kestrel::slam_keyframe_t& keyframe, const 
 
 struct Restored {
   int64_t keyframes = 0;      ///< keyframe records put into the store
+  int64_t pinned = 0;         ///< frames pinned again (their keyframes had not joined)
   int64_t last_revision = -1; ///< of the last graph record (-1: none)
 };
 
 /// Replays `journal` into `mapper` (Mapper::restore_keyframe, restore_poses: the steps
 /// apply_graph took, so the keyframes end at the same poses, bit for bit) and rebuilds its
-/// map from them. `what` names the journal in errors.
+/// map from them; pins again the pinned frames no later keyframe record took
+/// (Mapper::restore_pinned). `what` names the journal in errors.
 Restored restore_journal(const JournalContents& journal, Mapper& mapper, const std::string& what);
 
 /// How many journals set aside of each kind a writer keeps unless told otherwise.
@@ -136,6 +142,8 @@ class JournalWriter {
 
   void keyframe(const kestrel::slam_keyframe_t& keyframe, const RgbdFrame& frame);
   void graph(const kestrel::slam_graph_t& graph);
+  /// A frame the mapper pinned (Mapper::pin), as it keeps it.
+  void pinned(const RgbdFrame& frame);
   /// The map was reset: `path` starts again as an empty journal, the one it ends kept as
   /// "<path>.reset-<utime>" (if it holds a record). Throws InputError (nothing changed) if the
   /// old one cannot be kept.
@@ -144,10 +152,11 @@ class JournalWriter {
   /// this journal placed it (its keyframe record, or the last graph record that moved it: the
   /// pose exactly as SLAM sent it, so a restore is bit for bit), and, when `graph_revision`
   /// >= 0, a graph record of that revision that moves nothing (a restored mapper then still
-  /// refuses older graphs); see the top of this file. Atomic: on any failure (InputError
-  /// naming the file; std::invalid_argument for a keyframe this journal never held) the old
-  /// journal is still whole and still appended to.
-  void compact(const std::vector<LiveKeyframe>& keyframes, int64_t graph_revision);
+  /// refuses older graphs), then the frames still `pinned`; see the top of this file. Atomic:
+  /// on any failure (InputError naming the file; std::invalid_argument for a keyframe this
+  /// journal never held) the old journal is still whole and still appended to.
+  void compact(const std::vector<LiveKeyframe>& keyframes, int64_t graph_revision,
+               const std::vector<const RgbdFrame*>& pinned = {});
   /// How many times compact() replaced the journal.
   int compactions() const { return compactions_; }
 
@@ -168,6 +177,7 @@ class JournalWriter {
   // place a record's layout is written, for appends and for compaction alike.
   static uint64_t write_record(std::ostream& out, char kind, const std::vector<uint8_t>& payload);
   static std::vector<uint8_t> keyframe_payload(const kestrel::slam_keyframe_t& keyframe, const RgbdFrame& frame);
+  static std::vector<uint8_t> frame_payload(const RgbdFrame& frame);
 
   std::string path_;
   int keep_;

@@ -39,6 +39,7 @@ void KeyframeStore::add(StoredKeyframe keyframe) {
     keyframes_.erase(old);
   }
   bins_.insert(id, keyframe.T_world_camera);
+  keyframe.stored_order = next_stored_order_++;
   bytes_ += keyframe.bytes();
   keyframes_.emplace(id, std::move(keyframe));
   const double budget = options_.max_megabytes * 1e6;
@@ -68,12 +69,13 @@ const StoredKeyframe* KeyframeStore::find(int64_t id) const {
   return it == keyframes_.end() ? nullptr : &it->second;
 }
 
-std::vector<const StoredKeyframe*> KeyframeStore::in_time_order() const {
+std::vector<const StoredKeyframe*> KeyframeStore::in_stored_order() const {
   std::vector<const StoredKeyframe*> out;
   out.reserve(keyframes_.size());
   for (const auto& [id, kf] : keyframes_) out.push_back(&kf);
-  std::stable_sort(out.begin(), out.end(),
-                   [](const StoredKeyframe* a, const StoredKeyframe* b) { return a->utime < b->utime; });
+  std::sort(out.begin(), out.end(), [](const StoredKeyframe* a, const StoredKeyframe* b) {
+    return a->stored_order < b->stored_order;
+  });
   return out;
 }
 

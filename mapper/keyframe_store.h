@@ -38,6 +38,9 @@ struct StoredKeyframe {
   /// The depth image's camera in the camera at utime (a SLAM keyframe's timing; identity for
   /// frames placed at their depth time already). The depth goes in at T_world_depth().
   Eigen::Isometry3d T_camera_depth = Eigen::Isometry3d::Identity();
+  /// When it was stored, counted by the store (KeyframeStore::add sets it; a replaced keyframe
+  /// counts as stored anew).
+  uint64_t stored_order = 0;
   Eigen::Isometry3d T_world_depth() const { return T_world_camera * T_camera_depth; }
   size_t bytes() const;
 };
@@ -57,8 +60,11 @@ class KeyframeStore {
   std::optional<int64_t> max_id() const {
     return keyframes_.empty() ? std::nullopt : std::optional<int64_t>(keyframes_.rbegin()->first);
   }
-  /// Stored keyframes, ordered by sensor time (the order to rebuild in).
-  std::vector<const StoredKeyframe*> in_time_order() const;
+  /// Stored keyframes in the order they were stored: the order the live map took them in, and
+  /// so the order a rebuild inserts them in and a journal's compaction writes them in. Not
+  /// sensor time: two flights on one saved map may share sensor times (both simulated ones
+  /// start at 0), and a keyframe SLAM places late (a joined session's) is stored after newer ones.
+  std::vector<const StoredKeyframe*> in_stored_order() const;
 
   size_t size() const { return keyframes_.size(); }
   size_t bytes() const { return bytes_; }
@@ -73,6 +79,7 @@ class KeyframeStore {
   ViewBins bins_;
   size_t bytes_ = 0;
   size_t dropped_ = 0;
+  uint64_t next_stored_order_ = 0;
 };
 
 }  // namespace kestrel::mapper

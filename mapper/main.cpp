@@ -56,7 +56,8 @@ int serve(Options& o) {
                    "what was read", o.node.journal_path, map.journal_damage(), map.journal_kept_aside());
       log_pruned_journals(map, o.node.journal_keep);
     }
-    spdlog::info("journal {}: {} keyframes restored", o.node.journal_path, map.stats().keyframes_restored);
+    spdlog::info("journal {}: {} keyframes restored, {} frames of unplaced keyframes pinned again", o.node.journal_path,
+                 map.stats().keyframes_restored, map.stats().pinned_restored);
   }
 
   std::unique_ptr<transport::Node> node;

@@ -43,6 +43,7 @@ MapNode::MapNode(const NodeOptions& options)
   journal_damage_ = journal.damage;
   const Restored restored = restore_journal(journal, mapper_, options_.journal_path);
   stats_.keyframes_restored = restored.keyframes;
+  stats_.pinned_restored = restored.pinned;
   last_graph_revision_ = restored.last_revision;
   // A damaged journal is kept aside whole and continued as a fresh copy of what was read. If
   // that fails (a full disk is the usual cause of the damage), the restored map is kept and
@@ -101,12 +102,12 @@ void MapNode::compact_journal_if_due() {
   const double margin = options_.journal_compact_mb * 1e6;
   const double due = std::max(2.0 * static_cast<double>(store.bytes()) + margin, compact_retry_bytes_);
   if (static_cast<double>(journal_->bytes()) <= due) return;
-  // In sensor time, about the order they were stored in (a restore bins them in this order).
+  // In the order they were stored: a restore stores and bins them in this order again.
   std::vector<LiveKeyframe> live;
   live.reserve(store.size());
-  for (const StoredKeyframe* k : store.in_time_order()) live.push_back({k->id, &k->frame});
+  for (const StoredKeyframe* k : store.in_stored_order()) live.push_back({k->id, &k->frame});
   try {
-    journal_->compact(live, last_graph_revision_);
+    journal_->compact(live, last_graph_revision_, mapper_.pinned_frames());
     journal_compaction_error_.clear();
   } catch (const std::exception& e) {
     // compact() is atomic: the old journal is whole and still appended to, so journalling goes
@@ -290,7 +291,10 @@ void MapNode::on_unplaced_graph(const kestrel::slam_graph_t& msg, const char* ch
   mapper_.keep_pinned(listed);  // a keyframe no longer listed will not join (a SLAM restarted)
   for (const auto& k : msg.keyframes) {
     if (mapper_.keyframes().find(k.id) != nullptr) continue;  // already in the map
-    if (mapper_.pin(k.utime) == Mapper::Pin::kPinned) ++stats_.unplaced_pinned;
+    if (mapper_.pin(k.utime) != Mapper::Pin::kPinned) continue;
+    ++stats_.unplaced_pinned;
+    // On disk too: a mapper restarted before the placement would otherwise have lost the frame.
+    journal([&](JournalWriter& writer) { writer.pinned(*mapper_.buffered(k.utime)); });
   }
 }
 

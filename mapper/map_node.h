@@ -94,6 +94,7 @@ struct NodeStats {
   int64_t repeated = 0;           ///< the last map sent again (kSlamGraph, no new map for a period)
   double last_rebuild_keyframes = 0;
   int64_t keyframes_restored = 0;  ///< from the journal at start
+  int64_t pinned_restored = 0;     ///< frames of unplaced keyframes pinned again from the journal at start
   int64_t located = 0;             ///< located frames inserted (insert_located)
   int64_t located_missing = 0;     ///< located frames no longer buffered
   int64_t unplaced_pinned = 0;     ///< frames of unplaced keyframes pinned (kept past the buffer)
@@ -114,7 +115,8 @@ class MapNode {
                                                     const char* channel);
   /// kSlamGraph: SLAM_GRAPH_UNPLACED, the keyframes SLAM made before it placed the camera in
   /// its saved map (in a frame of their own, not in the map): their frames are kept past the
-  /// buffer (Mapper::pin) until the placement joins them and a SLAM_GRAPH names them; frames
+  /// buffer (Mapper::pin; journaled, so a restarted mapper keeps them too) until the placement
+  /// joins them and a SLAM_GRAPH names them; frames
   /// pinned for keyframes a later list leaves out, and all once a SLAM_GRAPH comes (SLAM sends
   /// whole graphs only once placed), are let go. Nothing goes into the map. Throws InputError
   /// naming the channel for a count that disagrees.

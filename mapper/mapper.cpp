@@ -145,9 +145,27 @@ Mapper::Pin Mapper::pin(int64_t utime) {
   if (pinned_.count(utime) != 0) return Pin::kAlready;
   const RgbdFrame* frame = buffered(utime);
   if (frame == nullptr) return Pin::kGone;
-  pinned_.emplace(utime, *frame);
+  return hold_pinned(RgbdFrame(*frame));
+}
+
+Mapper::Pin Mapper::hold_pinned(RgbdFrame frame) {
+  const int64_t utime = frame.utime;
+  pinned_.emplace(utime, std::move(frame));
   while (static_cast<int>(pinned_.size()) > options_.max_pinned_frames) pinned_.erase(pinned_.begin());
   return pinned_.count(utime) != 0 ? Pin::kPinned : Pin::kGone;  // the oldest itself may go
+}
+
+std::vector<const RgbdFrame*> Mapper::pinned_frames() const {
+  std::vector<const RgbdFrame*> frames;
+  frames.reserve(pinned_.size());
+  for (const auto& [utime, frame] : pinned_) frames.push_back(&frame);
+  return frames;
+}
+
+Mapper::Pin Mapper::restore_pinned(RgbdFrame decimated) {
+  decimated.validate("restored pinned frame");
+  if (pinned_.count(decimated.utime) != 0) return Pin::kAlready;
+  return hold_pinned(std::move(decimated));
 }
 
 void Mapper::keep_pinned(const std::set<int64_t>& utimes) {
@@ -219,10 +237,10 @@ GraphResult Mapper::apply_graph(const std::vector<GraphKeyframe>& graph) {
 }
 
 void Mapper::store(StoredKeyframe kf, bool insert_now) {
-  // A keyframe older than a stored one breaks the live map's time order (a rebuild would
-  // insert it earlier), so the live map is no longer a checkpointable sequence.
-  const auto order = keyframes_.in_time_order();
-  if (!order.empty() && order.back()->utime >= kf.utime) map_is_sequence_ = false;
+  // A new keyframe goes last in the store's order, as into the live map. One that replaces a
+  // stored keyframe does too, but the map also holds its earlier insertion, which no rebuild
+  // repeats: the live map is no longer a checkpointable sequence.
+  if (keyframes_.contains(kf.id)) map_is_sequence_ = false;
   if (insert_now) integrate_keyframe(kf);
   keyframes_.add(std::move(kf));
 }
@@ -244,7 +262,7 @@ size_t Mapper::rebuild() { return rebuild_from(true); }
 size_t Mapper::rebuild_from_scratch() { return rebuild_from(false); }
 
 size_t Mapper::rebuild_from(bool use_checkpoints) {
-  const std::vector<const StoredKeyframe*> order = keyframes_.in_time_order();
+  const std::vector<const StoredKeyframe*> order = keyframes_.in_stored_order();
   // The newest checkpoint holding exactly the first keyframes of `order` at their current
   // poses (a pose that moved by less than the rebuild threshold was not updated, so equality
   // is exact); the ones after it are stale.

@@ -15,7 +15,7 @@
 //    rebuild_interval_s of sensor time (later moves wait for the next allowed rebuild).
 //
 // The log-odds of a frame cannot be taken out of a clamped map, so moved keyframes mean a
-// rebuild rather than an update. A rebuild inserts the keyframes in time order; copies of the
+// rebuild rather than an update. A rebuild inserts the keyframes in the order they were stored; copies of the
 // map taken along the way (checkpoints, every checkpoint_every keyframes, within a memory
 // budget) each remember which keyframes at which poses they hold, so the next rebuild starts
 // from the newest checkpoint whose keyframes are unchanged and re-inserts only the rest. When a
@@ -49,7 +49,7 @@ struct MapperOptions {
   double rebuild_interval_s = 1.0;       ///< at most one rebuild per this much sensor time
   double frame_buffer_s = 5.0;           ///< frames kept for SLAM keyframes to refer to
   int max_pinned_frames = 300;           ///< frames kept past the buffer for keyframes SLAM has not placed yet (pin())
-  /// Rebuild checkpoints: a copy of the map after every this many keyframes (in time order),
+  /// Rebuild checkpoints: a copy of the map after every this many keyframes (in stored order),
   /// so a rebuild starts from the last one whose keyframes did not move (0 = none).
   int checkpoint_every = 8;
   double checkpoint_megabytes = 128.0;   ///< budget of the copies; over it every other one goes
@@ -112,6 +112,11 @@ class Mapper {
   /// empty: all, once SLAM placed the camera and sends whole graphs).
   void keep_pinned(const std::set<int64_t>& utimes);
   size_t pinned() const { return pinned_.size(); }
+  /// The pinned frames, oldest first (for the journal's compaction).
+  std::vector<const RgbdFrame*> pinned_frames() const;
+  /// A restarted mapper (map_node.h's journal): a frame pinned before the restart, as it was
+  /// pinned (decimated), pinned again; InputError for a broken frame. Same result as pin().
+  Pin restore_pinned(RgbdFrame decimated);
 
   /// A restarted mapper (map_node.h's journal): a keyframe stored before the restart, its frame
   /// as stored then. It goes into the store, not yet into the map: rebuild() after the last.
@@ -164,6 +169,7 @@ class Mapper {
   Scan scan_;                      // reused: a fresh one per frame cost page faults
   std::deque<RgbdFrame> buffer_;   // decimated, by increasing utime
   std::map<int64_t, RgbdFrame> pinned_;  // utime -> frame kept past the buffer (pin())
+  Pin hold_pinned(RgbdFrame frame);      // into pinned_, the oldest let go past the limit
   bool have_last_keyframe_ = false;
   Eigen::Isometry3d last_keyframe_pose_ = Eigen::Isometry3d::Identity();
   int64_t next_keyframe_id_ = 0;
@@ -172,7 +178,7 @@ class Mapper {
   size_t frames_inserted_ = 0;
   size_t rebuilds_ = 0;
   // The live map is exactly sequence_'s keyframes inserted in order (false once insert() put
-  // a non-keyframe frame in, or a keyframe arrived out of time order).
+  // a non-keyframe frame in, or a stored keyframe was replaced).
   bool map_is_sequence_ = true;
   std::vector<Placed> sequence_;
   std::vector<Checkpoint> checkpoints_;  // increasing length, each a prefix of the next

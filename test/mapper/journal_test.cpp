@@ -87,7 +87,11 @@ std::string summary(const JournalContents& c) {
   std::string s;
   for (const JournalRecord& r : c.records) {
     if (!s.empty()) s += ' ';
-    s += r.kind == JournalRecord::Kind::kGraph ? "G" : "K" + std::to_string(r.keyframe.id);
+    switch (r.kind) {
+      case JournalRecord::Kind::kGraph: s += "G"; break;
+      case JournalRecord::Kind::kKeyframe: s += "K" + std::to_string(r.keyframe.id); break;
+      case JournalRecord::Kind::kPinned: s += "P" + std::to_string(r.frame.utime / 100000); break;
+    }
   }
   return s;
 }
@@ -372,6 +376,72 @@ TEST(KeyframeJournal, CompactionKeepsTheKeyframesAsPlacedOrChangesNothing) {
   writer.graph(later);
   EXPECT_EQ(summary(read_journal(w.path)), "K0 K2 K3 G G");
   EXPECT_TRUE(kept_journals(w.path, "reset").empty() && kept_journals(w.path, "damaged").empty());
+}
+
+// Frames pinned for keyframes SLAM has not placed yet (version 2's 'P' records): read past
+// damage like the other kinds, written by a compaction, and pinned again by a restore unless a
+// later keyframe record of the same time shows that their keyframe joined. A version 1 journal
+// (no such records) still reads whole.
+TEST(KeyframeJournal, PinnedFramesAreJournaledAndPinnedAgainUnlessTheirKeyframeJoined) {
+  kestrel::test::TempDir dir;
+  const test::Scene scene = test::room_with_a_box();
+  const Written w = write_journal(dir.path());
+  const auto frame_at = [&](int64_t utime) {
+    return decimate(scene.render(test::kinect_camera(160, 120), test::look_at({-0.5, 0.0, 1.2}, {2.0, 0.3, 0.7}), utime), 5);
+  };
+  {
+    JournalWriter writer(w.path, read_journal(w.path));
+    writer.pinned(frame_at(500000));
+    writer.pinned(frame_at(600000));
+    writer.pinned(frame_at(700000));
+    writer.keyframe(keyframe(6, 700000, 0.6), frame_at(700000));  // 7's keyframe joined
+  }
+  const JournalContents read = read_journal(w.path);
+  ASSERT_EQ(read.damage, "");
+  EXPECT_EQ(summary(read), "K0 K1 G K2 K3 P5 P6 P7 K6");
+  MapperOptions options;
+  options.max_pinned_frames = 1;
+  Mapper bounded(options);
+  EXPECT_EQ(restore_journal(read, bounded, w.path).pinned, 1);
+  EXPECT_EQ(bounded.pinned_frames().front()->utime, 600000) << "the newest kept within the bound";
+  Mapper mapper;
+  const Restored restored = restore_journal(read, mapper, w.path);
+  EXPECT_EQ(restored.keyframes, 5);
+  EXPECT_EQ(restored.pinned, 2);
+  ASSERT_EQ(mapper.pinned(), 2u);
+  EXPECT_NE(mapper.buffered(500000), nullptr);
+  EXPECT_NE(mapper.buffered(600000), nullptr);
+  EXPECT_EQ(mapper.buffered(700000), nullptr) << "its keyframe joined before the restart";
+
+  // A flipped byte in the first pinned record loses it alone: reading finds the next one.
+  const std::string whole = kestrel::test::read_file(w.path);
+  const size_t first_pin = w.ends.back() + 100;
+  std::string damaged = whole;
+  damaged[first_pin] = static_cast<char>(damaged[first_pin] ^ 0x5a);
+  kestrel::test::TempDir dir2;
+  const std::string damaged_path = (dir2.path() / "mapper.journal").string();
+  const auto write_file = [](const std::string& path, const std::string& bytes) {
+    std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
+  };
+  write_file(damaged_path, damaged);
+  EXPECT_EQ(summary(read_journal(damaged_path)), "K0 K1 G K2 K3 P6 P7 K6");
+
+  // A compaction writes the pins it is given, after the keyframes and the graph.
+  {
+    JournalWriter writer(w.path, read);
+    const RgbdFrame pin = frame_at(500000);
+    writer.compact({{0, &read.records[0].frame}}, 2, {&pin});
+  }
+  EXPECT_EQ(summary(read_journal(w.path)), "K0 G P5");
+
+  // Version 1: the same records but pinned ones, under the old header.
+  std::string version1 = kestrel::test::read_file(w.path).substr(0, w.ends[0]);
+  version1 += whole.substr(w.ends[0], w.ends.back() - w.ends[0]);
+  version1.replace(0, version1.find('\n'), "kestrel mapper journal 1");
+  write_file(damaged_path, version1);
+  const JournalContents old = read_journal(damaged_path);
+  EXPECT_EQ(old.damage, "");
+  EXPECT_EQ(summary(old), "K0 K1 G K2 K3");
 }
 
 }  // namespace

@@ -179,7 +179,7 @@ void BM_Rebuild(benchmark::State& state) {
   const Frames& f = frames();
   for (size_t i = 0; i < f.frames.size(); ++i) mapper.insert(f.frames[i], f.poses[i]);
   std::vector<GraphKeyframe> graph;
-  for (const StoredKeyframe* kf : mapper.keyframes().in_time_order())
+  for (const StoredKeyframe* kf : mapper.keyframes().in_stored_order())
     graph.push_back({kf->id, kf->utime, kf->T_world_camera});
   mapper.rebuild();  // the first rebuild takes the checkpoints
   const size_t moved_from = graph.size() - graph.size() / 4;

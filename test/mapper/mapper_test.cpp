@@ -142,6 +142,64 @@ TEST(Mapper, RebuildStartsFromTheLastCheckpointBeforeTheFirstMovedKeyframe) {
   expect_same_maps(thin.map(), mapper.map());
 }
 
+// A second flight on a saved map (the first flight's keyframes restored from its journal)
+// starts its sensor time again, so its keyframes share times with the first's; here the box was
+// moved between the flights. The live map took the first flight, then the second, and a rebuild
+// must insert them in that order too: interleaved by time, the clamped log-odds of the cells
+// the box left (and moved to) come out otherwise.
+TEST(Mapper, ARebuildKeepsTheOrderTheKeyframesWereStoredInAcrossFlightsThatShareTimes) {
+  const Scene before = test::room_with_a_box();
+  Scene after = before;
+  after.clear_boxes();
+  after.add_box(Eigen::Vector3d(0.8, 0.5, 0.0), Eigen::Vector3d(1.4, 1.2, 0.9));
+  const auto poses = sweep(8);
+  MapperOptions options;
+  options.rebuild_interval_s = 0.0;
+  options.checkpoint_every = 3;
+  const auto flight = [&](Mapper& mapper, const Scene& scene, int64_t first_id) {
+    std::vector<GraphKeyframe> graph;
+    for (size_t i = 0; i < poses.size(); ++i) {
+      const int64_t utime = 1000000 + 200000 * static_cast<int64_t>(i);
+      mapper.buffer_frame(scene.render(test::kinect_camera(), poses[i], utime));
+      graph.push_back({first_id + static_cast<int64_t>(i), utime, poses[i]});
+    }
+    EXPECT_EQ(mapper.apply_graph(graph).inserted.size(), poses.size());
+    return graph;
+  };
+  Mapper first(options);
+  const std::vector<GraphKeyframe> first_graph = flight(first, before, 0);
+  // The second flight's mapper starts from the first's keyframes, as from its journal.
+  Mapper second(options);
+  for (const GraphKeyframe& g : first_graph) second.restore_keyframe(g, first.keyframes().find(g.id)->frame);
+  second.rebuild();
+  expect_same_maps(second.map(), first.map());
+  std::vector<GraphKeyframe> graph = flight(second, after, 100);
+  const VoxelMap live = second.map();
+  // Interleaved by time, the same keyframes make another map: the order matters for this test.
+  Mapper interleaved(options);
+  for (size_t i = 0; i < poses.size(); ++i) {
+    interleaved.restore_keyframe(first_graph[i], first.keyframes().find(first_graph[i].id)->frame);
+    interleaved.restore_keyframe(graph[i], second.keyframes().find(graph[i].id)->frame);
+  }
+  interleaved.rebuild();
+  ASSERT_EQ(interleaved.map().num_cells(), live.num_cells());
+  size_t differing = 0;
+  live.for_each_cell([&](const Key& k, float v) { differing += interleaved.map().log_odds(k) != v; });
+  ASSERT_GT(differing, 20u) << "where the box was and went, the flights' order should show";
+
+  second.rebuild_from_scratch();
+  expect_same_maps(second.map(), live);
+  // A loop closure that moves the second flight's last keyframe and back: the rebuild from the
+  // checkpoints gives the map again.
+  graph.back().T_world_camera.translation().x() += 0.05;
+  ASSERT_TRUE(second.apply_graph(graph).rebuilt);
+  graph.back().T_world_camera.translation().x() -= 0.05;
+  const GraphResult back = second.apply_graph(graph);
+  ASSERT_TRUE(back.rebuilt);
+  EXPECT_LT(back.reinserted, 2 * poses.size()) << "a checkpoint of the live sequence was used";
+  expect_same_maps(second.map(), live);
+}
+
 TEST(Mapper, RebuildsAreRateLimitedAndMissingFramesCounted) {
   const Scene scene = test::room_with_a_box();
   const auto truth = sweep(3);

@@ -227,8 +227,8 @@ TEST(MapNode, BadFramesAreRejectedNamingTheChannel) {
 }
 
 void expect_same_keyframes(const Mapper& a, const Mapper& b) {
-  const auto ka = a.keyframes().in_time_order();
-  const auto kb = b.keyframes().in_time_order();
+  const auto ka = a.keyframes().in_stored_order();
+  const auto kb = b.keyframes().in_stored_order();
   ASSERT_EQ(ka.size(), kb.size());
   for (size_t i = 0; i < ka.size(); ++i) {
     EXPECT_EQ(ka[i]->id, kb[i]->id);
@@ -314,6 +314,53 @@ TEST(MapNode, KeyframesSlamHasNotPlacedYetKeepTheirFramesUntilTheyJoin) {
   ASSERT_EQ(node.mapper().pinned(), 1u);
   node.reset();
   EXPECT_EQ(node.mapper().pinned(), 0u);
+}
+
+// The pinned frames are journaled: a mapper restarted (its buffer empty) before SLAM places
+// the camera pins them again, and the placement joins them as if it had not restarted. A frame
+// whose keyframe joined before the restart is not pinned again (compaction and damage:
+// KeyframeJournal.PinnedFramesAreJournaledAndPinnedAgainUnlessTheirKeyframeJoined).
+TEST(MapNode, ARestartedMapperKeepsTheFramesOfKeyframesSlamHasNotPlacedYet) {
+  const test::Scene scene = test::room_with_a_box();
+  kestrel::test::TempDir dir;
+  NodeOptions options;
+  options.mapper.frame_buffer_s = 0.5;
+  options.journal_path = (dir / "mapper.journal").string();
+  const auto announce = [&](MapNode& node, int first, int last) {
+    kestrel::slam_graph_t unplaced{};
+    for (int i = first; i <= last; ++i) {
+      const int64_t t = 100000 * (i + 1);
+      node.on_frame(frame_message(scene, t), "CAMERA_RGBD");
+      unplaced.keyframes.push_back(keyframe_message(i, t));
+    }
+    unplaced.num_keyframes = static_cast<int32_t>(unplaced.keyframes.size());
+    node.on_unplaced_graph(unplaced, "SLAM_GRAPH_UNPLACED");
+  };
+  const auto placement = [&](int last, int64_t revision) {
+    kestrel::slam_graph_t joined{};
+    for (int i = 0; i <= last; ++i) joined.keyframes.push_back(keyframe_message(i, 100000 * (i + 1)));
+    joined.num_keyframes = static_cast<int32_t>(joined.keyframes.size());
+    joined.revision = revision;
+    return joined;
+  };
+  {
+    MapNode first(options);
+    announce(first, 0, 2);
+    ASSERT_EQ(first.stats().unplaced_pinned, 3);
+  }
+  MapNode restarted(options);
+  EXPECT_EQ(restarted.stats().pinned_restored, 3);
+  EXPECT_EQ(restarted.mapper().pinned(), 3u);
+  restarted.on_frame(frame_message(scene, 2000000), "CAMERA_RGBD");  // no earlier frame is buffered
+  restarted.on_graph(placement(2, 1), "SLAM_GRAPH");
+  EXPECT_EQ(restarted.stats().frames_inserted, 3) << "the three keyframes joined from the journal's frames";
+  EXPECT_EQ(restarted.stats().unplaced_joined, 3);
+  for (int i = 0; i < 3; ++i) EXPECT_NE(restarted.mapper().keyframes().find(i), nullptr) << i;
+  // Joined before this restart: stored, not pinned again.
+  MapNode again(options);
+  EXPECT_EQ(again.stats().keyframes_restored, 3);
+  EXPECT_EQ(again.stats().pinned_restored, 0);
+  expect_same_map(restarted.mapper().map(), again.mapper().map());
 }
 
 // SLAM_CORRECTION for a frame SLAM located on its map without a keyframe (a localisation-only
