@@ -72,7 +72,7 @@ LoadedSequence load_tum_sequence(const std::string& folder) {
 }
 
 const sensors::SensorProfile& tum_sensor(const std::string& folder) {
-  return sensors::profile_of_sensor(tum::sensor_model_of(tum::detect_camera(folder)));
+  return sensors::profile_of_sensor(tum::sensor_model_of_folder(folder));
 }
 
 VoOptions with_tum_sensor(const std::string& folder, VoOptions options) {

@@ -66,10 +66,10 @@ struct LoadedSequence {
 /// (tum::TumSequence).
 LoadedSequence load_tum_sequence(const std::string& folder);
 
-/// The sensor profile of the recording in `folder`: kinect1's for a freiburg1 recording (named
-/// as TUM names them, tum::detect_camera); "default" (the built-in defaults) for any other --
-/// freiburg2/3, whose timing was not measured, and the simulator's TUM-format exports too (run
-/// those with `--sensor simulator` to get the simulator's profile).
+/// The sensor profile of the recording in `folder`: the one its camera.txt names (the
+/// simulator's TUM-format exports name `simulator`), else kinect1's for a freiburg1 recording
+/// (named as TUM names them, tum::detect_camera), else "default" (the built-in defaults: e.g.
+/// freiburg2/3, whose timing was not measured).
 const sensors::SensorProfile& tum_sensor(const std::string& folder);
 
 /// `options` with the profile of the recording in `folder` (tum_sensor()). Every offline run

@@ -64,7 +64,7 @@ TumFolderWriter::TumFolderWriter(const std::string& folder, const PinholeCamera&
   cam << camera.fx << ' ' << camera.fy << ' ' << camera.cx << ' ' << camera.cy << ' ' << camera.width << ' '
       << camera.height << "\n# T_body_camera x y z qx qy qz qw\nT_body_camera";
   pose_line(cam, T_body_camera);
-  cam << '\n';
+  cam << "\n# the sensor profile (sensors/profiles/)\nsensor " << sensor_model::kSimulator << '\n';
   if (!cam) throw InputError(folder + "/camera.txt: write error");
 }
 

@@ -12,7 +12,8 @@
 //   imu.txt                      "timestamp gx gy gz ax ay az": the IMU, body frame (x forward,
 //                                y left, z up), rad/s and m/s^2
 //   imu_biases.txt               "timestamp bgx bgy bgz bax bay baz": the true biases
-//   camera.txt                   "fx fy cx cy width height" and T_body_camera (x y z qx qy qz qw)
+//   camera.txt                   "fx fy cx cy width height", T_body_camera (x y z qx qy qz qw)
+//                                and "sensor simulator" (drivers/tum/tum_lists.h reads it)
 // Time stamps are seconds with six decimals (common/time.h). Every failure to write is an
 // InputError naming the file.
 

@@ -85,7 +85,9 @@ int run(const Options& o) {
   const tum::TumSequence sequence = open_sequence(o);
   const auto& a = sequence.association();
   spdlog::info("{}: {} frames ({} camera, fx={}), {} unmatched RGB images, {} unused depth images, {} shared",
-               o.folder, a.frames, tum::camera_name(sequence.camera_model()), sequence.camera().fx,
+               o.folder, a.frames,
+               sequence.has_camera_file() ? "camera.txt's" : tum::camera_name(sequence.camera_model()),
+               sequence.camera().fx,
                a.unmatched_rgb, a.unused_depth, a.shared_depth);
   if (!sequence.has_ground_truth() && !o.no_ground_truth)
     spdlog::warn("{}: no groundtruth.txt, publishing no ground truth", o.folder);

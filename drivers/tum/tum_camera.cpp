@@ -55,4 +55,16 @@ const char* sensor_model_of(TumCamera camera) {
   return camera == TumCamera::kFreiburg1 ? sensor_model::kKinect1 : "";
 }
 
+std::optional<CameraFile> camera_file_of(const std::string& folder) {
+  const std::filesystem::path path = std::filesystem::path(folder) / "camera.txt";
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) return std::nullopt;
+  return read_camera_file(path.string());
+}
+
+std::string sensor_model_of_folder(const std::string& folder) {
+  const std::optional<CameraFile> file = camera_file_of(folder);
+  return file && !file->sensor.empty() ? file->sensor : sensor_model_of(detect_camera(folder));
+}
+
 }  // namespace kestrel::tum

@@ -1,5 +1,6 @@
 #pragma once
-// The colour camera of a TUM RGB-D sequence, chosen from the folder name.
+// The colour camera of a TUM RGB-D sequence, chosen from the folder name (or given by the
+// folder's camera.txt, which wins: tum_sequence.h).
 //
 // TUM recorded with three Kinects, "freiburg1", "freiburg2" and "freiburg3"; the sequence
 // folders carry that name (rgbd_dataset_freiburg1_xyz). For each, TUM publishes calibrated
@@ -13,10 +14,12 @@
 // map raw pixels to ideal ones (sensors::Lens); freiburg3's images are undistorted by TUM
 // already, and unknown folders report none.
 
+#include <optional>
 #include <string>
 
 #include "common/camera.h"
 #include "common/rgbd_frame.h"
+#include "drivers/tum/tum_lists.h"
 
 namespace kestrel::tum {
 
@@ -35,5 +38,12 @@ const char* camera_name(TumCamera camera);
 /// The sensor model the frames name (RgbdFrame::sensor): kinect1 for freiburg1, whose Kinect
 /// the profile was measured on; "" for the others (their timing is not measured here).
 const char* sensor_model_of(TumCamera camera);
+
+/// The folder's camera.txt (tum_lists.h), if it has one; InputError naming it if it is bad.
+std::optional<CameraFile> camera_file_of(const std::string& folder);
+
+/// The sensor model the frames of `folder` name: its camera.txt's, else sensor_model_of() its
+/// name's camera.
+std::string sensor_model_of_folder(const std::string& folder);
 
 }  // namespace kestrel::tum

@@ -8,9 +8,13 @@
 // and line; '#' lines and blank lines are skipped.
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
+
+#include "common/camera.h"
 
 namespace kestrel::tum {
 
@@ -35,5 +39,22 @@ std::vector<ImageEntry> read_image_list(const std::string& path);
 /// Reads accelerometer.txt (an empty log is allowed). Throws InputError for a missing file, a
 /// malformed line, a non-finite value or a time stamp not after the previous one.
 std::vector<AccelerometerSample> read_accelerometer(const std::string& path);
+
+/// camera.txt, kestrel's own addition to the folder: which camera took it, for a recording
+/// whose folder name says nothing (kestrel-sim writes one; a user may write one for a recording
+/// of any other camera). The first data line is "fx fy cx cy width height", optionally followed
+/// by the lens distortion "k1 k2 p1 p2 k3" (OpenCV's, of the raw images); then, each at most
+/// once, "T_body_camera x y z qx qy qz qw" (the camera in the body frame; a quaternion of norm
+/// 1 within 1e-3) and "sensor NAME" (the sensor profile the frames name: sensors/profiles/).
+struct CameraFile {
+  PinholeCamera camera;
+  std::optional<Eigen::Isometry3d> T_body_camera;
+  std::string sensor;  ///< "" when the file names none
+};
+
+/// Reads camera.txt. Throws InputError naming the file and line for a missing file, a malformed
+/// or repeated line, an unknown key, a non-finite or impossible value (focal lengths and sizes
+/// must be positive, sizes whole numbers up to 16384), or a file without the intrinsics line.
+CameraFile read_camera_file(const std::string& path);
 
 }  // namespace kestrel::tum

@@ -14,7 +14,12 @@
 // time stamp (|difference| <= max_time_difference_us), seq = the RGB image's index in
 // rgb.txt (0-based, counting every listed image, so unmatched ones leave gaps), camera = the
 // sequence's intrinsics, T_body_camera = identity (for TUM data the body frame is the camera's
-// optical frame), and RgbdFrame's own invariants (rgb R,G,B; depth in millimetres).
+// optical frame) unless camera.txt gives it, and RgbdFrame's own invariants (rgb R,G,B; depth
+// in millimetres).
+//
+// The camera: a `camera.txt` in the folder (tum_lists.h: intrinsics, image size, lens, mounting,
+// sensor profile; kestrel-sim writes one) wins over the folder's name (tum_camera.h);
+// SequenceOptions::intrinsics wins over both.
 
 #include <cstdint>
 #include <optional>
@@ -35,7 +40,8 @@ struct SequenceOptions {
   int64_t max_time_difference_us = 20000;
   /// Multiplies every depth reading (TUM suggests about 1.035 for freiburg1); finite, > 0.
   double depth_scale_correction = 1.0;
-  /// Replaces the intrinsics chosen from the folder name (width and height stay 640x480).
+  /// Replaces the intrinsics chosen from camera.txt or the folder name (width and height stay
+  /// theirs).
   std::optional<PinholeCamera> intrinsics;
 };
 
@@ -72,6 +78,10 @@ class TumSequence {
   const std::string& folder() const { return folder_; }
   TumCamera camera_model() const { return camera_model_; }
   const PinholeCamera& camera() const { return camera_; }
+  /// The sensor model the frames name (RgbdFrame::sensor): camera.txt's, else the folder's.
+  const std::string& sensor() const { return sensor_; }
+  /// Whether the camera came from the folder's camera.txt rather than its name.
+  bool has_camera_file() const { return has_camera_file_; }
   const AssociationStats& association() const { return stats_; }
   /// groundtruth.txt: T_world_camera (colour camera's optical frame in the mocap frame).
   const Trajectory& ground_truth() const { return ground_truth_; }
@@ -93,6 +103,9 @@ class TumSequence {
   std::string depth_list_;
   TumCamera camera_model_ = TumCamera::kUnknown;
   PinholeCamera camera_;
+  std::string sensor_;
+  Eigen::Isometry3d T_body_camera_ = Eigen::Isometry3d::Identity();
+  bool has_camera_file_ = false;
   DepthToMillimetres to_mm_;
   std::vector<ImageEntry> rgb_;
   std::vector<ImageEntry> depth_;

@@ -9,6 +9,7 @@
 
 
 #include "common/error.h"
+#include "common/numbers.h"
 #include "common/image/image_io.h"
 #include "common/time.h"
 #include "drivers/tum/tum_sequence.h"
@@ -126,6 +127,70 @@ TEST(TumSequence, IntrinsicsAndSensorModelFollowTheFolderNameOrTheOverride) {
   c.fx = -1;
   o.intrinsics = c;
   EXPECT_THROW(TumSequence(fx.folder().string(), o), InputError);
+}
+
+// camera.txt (kestrel-sim writes one; a user writes one for a recording of any other camera)
+// gives the intrinsics, the lens, the mounting and the sensor profile, and wins over the
+// folder's name; without a sensor line the name's sensor stays.
+TEST(TumSequence, ACameraFileGivesTheCameraItsMountingAndItsSensorOverTheFolderName) {
+  test::TempDir dir;
+  const TumFixture fx(dir.path(), 1, "rgbd_dataset_freiburg1_o");
+  test::write_text(fx / "camera.txt",
+                   "# fx fy cx cy width height k1 k2 p1 p2 k3\n500 501 320.5 240.5 640 480 0.1 -0.2 0 0 0.05\n"
+                   "T_body_camera 0.1 0 0.05 0 0 0.7071068 0.7071068\nsensor simulator\n");
+  const TumSequence s(fx.folder().string());
+  EXPECT_TRUE(s.has_camera_file());
+  EXPECT_EQ(s.camera().fx, 500);
+  EXPECT_EQ(s.camera().cy, 240.5);
+  EXPECT_EQ(s.camera().distortion, (std::array<double, 5>{0.1, -0.2, 0, 0, 0.05}));
+  const RgbdFrame f = s.frame(0);
+  EXPECT_EQ(f.sensor, "simulator");
+  EXPECT_EQ(sensor_model_of_folder(fx.folder().string()), "simulator");
+  EXPECT_TRUE(f.T_body_camera.translation().isApprox(Eigen::Vector3d(0.1, 0, 0.05)));
+  EXPECT_TRUE(f.T_body_camera.linear().isApprox(
+      Eigen::AngleAxisd(kestrel::kPi / 2, Eigen::Vector3d::UnitZ()).toRotationMatrix(), 1e-6));
+
+  test::write_text(fx / "camera.txt", "500 501 320.5 240.5 640 480\n");
+  const TumSequence plain(fx.folder().string());
+  EXPECT_EQ(plain.frame(0).sensor, "kinect1") << "no sensor line: the folder name's";
+  EXPECT_EQ(plain.camera().distortion, (std::array<double, 5>{})) << "the file's lens, not freiburg1's";
+  EXPECT_TRUE(plain.frame(0).T_body_camera.isApprox(Eigen::Isometry3d::Identity()));
+
+  // Images of another size than the file says: the frame is an InputError naming its line.
+  test::write_text(fx / "camera.txt", "250 250 160 120 320 240\n");
+  const TumSequence small(fx.folder().string());
+  EXPECT_NE(input_error([&] { small.frame(0); }).find("rgb.txt"), std::string::npos);
+}
+
+// A bad camera.txt is an InputError naming the file and line: the family of a user's mistakes.
+TEST(TumSequence, ABadCameraFileIsAnInputErrorNamingItsLine) {
+  test::TempDir dir;
+  const TumFixture fx(dir.path(), 1, "rgbd_dataset_freiburg1_o");
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"500 501 320 240 640\n", "camera.txt:1: expected 'fx fy cx cy width height"},
+      {"500 501 320 240 640 480 0.1\n", "camera.txt:1: expected"},
+      {"500 nan 320 240 640 480\n", "camera.txt:1: 'nan' is not a finite number"},
+      {"500 1e999 320 240 640 480\n", "camera.txt:1:"},
+      {"-500 501 320 240 640 480\n", "camera.txt:1: the focal lengths must be > 0"},
+      {"500 501 320 240 640.5 480\n", "camera.txt:1: the image size must be whole numbers"},
+      {"500 501 320 240 0 480\n", "camera.txt:1: the image size"},
+      {"500 501 320 240 99999 480\n", "camera.txt:1: the image size"},
+      {"# nothing but a comment\n", "camera.txt: no 'fx fy cx cy width height' line"},
+      {"\n500 501 320 240 640 480\nsensor\n", "camera.txt:3: expected 'sensor NAME'"},
+      {"500 501 320 240 640 480\nsensor a\nsensor b\n", "camera.txt:3: a second 'sensor' line"},
+      {"500 501 320 240 640 480\nT_body_camera 0 0 0 0 0 0 2\n", "camera.txt:2: the quaternion's norm"},
+      {"500 501 320 240 640 480\nT_body_camera 0 0 0 0 0 1\n", "camera.txt:2: expected 'T_body_camera"},
+      {"500 501 320 240 640 480\nT_body_camera 0 0 0 0 0 0 1\nT_body_camera 0 0 0 0 0 0 1\n",
+       "camera.txt:3: a second 'T_body_camera' line"},
+      {"500 501 320 240 640 480\n500 501 320 240 640 480\n", "camera.txt:2: unknown line"},
+      {"500 501 320 240 640 480\nlens 1 2\n", "camera.txt:2: unknown line 'lens 1 2'"},
+  };
+  for (const auto& [text, expected] : cases) {
+    test::write_text(fx / "camera.txt", text);
+    const std::string e = input_error([&] { TumSequence(fx.folder().string()); });
+    EXPECT_NE(e.find(expected), std::string::npos) << "got: " << e << "\nfor: " << text;
+    EXPECT_EQ(input_error([&] { sensor_model_of_folder(fx.folder().string()); }), e) << text;
+  }
 }
 
 TEST(TumSequence, CountsUnmatchedAndUnusedFrames) {

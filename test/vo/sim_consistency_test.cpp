@@ -1,6 +1,6 @@
 // The reported covariance is consistent on the synthetic world, where the ground truth is
 // exact: the room figure-eight rendered by kestrel-sim to a TUM folder, the odometry with the
-// simulator camera's profile (as it flies), and the NEES of every relative motion against the
+// simulator camera's profile, which the export's camera.txt names (as it flies), and the NEES of every relative motion against the
 // truth. Label `integration`: it renders 600 frames (about half a minute).
 //
 // Before the pixel noise was taken from the residuals, the covariance here was ~30 times too
@@ -12,7 +12,6 @@
 #include <iostream>
 
 #include "test/support/figures.h"
-#include "sensors/builtin_profiles.h"
 #include "test/support/test_support.h"
 #include "vo/sequence_run.h"
 
@@ -28,8 +27,10 @@ TEST(VoSimulator, CovarianceIsConsistentOnTheFigureEight) {
   ASSERT_EQ(sim.exit_code, 0) << sim.err;
   const LoadedSequence sequence = load_tum_sequence(folder);
   ASSERT_GE(sequence.frames.size(), 600u);
-  // A sim export's folder names no camera (it would take `default`): the camera that rendered it.
-  const SequenceRun run = run_sequence(sequence.frames, with_sensor(sensors::builtin_profile("simulator"), VoOptions{}));
+  // The export's camera.txt names the camera that rendered it, as every offline tool reads it.
+  ASSERT_EQ(tum_sensor(folder).name, "simulator");
+  ASSERT_EQ(sequence.frames.front().sensor, "simulator");
+  const SequenceRun run = run_sequence(sequence.frames, with_tum_sensor(folder, VoOptions{}));
   const RunFigures f = score(run, sequence.ground_truth);
   std::cout << "figure-eight: ATE " << f.ate_rmse_m << " m, NEES " << f.mean_nees << " (" << 100.0 * f.nees_within_95
             << " % within the 95 % bound, " << f.nees_frames << " frames)\n";
