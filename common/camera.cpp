@@ -3,6 +3,8 @@
 #include <cmath>
 
 #include "common/error.h"
+#include "common/numbers.h"
+#include "common/text.h"
 
 namespace kestrel {
 
@@ -59,5 +61,33 @@ void PinholeCamera::validate(const char* what) const {
     if (!std::isfinite(k)) throw InputError(std::string(what) + ": non-finite lens distortion coefficient");
   }
 }
+
+// The bounds are deliberately loose: they reject impossible cameras, not unusual ones.
+void check_plausible_camera(const PinholeCamera& c, const Eigen::Isometry3d& T_body_camera,
+                            const char* what) {
+  auto fail = [&](const std::string& why) {
+    throw InputError(std::string(what) + ": implausible camera: " + why);
+  };
+  const double max_half_fov_rad = 85.0 * kDegree, min_half_fov_rad = 0.005 * kDegree;
+  auto check_focal = [&](const char* name, double f_px, int pixels, const char* side) {
+    if (f_px < 0.5 * pixels / std::tan(max_half_fov_rad) || f_px > 0.5 * pixels / std::tan(min_half_fov_rad))
+      fail(std::string(name) + " = " + number_text(f_px) + " px for images " + std::to_string(pixels) +
+           " px " + side + " (a field of view outside 0.01..170 deg)");
+  };
+  check_focal("fx", c.fx, c.width, "wide");
+  check_focal("fy", c.fy, c.height, "high");
+  auto check_centre = [&](const char* name, double centre_px, int pixels, const char* side) {
+    if (centre_px < -pixels || centre_px > 2.0 * pixels)
+      fail(std::string(name) + " = " + number_text(centre_px) + " px, more than an image outside images " +
+           std::to_string(pixels) + " px " + side);
+  };
+  check_centre("cx", c.cx, c.width, "wide");
+  check_centre("cy", c.cy, c.height, "high");
+  for (double k : c.distortion)
+    if (std::abs(k) > 1e3) fail("lens distortion coefficient " + number_text(k) + " (beyond +-1000)");
+  const double offset_m = T_body_camera.translation().norm();
+  if (offset_m > 100.0) fail("mounted " + number_text(offset_m) + " m from the body (more than 100 m)");
+}
+
 
 }  // namespace kestrel

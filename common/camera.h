@@ -9,6 +9,7 @@
 // reads each ideal pixel's value at its raw pixel, distort() (the mapper's decimated grid).
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <array>
 
 namespace kestrel {
@@ -58,5 +59,12 @@ struct PinholeCamera {
   /// Throws InputError naming `what` unless the values are usable.
   void validate(const char* what) const;
 };
+
+/// Beyond PinholeCamera::validate: throws InputError naming `what` for values no pinhole camera
+/// has (a field of view beyond 0.01..170 degrees, a principal point more than an image away from
+/// the image, a lens coefficient beyond +-1000, a camera mounted more than 100 m from the body).
+/// Every reader of a camera from outside (a frame on the wire, a TUM folder's camera.txt) checks
+/// it, so the consumers' back-projection never turns such values into garbage points.
+void check_plausible_camera(const PinholeCamera& camera, const Eigen::Isometry3d& T_body_camera, const char* what);
 
 }  // namespace kestrel

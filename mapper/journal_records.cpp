@@ -54,8 +54,8 @@ namespace {
 
 JournalRecord decode_record(char kind, const std::vector<uint8_t>& payload, const std::string& what) {
   JournalRecord r;
-  if (kind == kGraph) {
-    r.kind = JournalRecord::Kind::kGraph;
+  if (kind == kGraph || kind == kReleased) {
+    r.kind = kind == kGraph ? JournalRecord::Kind::kGraph : JournalRecord::Kind::kReleased;
     r.graph = transport::decode_message<kestrel::slam_graph_t>(payload.data(), payload.size(), what);
     return r;
   }
@@ -148,13 +148,13 @@ std::optional<uint64_t> next_record(const JournalBytes& file, uint64_t from, con
       const uint8_t* p = window.data() + i;
       const size_t left = n - i;
       if (left < kRecordHead + kFingerprint + kRecordTail) break;  // no record is smaller
-      if (p[0] != kKeyframe && p[0] != kGraph && p[0] != kPinned) continue;
+      if (p[0] != kKeyframe && p[0] != kGraph && p[0] != kPinned && p[0] != kReleased) continue;
       const uint32_t size = get_u32(p + 1);
       if (size > kMaxPayload || base + i + kRecordHead + size + kRecordTail > file.size()) continue;
       const bool keyframe = p[0] == kKeyframe;  // the only kind with a u32 before its message
       const size_t hash_at = kRecordHead + (keyframe ? 4 : 0);
       if (size < hash_at - kRecordHead + kFingerprint || left < hash_at + kFingerprint) continue;
-      const std::vector<uint8_t>& hash = keyframe ? keyframe_hash : p[0] == kGraph ? graph_hash : frame_hash;
+      const std::vector<uint8_t>& hash = keyframe ? keyframe_hash : p[0] == kPinned ? frame_hash : graph_hash;
       if (!std::equal(hash.begin(), hash.end(), p + hash_at)) continue;
       if (size > crc_budget) return std::nullopt;
       crc_budget -= size;

@@ -19,7 +19,8 @@
 
 namespace kestrel::mapper::journal {
 
-// Version 2 added the pinned-frame record; a version 1 journal (no such records) reads as before.
+// Version 2 added the pinned-frame and released-pins records; a version 1 journal (no such
+// records) reads as before.
 constexpr char kHeader[] = "kestrel mapper journal 2\n";
 constexpr char kHeaderVersion1[] = "kestrel mapper journal 1\n";
 constexpr size_t kHeaderSize = sizeof(kHeader) - 1;
@@ -27,6 +28,7 @@ static_assert(sizeof(kHeaderVersion1) == sizeof(kHeader), "the versions' headers
 constexpr char kKeyframe = 'K';
 constexpr char kGraph = 'G';
 constexpr char kPinned = 'P';
+constexpr char kReleased = 'R';
 constexpr size_t kRecordHead = 5;  // kind + size
 constexpr size_t kRecordTail = 4;  // CRC
 // Far above any record (a 640x480 frame stored undecimated is under 2 MB): a larger size

@@ -115,8 +115,9 @@ JournalContents read_journal(const std::string& path) {
   contents.file_bytes = file.size();
   std::string header(journal::kHeaderSize, '\0');
   uint64_t at = 0;
-  const bool header_ok = file.read(0, header.data(), journal::kHeaderSize) &&
-                         (header == journal::kHeader || header == journal::kHeaderVersion1);
+  const bool header_read = file.read(0, header.data(), journal::kHeaderSize);
+  const bool header_ok = header_read && (header == journal::kHeader || header == journal::kHeaderVersion1);
+  if (header_ok) contents.version = header == journal::kHeader ? 2 : 1;
   if (header_ok) {
     at = journal::kHeaderSize;
   } else {
@@ -182,6 +183,8 @@ Restored restore_journal(const JournalContents& journal, Mapper& mapper, const s
   for (const JournalRecord& r : journal.records) {
     if (r.kind == JournalRecord::Kind::kPinned) {
       pinned[r.frame.utime] = &r.frame;
+    } else if (r.kind == JournalRecord::Kind::kReleased) {
+      for (const auto& k : r.graph.keyframes) pinned.erase(k.utime);
     } else if (r.kind == JournalRecord::Kind::kKeyframe) {
       mapper.restore_keyframe(to_graph_keyframe(r.keyframe, what.c_str()), r.frame);
       pinned.erase(r.keyframe.utime);
@@ -215,6 +218,10 @@ JournalWriter::JournalWriter(std::string path, const JournalContents& contents, 
   }
   if (contents.file_bytes == 0) {
     start_fresh("", {});
+  } else if (contents.damage.empty() && contents.version == 1) {
+    // Continued as version 2 (its records copied byte for byte under the new header), so that
+    // no version 2 record lands under a header that does not announce it.
+    start_fresh(path_, contents.spans);
   } else if (!contents.damage.empty()) {
     // Kept whole under a new name first; then `path_` becomes a valid journal of the records
     // read, copied byte for byte, so the damage is neither cut off nor appended after.
@@ -259,6 +266,10 @@ void JournalWriter::open_for_append() {
 }
 
 uint64_t JournalWriter::write_record(std::ostream& out, char kind, const std::vector<uint8_t>& payload) {
+  // A reader takes a larger size field for damage: such a record would be lost on reading.
+  if (payload.size() > journal::kMaxPayload)
+    throw std::runtime_error("a mapper journal record of " + std::to_string(payload.size()) + " bytes (at most " +
+                             std::to_string(journal::kMaxPayload) + ")");
   std::vector<uint8_t> bytes{static_cast<uint8_t>(kind)};
   journal::put_u32(bytes, static_cast<uint32_t>(payload.size()));
   const uint32_t crc = journal::crc32(payload.data(), payload.size(), journal::crc32(bytes.data(), bytes.size()));
@@ -302,6 +313,17 @@ void JournalWriter::graph(const kestrel::slam_graph_t& graph) {
 }
 
 void JournalWriter::pinned(const RgbdFrame& frame) { append(journal::kPinned, frame_payload(frame)); }
+
+void JournalWriter::released(const std::vector<int64_t>& utimes) {
+  kestrel::slam_graph_t message{};
+  for (const int64_t utime : utimes) {
+    kestrel::slam_keyframe_t k{};
+    k.utime = utime;
+    message.keyframes.push_back(k);
+  }
+  message.num_keyframes = static_cast<int32_t>(message.keyframes.size());
+  append(journal::kReleased, transport::encode_message(message));
+}
 
 void JournalWriter::compact(const std::vector<LiveKeyframe>& keyframes, int64_t graph_revision,
                             const std::vector<const RgbdFrame*>& pinned) {

@@ -6,7 +6,7 @@
 //
 // File: the header "kestrel mapper journal 2\n" (version 1, without pinned records, still
 // reads), then records, each
-//   kind (1 byte: 'K' keyframe, 'G' graph, 'P' pinned frame) | payload size (u32,
+//   kind (1 byte: 'K' keyframe, 'G' graph, 'P' pinned frame, 'R' released pins) | payload size (u32,
 //   little-endian) | payload | CRC-32 of kind, size and payload (u32, little-endian).
 // A keyframe's payload is the keyframe as SLAM_GRAPH gave it and the frame the mapper stored
 // (decimated; raw colour and zstd depth, so lossless), both LCM-encoded, the first with its
@@ -14,8 +14,10 @@
 // keyframes that graph moved (their new poses; no edges), so the journal grows with what moved,
 // not with the whole graph at each loop closure. A pinned frame's payload is a frame the mapper
 // keeps for a keyframe SLAM has not placed in its saved map yet (Mapper::pin; LCM-encoded as a
-// keyframe's): a mapper restarted before the placement pins it again, unless a keyframe record
-// after it shows that its keyframe joined.
+// keyframe's); a released-pins payload is a SLAM_GRAPH message whose keyframes' utimes name the
+// pinned frames the mapper let go (joined, or left out of SLAM's list). A mapper restarted
+// before the placement pins again the frames pinned and neither released nor taken by a
+// keyframe record of the same time after them.
 // Records are written whole and flushed to the kernel at once, so a process killed at any
 // point leaves every earlier record intact.
 //
@@ -34,11 +36,13 @@
 //  * A damaged journal is kept whole as "<file>.damaged-<utime>" (keep_aside: a hard link, or a
 //    copy), and "<file>" is replaced (atomically) by a valid journal of the records read,
 //    copied byte for byte, which the writer then appends to.
+//  * A version 1 journal is continued as version 2: replaced (atomically) by the same records,
+//    byte for byte, under the new header before anything is appended.
 //  * A reset (lock-step replay's RESET) keeps the journal it ends as "<file>.reset-<utime>" and
 //    starts "<file>" again empty; a journal without records is simply kept.
 //  * Compaction (JournalWriter::compact): the file is replaced, by one rename, with a journal
 //    that restores the same store: one record per stored keyframe at its current pose, and a
-//    graph record of the last revision. The records it drops are of keyframes the store itself
+//    graph record of the last revision, then a record per frame still pinned. The records it drops are of keyframes the store itself
 //    has dropped (over its budget) and of poses since superseded, so a mapper restored from
 //    either file holds the same keyframes at the same poses, bit for bit; until the rename
 //    the old file is whole. So the journal stays within a bound of the store instead of
@@ -64,11 +68,11 @@
 namespace kestrel::mapper {
 
 struct JournalRecord {
-  enum class Kind { kKeyframe, kGraph, kPinned };
+  enum class Kind { kKeyframe, kGraph, kPinned, kReleased };
   Kind kind = Kind::kKeyframe;
   kestrel::slam_keyframe_t keyframe;  ///< kKeyframe
   RgbdFrame frame;                    ///< kKeyframe: as the mapper stored it; kPinned: as it pinned it (decimated)
-  kestrel::slam_graph_t graph;        ///< kGraph
+  kestrel::slam_graph_t graph;        ///< kGraph; kReleased: the released frames' utimes (keyframes' utime)
 };
 
 struct JournalContents {
@@ -80,6 +84,7 @@ struct JournalContents {
   uint64_t skipped_bytes = 0;  ///< in damaged stretches
   int damaged_stretches = 0;
   std::string damage;          ///< the first damage and a summary ("" = the file is whole)
+  int version = 0;             ///< of the header: 1 or 2 (0: no intact header)
 };
 
 /// What the journal at `path` holds; empty for a missing or empty file. Throws InputError
@@ -144,6 +149,8 @@ class JournalWriter {
   void graph(const kestrel::slam_graph_t& graph);
   /// A frame the mapper pinned (Mapper::pin), as it keeps it.
   void pinned(const RgbdFrame& frame);
+  /// The pinned frames at `utimes` were let go.
+  void released(const std::vector<int64_t>& utimes);
   /// The map was reset: `path` starts again as an empty journal, the one it ends kept as
   /// "<path>.reset-<utime>" (if it holds a record). Throws InputError (nothing changed) if the
   /// old one cannot be kept.

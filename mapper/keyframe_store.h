@@ -62,8 +62,9 @@ class KeyframeStore {
   }
   /// Stored keyframes in the order they were stored: the order the live map took them in, and
   /// so the order a rebuild inserts them in and a journal's compaction writes them in. Not
-  /// sensor time: two flights on one saved map may share sensor times (both simulated ones
-  /// start at 0), and a keyframe SLAM places late (a joined session's) is stored after newer ones.
+  /// sensor time: two flights on one saved map may share sensor times (simulated ones all start
+  /// at the same utime), and a keyframe SLAM places late (a joined session's) is stored after
+  /// newer ones.
   std::vector<const StoredKeyframe*> in_stored_order() const;
 
   size_t size() const { return keyframes_.size(); }

@@ -96,6 +96,20 @@ void MapNode::write_journal(const kestrel::slam_graph_t& msg, const GraphResult&
   });
 }
 
+std::set<int64_t> MapNode::pinned_utimes() const {
+  std::set<int64_t> utimes;
+  for (const RgbdFrame* frame : mapper_.pinned_frames()) utimes.insert(frame->utime);
+  return utimes;
+}
+
+void MapNode::journal_released_pins(const std::set<int64_t>& were_pinned) {
+  const std::set<int64_t> pinned = pinned_utimes();
+  std::vector<int64_t> released;
+  for (const int64_t utime : were_pinned)
+    if (pinned.count(utime) == 0) released.push_back(utime);
+  if (!released.empty()) journal([&](JournalWriter& writer) { writer.released(released); });
+}
+
 void MapNode::compact_journal_if_due() {
   if (!journal_) return;
   const KeyframeStore& store = mapper_.keyframes();
@@ -288,14 +302,18 @@ void MapNode::on_unplaced_graph(const kestrel::slam_graph_t& msg, const char* ch
   }
   std::set<int64_t> listed;
   for (const auto& k : msg.keyframes) listed.insert(k.utime);
+  std::set<int64_t> were_pinned = pinned_utimes();
   mapper_.keep_pinned(listed);  // a keyframe no longer listed will not join (a SLAM restarted)
   for (const auto& k : msg.keyframes) {
     if (mapper_.keyframes().find(k.id) != nullptr) continue;  // already in the map
     if (mapper_.pin(k.utime) != Mapper::Pin::kPinned) continue;
     ++stats_.unplaced_pinned;
+    were_pinned.insert(k.utime);  // (the bound may let it go again at once)
     // On disk too: a mapper restarted before the placement would otherwise have lost the frame.
     journal([&](JournalWriter& writer) { writer.pinned(*mapper_.buffered(k.utime)); });
   }
+  journal_released_pins(were_pinned);
+  compact_journal_if_due();
 }
 
 std::optional<kestrel::octomap_t> MapNode::on_graph(const kestrel::slam_graph_t& msg, const char* channel) {
@@ -313,12 +331,14 @@ std::optional<kestrel::octomap_t> MapNode::on_graph(const kestrel::slam_graph_t&
   for (const auto& k : msg.keyframes) keyframes.push_back(to_graph_keyframe(k, channel));
   last_graph_revision_ = msg.revision;
   ++stats_.graphs;
+  const std::set<int64_t> were_pinned = pinned_utimes();
   const GraphResult result = mapper_.apply_graph(keyframes);
   mapper_.keep_pinned({});  // placed: SLAM sends no unplaced keyframes any more
   stats_.unplaced_joined += static_cast<int64_t>(result.from_pinned);
   // keyframes: the frames a SLAM map is made of
   stats_.frames_inserted += static_cast<int64_t>(result.inserted.size());
   write_journal(msg, result);
+  journal_released_pins(were_pinned);
   compact_journal_if_due();
   if (result.rebuilt) {
     ++stats_.rebuilds;

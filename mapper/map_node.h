@@ -44,6 +44,7 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <set>
 #include <string>
 
 #include "common/trajectory.h"
@@ -163,6 +164,11 @@ class MapNode {
   void journal(const std::function<void(JournalWriter&)>& write);
   void write_journal(const kestrel::slam_graph_t& msg, const GraphResult& result);
   void compact_journal_if_due();
+  /// The utimes of the frames pinned now.
+  std::set<int64_t> pinned_utimes() const;
+  /// Journals the frames of `were_pinned` that are no longer pinned (joined or let go), so a
+  /// restart does not pin them again.
+  void journal_released_pins(const std::set<int64_t>& were_pinned);
 
   NodeOptions options_;
   Mapper mapper_;

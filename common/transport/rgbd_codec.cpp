@@ -100,38 +100,6 @@ std::vector<uint8_t> raw_bytes(const cv::Mat& m) {
   return bytes;
 }
 
-// What a frame on the wire may claim about its camera, beyond PinholeCamera::validate (finite,
-// positive, at most 16384 pixels a side). These are values no pinhole camera has (a field of
-// view beyond 0.01..170 degrees, a principal point more than an image away from the image, a
-// camera mounted 100 m from the body); they are finite, so without this gate the consumers'
-// back-projection would turn them into garbage points and poses rather than fail. The bounds
-// are deliberately loose: they reject impossible cameras, not unusual ones.
-void check_plausible_camera(const PinholeCamera& c, const Eigen::Isometry3d& T_body_camera,
-                            const char* what) {
-  auto fail = [&](const std::string& why) {
-    throw InputError(std::string(what) + ": implausible camera: " + why);
-  };
-  const double max_half_fov_rad = 85.0 * kDegree, min_half_fov_rad = 0.005 * kDegree;
-  auto check_focal = [&](const char* name, double f_px, int pixels, const char* side) {
-    if (f_px < 0.5 * pixels / std::tan(max_half_fov_rad) || f_px > 0.5 * pixels / std::tan(min_half_fov_rad))
-      fail(std::string(name) + " = " + number_text(f_px) + " px for images " + std::to_string(pixels) +
-           " px " + side + " (a field of view outside 0.01..170 deg)");
-  };
-  check_focal("fx", c.fx, c.width, "wide");
-  check_focal("fy", c.fy, c.height, "high");
-  auto check_centre = [&](const char* name, double centre_px, int pixels, const char* side) {
-    if (centre_px < -pixels || centre_px > 2.0 * pixels)
-      fail(std::string(name) + " = " + number_text(centre_px) + " px, more than an image outside images " +
-           std::to_string(pixels) + " px " + side);
-  };
-  check_centre("cx", c.cx, c.width, "wide");
-  check_centre("cy", c.cy, c.height, "high");
-  for (double k : c.distortion)
-    if (std::abs(k) > 1e3) fail("lens distortion coefficient " + number_text(k) + " (beyond +-1000)");
-  const double offset_m = T_body_camera.translation().norm();
-  if (offset_m > 100.0) fail("mounted " + number_text(offset_m) + " m from the body (more than 100 m)");
-}
-
 static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__,
               "DEPTH_U16_MM is little-endian on the wire; add byte swapping for this host");
 

@@ -107,6 +107,11 @@ int run(const Options& o, bool rgb_intrinsics_given) {
   so.max_time_difference_us = std::llround(o.max_dt_s * 1e6);
   so.depth_scale_correction = o.depth_scale;
   const tum::TumSequence sequence(o.folder, so);
+  if (sequence.camera().width != 640 || sequence.camera().height != 480) {
+    // A Kinect's dump (fakenect_dump.h) is 640x480; anything else would fail half-written.
+    throw InputError(o.folder + ": the images are " + std::to_string(sequence.camera().width) + "x" +
+                     std::to_string(sequence.camera().height) + " (its camera.txt), a Kinect dump is 640x480");
+  }
 
   kinect::KinectCalibration calibration = o.calibration.calibration();
   if (!rgb_intrinsics_given) {

@@ -141,6 +141,7 @@ CameraFile read_camera_file(const std::string& path) {
     have_camera = true;
   });
   if (!have_camera) throw InputError(path + ": no 'fx fy cx cy width height' line");
+  check_plausible_camera(file.camera, file.T_body_camera.value_or(Eigen::Isometry3d::Identity()), path.c_str());
   return file;
 }
 

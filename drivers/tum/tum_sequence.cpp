@@ -32,7 +32,6 @@ TumSequence::TumSequence(const std::string& folder, SequenceOptions options)
   if (const std::optional<CameraFile> file = camera_file_of(folder_)) {
     camera_ = file->camera;
     if (!file->sensor.empty()) sensor_ = file->sensor;
-    if (file->T_body_camera) T_body_camera_ = *file->T_body_camera;
     has_camera_file_ = true;
   }
   if (options.intrinsics) {
@@ -104,7 +103,6 @@ RgbdFrame TumSequence::frame(size_t i) const {
   f.seq = static_cast<int64_t>(ref.rgb);
   f.camera = camera_;
   f.sensor = sensor_;
-  f.T_body_camera = T_body_camera_;
   f.rgb = load_rgb(path_of(rgb), camera_.width, camera_.height, {rgb_list_, rgb.line});
   f.depth_mm = to_mm_(
       load_depth_raw(path_of(depth), camera_.width, camera_.height, {depth_list_, depth.line}));

@@ -13,13 +13,14 @@
 // Invariants of frame(i): utime = the RGB time stamp, depth_utime = the associated depth
 // time stamp (|difference| <= max_time_difference_us), seq = the RGB image's index in
 // rgb.txt (0-based, counting every listed image, so unmatched ones leave gaps), camera = the
-// sequence's intrinsics, T_body_camera = identity (for TUM data the body frame is the camera's
-// optical frame) unless camera.txt gives it, and RgbdFrame's own invariants (rgb R,G,B; depth
-// in millimetres).
+// sequence's intrinsics, T_body_camera = identity (for a TUM folder the body frame is the
+// camera's optical frame: the player publishes the IMU and the ground truth in it), and
+// RgbdFrame's own invariants (rgb R,G,B; depth in millimetres).
 //
-// The camera: a `camera.txt` in the folder (tum_lists.h: intrinsics, image size, lens, mounting,
-// sensor profile; kestrel-sim writes one) wins over the folder's name (tum_camera.h);
-// SequenceOptions::intrinsics wins over both.
+// The camera: a `camera.txt` in the folder (tum_lists.h: intrinsics, image size, lens, sensor
+// profile; kestrel-sim writes one) wins over the folder's name (tum_camera.h);
+// SequenceOptions::intrinsics wins over both. Its mounting line is checked but not applied
+// (above).
 
 #include <cstdint>
 #include <optional>
@@ -104,7 +105,6 @@ class TumSequence {
   TumCamera camera_model_ = TumCamera::kUnknown;
   PinholeCamera camera_;
   std::string sensor_;
-  Eigen::Isometry3d T_body_camera_ = Eigen::Isometry3d::Identity();
   bool has_camera_file_ = false;
   DepthToMillimetres to_mm_;
   std::vector<ImageEntry> rgb_;

@@ -113,6 +113,19 @@ TEST(KinectTool, ADroppedFrameIsCountedAndTheRestPublished) {
   EXPECT_NE(r.out.find("unused depth 1, shared depth 0, dropped rgb 1, dropped depth 0"), std::string::npos) << r.out;
 }
 
+// A folder whose camera.txt gives another image size cannot become a Kinect's dump (640x480):
+// exit 3 naming the size before anything is written.
+TEST(KinectTool, AFolderOfAnotherImageSizeIsRefusedBeforeAnythingIsWritten) {
+  test::TempDir dir;
+  const TumFixture fx(dir.path(), 2);
+  test::write_text(fx / "camera.txt", "262.5 262.5 159.5 119.5 320 240\n");
+  const auto dump = dir / "dump";
+  const auto r = test::run({test::tool("tum-to-fakenect").string(), fx.folder().string(), dump.string()});
+  EXPECT_EQ(r.exit_code, 3) << r.err;
+  EXPECT_NE(r.err.find("the images are 320x240 (its camera.txt), a Kinect dump is 640x480"), std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(dump / "INDEX.txt"));
+}
+
 TEST(KinectTool, PublishesLiveWithHeartbeatsInsideANetworkNamespace) {
   KESTREL_REQUIRE_FAKENECT();
   if (const std::string why = test::LiveSystem::isolate(); !why.empty())

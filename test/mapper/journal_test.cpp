@@ -91,6 +91,7 @@ std::string summary(const JournalContents& c) {
       case JournalRecord::Kind::kGraph: s += "G"; break;
       case JournalRecord::Kind::kKeyframe: s += "K" + std::to_string(r.keyframe.id); break;
       case JournalRecord::Kind::kPinned: s += "P" + std::to_string(r.frame.utime / 100000); break;
+      case JournalRecord::Kind::kReleased: s += "R"; break;
     }
   }
   return s;
@@ -394,11 +395,14 @@ TEST(KeyframeJournal, PinnedFramesAreJournaledAndPinnedAgainUnlessTheirKeyframeJ
     writer.pinned(frame_at(500000));
     writer.pinned(frame_at(600000));
     writer.pinned(frame_at(700000));
+    writer.pinned(frame_at(800000));
     writer.keyframe(keyframe(6, 700000, 0.6), frame_at(700000));  // 7's keyframe joined
+    writer.released({800000});                                     // 8's was let go
   }
   const JournalContents read = read_journal(w.path);
   ASSERT_EQ(read.damage, "");
-  EXPECT_EQ(summary(read), "K0 K1 G K2 K3 P5 P6 P7 K6");
+  EXPECT_EQ(read.version, 2);
+  EXPECT_EQ(summary(read), "K0 K1 G K2 K3 P5 P6 P7 P8 K6 R");
   MapperOptions options;
   options.max_pinned_frames = 1;
   Mapper bounded(options);
@@ -412,6 +416,7 @@ TEST(KeyframeJournal, PinnedFramesAreJournaledAndPinnedAgainUnlessTheirKeyframeJ
   EXPECT_NE(mapper.buffered(500000), nullptr);
   EXPECT_NE(mapper.buffered(600000), nullptr);
   EXPECT_EQ(mapper.buffered(700000), nullptr) << "its keyframe joined before the restart";
+  EXPECT_EQ(mapper.buffered(800000), nullptr) << "let go before the restart";
 
   // A flipped byte in the first pinned record loses it alone: reading finds the next one.
   const std::string whole = kestrel::test::read_file(w.path);
@@ -424,7 +429,7 @@ TEST(KeyframeJournal, PinnedFramesAreJournaledAndPinnedAgainUnlessTheirKeyframeJ
     std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
   };
   write_file(damaged_path, damaged);
-  EXPECT_EQ(summary(read_journal(damaged_path)), "K0 K1 G K2 K3 P6 P7 K6");
+  EXPECT_EQ(summary(read_journal(damaged_path)), "K0 K1 G K2 K3 P6 P7 P8 K6 R");
 
   // A compaction writes the pins it is given, after the keyframes and the graph.
   {
@@ -434,14 +439,26 @@ TEST(KeyframeJournal, PinnedFramesAreJournaledAndPinnedAgainUnlessTheirKeyframeJ
   }
   EXPECT_EQ(summary(read_journal(w.path)), "K0 G P5");
 
-  // Version 1: the same records but pinned ones, under the old header.
-  std::string version1 = kestrel::test::read_file(w.path).substr(0, w.ends[0]);
-  version1 += whole.substr(w.ends[0], w.ends.back() - w.ends[0]);
+  // Version 1: the records before the pins, under the old header. It reads whole, and a
+  // writer continues it as version 2 (the same records under the new header) before appending.
+  std::string version1 = whole.substr(0, w.ends.back());
   version1.replace(0, version1.find('\n'), "kestrel mapper journal 1");
   write_file(damaged_path, version1);
   const JournalContents old = read_journal(damaged_path);
   EXPECT_EQ(old.damage, "");
+  EXPECT_EQ(old.version, 1);
   EXPECT_EQ(summary(old), "K0 K1 G K2 K3");
+  {
+    JournalWriter writer(damaged_path, old);
+    writer.pinned(frame_at(500000));
+  }
+  const std::string continued = kestrel::test::read_file(damaged_path);
+  EXPECT_EQ(continued.substr(0, w.ends.back()), whole.substr(0, w.ends.back())) << "the same bytes under the version 2 header";
+  const JournalContents upgraded = read_journal(damaged_path);
+  EXPECT_EQ(upgraded.version, 2);
+  EXPECT_EQ(upgraded.damage, "");
+  EXPECT_EQ(summary(upgraded), "K0 K1 G K2 K3 P5");
+  EXPECT_TRUE(kept_journals(damaged_path, "damaged").empty());
 }
 
 }  // namespace

@@ -345,17 +345,26 @@ TEST(MapNode, ARestartedMapperKeepsTheFramesOfKeyframesSlamHasNotPlacedYet) {
   };
   {
     MapNode first(options);
-    announce(first, 0, 2);
-    ASSERT_EQ(first.stats().unplaced_pinned, 3);
+    announce(first, 0, 3);
+    ASSERT_EQ(first.stats().unplaced_pinned, 4);
+    // SLAM's next list leaves keyframe 0 out (it will not join): its frame is let go.
+    kestrel::slam_graph_t fewer{};
+    for (int i = 1; i <= 3; ++i) fewer.keyframes.push_back(keyframe_message(i, 100000 * (i + 1)));
+    fewer.num_keyframes = 3;
+    first.on_unplaced_graph(fewer, "SLAM_GRAPH_UNPLACED");
+    ASSERT_EQ(first.mapper().pinned(), 3u);
   }
   MapNode restarted(options);
-  EXPECT_EQ(restarted.stats().pinned_restored, 3);
-  EXPECT_EQ(restarted.mapper().pinned(), 3u);
+  EXPECT_EQ(restarted.stats().pinned_restored, 3) << "the one let go stays gone";
+  EXPECT_EQ(restarted.mapper().buffered(100000), nullptr);
   restarted.on_frame(frame_message(scene, 2000000), "CAMERA_RGBD");  // no earlier frame is buffered
-  restarted.on_graph(placement(2, 1), "SLAM_GRAPH");
+  kestrel::slam_graph_t joined = placement(3, 1);
+  joined.keyframes.erase(joined.keyframes.begin());
+  joined.num_keyframes = 3;
+  restarted.on_graph(joined, "SLAM_GRAPH");
   EXPECT_EQ(restarted.stats().frames_inserted, 3) << "the three keyframes joined from the journal's frames";
   EXPECT_EQ(restarted.stats().unplaced_joined, 3);
-  for (int i = 0; i < 3; ++i) EXPECT_NE(restarted.mapper().keyframes().find(i), nullptr) << i;
+  for (int i = 1; i <= 3; ++i) EXPECT_NE(restarted.mapper().keyframes().find(i), nullptr) << i;
   // Joined before this restart: stored, not pinned again.
   MapNode again(options);
   EXPECT_EQ(again.stats().keyframes_restored, 3);

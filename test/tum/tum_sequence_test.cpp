@@ -130,9 +130,10 @@ TEST(TumSequence, IntrinsicsAndSensorModelFollowTheFolderNameOrTheOverride) {
 }
 
 // camera.txt (kestrel-sim writes one; a user writes one for a recording of any other camera)
-// gives the intrinsics, the lens, the mounting and the sensor profile, and wins over the
-// folder's name; without a sensor line the name's sensor stays.
-TEST(TumSequence, ACameraFileGivesTheCameraItsMountingAndItsSensorOverTheFolderName) {
+// gives the intrinsics, the lens and the sensor profile, and wins over the folder's name
+// (--intrinsics wins over it); without a sensor line the name's sensor stays. Its mounting is
+// checked, not applied: a TUM folder's body frame is its camera's.
+TEST(TumSequence, ACameraFileGivesTheCameraAndItsSensorOverTheFolderName) {
   test::TempDir dir;
   const TumFixture fx(dir.path(), 1, "rgbd_dataset_freiburg1_o");
   test::write_text(fx / "camera.txt",
@@ -146,9 +147,13 @@ TEST(TumSequence, ACameraFileGivesTheCameraItsMountingAndItsSensorOverTheFolderN
   const RgbdFrame f = s.frame(0);
   EXPECT_EQ(f.sensor, "simulator");
   EXPECT_EQ(sensor_model_of_folder(fx.folder().string()), "simulator");
-  EXPECT_TRUE(f.T_body_camera.translation().isApprox(Eigen::Vector3d(0.1, 0, 0.05)));
-  EXPECT_TRUE(f.T_body_camera.linear().isApprox(
-      Eigen::AngleAxisd(kestrel::kPi / 2, Eigen::Vector3d::UnitZ()).toRotationMatrix(), 1e-6));
+  EXPECT_TRUE(f.T_body_camera.isApprox(Eigen::Isometry3d::Identity()));
+  SequenceOptions given;
+  given.intrinsics = PinholeCamera::vga(510, 511, 319, 239);
+  const TumSequence overridden(fx.folder().string(), given);
+  EXPECT_EQ(overridden.camera().fx, 510);
+  EXPECT_EQ(overridden.camera().distortion, (std::array<double, 5>{})) << "--intrinsics: no lens";
+  EXPECT_EQ(overridden.frame(0).sensor, "simulator") << "the sensor is still camera.txt's";
 
   test::write_text(fx / "camera.txt", "500 501 320.5 240.5 640 480\n");
   const TumSequence plain(fx.folder().string());
@@ -184,6 +189,9 @@ TEST(TumSequence, ABadCameraFileIsAnInputErrorNamingItsLine) {
        "camera.txt:3: a second 'T_body_camera' line"},
       {"500 501 320 240 640 480\n500 501 320 240 640 480\n", "camera.txt:2: unknown line"},
       {"500 501 320 240 640 480\nlens 1 2\n", "camera.txt:2: unknown line 'lens 1 2'"},
+      {"0.01 501 320 240 640 480\n", "camera.txt: implausible camera: fx"},
+      {"500 501 1e6 240 640 480\n", "camera.txt: implausible camera: cx"},
+      {"500 501 320 240 640 480\nT_body_camera 1000 0 0 0 0 0 1\n", "camera.txt: implausible camera: mounted"},
   };
   for (const auto& [text, expected] : cases) {
     test::write_text(fx / "camera.txt", text);

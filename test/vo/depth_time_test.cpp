@@ -6,12 +6,16 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <stdexcept>
 
+#include "common/error.h"
 #include "common/geometry/se3.h"
 #include "sensors/builtin_profiles.h"
 #include "sensors/depth_image.h"
+#include "test/support/test_support.h"
 #include "test/vo/synthetic_scene.h"
 #include "vo/depth_lookup.h"
 #include "vo/sequence_run.h"
@@ -104,7 +108,9 @@ TEST(DepthTimeOffset, TakenFromTheStampsOrTheConfiguredValue) {
 }
 
 // The freiburg1 Kinect's timing is applied to freiburg1 recordings only: not to the simulator's
-// TUM-format exports (global shutter, one capture time) nor to the unmeasured freiburg2/3.
+// TUM-format exports (global shutter, one capture time: their camera.txt names `simulator`),
+// nor to the unmeasured freiburg2/3, nor to a folder that names no camera. A camera.txt naming
+// no built-in profile is an error naming it.
 TEST(DepthTimeOffset, TheKinectTimingIsForFreiburg1RecordingsOnly) {
   const VoOptions given;
   EXPECT_EQ(tum_sensor("../data/tum/rgbd_dataset_freiburg1_rpy").name, "kinect1");
@@ -119,7 +125,25 @@ TEST(DepthTimeOffset, TheKinectTimingIsForFreiburg1RecordingsOnly) {
   EXPECT_DOUBLE_EQ(fr1.covariance.translation_per_rad_m, 0.10);
   EXPECT_DOUBLE_EQ(fr1.covariance.rotation_per_rad, 0.085);
   EXPECT_DOUBLE_EQ(fr1.dense.weight, 2.0);
-  for (const char* other : {"/tmp/sim_room_export", "rgbd_dataset_freiburg2_desk", "rgbd_dataset_freiburg3_office"}) {
+  ::kestrel::test::TempDir dir;
+  const std::string unnamed = (dir / "my_recording").string(), exported = (dir / "sim_export").string(),
+                    misspelt = (dir / "misspelt").string();
+  for (const std::string& d : {unnamed, exported, misspelt}) std::filesystem::create_directories(d);
+  const auto write_camera = [](const std::string& folder, const char* text) {
+    std::ofstream(std::filesystem::path(folder) / "camera.txt") << text;
+  };
+  write_camera(exported, "525 525 319.5 239.5 640 480\nsensor simulator\n");
+  write_camera(misspelt, "525 525 319.5 239.5 640 480\nsensor simulater\n");
+  EXPECT_EQ(tum_sensor(exported).name, "simulator");
+  EXPECT_DOUBLE_EQ(with_tum_sensor(exported, given).keyframe.floor_cap_fraction, 0.7);
+  try {
+    tum_sensor(misspelt);
+    ADD_FAILURE() << "a misspelt profile name";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("camera.txt: sensor 'simulater' is not a built-in profile"), std::string::npos)
+        << e.what();
+  }
+  for (const std::string& other : {unnamed, std::string("rgbd_dataset_freiburg2_desk"), std::string("rgbd_dataset_freiburg3_office")}) {
     EXPECT_EQ(tum_sensor(other).name, "default") << other;
     const VoOptions o = with_tum_sensor(other, given);
     EXPECT_FALSE(o.depth.compensate_time_offset) << other;
