@@ -31,6 +31,9 @@ struct DepthOptions {
 struct RgbOptions {
   bool noise = true;             ///< photon and read noise
   double exposure = 1.0;         ///< digital numbers = 255 * exposure * albedo * irradiance
+  /// Auto-exposure (rgb_sensor.h): the exposure is lowered where the frame's mean grey would be
+  /// above this (the brightest of a Kinect's frames in TUM's freiburg1: 155 / 161); 0 = off.
+  double max_mean_grey = 160.0;
   double read_noise_dn = 1.5;    ///< sigma of the signal-independent noise, digital numbers
   double shot_noise_dn = 0.08;   ///< variance of the photon noise per digital number of signal
   double vignetting = 0.25;      ///< relative fall-off of brightness at the image corners

@@ -49,6 +49,7 @@ struct Options {
   std::string lcm_url;
   bool exact = false;
   int motion_blur = 1;
+  double max_mean_grey = sim::RgbOptions{}.max_mean_grey;
   std::string rgb_encoding = "jpeg";
   std::string depth_encoding = "zstd";
   int jpeg_quality = 95;
@@ -115,6 +116,11 @@ void add_options(cli::App& app, Options& o) {
   app.add_option("--motion-blur", o.motion_blur, "Renders averaged per colour frame (1 = no motion blur)")
       ->check(CLI::Range(1, 16))
       ->capture_default_str();
+  app.add_option("--max-mean-grey", o.max_mean_grey,
+                 "Auto-exposure: the exposure is lowered where a frame's mean grey would be above this, as a "
+                 "Kinect's own does (0 = a fixed exposure)")
+      ->check(CLI::Range(0.0, 255.0))
+      ->capture_default_str();
   app.add_option("--rgb-encoding", o.rgb_encoding, "Colour on the wire: raw or jpeg")
       ->check(CLI::IsMember({"raw", "jpeg"}))
       ->capture_default_str();
@@ -180,6 +186,7 @@ int run(const Options& o) {
   sim::SimulationOptions so;
   so.seed = o.seed;
   so.camera.rgb.motion_blur_samples = o.motion_blur;
+  so.camera.rgb.max_mean_grey = o.max_mean_grey;
   so.camera.rate_hz = o.camera_rate_hz;
   so.camera.T_body_camera = sim::CameraOptions::default_T_body_camera(o.tilt_deg);
   if (!o.intrinsics.empty()) {

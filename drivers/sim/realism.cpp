@@ -24,6 +24,8 @@ FrameStats frame_stats(const RgbdFrame& frame) {
   std::vector<cv::KeyPoint> corners;
   cv::FAST(grey, corners, 20, true);
   s.fast_corners = static_cast<int>(corners.size());
+  s.mean_grey = cv::mean(grey)[0];
+  s.saturated = static_cast<double>(cv::countNonZero(grey >= 250)) / static_cast<double>(grey.total());
   s.valid_depth = static_cast<double>(cv::countNonZero(frame.depth_mm)) / static_cast<double>(frame.depth_mm.total());
   constexpr int kBlock = 8;
   Eigen::Matrix<double, kBlock * kBlock, 3> A;
@@ -55,16 +57,27 @@ FrameStats frame_stats(const RgbdFrame& frame) {
 SequenceStats summarise(const std::vector<FrameStats>& frames) {
   SequenceStats out;
   out.frames = static_cast<int>(frames.size());
-  std::vector<double> fast, valid, noise;
+  std::vector<double> fast, valid, noise, grey, saturated;
   for (const FrameStats& f : frames) {
     fast.push_back(f.fast_corners);
     valid.push_back(f.valid_depth);
+    grey.push_back(f.mean_grey);
+    saturated.push_back(f.saturated);
+    out.frames_over_a_tenth_saturated += f.saturated > 0.1 ? 1.0 / static_cast<double>(frames.size()) : 0.0;
     noise.insert(noise.end(), f.noise_k.begin(), f.noise_k.end());
   }
   out.fast_corners_median = median(fast);
   out.valid_depth_median = median(valid);
   out.noise_k_median = median(noise);
   out.noise_blocks = static_cast<int>(noise.size());
+  out.mean_grey_median = median(grey);
+  out.saturated_median = median(saturated);
+  if (!grey.empty()) {
+    std::sort(grey.begin(), grey.end());
+    out.mean_grey_p95 = grey[std::min(grey.size() - 1, static_cast<size_t>(0.95 * static_cast<double>(grey.size())))];
+    out.mean_grey_max = grey.back();
+    out.saturated_max = *std::max_element(saturated.begin(), saturated.end());
+  }
   return out;
 }
 

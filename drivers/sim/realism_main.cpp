@@ -59,6 +59,12 @@ int run(const Options& o) {
   row("FAST corners (threshold 20)", r.fast_corners_median, s.fast_corners_median);
   row("valid depth fraction", r.valid_depth_median, s.valid_depth_median);
   row("depth noise k = sigma/z^2 (1/m)", r.noise_k_median, s.noise_k_median);
+  row("mean grey", r.mean_grey_median, s.mean_grey_median);
+  row("mean grey, 95th percentile", r.mean_grey_p95, s.mean_grey_p95);
+  row("mean grey, brightest frame", r.mean_grey_max, s.mean_grey_max);
+  row("pixels at 250+ (fraction)", r.saturated_median, s.saturated_median);
+  row("pixels at 250+, most in a frame", r.saturated_max, s.saturated_max);
+  row("frames with > 10 % at 250+", r.frames_over_a_tenth_saturated, s.frames_over_a_tenth_saturated);
   std::printf("frames: %d real (%s), %d sim (%s, %s, seed %llu); plane blocks: %d real, %d sim\n", r.frames,
               o.tum.c_str(), s.frames, world.name().c_str(), flight->name().c_str(),
               static_cast<unsigned long long>(o.seed), r.noise_blocks, s.noise_blocks);

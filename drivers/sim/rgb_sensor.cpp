@@ -26,6 +26,32 @@ struct RowBuffers {
 
 }  // namespace
 
+float auto_exposure_gain(const std::vector<float> (&planes)[3], int width, int height, double max_mean_grey) {
+  if (!(max_mean_grey > 0.0)) return 1.0f;
+  constexpr int kStep = 4;
+  std::vector<float> grey;
+  grey.reserve(static_cast<size_t>((width / kStep + 1) * (height / kStep + 1)));
+  for (int v = kStep / 2; v < height; v += kStep)
+    for (int u = kStep / 2; u < width; u += kStep) {
+      const size_t i = static_cast<size_t>(v) * static_cast<size_t>(width) + static_cast<size_t>(u);
+      grey.push_back(0.299f * planes[0][i] + 0.587f * planes[1][i] + 0.114f * planes[2][i]);
+    }
+  if (grey.empty()) return 1.0f;
+  const auto clipped_mean = [&](double gain) {
+    double sum = 0.0;
+    for (const float y : grey) sum += std::min(gain * static_cast<double>(y), 255.0);
+    return sum / static_cast<double>(grey.size());
+  };
+  if (clipped_mean(1.0) <= max_mean_grey) return 1.0f;
+  // The clipped mean grows with the gain: bisect for the gain that gives max_mean_grey.
+  double low = 0.0, high = 1.0;
+  while (high - low > 1e-4 * high) {
+    const double mid = 0.5 * (low + high);
+    (clipped_mean(mid) > max_mean_grey ? high : low) = mid;
+  }
+  return static_cast<float>(low);
+}
+
 void expose_rgb(std::vector<float> (&planes)[3], const PinholeCamera& cam, const RgbOptions& o, uint32_t key,
                 cv::Mat& rgb) {
   const int w = cam.width, h = cam.height;
@@ -49,6 +75,7 @@ void expose_rgb(std::vector<float> (&planes)[3], const PinholeCamera& cam, const
     buf.fall_u[static_cast<size_t>(u)] = a * x * x;
   }
   const NormalTable& normal = normal_table();
+  const float exposure_gain = auto_exposure_gain(planes, w, h, o.max_mean_grey);
   const float read_var = static_cast<float>(o.read_noise_dn * o.read_noise_dn);
   const float shot = static_cast<float>(o.shot_noise_dn);
   rgb.create(h, w, CV_8UC3);
@@ -89,6 +116,9 @@ void expose_rgb(std::vector<float> (&planes)[3], const PinholeCamera& cam, const
         const float* mid = planes[c].data() + static_cast<size_t>(v) * w;
         for (int u = 0; u < w; ++u) value[u] = mid[u] * (gain_v - fall_u[u]);
       }
+      // Only where the auto-exposure acts: elsewhere the frame is bit for bit the fixed exposure's.
+      if (exposure_gain != 1.0f)
+        for (int u = 0; u < w; ++u) value[u] *= exposure_gain;
       if (o.noise) {
         const float* nc = noise + static_cast<size_t>(c) * n;
         for (int u = 0; u < w; ++u) value[u] += std::sqrt(read_var + shot * std::max(value[u], 0.0f)) * nc[u];

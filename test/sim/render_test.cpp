@@ -14,6 +14,7 @@
 #include "drivers/sim/kinect_depth.h"
 #include "drivers/sim/random.h"
 #include "drivers/sim/renderer.h"
+#include "drivers/sim/rgb_sensor.h"
 #include "drivers/sim/texture.h"
 #include "sim_fixture.h"
 
@@ -141,6 +142,55 @@ TEST(RenderTest, TexturedWallsHaveCornersAtSeveralScalesAndTheBlankWallFew) {
     EXPECT_GT(textured[level], minimum[level]);
     EXPECT_LT(blank[level] * 5, textured[level]);
   }
+}
+
+// The auto-exposure's factor, by hand: it meters the grey clipped at 255, and acts only above
+// the bound.
+TEST(RgbSensor, AutoExposureLowersOnlyAFrameBrighterThanTheBoundAndMetersTheClippedGrey) {
+  const int w = 64, h = 48;
+  const auto planes_of = [&](float left, float right) {
+    std::vector<float> p(static_cast<size_t>(w * h));
+    for (int v = 0; v < h; ++v)
+      for (int u = 0; u < w; ++u) p[static_cast<size_t>(v * w + u)] = u < w / 2 ? left : right;
+    return std::array<std::vector<float>, 3>{p, p, p};
+  };
+  const auto gain = [&](float left, float right, double bound) {
+    auto a = planes_of(left, right);
+    std::vector<float> planes[3] = {a[0], a[1], a[2]};
+    return auto_exposure_gain(planes, w, h, bound);
+  };
+  EXPECT_EQ(gain(100, 100, 160), 1.0f);
+  EXPECT_NEAR(gain(400, 400, 160), 0.4f, 1e-4);
+  // Unclipped the mean would be 525; clipped, (255 + 50) / 2 = 152.5: within the bound.
+  EXPECT_EQ(gain(1000, 50, 160), 1.0f);
+  // (255 + 200 g) / 2 = 160 with 1000 g >= 255: g = 0.325.
+  EXPECT_NEAR(gain(1000, 200, 160), 0.325f, 1e-4);
+  EXPECT_EQ(gain(1000, 1000, 0), 1.0f) << "0: off";
+}
+
+// Under the floor's lamps a fixed exposure washes the frame out; with the auto-exposure its mean
+// grey stays within a Kinect's and the clipped highlights shrink; the room, dimmer, is rendered
+// exactly as with a fixed exposure.
+TEST(RenderTest, AFrameUnderTheLampsIsNotWashedOutAndADimOneIsUntouched) {
+  const auto stats = [](const cv::Mat& rgb) {
+    cv::Mat grey;
+    cv::cvtColor(rgb, grey, cv::COLOR_RGB2GRAY);
+    return std::make_pair(cv::mean(grey)[0], cv::countNonZero(grey >= 250) / static_cast<double>(grey.total()));
+  };
+  CameraOptions fixed;
+  fixed.rgb.max_mean_grey = 0.0;
+  const World& floor = test::builtin("floor");
+  const Eigen::Isometry3d under_lamps = look({6.5, 2.5, 1.2}, 1.5708);
+  const auto [fixed_mean, fixed_clipped] = stats(Renderer(floor, fixed, 3).render(under_lamps, 0, 0).rgb);
+  const auto [auto_mean, auto_clipped] = stats(Renderer(floor, CameraOptions{}, 3).render(under_lamps, 0, 0).rgb);
+  EXPECT_GT(fixed_mean, 180.0) << "the case this is about";
+  EXPECT_LT(auto_mean, 161.0);
+  EXPECT_GT(auto_mean, 130.0);
+  EXPECT_LT(auto_clipped, 0.5 * fixed_clipped);
+  const World& room = test::builtin("room");
+  const Eigen::Isometry3d dim = look({8.0, 2.0, 1.5}, -1.5708);
+  const cv::Mat a = Renderer(room, fixed, 3).render(dim, 0, 0).rgb, b = Renderer(room, CameraOptions{}, 3).render(dim, 0, 0).rgb;
+  EXPECT_EQ(cv::norm(a, b, cv::NORM_INF), 0.0);
 }
 
 // The spans (SIMD groups of 4 and 8 pixels plus scalar tails, stored wrap copies) against
