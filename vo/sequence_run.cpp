@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <ctime>
-#include <filesystem>
 #include <cmath>
 #include <nlohmann/json.hpp>
 
@@ -73,19 +72,7 @@ LoadedSequence load_tum_sequence(const std::string& folder) {
 }
 
 const sensors::SensorProfile& tum_sensor(const std::string& folder) {
-  const std::string model = tum::sensor_model_of_folder(folder);
-  if (!model.empty()) {
-    // A name in the folder's camera.txt was written on purpose: a misspelt one is an error,
-    // not the silent `default` an unknown camera on the wire gets.
-    std::string names;
-    for (const sensors::SensorProfile& p : sensors::builtin_profiles()) {
-      if (p.name == model) return p;
-      names += (names.empty() ? "" : ", ") + p.name;
-    }
-    throw InputError((std::filesystem::path(folder) / "camera.txt").string() + ": sensor '" + model +
-                     "' is not a built-in profile (" + names + "); give a profile file with --sensor");
-  }
-  return sensors::profile_of_sensor(model);
+  return sensors::profile_of_sensor(tum::sensor_model_of_folder(folder));
 }
 
 VoOptions with_tum_sensor(const std::string& folder, VoOptions options) {

@@ -69,8 +69,8 @@ LoadedSequence load_tum_sequence(const std::string& folder);
 /// The sensor profile of the recording in `folder`: the one its camera.txt names (the
 /// simulator's TUM-format exports name `simulator`), else kinect1's for a freiburg1 recording
 /// (named as TUM names them, tum::detect_camera), else "default" (the built-in defaults: e.g.
-/// freiburg2/3, whose timing was not measured). InputError naming camera.txt for a name there
-/// that is no built-in profile, or a bad camera.txt.
+/// freiburg2/3, whose timing was not measured). InputError naming camera.txt and its line for a
+/// bad camera.txt (tum::read_camera_file).
 const sensors::SensorProfile& tum_sensor(const std::string& folder);
 
 /// `options` with the profile of the recording in `folder` (tum_sensor()). Every offline run

@@ -34,7 +34,8 @@ float auto_exposure_gain(const std::vector<float> (&planes)[3], int width, int h
   for (int v = kStep / 2; v < height; v += kStep)
     for (int u = kStep / 2; u < width; u += kStep) {
       const size_t i = static_cast<size_t>(v) * static_cast<size_t>(width) + static_cast<size_t>(u);
-      grey.push_back(0.299f * planes[0][i] + 0.587f * planes[1][i] + 0.114f * planes[2][i]);
+      const float y = 0.299f * planes[0][i] + 0.587f * planes[1][i] + 0.114f * planes[2][i];
+      if (std::isfinite(y)) grey.push_back(y);  // (the renderer gives none other; a NaN must not meter)
     }
   if (grey.empty()) return 1.0f;
   const auto clipped_mean = [&](double gain) {
@@ -45,7 +46,7 @@ float auto_exposure_gain(const std::vector<float> (&planes)[3], int width, int h
   if (clipped_mean(1.0) <= max_mean_grey) return 1.0f;
   // The clipped mean grows with the gain: bisect for the gain that gives max_mean_grey.
   double low = 0.0, high = 1.0;
-  while (high - low > 1e-4 * high) {
+  for (int i = 0; i < 60 && high - low > 1e-4 * high; ++i) {
     const double mid = 0.5 * (low + high);
     (clipped_mean(mid) > max_mean_grey ? high : low) = mid;
   }

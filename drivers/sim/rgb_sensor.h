@@ -10,7 +10,7 @@
 // fr1_rpy, `kestrel sim-realism`). A fixed exposure does not: near the simulated lamps the
 // frames washed out (stata's median frame had 76 % of its pixels at 250+). Where an image's
 // mean grey, clipped as the sensor clips it, would be above RgbOptions::max_mean_grey, the
-// exposure is lowered until it is that; elsewhere it stays as set, so a frame within the range
+// exposure is lowered until the metered mean is that; elsewhere it stays as set, so a frame within the range
 // a Kinect gives is rendered exactly as without it. Instantaneous (no lag over frames): a frame
 // depends on its own pose only. Dim frames are not brightened (not modelled).
 
@@ -30,8 +30,10 @@ void expose_rgb(std::vector<float> (&planes)[3], const PinholeCamera& camera, co
 
 /// The auto-exposure's factor on the exposure for `planes` (width x height; see the top of this
 /// file): 1 when `max_mean_grey` <= 0 or the clipped mean grey (metered on every 4th pixel of
-/// every 4th row, before the optics) is at most `max_mean_grey`; else the factor in (0, 1)
-/// that brings it to `max_mean_grey` (within 1e-4 of it, relative).
+/// every 4th row, before the optics and the vignetting; non-finite values are not metered) is
+/// at most `max_mean_grey`; else the factor in [0, 1) that brings the metered mean to
+/// `max_mean_grey` (within 1e-4 of it, relative). The frame that comes out is a little darker
+/// still (vignetting): ~148 for 160.
 float auto_exposure_gain(const std::vector<float> (&planes)[3], int width, int height, double max_mean_grey);
 
 }  // namespace kestrel::sim

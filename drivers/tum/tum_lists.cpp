@@ -6,6 +6,7 @@
 #include "common/error.h"
 #include "common/text.h"
 #include "common/time.h"
+#include "sensors/builtin_profiles.h"
 
 namespace kestrel::tum {
 namespace {
@@ -99,7 +100,15 @@ CameraFile read_camera_file(const std::string& path) {
     if (f[0] == "sensor") {
       if (f.size() != 2) throw InputError(at_line(path, line_no, "expected 'sensor NAME', got '" + line + "'"));
       if (!file.sensor.empty()) throw InputError(at_line(path, line_no, "a second 'sensor' line"));
-      file.sensor = std::string(f[1]);
+      // A name written on purpose: a misspelt one is an error, not the silent `default` an
+      // unknown camera on the wire gets.
+      std::string names;
+      for (const sensors::SensorProfile& p : sensors::builtin_profiles()) {
+        if (p.name == f[1]) file.sensor = p.name;
+        names += (names.empty() ? "" : ", ") + p.name;
+      }
+      if (file.sensor.empty())
+        throw InputError(at_line(path, line_no, "sensor '" + std::string(f[1]) + "' is not a built-in profile (" + names + ")"));
       return;
     }
     if (f[0] == "T_body_camera") {

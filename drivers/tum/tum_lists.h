@@ -45,8 +45,8 @@ std::vector<AccelerometerSample> read_accelerometer(const std::string& path);
 /// of any other camera). The first data line is "fx fy cx cy width height", optionally followed
 /// by the lens distortion "k1 k2 p1 p2 k3" (OpenCV's, of the raw images); then, each at most
 /// once, "T_body_camera x y z qx qy qz qw" (the camera in the vehicle's body frame, as the
-/// simulator mounted it; a quaternion of norm 1 within 1e-3) and "sensor NAME" (the built-in
-/// sensor profile the frames name: sensors/profiles/).
+/// simulator mounted it; a quaternion of norm 1 within 1e-3) and "sensor NAME" (a built-in
+/// sensor profile, which the frames then name: sensors/profiles/).
 struct CameraFile {
   PinholeCamera camera;
   std::optional<Eigen::Isometry3d> T_body_camera;
@@ -56,7 +56,7 @@ struct CameraFile {
 /// Reads camera.txt. Throws InputError naming the file and line for a missing file, a malformed
 /// or repeated line, an unknown key, a non-finite or impossible value (focal lengths and sizes
 /// must be positive, sizes whole numbers up to 16384; check_plausible_camera, common/camera.h),
-/// or a file without the intrinsics line.
+/// a sensor that is no built-in profile, or a file without the intrinsics line.
 CameraFile read_camera_file(const std::string& path);
 
 }  // namespace kestrel::tum

@@ -140,7 +140,7 @@ TEST(DepthTimeOffset, TheKinectTimingIsForFreiburg1RecordingsOnly) {
     tum_sensor(misspelt);
     ADD_FAILURE() << "a misspelt profile name";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("camera.txt: sensor 'simulater' is not a built-in profile"), std::string::npos)
+    EXPECT_NE(std::string(e.what()).find("camera.txt:2: sensor 'simulater' is not a built-in profile"), std::string::npos)
         << e.what();
   }
   for (const std::string& other : {unnamed, std::string("rgbd_dataset_freiburg2_desk"), std::string("rgbd_dataset_freiburg3_office")}) {
