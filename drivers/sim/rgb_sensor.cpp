@@ -29,8 +29,8 @@ struct RowBuffers {
 float auto_exposure_gain(const std::vector<float> (&planes)[3], int width, int height, double max_mean_grey) {
   if (!(max_mean_grey > 0.0)) return 1.0f;
   constexpr int kStep = 4;
-  std::vector<float> grey;
-  grey.reserve(static_cast<size_t>((width / kStep + 1) * (height / kStep + 1)));
+  thread_local std::vector<float> grey;  // per thread, as RowBuffers: no allocation per frame
+  grey.clear();
   for (int v = kStep / 2; v < height; v += kStep)
     for (int u = kStep / 2; u < width; u += kStep) {
       const size_t i = static_cast<size_t>(v) * static_cast<size_t>(width) + static_cast<size_t>(u);

@@ -62,9 +62,12 @@ std::optional<CameraFile> camera_file_of(const std::string& folder) {
   return read_camera_file(path.string());
 }
 
+std::string sensor_model_of(TumCamera camera, const std::optional<CameraFile>& file) {
+  return file && !file->sensor.empty() ? file->sensor : sensor_model_of(camera);
+}
+
 std::string sensor_model_of_folder(const std::string& folder) {
-  const std::optional<CameraFile> file = camera_file_of(folder);
-  return file && !file->sensor.empty() ? file->sensor : sensor_model_of(detect_camera(folder));
+  return sensor_model_of(detect_camera(folder), camera_file_of(folder));
 }
 
 }  // namespace kestrel::tum

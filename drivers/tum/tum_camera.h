@@ -42,8 +42,11 @@ const char* sensor_model_of(TumCamera camera);
 /// The folder's camera.txt (tum_lists.h), if it has one; InputError naming it if it is bad.
 std::optional<CameraFile> camera_file_of(const std::string& folder);
 
-/// The sensor model the frames of `folder` name: its camera.txt's, else sensor_model_of() its
-/// name's camera.
+/// The sensor model the frames name: `file`'s (a folder's camera.txt) if it names one, else
+/// sensor_model_of(camera), the camera the folder's name says.
+std::string sensor_model_of(TumCamera camera, const std::optional<CameraFile>& file);
+
+/// The same for `folder`: sensor_model_of(detect_camera(folder), camera_file_of(folder)).
 std::string sensor_model_of_folder(const std::string& folder);
 
 }  // namespace kestrel::tum

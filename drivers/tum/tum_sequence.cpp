@@ -28,10 +28,10 @@ TumSequence::TumSequence(const std::string& folder, SequenceOptions options)
 
   camera_model_ = detect_camera(folder_);
   camera_ = camera_intrinsics(camera_model_);
-  sensor_ = sensor_model_of(camera_model_);
-  if (const std::optional<CameraFile> file = camera_file_of(folder_)) {
+  const std::optional<CameraFile> file = camera_file_of(folder_);
+  sensor_ = sensor_model_of(camera_model_, file);
+  if (file) {
     camera_ = file->camera;
-    if (!file->sensor.empty()) sensor_ = file->sensor;
     has_camera_file_ = true;
   }
   if (options.intrinsics) {
