@@ -11,10 +11,11 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
+#include <exception>
 #include <string>
 #include <vector>
 
+#include "common/atomic_file.h"
 #include "fuzz/target.h"
 
 extern "C" int LLVMFuzzerRunDriver(int* argc, char*** argv, int (*callback)(const uint8_t* data, size_t size));
@@ -48,10 +49,10 @@ int write_seeds(const kestrel::fuzz::Target& t, const std::string& dir) {
   int i = 0;
   for (const auto& seed : t.seeds()) {
     const std::string path = dir + "/seed-" + std::to_string(i++);
-    std::ofstream out(path, std::ios::binary | std::ios::trunc);
-    out.write(reinterpret_cast<const char*>(seed.data()), static_cast<std::streamsize>(seed.size()));
-    if (!out) {
-      std::fprintf(stderr, "kestrel-fuzz: error: cannot write %s\n", path.c_str());
+    try {
+      kestrel::write_file_atomically(path, seed.data(), seed.size());
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "kestrel-fuzz: error: %s\n", e.what());
       return 4;
     }
   }

@@ -7,10 +7,10 @@
 
 #include <algorithm>
 #include <filesystem>
-#include <fstream>
 #include <iomanip>
 #include <iostream>
 
+#include "common/atomic_file.h"
 #include "common/cli.h"
 #include "common/error.h"
 #include "common/image/image_io.h"
@@ -92,15 +92,15 @@ int main(int argc, char** argv) {
       if (!std::filesystem::is_directory(png_dir) || ::access(png_dir.c_str(), W_OK) != 0)
         throw InputError(png_dir + ": not a writable folder");
     }
-    std::ofstream out;
-    if (!out_path.empty()) {
-      out.open(out_path);
-      if (!out) throw InputError(out_path + ": cannot write");
-    }
-    // Each section goes to the file as it is done, so an interrupted run keeps what it made.
+    // Each section goes to the file as it is done, so an interrupted run keeps what it made:
+    // the file is replaced by all the text so far, atomically, so an earlier result is never cut
+    // short in place and a run killed mid-write leaves whole sections only.
+    std::string written;
     const auto emit = [&](const std::string& text) {
       std::cout << text << std::flush;
-      if (out.is_open() && !(out << text << std::flush)) throw InputError(out_path + ": cannot write");
+      if (out_path.empty()) return;
+      written += text;
+      write_file_atomically(out_path, written);
     };
     const auto section = [&](const std::string& name, const std::string& title, const auto& body) {
       if (only != "all" && only != name) return;

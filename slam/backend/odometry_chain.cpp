@@ -15,6 +15,13 @@ void OdometryChain::reset() {
   pending_break_ = false;
 }
 
+void OdometryChain::remember(int64_t utime, const Reference& reference) {
+  // The oldest go first, never the one remembered now.
+  while (references_.size() >= kMaxReferences && references_.begin()->first != utime)
+    references_.erase(references_.begin());
+  references_[utime] = reference;
+}
+
 std::optional<OdometryPose> OdometryChain::add(const VoMotion& m) {
   if (last_utime_ != 0 && m.utime <= last_utime_) {
     throw InputError("VO update utime " + std::to_string(m.utime) + " does not follow " + std::to_string(last_utime_));
@@ -28,44 +35,47 @@ std::optional<OdometryPose> OdometryChain::add(const VoMotion& m) {
   OdometryPose out;
   out.utime = m.utime;
   if (m.ok) {
-    const auto ref = references_.find(m.reference_utime);
-    if (ref != references_.end()) {
-      T_odom_camera = ref->second.T_odom_camera * m.T_reference_current;
-      out.reference_utime = m.reference_utime;
-      out.T_reference_camera = m.T_reference_current;
-      if (m.covariance.allFinite() && !m.covariance.isZero(0.0)) {
-        // Per-axis floors: isotropic in each block, so the same in any frame. Floors the
-        // covariance cannot contain (negative, not finite, above its diagonal) are not taken
-        // out: the whole covariance then counts per motion.
-        out.floor.diagonal() << Eigen::Vector3d::Constant(m.translation_floor_m * m.translation_floor_m),
-            Eigen::Vector3d::Constant(m.rotation_floor_rad * m.rotation_floor_rad);
-        const bool floors_ok = std::isfinite(m.translation_floor_m) && std::isfinite(m.rotation_floor_rad) &&
-                               m.translation_floor_m >= 0.0 && m.rotation_floor_rad >= 0.0 &&
-                               (m.covariance.diagonal() - out.floor.diagonal()).minCoeff() >= 0.0;
-        if (!floors_ok) out.floor.setZero();
-        // [dp; dtheta] with dp in the reference frame -> right perturbation: rho = R^T dp.
-        Matrix6d J = Matrix6d::Identity();
-        J.topLeftCorner<3, 3>() = m.T_reference_current.linear().transpose();
-        out.covariance = J * (m.covariance - out.floor) * J.transpose();
-        out.covariance = 0.5 * (out.covariance + out.covariance.transpose()).eval();
-        out.has_covariance = true;
-      }
+    auto ref = references_.find(m.reference_utime);
+    if (ref == references_.end()) {
+      // A motion against a reference this chain never had: its announcement was lost (a lossy
+      // link) or is older than the kMaxReferences remembered. A new segment starts at this
+      // frame, and the reference is remembered where this motion puts it, so the motions after
+      // it against the same reference chain on from here: one break, rather than no pose at
+      // all until the VO takes its next reference (a hovering VO keeps one for minutes).
+      pending_break_ = last_.has_value();
+      const Eigen::Isometry3d T_odom_here = last_ ? *last_ : m.T_body_camera;
+      remember(m.reference_utime, Reference{T_odom_here * m.T_reference_current.inverse(), 0, Matrix6d::Zero(), false});
+      ref = references_.find(m.reference_utime);
+    }
+    T_odom_camera = ref->second.T_odom_camera * m.T_reference_current;
+    out.reference_utime = m.reference_utime;
+    out.T_reference_camera = m.T_reference_current;
+    if (m.covariance.allFinite() && !m.covariance.isZero(0.0)) {
+      // Per-axis floors: isotropic in each block, so the same in any frame. Floors the
+      // covariance cannot contain (negative, not finite, above its diagonal) are not taken
+      // out: the whole covariance then counts per motion.
+      out.floor.diagonal() << Eigen::Vector3d::Constant(m.translation_floor_m * m.translation_floor_m),
+          Eigen::Vector3d::Constant(m.rotation_floor_rad * m.rotation_floor_rad);
+      const bool floors_ok = std::isfinite(m.translation_floor_m) && std::isfinite(m.rotation_floor_rad) &&
+                             m.translation_floor_m >= 0.0 && m.rotation_floor_rad >= 0.0 &&
+                             (m.covariance.diagonal() - out.floor.diagonal()).minCoeff() >= 0.0;
+      if (!floors_ok) out.floor.setZero();
+      // [dp; dtheta] with dp in the reference frame -> right perturbation: rho = R^T dp.
+      Matrix6d J = Matrix6d::Identity();
+      J.topLeftCorner<3, 3>() = m.T_reference_current.linear().transpose();
+      out.covariance = J * (m.covariance - out.floor) * J.transpose();
+      out.covariance = 0.5 * (out.covariance + out.covariance.transpose()).eval();
+      out.has_covariance = true;
     }
   }
   if (!T_odom_camera) {
-    if (!m.new_reference) {
-      // No estimate for this frame; if the odometry lost its reference, what follows restarts.
-      if (m.ok) pending_break_ = last_.has_value();
-      return std::nullopt;
-    }
+    if (!m.new_reference) return std::nullopt;  // a failed frame: no estimate
     // A new segment: a restart after earlier poses, or the very first frame.
     pending_break_ = last_.has_value();
     T_odom_camera = last_ ? *last_ : m.T_body_camera;
   }
-  if (m.new_reference) {
-    references_[m.utime] = Reference{*T_odom_camera, out.reference_utime, out.covariance, out.has_covariance};
-    while (references_.size() > kMaxReferences) references_.erase(references_.begin());
-  }
+  if (m.new_reference)
+    remember(m.utime, Reference{*T_odom_camera, out.reference_utime, out.covariance, out.has_covariance});
   out.T_odom_camera = *T_odom_camera;
   out.broken = pending_break_;
   pending_break_ = false;

@@ -3,9 +3,11 @@
 // earlier frame announced) into odometry poses T_odom_camera that SLAM takes (slam.h).
 //
 // "odom" is the body frame at the first frame: the first camera pose is T_body_camera. When the
-// odometry restarts (no reference, or a reference this chain never saw), the new segment starts
-// at the last known pose and the pose is flagged `broken`: it is not related to the earlier
-// ones. Invariants: utimes increase; at most kMaxReferences references are remembered.
+// odometry restarts (no reference, or a reference this chain never saw: its announcement lost
+// on a link, or forgotten), the new segment starts at the last known pose and the pose is
+// flagged `broken`: it is not related to the earlier ones. An unseen reference is remembered
+// where that first motion puts it, so the later motions against it chain on. Invariants: utimes
+// increase; at most kMaxReferences references are remembered.
 //
 // Uncertainty: when the VO reports a covariance with each motion, the chain keeps it with each
 // reference (relative to the reference it was measured from), so that relative_covariance()
@@ -78,6 +80,9 @@ class OdometryChain {
     Matrix6d covariance = Matrix6d::Zero();  ///< right perturbation of T_parent_this
     bool has_covariance = false;
   };
+  /// Keeps `reference` under `utime`, forgetting the oldest beyond kMaxReferences.
+  void remember(int64_t utime, const Reference& reference);
+
   std::map<int64_t, Reference> references_;  ///< utime -> reference
   std::optional<Eigen::Isometry3d> last_;            ///< last pose given out
   int64_t last_utime_ = 0;

@@ -522,6 +522,41 @@ TEST(OdometryChain, ChainsMotionsThroughReferencesAndFlagsRestarts) {
   EXPECT_NEAR(x(next), 0.6, 1e-12);
 }
 
+// A reference whose announcement never reached SLAM (lost on a lossy link, the first frame's
+// included): the first motion against it starts a segment, and the next ones chain on from it,
+// with their covariances. Before, every motion against it had no pose, for as long as the VO
+// kept that reference (a hover: the whole flight).
+TEST(OdometryChain, AMotionAgainstAReferenceItNeverSawStartsASegmentTheNextOnesChainOn) {
+  OdometryChain chain;
+  auto x = [](const std::optional<OdometryPose>& p) { return p.value().T_odom_camera.translation().x(); };
+  auto with_covariance = [](VoMotion m) {
+    m.covariance = Matrix6d::Identity() * 1e-4;
+    return m;
+  };
+  // The first frame (10, the reference) was lost.
+  const auto p20 = chain.add(with_covariance(motion(20, 10, true, false, 0.1)));
+  ASSERT_TRUE(p20.has_value());
+  EXPECT_FALSE(p20->broken) << "nothing came before it";
+  EXPECT_NEAR(x(p20), 0.0, 1e-12) << "the first pose is the mounting's, as for a first frame";
+  const auto p30 = chain.add(with_covariance(motion(30, 10, true, false, 0.3)));
+  EXPECT_FALSE(p30.value().broken);
+  EXPECT_NEAR(x(p30), 0.2, 1e-12) << "chained from the reference as the first motion placed it";
+  EXPECT_TRUE(chain.relative_covariance(*p20, *p30).has_value());
+  EXPECT_NEAR(x(chain.add(with_covariance(motion(40, 10, true, true, 0.5)))), 0.4, 1e-12);
+  // The announcement of reference 50 was lost; 60 and 70 are measured from it.
+  const auto p60 = chain.add(with_covariance(motion(60, 50, true, false, 0.2)));
+  ASSERT_TRUE(p60.has_value());
+  EXPECT_TRUE(p60->broken) << "not related to the poses before";
+  EXPECT_NEAR(x(p60), 0.4, 1e-12) << "a new segment starts at the last pose";
+  const auto p70 = chain.add(with_covariance(motion(70, 50, true, false, 0.3)));
+  ASSERT_TRUE(p70.has_value());
+  EXPECT_FALSE(p70->broken);
+  EXPECT_NEAR(x(p70), 0.5, 1e-12);
+  EXPECT_TRUE(chain.relative_covariance(*p60, *p70).has_value()) << "one segment";
+  EXPECT_FALSE(chain.relative_covariance(*p30, *p70).has_value()) << "across the break";
+  EXPECT_FALSE(chain.add(motion(80, 50, false, false)).has_value()) << "a failed frame still has none";
+}
+
 TEST(OdometryChain, RefusesTimeGoingBackAndNonRigidMotion) {
   OdometryChain chain;
   chain.add(motion(10, 0, false, true));

@@ -21,12 +21,12 @@
 #include <chrono>
 #include <cstring>
 #include <deque>
-#include <fstream>
 #include <map>
 #include <set>
 #include <string>
 #include <vector>
 
+#include "common/atomic_file.h"
 #include "common/cli.h"
 #include "common/error.h"
 #include "common/interrupt.h"
@@ -179,7 +179,8 @@ struct Direction {
 };
 
 void write_stats(const std::string& path, const std::vector<Direction*>& directions, double seconds) {
-  std::ofstream out(path);
+  kestrel::AtomicFile file(path);  // a link killed while writing leaves no cut file that looks whole
+  std::ostream& out = file.stream();
   out << "{\n  \"seconds\": " << fmt::format("{:.3f}", seconds) << ",\n";
   for (size_t i = 0; i < directions.size(); ++i) {
     const Direction& d = *directions[i];
@@ -197,7 +198,7 @@ void write_stats(const std::string& path, const std::vector<Direction*>& directi
     out << "}}" << (i + 1 < directions.size() ? "," : "") << "\n";
   }
   out << "}\n";
-  if (!out) throw kestrel::InputError("cannot write " + path);
+  file.commit();
 }
 
 int run(const Options& o) {

@@ -8,10 +8,10 @@
 #include <unistd.h>
 
 #include <filesystem>
-#include <fstream>
 #include <string>
 #include <vector>
 
+#include "common/atomic_file.h"
 #include "common/cli.h"
 #include "common/error.h"
 #include "tools/link/split_flight.h"
@@ -75,11 +75,10 @@ int sweep(const Options& o) {
              "|---|---|---|---|---|---|---|---|\n");
   for (const auto& row : rows) fmt::print("{}\n", row);
   if (!o.json.empty()) {
-    std::ofstream json(o.json);
-    json << "[\n";
-    for (size_t i = 0; i < json_rows.size(); ++i) json << "  " << json_rows[i] << (i + 1 < json_rows.size() ? ",\n" : "\n");
-    json << "]\n";
-    if (!json) throw kestrel::InputError("cannot write " + o.json);
+    std::string json = "[\n";
+    for (size_t i = 0; i < json_rows.size(); ++i) json += "  " + json_rows[i] + (i + 1 < json_rows.size() ? ",\n" : "\n");
+    json += "]\n";
+    kestrel::write_file_atomically(o.json, json);
   }
   return all_well ? kestrel::kExitOk : kestrel::kExitFailure;
 }
