@@ -55,6 +55,7 @@ AtomicFile::AtomicFile(std::string path) : path_(std::move(path)), target_(resol
   const bool exists = ::stat(target_.c_str(), &st) == 0;
   if (exists && S_ISDIR(st.st_mode)) throw InputError(path_ + ": is a folder, not a file to write");
   if (exists && !S_ISREG(st.st_mode)) {
+    // in-place: a device or FIFO target, which a rename would replace
     out_.open(target_, std::ios::binary | std::ios::out | std::ios::trunc);
     if (!out_) throw InputError(path_ + ": cannot open for writing: " + errno_text());
     return;
@@ -68,6 +69,7 @@ AtomicFile::AtomicFile(std::string path) : path_(std::move(path)), target_(resol
     temp_ = (fs::path(folder) / ("." + name + ".tmp-" + std::to_string(::getpid()) + "-" +
                                  std::to_string(counter.fetch_add(1))))
                 .string();
+    // in-place: the temporary, new (O_EXCL)
     fd = ::open(temp_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
     if (fd < 0 && errno != EEXIST) break;
   }
@@ -79,6 +81,7 @@ AtomicFile::AtomicFile(std::string path) : path_(std::move(path)), target_(resol
   // A replaced file keeps its permissions (0666 less the umask for a new one).
   if (exists) (void)::fchmod(fd, st.st_mode & 07777);
   ::close(fd);
+  // in-place: the temporary
   out_.open(temp_, std::ios::binary | std::ios::out | std::ios::trunc);
   if (!out_) {
     const std::string why = errno_text();
@@ -156,6 +159,7 @@ std::string keep_aside(const std::string& path, const std::string& tag) {
     if (errno != EPERM && errno != EXDEV && errno != EMLINK && errno != ENOTSUP && errno != EOPNOTSUPP)
       throw InputError(path + ": cannot keep it as " + aside + ": " + errno_text());
     // No hard links here: a copy, complete on disk before anything replaces the original.
+    // in-place: a new name beside the file (copy_options::none never overwrites)
     if (!fs::copy_file(source, aside, fs::copy_options::none, ec)) {
       fs::remove(aside, ec);
       throw InputError(path + ": cannot keep a copy as " + aside + ": " + ec.message());

@@ -49,6 +49,7 @@ class AtomicFile {
   std::string path_;   // as given, for messages
   std::string target_; // path_ with a symbolic link resolved
   std::string temp_;   // "" when writing in place
+  // in-place: the temporary, renamed over the target by commit() (or a device or FIFO target itself)
   std::ofstream out_;
   bool committed_ = false;
 };

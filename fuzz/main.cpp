@@ -45,16 +45,14 @@ const kestrel::fuzz::Target* target_named(const char* name) {
 }
 
 int write_seeds(const kestrel::fuzz::Target& t, const std::string& dir) {
-  std::filesystem::create_directories(dir);
-  int i = 0;
-  for (const auto& seed : t.seeds()) {
-    const std::string path = dir + "/seed-" + std::to_string(i++);
-    try {
-      kestrel::write_file_atomically(path, seed.data(), seed.size());
-    } catch (const std::exception& e) {
-      std::fprintf(stderr, "kestrel-fuzz: error: %s\n", e.what());
-      return 4;
-    }
+  try {
+    std::filesystem::create_directories(dir);
+    int i = 0;
+    for (const auto& seed : t.seeds())
+      kestrel::write_file_atomically(dir + "/seed-" + std::to_string(i++), seed.data(), seed.size());
+  } catch (const std::exception& e) {  // the folder or a file cannot be written
+    std::fprintf(stderr, "kestrel-fuzz: error: %s: %s\n", dir.c_str(), e.what());
+    return 3;
   }
   return 0;
 }

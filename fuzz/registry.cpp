@@ -68,6 +68,7 @@ const std::string& scratch_dir() {
 
 std::string scratch_file(const std::string& name, const uint8_t* data, size_t size) {
   const std::string path = scratch_dir() + "/" + name;
+  // in-place: input for the code under test, in a scratch folder of its own
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   out.write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(size));
   out.close();

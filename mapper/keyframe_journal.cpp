@@ -259,6 +259,7 @@ void JournalWriter::start_fresh(const std::string& source, const std::vector<std
 }
 
 void JournalWriter::open_for_append() {
+  // in-place: the journal, appended record by record (compaction is atomic)
   out_.open(path_, std::ios::binary | std::ios::app);
   if (!out_) throw InputError(path_ + ": cannot write the mapper journal: " + std::strerror(errno));
   std::error_code ec;

@@ -188,6 +188,7 @@ class JournalWriter {
 
   std::string path_;
   int keep_;
+  // in-place: the journal, appended record by record (compaction is atomic)
   std::ofstream out_;
   uint64_t bytes_ = 0;
   std::string kept_aside_;

@@ -95,12 +95,16 @@ int main(int argc, char** argv) {
     // Each section goes to the file as it is done, so an interrupted run keeps what it made:
     // the file is replaced by all the text so far, atomically, so an earlier result is never cut
     // short in place and a run killed mid-write leaves whole sections only.
+    // A device or a FIFO (`--out /dev/stderr`) is a stream: it gets each section once.
+    std::error_code ec;
+    const bool stream = !out_path.empty() && std::filesystem::exists(out_path, ec) &&
+                        !std::filesystem::is_regular_file(out_path, ec);
     std::string written;
     const auto emit = [&](const std::string& text) {
       std::cout << text << std::flush;
       if (out_path.empty()) return;
       written += text;
-      write_file_atomically(out_path, written);
+      write_file_atomically(out_path, stream ? text : written);
     };
     const auto section = [&](const std::string& name, const std::string& title, const auto& body) {
       if (only != "all" && only != name) return;

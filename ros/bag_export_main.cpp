@@ -35,6 +35,7 @@ int run(const Options& o) {
   {
     rosbag::Bag bag;
     try {
+      // in-place: AtomicFile's temporary (or a device target), committed once the bag is whole
       bag.open(out.temp_path().empty() ? o.bag : out.temp_path(), rosbag::bagmode::Write);
     } catch (const rosbag::BagException& e) {
       throw InputError(o.bag + ": cannot write the bag: " + e.what());

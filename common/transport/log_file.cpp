@@ -163,6 +163,7 @@ std::string LogReader::damage_report() const {
 }
 
 LogWriter::LogWriter(const std::string& path) : path_(path) {
+  // in-place: an LCM log, appended event by event as it is recorded; readers stop at a cut event
   file_ = std::fopen(path.c_str(), "wb");
   if (!file_) throw InputError(path + ": cannot write LCM log: " + std::strerror(errno));
 }

@@ -34,6 +34,7 @@ FakenectDumpWriter::FakenectDumpWriter(const std::string& folder) : folder_(fold
   if (!fs::is_directory(folder_, ec)) throw InputError(folder_ + ": cannot create the dump folder");
   const std::string index = (fs::path(folder_) / "INDEX.txt").string();
   if (fs::exists(index, ec)) throw InputError(index + ": a fakenect dump is already there");
+  // in-place: a recording, its index appended a line per frame as frames come
   index_ = std::fopen(index.c_str(), "w");
   if (!index_) throw InputError(index + ": cannot create");
 }
@@ -58,6 +59,7 @@ std::string FakenectDumpWriter::add_entry(char type, int64_t utime, const char* 
 void FakenectDumpWriter::write_file(const std::string& name, const std::string& header,
                                     const void* data, size_t size) {
   const std::string path = (fs::path(folder_) / name).string();
+  // in-place: a recording, one file per frame as frames come
   std::unique_ptr<std::FILE, FileCloser> f(std::fopen(path.c_str(), "wb"));
   if (!f) throw InputError(path + ": cannot create");
   bool ok = std::fwrite(header.data(), 1, header.size(), f.get()) == header.size() &&

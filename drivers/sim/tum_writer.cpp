@@ -2,9 +2,11 @@
 
 #include <filesystem>
 #include <iomanip>
+#include <sstream>
 #include <opencv2/imgproc.hpp>
 #include <vector>
 
+#include "common/atomic_file.h"
 #include "common/error.h"
 #include "common/image/image_io.h"
 #include "common/time.h"
@@ -21,6 +23,7 @@ namespace {
 // place, not atomically: an fsync per frame would be most of the run.
 void write_image(const std::string& path, const cv::Mat& image, image::PngFilter filter) {
   const std::vector<uint8_t> png = image::encode_png(image, 1, filter);
+  // in-place: a recording, one image per frame; an fsync per frame would be most of the run
   std::ofstream out(path, std::ios::binary);
   out.write(reinterpret_cast<const char*>(png.data()), static_cast<std::streamsize>(png.size()));
   if (!out.flush()) throw InputError(path + ": cannot write image");
@@ -34,8 +37,10 @@ void pose_line(std::ostream& out, const Eigen::Isometry3d& T) {
 
 }  // namespace
 
+// in-place: a recording, its lists appended a line per sample
 std::ofstream TumFolderWriter::open(const std::string& name, const char* header) {
   const std::string path = (fs::path(folder_) / name).string();
+  // in-place: a recording, its lists appended a line per sample
   std::ofstream out(path);
   if (!out) throw InputError(path + ": cannot create file");
   out << header;
@@ -60,12 +65,13 @@ TumFolderWriter::TumFolderWriter(const std::string& folder, const PinholeCamera&
                         "# accelerometer data (Kinect accelerometer axes)\n# file: 'kestrel-sim'\n# timestamp ax ay az\n");
   imu_ = open("imu.txt", "# imu (body frame: x forward, y left, z up)\n# timestamp gx gy gz ax ay az\n");
   biases_ = open("imu_biases.txt", "# true imu biases (as added to the readings)\n# timestamp bgx bgy bgz bax bay baz\n");
-  std::ofstream cam = open("camera.txt", "# fx fy cx cy width height\n");
-  cam << camera.fx << ' ' << camera.fy << ' ' << camera.cx << ' ' << camera.cy << ' ' << camera.width << ' '
+  std::ostringstream cam;  // a whole file, written at once
+  cam << std::setprecision(9) << "# fx fy cx cy width height\n"
+      << camera.fx << ' ' << camera.fy << ' ' << camera.cx << ' ' << camera.cy << ' ' << camera.width << ' '
       << camera.height << "\n# T_body_camera x y z qx qy qz qw\nT_body_camera";
   pose_line(cam, T_body_camera);
   cam << "\n# the sensor profile (sensors/profiles/)\nsensor " << sensor_model::kSimulator << '\n';
-  if (!cam) throw InputError(folder + "/camera.txt: write error");
+  write_file_atomically((fs::path(folder) / "camera.txt").string(), cam.str());
 }
 
 void TumFolderWriter::add_pose(int64_t utime, const Eigen::Isometry3d& T_world_camera) {

@@ -41,10 +41,12 @@ class TumFolderWriter {
 
  private:
   void add_pose(int64_t utime, const Eigen::Isometry3d& T_world_camera);
+  // in-place: a recording, its lists appended a line per sample
   std::ofstream open(const std::string& name, const char* header);
 
   std::string folder_;
   Eigen::Isometry3d T_body_camera_;
+  // in-place: a recording, its lists appended a line per sample
   std::ofstream rgb_, depth_, ground_truth_, accelerometer_, imu_, biases_;
   int64_t last_pose_utime_ = -1;
   int64_t frames_ = 0;

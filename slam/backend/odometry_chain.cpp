@@ -12,7 +12,6 @@ void OdometryChain::reset() {
   references_.clear();
   last_.reset();
   last_utime_ = 0;
-  pending_break_ = false;
 }
 
 void OdometryChain::remember(int64_t utime, const Reference& reference) {
@@ -29,22 +28,36 @@ std::optional<OdometryPose> OdometryChain::add(const VoMotion& m) {
   if (m.ok && !se3::is_valid(m.T_reference_current, 1e-6)) {
     throw InputError("VO update " + std::to_string(m.utime) + ": motion is not a finite rigid transform");
   }
+  if (m.ok && (m.reference_utime <= 0 || m.reference_utime >= m.utime)) {
+    throw InputError("VO update " + std::to_string(m.utime) + ": its reference " + std::to_string(m.reference_utime) +
+                     " is not an earlier frame");
+  }
   last_utime_ = m.utime;
 
   std::optional<Eigen::Isometry3d> T_odom_camera;
   OdometryPose out;
   out.utime = m.utime;
+  bool broken = false;  // not related to the poses before
   if (m.ok) {
     auto ref = references_.find(m.reference_utime);
     if (ref == references_.end()) {
-      // A motion against a reference this chain never had: its announcement was lost (a lossy
-      // link) or is older than the kMaxReferences remembered. A new segment starts at this
-      // frame, and the reference is remembered where this motion puts it, so the motions after
-      // it against the same reference chain on from here: one break, rather than no pose at
-      // all until the VO takes its next reference (a hovering VO keeps one for minutes).
-      pending_break_ = last_.has_value();
-      const Eigen::Isometry3d T_odom_here = last_ ? *last_ : m.T_body_camera;
-      remember(m.reference_utime, Reference{T_odom_here * m.T_reference_current.inverse(), 0, Matrix6d::Zero(), false});
+      if (last_ && last_->utime == m.reference_utime) {
+        // Measured from the frame before, which no update announced: the VO's fall-back when
+        // its keyframe fails. That frame's pose and how it was chained are known: go on
+        // through it.
+        remember(m.reference_utime,
+                 Reference{last_->T_odom_camera, last_->reference_utime, last_->covariance, last_->has_covariance});
+      } else {
+        // A reference this chain never had: its announcement was lost (a lossy link) or is
+        // older than the kMaxReferences remembered. A new segment starts at this frame, and
+        // the reference is remembered where this motion puts it, so the motions after it
+        // against the same reference chain on from here: one break, rather than no pose at
+        // all until the VO takes its next reference (a hovering VO keeps one for minutes).
+        broken = last_.has_value();
+        const Eigen::Isometry3d T_odom_here = last_ ? last_->T_odom_camera : m.T_body_camera;
+        remember(m.reference_utime,
+                 Reference{T_odom_here * m.T_reference_current.inverse(), 0, Matrix6d::Zero(), false, true});
+      }
       ref = references_.find(m.reference_utime);
     }
     T_odom_camera = ref->second.T_odom_camera * m.T_reference_current;
@@ -71,15 +84,14 @@ std::optional<OdometryPose> OdometryChain::add(const VoMotion& m) {
   if (!T_odom_camera) {
     if (!m.new_reference) return std::nullopt;  // a failed frame: no estimate
     // A new segment: a restart after earlier poses, or the very first frame.
-    pending_break_ = last_.has_value();
-    T_odom_camera = last_ ? *last_ : m.T_body_camera;
+    broken = last_.has_value();
+    T_odom_camera = last_ ? last_->T_odom_camera : m.T_body_camera;
   }
   if (m.new_reference)
     remember(m.utime, Reference{*T_odom_camera, out.reference_utime, out.covariance, out.has_covariance});
   out.T_odom_camera = *T_odom_camera;
-  out.broken = pending_break_;
-  pending_break_ = false;
-  last_ = *T_odom_camera;
+  out.broken = broken;
+  last_ = out;
   return out;
 }
 
@@ -93,6 +105,10 @@ std::optional<Matrix6d> OdometryChain::relative_covariance(const OdometryPose& a
   bool from_a = false;  // the walk reached a itself: a's own motion is part of z's path
   for (size_t steps = 0;; ++steps) {
     if (node == a.utime) {
+      // a itself, unless the chain placed a reference at a's time after a break (a reference
+      // forgotten and met again): a's own pose is not that one.
+      if (const auto it = references_.find(node); it != references_.end() && it->second.placed_at_break)
+        return std::nullopt;
       from_a = true;
       break;
     }

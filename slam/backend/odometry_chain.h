@@ -6,8 +6,10 @@
 // odometry restarts (no reference, or a reference this chain never saw: its announcement lost
 // on a link, or forgotten), the new segment starts at the last known pose and the pose is
 // flagged `broken`: it is not related to the earlier ones. An unseen reference is remembered
-// where that first motion puts it, so the later motions against it chain on. Invariants: utimes
-// increase; at most kMaxReferences references are remembered.
+// where that first motion puts it, so the later motions against it chain on. A motion from the
+// previous frame, which no update announced (the VO falls back to it when its keyframe fails),
+// chains on through that frame's pose: no break. Invariants: utimes increase; an OK motion's
+// reference is an earlier frame; at most kMaxReferences references are remembered.
 //
 // Uncertainty: when the VO reports a covariance with each motion, the chain keeps it with each
 // reference (relative to the reference it was measured from), so that relative_covariance()
@@ -79,14 +81,16 @@ class OdometryChain {
     int64_t parent_utime = 0;  ///< the reference it was measured from (0: segment start)
     Matrix6d covariance = Matrix6d::Zero();  ///< right perturbation of T_parent_this
     bool has_covariance = false;
+    /// Never announced: placed where the first motion against it put it, at a break, so not
+    /// that frame's own pose in the chain.
+    bool placed_at_break = false;
   };
   /// Keeps `reference` under `utime`, forgetting the oldest beyond kMaxReferences.
   void remember(int64_t utime, const Reference& reference);
 
   std::map<int64_t, Reference> references_;  ///< utime -> reference
-  std::optional<Eigen::Isometry3d> last_;            ///< last pose given out
+  std::optional<OdometryPose> last_;  ///< the last pose given out
   int64_t last_utime_ = 0;
-  bool pending_break_ = false;  ///< a restart was seen; flag the next pose
 };
 
 }  // namespace kestrel::slam

@@ -522,39 +522,87 @@ TEST(OdometryChain, ChainsMotionsThroughReferencesAndFlagsRestarts) {
   EXPECT_NEAR(x(next), 0.6, 1e-12);
 }
 
+// A motion that turns and moves, with a covariance: what the chain does to it shows in every axis.
+VoMotion turning(int64_t utime, int64_t reference, bool ok, bool new_reference, double k) {
+  VoMotion m = motion(utime, reference, ok, new_reference);
+  m.T_reference_current = se3::exp((Vector6d() << 0.1 * k, -0.05 * k, 0.02 * k, 0.03 * k, 0.1 * k, -0.02 * k).finished());
+  m.T_body_camera = se3::exp((Vector6d() << 0.1, 0.0, 0.05, -1.2, 0.0, -1.5).finished());
+  m.covariance = Matrix6d::Identity() * 1e-4 * k;
+  m.covariance(0, 4) = m.covariance(4, 0) = 2e-5 * k;
+  return m;
+}
+
 // A reference whose announcement never reached SLAM (lost on a lossy link, the first frame's
-// included): the first motion against it starts a segment, and the next ones chain on from it,
-// with their covariances. Before, every motion against it had no pose, for as long as the VO
-// kept that reference (a hover: the whole flight).
+// included): the first motion against it starts a segment, and within it the chain is what it
+// would have been with the announcement (the same relative poses and covariances). Before,
+// every motion against it had no pose for as long as the VO kept that reference (a hover: the
+// whole flight).
 TEST(OdometryChain, AMotionAgainstAReferenceItNeverSawStartsASegmentTheNextOnesChainOn) {
-  OdometryChain chain;
-  auto x = [](const std::optional<OdometryPose>& p) { return p.value().T_odom_camera.translation().x(); };
-  auto with_covariance = [](VoMotion m) {
-    m.covariance = Matrix6d::Identity() * 1e-4;
-    return m;
-  };
-  // The first frame (10, the reference) was lost.
-  const auto p20 = chain.add(with_covariance(motion(20, 10, true, false, 0.1)));
-  ASSERT_TRUE(p20.has_value());
-  EXPECT_FALSE(p20->broken) << "nothing came before it";
-  EXPECT_NEAR(x(p20), 0.0, 1e-12) << "the first pose is the mounting's, as for a first frame";
-  const auto p30 = chain.add(with_covariance(motion(30, 10, true, false, 0.3)));
-  EXPECT_FALSE(p30.value().broken);
-  EXPECT_NEAR(x(p30), 0.2, 1e-12) << "chained from the reference as the first motion placed it";
-  EXPECT_TRUE(chain.relative_covariance(*p20, *p30).has_value());
-  EXPECT_NEAR(x(chain.add(with_covariance(motion(40, 10, true, true, 0.5)))), 0.4, 1e-12);
-  // The announcement of reference 50 was lost; 60 and 70 are measured from it.
-  const auto p60 = chain.add(with_covariance(motion(60, 50, true, false, 0.2)));
+  OdometryChain lossless, lossy;
+  ASSERT_TRUE(lossless.add(turning(10, 0, false, true, 0)).has_value());  // the first frame, lost on the link
+  const int64_t utimes[] = {20, 30, 40};
+  std::vector<OdometryPose> a, b;
+  for (int64_t t : utimes) {
+    const VoMotion m = turning(t, 10, true, t == 40, static_cast<double>(t) / 10.0);
+    a.push_back(lossless.add(m).value());
+    b.push_back(lossy.add(m).value());
+  }
+  EXPECT_FALSE(b[0].broken) << "nothing came before it";
+  EXPECT_TRUE(b[0].T_odom_camera.isApprox(turning(20, 0, false, true, 0).T_body_camera, 1e-12))
+      << "the first pose is the mounting's, as for a first frame";
+  for (size_t i = 1; i < a.size(); ++i) {
+    EXPECT_FALSE(b[i].broken);
+    EXPECT_TRUE((b[0].T_odom_camera.inverse() * b[i].T_odom_camera)
+                    .isApprox(a[0].T_odom_camera.inverse() * a[i].T_odom_camera, 1e-12));
+    const auto ca = lossless.relative_covariance(a[0], a[i]), cb = lossy.relative_covariance(b[0], b[i]);
+    ASSERT_TRUE(ca && cb);
+    EXPECT_TRUE(cb->isApprox(*ca, 1e-12)) << *cb << "\nagainst\n" << *ca;
+  }
+  // Later the announcement of reference 50 is lost; 60 and 70 are measured from it.
+  const auto p60 = lossy.add(turning(60, 50, true, false, 2.0));
   ASSERT_TRUE(p60.has_value());
   EXPECT_TRUE(p60->broken) << "not related to the poses before";
-  EXPECT_NEAR(x(p60), 0.4, 1e-12) << "a new segment starts at the last pose";
-  const auto p70 = chain.add(with_covariance(motion(70, 50, true, false, 0.3)));
+  EXPECT_TRUE(p60->T_odom_camera.isApprox(b.back().T_odom_camera, 1e-12)) << "a new segment starts at the last pose";
+  const auto p70 = lossy.add(turning(70, 50, true, false, 3.0));
   ASSERT_TRUE(p70.has_value());
   EXPECT_FALSE(p70->broken);
-  EXPECT_NEAR(x(p70), 0.5, 1e-12);
-  EXPECT_TRUE(chain.relative_covariance(*p60, *p70).has_value()) << "one segment";
-  EXPECT_FALSE(chain.relative_covariance(*p30, *p70).has_value()) << "across the break";
-  EXPECT_FALSE(chain.add(motion(80, 50, false, false)).has_value()) << "a failed frame still has none";
+  EXPECT_TRUE((p60->T_odom_camera.inverse() * p70->T_odom_camera)
+                  .isApprox(turning(60, 50, true, false, 2.0).T_reference_current.inverse() *
+                                turning(70, 50, true, false, 3.0).T_reference_current,
+                            1e-12));
+  EXPECT_TRUE(lossy.relative_covariance(*p60, *p70).has_value()) << "one segment";
+  EXPECT_FALSE(lossy.relative_covariance(b[1], *p70).has_value()) << "across the break";
+  EXPECT_FALSE(lossy.add(motion(80, 50, false, false)).has_value()) << "a failed frame still has none";
+}
+
+// The VO falls back to the previous frame when its keyframe fails: a motion from a frame no
+// update announced, whose pose the chain gave. It chains on through that frame, no break, as if
+// the frame had been announced (it was a break before: a SLAM keyframe at every fall-back).
+TEST(OdometryChain, AFallBackToThePreviousFrameChainsOnThroughItWithoutABreak) {
+  OdometryChain announced, fell_back;
+  for (OdometryChain* c : {&announced, &fell_back}) ASSERT_TRUE(c->add(turning(10, 0, false, true, 0)).has_value());
+  std::vector<OdometryPose> a, b;
+  for (int64_t t : {20, 30}) {
+    a.push_back(announced.add(turning(t, 10, true, t == 30, static_cast<double>(t) / 10.0)).value());
+    b.push_back(fell_back.add(turning(t, 10, true, false, static_cast<double>(t) / 10.0)).value());
+  }
+  const VoMotion fall_back = turning(40, 30, true, true, 1.5);  // measured from 30, the frame before
+  a.push_back(announced.add(fall_back).value());
+  b.push_back(fell_back.add(fall_back).value());
+  EXPECT_FALSE(b.back().broken);
+  EXPECT_TRUE(b.back().T_odom_camera.isApprox(a.back().T_odom_camera, 1e-12));
+  const auto ca = announced.relative_covariance(a[0], a.back()), cb = fell_back.relative_covariance(b[0], b.back());
+  ASSERT_TRUE(ca && cb);
+  EXPECT_TRUE(cb->isApprox(*ca, 1e-12));
+}
+
+TEST(OdometryChain, AMotionFromAFrameThatIsNotEarlierIsAnInputError) {
+  OdometryChain chain;
+  chain.add(motion(10, 0, false, true));
+  EXPECT_THROW(chain.add(motion(20, 0, true, false, 0.1)), InputError);   // no reference
+  EXPECT_THROW(chain.add(motion(30, 30, true, false, 0.1)), InputError);  // itself
+  EXPECT_THROW(chain.add(motion(40, 50, true, false, 0.1)), InputError);  // a later frame
+  EXPECT_NEAR(chain.add(motion(60, 10, true, false, 0.1)).value().T_odom_camera.translation().x(), 0.1, 1e-12);
 }
 
 TEST(OdometryChain, RefusesTimeGoingBackAndNonRigidMotion) {

@@ -19,6 +19,7 @@ namespace {
 std::string errno_text() { return std::strerror(errno); }
 
 void write_proc_file(const char* path, const std::string& text) {
+  // in-place: the kernel's /proc/self files, not data
   const int fd = ::open(path, O_WRONLY | O_CLOEXEC);
   const bool ok = fd >= 0 && ::write(fd, text.data(), text.size()) == static_cast<ssize_t>(text.size());
   const std::string why = errno_text();

@@ -93,6 +93,7 @@ ChildEvent Supervisor::start(Child& child) {
   std::vector<char*> envp;
   for (auto& e : env_strings) envp.push_back(e.data());
   envp.push_back(nullptr);
+  // in-place: a process's log, appended
   const int log_fd = ::open(child.log.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
   if (log_fd < 0) throw std::runtime_error(child.log.string() + ": " + std::strerror(errno));
   const pid_t launcher = ::getpid();

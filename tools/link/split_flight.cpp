@@ -11,6 +11,7 @@
 #include <sstream>
 #include <vector>
 
+#include "common/atomic_file.h"
 #include "common/transport/channels.h"
 #include "common/transport/convert.h"
 #include "common/transport/log_file.h"
@@ -67,7 +68,7 @@ SplitFlightResult fly_split(const SplitFlightOptions& o) {
     // The ground station's user, in the offboard namespace. A user asks again once when a
     // request was not flown: a PLAN lost on its way down is sent again by no one (goto heard
     // it at the ground station). Then it waits to be stopped with the others.
-    std::ofstream user(out / "user.sh");
+    std::ostringstream user;
     user << "cd " << quoted(out.string()) << "\n"
          << "sleep " << o.hover_s << "; date +%s%N > mark_a\n"
          << "for i in 1 2; do " << go << "9.5 3.5 1.3 0 >> goto_out.txt 2>&1; G1=$?; [ $G1 -eq 0 ] && break; done\n"
@@ -75,12 +76,13 @@ SplitFlightResult fly_split(const SplitFlightOptions& o) {
          << "for i in 1 2; do " << go << "9 3.5 1.3 0 >> goto_back.txt 2>&1; G2=$?; [ $G2 -eq 0 ] && break; done\n"
          << "echo $i > attempts_back; date +%s%N > mark_b; echo \"$G1 $G2\" > goto_status.txt\n"
          << "exec sleep 100000\n";
+    write_file_atomically((out / "user.sh").string(), user.str());
   }
   {
     // The recorder onboard and the user offboard are processes of the set, so that the
     // launcher puts them in their namespaces (no nsenter, no root). A process-set command
     // is split on blanks: the folder's path must have none.
-    std::ofstream sets(out / "sets.yaml");
+    std::ostringstream sets;
     sets << "# the split flight's processes (tools/link/split_flight.h)\n"
             "processes:\n"
             "  - {name: vo, command: vo, side: onboard}\n"
@@ -93,6 +95,7 @@ SplitFlightResult fly_split(const SplitFlightOptions& o) {
             "  - {name: planner, command: \"planner --height 1.3 --sensor kinect\", side: offboard}\n"
             "  - {name: user, command: \"sh "
          << (out / "user.sh").string() << "\", side: offboard}\n";
+    write_file_atomically((out / "sets.yaml").string(), sets.str());
   }
   const std::string link_options = fmt::format("--loss {} --delay {} --jitter {} --rate {} --seed {}", o.loss_percent,
                                                o.delay_ms, o.jitter_ms, o.rate_mbit, o.seed);
