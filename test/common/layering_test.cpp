@@ -26,6 +26,8 @@
 #include <string>
 #include <vector>
 
+#include "source_tree.h"
+
 namespace kestrel::test {
 namespace {
 
@@ -205,19 +207,10 @@ std::vector<std::string> layering_violations(
   return violations;
 }
 
-std::optional<std::string> read_source(const std::string& relative) {
-  std::ifstream in(fs::path(KESTREL_SOURCE_DIR) / relative, std::ios::binary);
-  if (!in) return std::nullopt;
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 TEST(Layering, EveryLibraryIncludesOnlyWhatItLinksAndAlgorithmsNoLcmToolsOrDrivers) {
-  const fs::path manifest = fs::path(KESTREL_BINARY_DIR) / "layering.json";
-  std::ifstream in(manifest);
-  ASSERT_TRUE(in) << manifest << " is missing: the build writes it at configure time";
-  const std::vector<Target> targets = parse_manifest(nlohmann::json::parse(in));
+  const std::optional<nlohmann::json> manifest = read_layering_manifest();
+  ASSERT_TRUE(manifest) << "layering.json is missing: the build writes it at configure time";
+  const std::vector<Target> targets = parse_manifest(*manifest);
   ASSERT_GE(targets.size(), 20u) << "the manifest lists too few targets to be this tree's";
   // The rule has something to bite on: the algorithm libraries are declared as such.
   for (const char* name : {"kestrel_common", "kestrel_vo", "kestrel_estimator", "kestrel_slam",

@@ -17,6 +17,8 @@
 #include <string>
 #include <vector>
 
+#include "source_tree.h"
+
 namespace kestrel::test {
 namespace {
 
@@ -116,19 +118,11 @@ std::vector<InPlaceWriter> find_in_place_writers(const std::string& file, const 
   return found;
 }
 
-std::string read_text(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 TEST(OutputFiles, EveryFileWrittenWholeGoesThroughAtomicFile) {
-  const fs::path manifest = fs::path(KESTREL_BINARY_DIR) / "layering.json";
-  std::ifstream in(manifest);
-  ASSERT_TRUE(in) << manifest << " is missing: the build writes it at configure time";
+  const std::optional<nlohmann::json> manifest = read_layering_manifest();
+  ASSERT_TRUE(manifest) << "layering.json is missing: the build writes it at configure time";
   std::set<std::string> dirs;
-  for (const auto& target : nlohmann::json::parse(in)) dirs.insert(target.at("dir").get<std::string>());
+  for (const auto& target : *manifest) dirs.insert(target.at("dir").get<std::string>());
   ASSERT_GE(dirs.size(), 10u) << "the manifest lists too few folders to be this tree's";
   const fs::path root(KESTREL_SOURCE_DIR);
   std::set<std::string> files;
@@ -142,7 +136,7 @@ TEST(OutputFiles, EveryFileWrittenWholeGoesThroughAtomicFile) {
   std::string unmarked;
   int marked = 0;
   for (const std::string& file : files)
-    for (const InPlaceWriter& w : find_in_place_writers(file, read_text(root / file))) {
+    for (const InPlaceWriter& w : find_in_place_writers(file, read_source(file).value_or(std::string()))) {
       if (w.marked) ++marked;
       else unmarked += "\n  " + w.file + ":" + std::to_string(w.line) + ": " + w.what;
     }
