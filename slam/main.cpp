@@ -75,6 +75,10 @@ void add_options(cli::App& app, Options& o, SlamOptions& s) {
                  "angle) and its reference's keyframe is a graph neighbour of a covering one; 0: never (localising only: "
                  "always carried)")
       ->check(CLI::NonNegativeNumber)->capture_default_str();
+  app.add_option("--reuse-min-points", s.coverage.min_points_to_verify,
+                 "A covered frame with fewer feature points with depth is carried at its predicted pose, not made a "
+                 "keyframe: a keyframe of it would hardly ever verify")
+      ->check(CLI::NonNegativeNumber)->capture_default_str();
   app.add_option("--keyframe-megabytes", s.memory.max_megabytes,
                  "Memory budget of the keyframes' features, MB: over it, keyframes of places seen from many similar "
                  "views are thinned (kept in the graph, no longer matched)")

@@ -23,8 +23,8 @@ void check_options(const SlamOptions& o) {
   const CoverageOptions& c = o.coverage;
   require(c.max_translation_m >= 0.0 && c.max_rotation_rad >= 0.0 && c.max_correction_m >= 0.0 &&
               c.max_correction_rad >= 0.0 && c.carry_within_sigmas >= 0.0 &&
-              c.max_candidates >= 1,
-          "coverage distances and carry_within_sigmas must be >= 0 and max_candidates >= 1");
+              c.max_candidates >= 1 && c.min_points_to_verify >= 0,
+          "coverage distances, carry_within_sigmas and min_points_to_verify must be >= 0 and max_candidates >= 1");
   const KeyframeMemoryOptions& m = o.memory;
   require(std::isfinite(m.max_megabytes) && m.max_megabytes > 0.0, "memory.max_megabytes must be > 0");
   require(std::isfinite(m.bin_size_m) && m.bin_size_m > 0.0, "memory.bin_size_m must be > 0");
@@ -645,9 +645,9 @@ bool Slam::reanchor(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_came
   const Matrix6d predicted =
       Ad * reference_.covariance * Ad.transpose() +
       right_covariance(odometry_edge_information(T_ref_frame, options_.odometry, link, odometry_covariance));
-  if (static_cast<int>(features.num_points()) < options_.verification.min_inliers) {
-    // No verification can pass (it needs min_inliers points with depth): a keyframe here would
-    // never be matched, and the covering keyframes hold the view. The frame becomes the
+  if (static_cast<int>(features.num_points()) < std::max(options_.verification.min_inliers, c.min_points_to_verify)) {
+    // No verification can pass (it needs min_inliers points with depth), or hardly any: a
+    // keyframe here would never be matched, and the covering keyframes hold the view. The frame becomes the
     // reference where the odometry puts it, so the next try comes after the keyframe spacing
     // rather than at every frame of a blank stretch.
     ++coverage_misses_.featureless;

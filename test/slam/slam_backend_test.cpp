@@ -15,6 +15,7 @@
 #include "slam/backend/odometry_chain.h"
 #include "slam/backend/slam.h"
 #include "slam/place/builtin_vocabulary.h"
+#include "slam/place/frame_features.h"
 #include "slam/posegraph/marginals.h"
 #include "test/slam/synthetic_room.h"
 
@@ -276,6 +277,45 @@ TEST(Slam, AFeaturelessFrameOverCoveredGroundIsCarriedNotAKeyframe) {
   EXPECT_TRUE(made.keyframe) << "nothing covers it";
   EXPECT_EQ(slam.keyframes().size(), keyframes + 1);
   EXPECT_EQ(slam.keyframes().back().link, OdometryLink::kBridged) << "as weak as the weakest link since";
+}
+
+// A covered frame with a few points, more than any verification needs but fewer than one is
+// likely to find again (a blank wall with an outline in view: CoverageOptions::
+// min_points_to_verify), is carried like a featureless one; it is not tried, and no keyframe
+// is made of it. With the bound at 0 the same frame is tried.
+TEST(Slam, ACoveredFrameWithTooFewPointsToBeFoundAgainIsCarriedNotTried) {
+  const SyntheticRoom room(5, 3.0, 2.5, 2.5);
+  const auto path = test::circle_path(30, 1.0, 0.5);
+  // The view of keyframe 0 with depth kept in a window only: its other keypoints have no point.
+  RgbdFrame sparse = room.render(path.front(), test::test_camera(), 0);
+  cv::Mat kept = cv::Mat::zeros(sparse.depth_mm.size(), sparse.depth_mm.type());
+  const cv::Rect window(sparse.depth_mm.cols / 2 - 15, sparse.depth_mm.rows / 2 - 15, 30, 30);
+  sparse.depth_mm(window).copyTo(kept(window));
+  sparse.depth_mm = kept;
+  const SlamOptions defaults;
+  const int points = static_cast<int>(FeatureExtractor(defaults.features).extract(sparse).num_points());
+  ASSERT_GE(points, defaults.verification.min_inliers) << "the frame must be verifiable in principle";
+  ASSERT_LT(points, defaults.coverage.min_points_to_verify) << "and below the bound";
+
+  for (const int bound : {defaults.coverage.min_points_to_verify, 0}) {
+    SlamOptions options;
+    options.coverage.min_points_to_verify = bound;
+    Slam slam(options, builtin_vocabulary());
+    int64_t utime = 1'000'000;
+    for (const auto& T : path) slam.add(room.render(T, test::test_camera(), utime += 200'000), T);
+    const size_t keyframes = slam.keyframes().size();
+    sparse.utime = utime += 200'000;
+    const SlamStep step = slam.add(sparse, path.front());  // back over keyframe 0
+    if (bound > 0) {
+      EXPECT_TRUE(step.carried) << points << " points";
+      EXPECT_FALSE(step.keyframe || step.reanchored);
+      EXPECT_EQ(slam.keyframes().size(), keyframes);
+      EXPECT_EQ(slam.coverage_misses().featureless, 1);
+    } else {
+      EXPECT_EQ(slam.coverage_misses().featureless, 0) << "tried: " << points << " points are enough to try";
+      EXPECT_TRUE(step.keyframe || step.reanchored || step.carried);
+    }
+  }
 }
 
 // A covered frame that no covering keyframe verifies (here: the same pose in a room of other
