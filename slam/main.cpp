@@ -76,8 +76,9 @@ void add_options(cli::App& app, Options& o, SlamOptions& s) {
                  "always carried)")
       ->check(CLI::NonNegativeNumber)->capture_default_str();
   app.add_option("--reuse-min-points", s.coverage.min_points_to_verify,
-                 "A covered frame with fewer feature points with depth is carried at its predicted pose, not made a "
-                 "keyframe: a keyframe of it would hardly ever verify")
+                 "A covered frame none verifies, too uncertain to carry by --reuse-carry-sigmas, is carried all the same, "
+                 "not made a keyframe, when it has fewer feature points with depth than this: a keyframe of it would "
+                 "hardly ever verify (0: never)")
       ->check(CLI::NonNegativeNumber)->capture_default_str();
   app.add_option("--keyframe-megabytes", s.memory.max_megabytes,
                  "Memory budget of the keyframes' features, MB: over it, keyframes of places seen from many similar "
@@ -222,7 +223,8 @@ int run_offline(const Options& o, const SlamOptions& options, std::shared_ptr<co
             << run.coverage_misses.not_verified << " none verified, " << run.coverage_misses.too_far
             << " located too far; carried instead: " << run.coverage_misses.featureless
             << " too featureless to locate, " << run.coverage_misses.unverified_carried
-            << " none verified)\n";
+            << " none verified but well predicted, " << run.coverage_misses.few_points_carried
+            << " none verified with too few points for a keyframe)\n";
   if (!ms.empty()) {
     std::cout << "ms per keyframe: median " << ms[ms.size() / 2] << ", p95 " << ms[ms.size() * 95 / 100]
               << ", max " << ms.back() << "\n";
@@ -317,12 +319,13 @@ int serve(const Options& o, const SlamOptions& options, std::shared_ptr<const Vo
   const auto& misses = adapter.slam().coverage_misses();
   spdlog::info("{} keyframes ({} thinned, features {:.1f} MB), {} loop closures, {} frames re-anchored on a "
                "covering keyframe (keyframes instead: {} with none near, {} none verified, {} located too far; carried "
-               "instead: {} too featureless to locate, {} none verified), {} VO restarts "
+               "instead: {} too featureless to locate, {} none verified but well predicted, {} none verified with too few "
+               "points for a keyframe), {} VO restarts "
                "bridged by the estimator, {} estimator restarts, {} levellings ({} tilts refused as too large), {} messages rejected",
                adapter.slam().keyframes().size(), adapter.slam().num_thinned(), adapter.slam().feature_bytes() / 1e6,
                adapter.slam().num_loop_closures(), adapter.slam().num_reanchors(),
                misses.none_near, misses.not_verified, misses.too_far, misses.featureless, misses.unverified_carried,
-               adapter.bridges(),
+               misses.few_points_carried, adapter.bridges(),
                adapter.estimator_restarts(), adapter.levellings(), adapter.levels_refused(),
                node->counters().messages_rejected);
   return status;

@@ -645,9 +645,9 @@ bool Slam::reanchor(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_came
   const Matrix6d predicted =
       Ad * reference_.covariance * Ad.transpose() +
       right_covariance(odometry_edge_information(T_ref_frame, options_.odometry, link, odometry_covariance));
-  if (static_cast<int>(features.num_points()) < std::max(options_.verification.min_inliers, c.min_points_to_verify)) {
-    // No verification can pass (it needs min_inliers points with depth), or hardly any: a
-    // keyframe here would never be matched, and the covering keyframes hold the view. The frame becomes the
+  if (static_cast<int>(features.num_points()) < options_.verification.min_inliers) {
+    // No verification can pass (it needs min_inliers points with depth): a keyframe here would
+    // never be matched, and the covering keyframes hold the view. The frame becomes the
     // reference where the odometry puts it, so the next try comes after the keyframe spacing
     // rather than at every frame of a blank stretch.
     ++coverage_misses_.featureless;
@@ -708,8 +708,17 @@ bool Slam::reanchor(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_came
   std::vector<size_t> covering_keyframes;
   for (const auto& entry : covering) covering_keyframes.push_back(entry.second);
   if (!localising && !carriable(covering_keyframes, predicted)) {
-    ++coverage_misses_.not_verified;
-    return false;
+    if (static_cast<int>(features.num_points()) >= c.min_points_to_verify) {
+      ++coverage_misses_.not_verified;
+      return false;
+    }
+    // A keyframe made of so few points would hardly ever verify either (CoverageOptions::
+    // min_points_to_verify): it would add a view the map cannot use, one every lap over a
+    // blank wall. Carried, the odometry goes on to a frame that can be located, or that, too
+    // far from its estimate, closes the loop through a keyframe of its own.
+    ++coverage_misses_.few_points_carried;
+    carry_reference(frame, T_odom_camera, link, predicted, step);
+    return true;
   }
   ++coverage_misses_.unverified_carried;
   carry_reference(frame, T_odom_camera, link, predicted, step);

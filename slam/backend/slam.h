@@ -174,6 +174,7 @@ class Slam {
     int none_near = 0, not_verified = 0, too_far = 0;
     int featureless = 0;         ///< covered, too few features to verify: carried
     int unverified_carried = 0;  ///< covered, none verified, prediction certain (localising only: any): carried
+    int few_points_carried = 0;  ///< covered, none verified, prediction not certain, too few points for a keyframe: carried
   };
   const CoverageMisses& coverage_misses() const { return coverage_misses_; }
   /// Keyframes that let their features go to keep within the memory budget, and the bytes the

@@ -45,13 +45,14 @@ struct CoverageOptions {
   /// reference holds as well. 0: never (in mapping; localising only, every unverified covered
   /// frame is carried).
   double carry_within_sigmas = 3.0;
-  /// A covered frame with fewer feature points with depth than this is carried at its
-  /// prediction, as one with fewer than the verifier's min_inliers: a keyframe made of it
-  /// would hardly ever verify. Where covered frames verify (the simulator's rooms), a fifth to
-  /// a half of their points come back as inliers; at a fifth, the verifier's 10 inliers need
-  /// 50 points. A blank wall with a box's outline in view gives 13-44, mostly where an edge
-  /// crosses another at a different depth, which no other view sees again
-  /// (docs/decisions/2026-12-07-soak-keyframes-on-a-poor-stretch.md).
+  /// A covered frame that no covering keyframe verifies, and whose prediction is not certain
+  /// and local enough to carry (above), is carried all the same when it has fewer feature
+  /// points with depth than this, rather than made a keyframe: a keyframe of it would hardly
+  /// ever verify. Where covered frames verify in the simulator's rooms, a fifth to a half of
+  /// their points come back as inliers; at a fifth, the verifier's 10 inliers need 50 points.
+  /// A blank wall with a box's outline in view gives 13-44, mostly where an edge crosses
+  /// another at a different depth, which no other view sees again
+  /// (docs/decisions/2026-12-07-soak-keyframes-on-a-poor-stretch.md). 0: never.
   int min_points_to_verify = 50;
 };
 

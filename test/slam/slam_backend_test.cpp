@@ -279,43 +279,61 @@ TEST(Slam, AFeaturelessFrameOverCoveredGroundIsCarriedNotAKeyframe) {
   EXPECT_EQ(slam.keyframes().back().link, OdometryLink::kBridged) << "as weak as the weakest link since";
 }
 
-// A covered frame with a few points, more than any verification needs but fewer than one is
+// A covered frame that no covering keyframe verifies and whose prediction is too uncertain to
+// carry (after a VO restart the estimator bridged) is a keyframe, whose loop is searched for;
+// but not when it has a few points only, more than a verification needs yet fewer than one is
 // likely to find again (a blank wall with an outline in view: CoverageOptions::
-// min_points_to_verify), is carried like a featureless one; it is not tried, and no keyframe
-// is made of it. With the bound at 0 the same frame is tried.
-TEST(Slam, ACoveredFrameWithTooFewPointsToBeFoundAgainIsCarriedNotTried) {
+// min_points_to_verify): a keyframe of it would hardly ever verify, so it is carried. With the
+// bound at 0 the same frame is a keyframe; with all its points, it is a keyframe.
+TEST(Slam, AnUnverifiedCoveredFrameWithTooFewPointsForAKeyframeIsCarried) {
   const SyntheticRoom room(5, 3.0, 2.5, 2.5);
+  const SyntheticRoom repainted(6, 3.0, 2.5, 2.5);  // the same room, other texture: nothing verifies
   const auto path = test::circle_path(30, 1.0, 0.5);
-  // The view of keyframe 0 with depth kept in a window only: its other keypoints have no point.
-  RgbdFrame sparse = room.render(path.front(), test::test_camera(), 0);
-  cv::Mat kept = cv::Mat::zeros(sparse.depth_mm.size(), sparse.depth_mm.type());
-  const cv::Rect window(sparse.depth_mm.cols / 2 - 15, sparse.depth_mm.rows / 2 - 15, 30, 30);
-  sparse.depth_mm(window).copyTo(kept(window));
+  const RgbdFrame full = repainted.render(path.front(), test::test_camera(), 0);
+  // The same view with depth kept in a window only: its other keypoints have no point.
+  RgbdFrame sparse = full;
+  cv::Mat kept = cv::Mat::zeros(full.depth_mm.size(), full.depth_mm.type());
+  const cv::Rect window(full.depth_mm.cols / 2 - 15, full.depth_mm.rows / 2 - 15, 30, 30);
+  full.depth_mm(window).copyTo(kept(window));
   sparse.depth_mm = kept;
   const SlamOptions defaults;
-  const int points = static_cast<int>(FeatureExtractor(defaults.features).extract(sparse).num_points());
+  const FeatureExtractor extractor(defaults.features);
+  const int points = static_cast<int>(extractor.extract(sparse).num_points());
   ASSERT_GE(points, defaults.verification.min_inliers) << "the frame must be verifiable in principle";
   ASSERT_LT(points, defaults.coverage.min_points_to_verify) << "and below the bound";
+  ASSERT_GE(static_cast<int>(extractor.extract(full).num_points()), defaults.coverage.min_points_to_verify);
 
-  for (const int bound : {defaults.coverage.min_points_to_verify, 0}) {
+  const auto back_over_keyframe_0 = [&](const RgbdFrame& frame, int bound, Slam::CoverageMisses& misses) {
     SlamOptions options;
     options.coverage.min_points_to_verify = bound;
     Slam slam(options, builtin_vocabulary());
     int64_t utime = 1'000'000;
     for (const auto& T : path) slam.add(room.render(T, test::test_camera(), utime += 200'000), T);
     const size_t keyframes = slam.keyframes().size();
-    sparse.utime = utime += 200'000;
-    const SlamStep step = slam.add(sparse, path.front());  // back over keyframe 0
-    if (bound > 0) {
-      EXPECT_TRUE(step.carried) << points << " points";
-      EXPECT_FALSE(step.keyframe || step.reanchored);
-      EXPECT_EQ(slam.keyframes().size(), keyframes);
-      EXPECT_EQ(slam.coverage_misses().featureless, 1);
-    } else {
-      EXPECT_EQ(slam.coverage_misses().featureless, 0) << "tried: " << points << " points are enough to try";
-      EXPECT_TRUE(step.keyframe || step.reanchored || step.carried);
-    }
-  }
+    RgbdFrame f = frame;
+    f.utime = utime += 200'000;
+    const SlamStep step = slam.add(f, path.front(), OdometryLink::kBridged);
+    misses = slam.coverage_misses();
+    EXPECT_EQ(slam.keyframes().size(), keyframes + (step.keyframe ? 1 : 0));
+    return step;
+  };
+  Slam::CoverageMisses misses;
+  const SlamStep carried = back_over_keyframe_0(sparse, defaults.coverage.min_points_to_verify, misses);
+  EXPECT_TRUE(carried.carried) << points << " points";
+  EXPECT_FALSE(carried.keyframe || carried.reanchored);
+  EXPECT_EQ(misses.few_points_carried, 1);
+  EXPECT_EQ(misses.not_verified, 0);
+  EXPECT_EQ(misses.featureless, 0) << "tried: " << points << " points are enough to try";
+
+  const SlamStep without = back_over_keyframe_0(sparse, 0, misses);
+  EXPECT_TRUE(without.keyframe);
+  EXPECT_EQ(misses.not_verified, 1);
+  EXPECT_EQ(misses.few_points_carried, 0);
+
+  const SlamStep all_points = back_over_keyframe_0(full, defaults.coverage.min_points_to_verify, misses);
+  EXPECT_TRUE(all_points.keyframe);
+  EXPECT_EQ(misses.not_verified, 1);
+  EXPECT_EQ(misses.few_points_carried, 0);
 }
 
 // A covered frame that no covering keyframe verifies (here: the same pose in a room of other
