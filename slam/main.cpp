@@ -5,6 +5,7 @@
 // lock-step replay. With --tum DIR it runs VO and SLAM in process over a TUM RGB-D folder and writes the
 // optimised trajectory (TUM format). See slam/README.md.
 
+#include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
@@ -14,6 +15,7 @@
 #include <iostream>
 #include <memory>
 #include <set>
+#include <string>
 
 #include "common/cli.h"
 #include "common/error.h"
@@ -52,6 +54,15 @@ struct Options {
   std::string graph_channel = channel::kSlamGraph;
   std::string correction_channel = channel::kSlamCorrection;
 };
+
+// Why frames over covered ground became keyframes or were carried (Slam::CoverageMisses), as
+// both the offline run and the process say it at the end.
+std::string coverage_summary(const Slam::CoverageMisses& m) {
+  return fmt::format(
+      "keyframes instead: {} with none near, {} none verified, {} located too far; carried instead: {} too "
+      "featureless to locate, {} none verified but well predicted, {} none verified with too few points for a keyframe",
+      m.none_near, m.not_verified, m.too_far, m.featureless, m.unverified_carried, m.few_points_carried);
+}
 
 void add_options(cli::App& app, Options& o, SlamOptions& s) {
   app.add_option("--vocabulary", o.vocabulary,
@@ -219,12 +230,7 @@ int run_offline(const Options& o, const SlamOptions& options, std::shared_ptr<co
             << "keyframes: " << run.keyframes << ", loop closures: " << run.loop_closures
             << " (" << run.candidates_verified << " candidates verified, " << run.inconsistent_loops
             << " verified but refused by the odometry check), re-anchored on a covering keyframe: "
-            << run.reanchors << " (keyframes instead: " << run.coverage_misses.none_near << " with none near, "
-            << run.coverage_misses.not_verified << " none verified, " << run.coverage_misses.too_far
-            << " located too far; carried instead: " << run.coverage_misses.featureless
-            << " too featureless to locate, " << run.coverage_misses.unverified_carried
-            << " none verified but well predicted, " << run.coverage_misses.few_points_carried
-            << " none verified with too few points for a keyframe)\n";
+            << run.reanchors << " (" << coverage_summary(run.coverage_misses) << ")\n";
   if (!ms.empty()) {
     std::cout << "ms per keyframe: median " << ms[ms.size() / 2] << ", p95 " << ms[ms.size() * 95 / 100]
               << ", max " << ms.back() << "\n";
@@ -316,16 +322,12 @@ int serve(const Options& o, const SlamOptions& options, std::shared_ptr<const Vo
   if (map && !adapter.slam().relocalisation()) report_relocalisation(std::nullopt, true);  // placed: said when it was
   if (!o.save_map.empty())
     save_map(o.save_map, adapter.slam().map(), "kestrel-slam (process " + o.name + ")");
-  const auto& misses = adapter.slam().coverage_misses();
   spdlog::info("{} keyframes ({} thinned, features {:.1f} MB), {} loop closures, {} frames re-anchored on a "
-               "covering keyframe (keyframes instead: {} with none near, {} none verified, {} located too far; carried "
-               "instead: {} too featureless to locate, {} none verified but well predicted, {} none verified with too few "
-               "points for a keyframe), {} VO restarts "
+               "covering keyframe ({}), {} VO restarts "
                "bridged by the estimator, {} estimator restarts, {} levellings ({} tilts refused as too large), {} messages rejected",
                adapter.slam().keyframes().size(), adapter.slam().num_thinned(), adapter.slam().feature_bytes() / 1e6,
                adapter.slam().num_loop_closures(), adapter.slam().num_reanchors(),
-               misses.none_near, misses.not_verified, misses.too_far, misses.featureless, misses.unverified_carried,
-               misses.few_points_carried, adapter.bridges(),
+               coverage_summary(adapter.slam().coverage_misses()), adapter.bridges(),
                adapter.estimator_restarts(), adapter.levellings(), adapter.levels_refused(),
                node->counters().messages_rejected);
   return status;

@@ -707,20 +707,18 @@ bool Slam::reanchor(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_came
   // mapping, none does while the prediction is certain and local (CoverageOptions).
   std::vector<size_t> covering_keyframes;
   for (const auto& entry : covering) covering_keyframes.push_back(entry.second);
-  if (!localising && !carriable(covering_keyframes, predicted)) {
-    if (static_cast<int>(features.num_points()) >= c.min_points_to_verify) {
-      ++coverage_misses_.not_verified;
-      return false;
-    }
+  if (localising || carriable(covering_keyframes, predicted)) {
+    ++coverage_misses_.unverified_carried;
+  } else if (static_cast<int>(features.num_points()) < c.min_points_to_verify) {
     // A keyframe made of so few points would hardly ever verify either (CoverageOptions::
     // min_points_to_verify): it would add a view the map cannot use, one every lap over a
     // blank wall. Carried, the odometry goes on to a frame that can be located, or that, too
     // far from its estimate, closes the loop through a keyframe of its own.
     ++coverage_misses_.few_points_carried;
-    carry_reference(frame, T_odom_camera, link, predicted, step);
-    return true;
+  } else {
+    ++coverage_misses_.not_verified;
+    return false;
   }
-  ++coverage_misses_.unverified_carried;
   carry_reference(frame, T_odom_camera, link, predicted, step);
   return true;
 }

@@ -11,7 +11,6 @@
 
 #include <algorithm>
 #include <filesystem>
-#include <fstream>
 #include <iterator>
 #include <regex>
 #include <set>
@@ -106,18 +105,21 @@ std::string writes_in(const std::string& code) {
 std::vector<InPlaceWriter> find_in_place_writers(const std::string& file, const std::string& text) {
   std::vector<InPlaceWriter> found;
   std::istringstream in(text);
-  std::string line, previous, statement;
-  bool in_block = false, marked = false;
+  std::string line, statement;
+  // A marker on a line of its own marks the statement after it; one after a statement's code
+  // marks that statement only.
+  bool in_block = false, marked = false, marker_line_before = false;
   int first = 0;
   for (int number = 1; std::getline(in, line); ++number) {
     const std::string code = code_of(line, in_block);
     if (statement.empty()) {
       first = number;
-      marked = previous.find("in-place:") != std::string::npos;
+      marked = marker_line_before;
     }
     statement += code + "\n";
-    marked = marked || line.find("in-place:") != std::string::npos;
-    previous = line;
+    const bool marker = line.find("in-place:") != std::string::npos;
+    marked = marked || marker;
+    marker_line_before = marker && code.find_first_not_of(" \t") == std::string::npos;
     if (code.find_first_of(";{}") == std::string::npos && !code.empty() && code.find('#') == std::string::npos) continue;
     if (const std::string what = writes_in(statement); !what.empty()) found.push_back({file, first, what, marked});
     statement.clear();
@@ -174,6 +176,9 @@ TEST(OutputFiles, TheFinderFindsEachWayOfWritingInPlaceAndNothingElse) {
       "// in-place: a log, appended\n"
       "FILE* log = std::fopen(path.c_str(), \"a\");\n"                  // 13, marked on the line before
       "int fd2 = creat(p, 0644);  // in-place: a lock file\n"           // 14, marked on its line
+      "FILE* d = fdopen(fd, \"w\");\n"                                   // 15
+      "bag.open(path, rosbag::bagmode::Write);\n"                       // 16
+      "FILE* e = std::freopen(path.c_str(), \"w\", stdout);\n"          // 17
       "FILE* r = std::fopen(path.c_str(), \"rb\");\n"                   // reads
       "std::ifstream read(path);\n"
       "int fd3 = ::open(p, O_RDONLY);\n"
@@ -185,7 +190,8 @@ TEST(OutputFiles, TheFinderFindsEachWayOfWritingInPlaceAndNothingElse) {
   const std::vector<InPlaceWriter> found = find_in_place_writers("x.cpp", text);
   const std::vector<std::pair<int, bool>> expected = {{1, false}, {2, false},  {3, false},  {4, false},
                                                       {5, false}, {6, false},  {8, false},  {9, false},
-                                                      {10, false}, {11, false}, {13, true}, {14, true}};
+                                                      {10, false}, {11, false}, {13, true}, {14, true},
+                                                      {15, false}, {16, false}, {17, false}};
   ASSERT_EQ(found.size(), expected.size());
   for (size_t i = 0; i < found.size(); ++i) {
     EXPECT_EQ(found[i].line, expected[i].first) << found[i].what;
