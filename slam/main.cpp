@@ -60,8 +60,10 @@ struct Options {
 std::string coverage_summary(const Slam::CoverageMisses& m) {
   return fmt::format(
       "keyframes instead: {} with none near, {} none verified, {} located too far; carried instead: {} too "
-      "featureless to locate, {} none verified but well predicted, {} none verified with too few points for a keyframe",
-      m.none_near, m.not_verified, m.too_far, m.featureless, m.unverified_carried, m.few_points_carried);
+      "featureless to locate, {} none verified but well predicted, {} none verified with too few points for a keyframe; "
+      "{} located too far closed their loop without a keyframe",
+      m.none_near, m.not_verified, m.too_far, m.featureless, m.unverified_carried, m.few_points_carried,
+      m.closed_in_place);
 }
 
 void add_options(cli::App& app, Options& o, SlamOptions& s) {
@@ -80,6 +82,11 @@ void add_options(cli::App& app, Options& o, SlamOptions& s) {
   app.add_option("--reuse-max-correction", s.coverage.max_correction_m,
                  "A frame is located in a covering keyframe only within this of its estimate, m (more: a loop closure)")
       ->check(CLI::NonNegativeNumber)->capture_default_str();
+  app.add_flag("--reuse-close-loops,!--no-reuse-close-loops", s.coverage.close_loops_in_place,
+               "A covered frame located beyond --reuse-max-correction closes the loop by an edge between the covering "
+               "keyframe and its reference's, when it verifies as a loop and agrees with the odometry, instead of "
+               "through a new keyframe (a revisit adds no keyframe)")
+      ->capture_default_str();
   app.add_option("--reuse-carry-sigmas", s.coverage.carry_within_sigmas,
                  "A covered frame no keyframe verifies is carried at its predicted pose, not made a keyframe, while "
                  "this many of the prediction's sigmas lie within the correction bounds (--reuse-max-correction and its "
@@ -280,6 +287,12 @@ int serve(const Options& o, const SlamOptions& options, std::shared_ptr<const Vo
       spdlog::info("keyframe {} closes a loop with keyframe {} ({} inliers, {:.2f} px); chi2 {:.4g} -> {:.4g}",
                    published_id(adapter.slam(), out.step->keyframe_id),
                    published_id(adapter.slam(), out.step->loop_keyframe_id), out.step->loop.inliers,
+                   out.step->loop.rms_px, out.step->optimisation->start_chi2, out.step->optimisation->final_chi2);
+    } else if (out.step && out.step->loop_closed && out.step->reanchored) {
+      spdlog::info("a frame located in keyframe {} closes a loop from it to keyframe {} ({} inliers, {:.2f} px); "
+                   "chi2 {:.4g} -> {:.4g}",
+                   published_id(adapter.slam(), out.step->loop_keyframe_id),
+                   published_id(adapter.slam(), adapter.slam().reference().keyframe_id), out.step->loop.inliers,
                    out.step->loop.rms_px, out.step->optimisation->start_chi2, out.step->optimisation->final_chi2);
     }
   };

@@ -279,7 +279,9 @@ AdapterOutputs SlamAdapter::process(const kestrel::rgbd_frame_t& message, const 
   // Placed in a saved map: the map's graph goes out too, so that the mapper (restored from its
   // journal) publishes the map the planner flies in before this flight makes a keyframe.
   // Not before: provisional keyframes (made before the placement) are in a frame of their own.
-  if ((step.keyframe || step.relocalised) && slam_.localized()) out.graph = graph_message(slam_);
+  // And after a loop closed without a keyframe (CoverageOptions::close_loops_in_place): the
+  // keyframes moved.
+  if ((step.keyframe || step.relocalised || step.loop_closed) && slam_.localized()) out.graph = graph_message(slam_);
   // Not placed yet: the keyframes waiting to join go out on their own, so that the mapper
   // keeps their frames until the placement brings them into the map.
   if (step.keyframe && !slam_.localized()) {

@@ -108,6 +108,23 @@ Matrix6d composed_information(const Eigen::Isometry3d& B, const Matrix6d& covari
   return information_of(Ad * covariance_A * Ad.transpose() + right_covariance(information_B));
 }
 
+// A loop edge kf -> r through one frame, located in keyframe kf (`located`: T_kf_frame and its
+// information) and predicted in keyframe r (T_r_frame, with its right-perturbation covariance):
+// T_kf_r = T_kf_frame T_r_frame^-1, the two uncertainties composed.
+struct EdgeThroughFrame {
+  Eigen::Isometry3d T_kf_r;
+  Matrix6d information;
+};
+EdgeThroughFrame edge_through_frame(const LoopConstraint& located, const Eigen::Isometry3d& T_r_frame,
+                                    const Matrix6d& covariance_r_frame) {
+  // Inverted: T Exp(d) inverse = T^-1 Exp(-Ad(T) d).
+  const Eigen::Isometry3d T_frame_r = T_r_frame.inverse();
+  const Matrix6d Ad = se3::adjoint(T_r_frame);
+  const Matrix6d information_frame_r = information_of(Ad * covariance_r_frame * Ad.transpose());
+  return {located.T_candidate_query * T_frame_r,
+          composed_information(T_frame_r, right_covariance(located.information), information_frame_r)};
+}
+
 // The standard deviation along the most uncertain axis of a 3x3 covariance (NaN when it is not finite).
 double largest_sigma(const Eigen::Matrix3d& covariance) {
   if (!covariance.allFinite()) return std::nan("");
@@ -575,41 +592,93 @@ void Slam::join_provisional(const OdometryReference& provisional, const RgbdFram
   // The placed frame in the provisional reference's keyframe r, through the odometry since the
   // reference (and the reference's own uncertainty in r, when it was re-anchored or carried),
   // as an odometry edge from r to it would be (never across a break: relocalise()).
-  const OdometryLink weakest = weaker(link, provisional.link);
   const Eigen::Isometry3d T_ref_frame = provisional.T_odom_camera.inverse() * T_odom_camera;
   const Eigen::Isometry3d T_r_frame = provisional.T_keyframe_camera * T_ref_frame;
   const Matrix6d covariance_r_frame = right_covariance(composed_information(
       T_ref_frame, provisional.covariance,
       odometry_edge_information(T_ref_frame, options_.odometry, link,
                                 link == OdometryLink::kContinuous ? odometry_covariance : std::nullopt)));
-  // Inverted: T Exp(d) inverse = T^-1 Exp(-Ad(T) d).
-  const Eigen::Isometry3d T_frame_r = T_r_frame.inverse();
-  const Matrix6d Ad = se3::adjoint(T_r_frame);
-  const Matrix6d information_frame_r = information_of(Ad * covariance_r_frame * Ad.transpose());
   // The join: r in the map's keyframe, as the placement and the odometry put it.
-  const Eigen::Isometry3d T_kf_r = located.T_candidate_query * T_frame_r;
-  const Matrix6d information =
-      composed_information(T_frame_r, right_covariance(located.information), information_frame_r);
+  const EdgeThroughFrame join = edge_through_frame(located, T_r_frame, covariance_r_frame);
   // The provisional keyframes move rigidly so that r sits where the join puts it: they keep
   // their shape, and the optimiser starts from a graph the join already agrees with.
   const auto r = static_cast<size_t>(provisional.keyframe_id);
   const auto k = static_cast<size_t>(kf.id);
-  const Eigen::Isometry3d T_world_provisional = graph_.poses[k] * T_kf_r * graph_.poses[r].inverse();
+  const Eigen::Isometry3d T_world_provisional = graph_.poses[k] * join.T_kf_r * graph_.poses[r].inverse();
   for (size_t v = static_cast<size_t>(provisional_from_); v < graph_.poses.size(); ++v)
     graph_.poses[v] = T_world_provisional * graph_.poses[v];
-  graph_.add_edge(static_cast<int>(k), static_cast<int>(r), T_kf_r, information, EdgeKind::kLoopClosure);
   provisional_from_ = -1;
+  // The odometry goes on from r (not from kf, as accept_placement put it: the next keyframe's
+  // edge would use the placement a second time).
+  add_loop_and_optimise(kf, static_cast<int64_t>(r), join.T_kf_r, join.information, step);
+  reference_ = OdometryReference{provisional.keyframe_id, frame.utime,        T_odom_camera,   frame.T_body_camera,
+                                 T_r_frame,                covariance_r_frame, weaker(link, provisional.link)};
+  reference_marginal_ = marginal_covariance(graph_, static_cast<int>(r), options_.optimizer.kernel);
+}
+
+void Slam::add_loop_and_optimise(const Keyframe& kf, int64_t to, const Eigen::Isometry3d& T_kf_to,
+                                 const Matrix6d& information, SlamStep& step) {
+  graph_.add_edge(static_cast<int>(kf.id), static_cast<int>(to), T_kf_to, information, EdgeKind::kLoopClosure);
   step.loop_closed = true;
   step.loop_keyframe_id = kf.id;
   ++loop_closures_;
   step.optimisation = optimize(graph_, options_.optimizer);
   rebin();
   ++revision_;
-  // The odometry goes on from r (not from kf, as accept_placement put it: the next keyframe's
-  // edge would use the placement a second time).
-  reference_ = OdometryReference{provisional.keyframe_id, frame.utime, T_odom_camera, frame.T_body_camera,
-                                 T_r_frame, covariance_r_frame, weakest};
-  reference_marginal_ = marginal_covariance(graph_, static_cast<int>(r), options_.optimizer.kernel);
+}
+
+void Slam::locate_reference(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera, const Keyframe& kf,
+                            const LoopConstraint& located, const Matrix6d& predicted, SlamStep& step) {
+  // The frame in keyframe k twice: predicted (the reference and the odometry since, with
+  // their covariances) and located (the features'); the reference becomes their fusion, so
+  // a precise odometry is not replaced by a coarser location, and drift is still bounded.
+  const auto k = static_cast<size_t>(kf.id);
+  const Eigen::Isometry3d T_k_predicted = graph_.poses[k].inverse() * world_pose(T_odom_camera);
+  const Eigen::Isometry3d T_predicted_located = T_k_predicted.inverse() * located.T_candidate_query;
+  const Matrix6d measured = right_covariance(located.information);
+  const Matrix6d gain = predicted * (predicted + measured).inverse();
+  const Eigen::Isometry3d T_k_frame = T_k_predicted * se3::exp(gain * se3::log(T_predicted_located));
+  Matrix6d fused = (Matrix6d::Identity() - gain) * predicted;
+  fused = 0.5 * (fused + fused.transpose());
+  reference_ = OdometryReference{kf.id, frame.utime, T_odom_camera, frame.T_body_camera, T_k_frame, fused};
+  reference_marginal_ = marginal_covariance(graph_, static_cast<int>(k), options_.optimizer.kernel);
+  step.reanchored = true;
+  step.reanchor_keyframe_id = kf.id;
+  step.loop = located;
+  ++reanchors_;
+}
+
+bool Slam::close_loop_in_place(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera, const Keyframe& kf, const Matrix6d& predicted, const FrameFeatures& features,
+                               const sensors::SensorProfile& sensor, uint64_t seed, SlamStep& step) {
+  if (!options_.coverage.close_loops_in_place || kf.id == reference_.keyframe_id) return false;
+  // A loop candidate as close_loop() takes them: old enough not to re-measure what the odometry
+  // just measured, and verified as a loop is (the re-anchoring's location drops the spread test).
+  const auto min_age_us = static_cast<int64_t>(std::llround(options_.loops.min_age_s * 1e6));
+  if (kf.session == session_ && kf.utime > frame.utime - min_age_us) return false;
+  const LoopConstraint loop =
+      verify_loop(features, kf.features, loop_verification(options_.verification, kf.sensor, sensor), seed);
+  if (!loop.accepted) return false;
+  const Eigen::Isometry3d T_r_frame =
+      reference_.T_keyframe_camera * reference_.T_odom_camera.inverse() * T_odom_camera;
+  const EdgeThroughFrame edge = edge_through_frame(loop, T_r_frame, predicted);
+  if (options_.loops.max_distance_m > 0.0 &&
+      !check_loop_against_odometry(graph_, static_cast<int>(kf.id), static_cast<int>(reference_.keyframe_id),
+                                   edge.T_kf_r, options_.loop_consistency, &gate_information_)
+           .consistent) {
+    ++step.inconsistent;
+    ++inconsistent_loops_;
+    return false;
+  }
+  add_loop_and_optimise(kf, reference_.keyframe_id, edge.T_kf_r, edge.information, step);
+  // Then the frame is located in kf as a re-anchoring does, against the optimised graph: the
+  // loop moved the keyframes as far as the edge could (little, when the odometry to the frame
+  // was uncertain), and the location places the frame itself. Its features enter twice, in the
+  // edge and in the reference, should the next keyframe be made from this reference rather than
+  // from a later re-anchoring; a keyframe made for the loop avoided that and kept a vertex and a
+  // scan per lap (docs/decisions/2026-12-07-loops-closed-without-a-keyframe.md).
+  locate_reference(frame, T_odom_camera, kf, loop, predicted, step);
+  ++coverage_misses_.closed_in_place;
+  return true;
 }
 
 bool Slam::reanchor(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera, OdometryLink link,
@@ -673,8 +742,14 @@ bool Slam::reanchor(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_came
     if (T_expected_located.translation().norm() > c.max_correction_m ||
         so3::angle(T_expected_located.linear()) > c.max_correction_rad) {
       step.loop = located;
+      if (!localising) {
+        // A loop to close: by an edge between keyframes the map has (CoverageOptions::
+        // close_loops_in_place), else through a new keyframe.
+        if (close_loop_in_place(frame, T_odom_camera, kf, predicted, features, sensor, seed, step)) return true;
+        ++coverage_misses_.too_far;
+        return false;
+      }
       ++coverage_misses_.too_far;
-      if (!localising) return false;  // a loop to close, through a new keyframe
       // Localisation only: the map stays as it is. One view placing the frame far from its
       // estimate may be a wrong place, so the frame is carried at its prediction and the next
       // frames are relocalised (with confirmation; this placement is the first hypothesis) for
@@ -685,22 +760,7 @@ bool Slam::reanchor(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_came
       lost_since_utime_ = frame.utime;
       return true;
     }
-    // The frame in keyframe k twice: predicted (the reference and the odometry since, with
-    // their covariances) and located (the features'); the reference becomes their fusion, so
-    // a precise odometry is not replaced by a coarser location, and drift is still bounded.
-    const Eigen::Isometry3d T_k_predicted = graph_.poses[k].inverse() * T_world_frame;
-    const Matrix6d measured = right_covariance(located.information);
-    const Matrix6d gain = predicted * (predicted + measured).inverse();
-    const Eigen::Isometry3d T_k_frame = T_k_predicted * se3::exp(gain * se3::log(T_expected_located));
-    Matrix6d fused = (Matrix6d::Identity() - gain) * predicted;
-    fused = 0.5 * (fused + fused.transpose());
-    const auto marginal = marginal_covariance(graph_, static_cast<int>(k), options_.optimizer.kernel);
-    reference_ = OdometryReference{kf.id, frame.utime, T_odom_camera, frame.T_body_camera, T_k_frame, fused};
-    reference_marginal_ = marginal;
-    step.reanchored = true;
-    step.reanchor_keyframe_id = kf.id;
-    step.loop = located;
-    ++reanchors_;
+    locate_reference(frame, T_odom_camera, kf, located, predicted, step);
     return true;
   }
   // Localisation only, a view of the map that does not verify adds no keyframe either; in

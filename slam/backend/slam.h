@@ -70,8 +70,12 @@ struct OdometryReference {
 struct SlamStep {
   bool keyframe = false;          ///< the frame became a keyframe
   int64_t keyframe_id = -1;
-  bool reanchored = false;        ///< instead, it was located in a covering keyframe...
-  int64_t reanchor_keyframe_id = -1;  ///< ...this one (`loop` holds the constraint)
+  /// Instead, it was located in a covering keyframe (`loop` holds the constraint)... When that
+  /// location was beyond the correction bound, `loop_closed` too: the loop closed by an edge from
+  /// that keyframe to the reference's (CoverageOptions::close_loops_in_place), which stays the
+  /// reference's keyframe.
+  bool reanchored = false;
+  int64_t reanchor_keyframe_id = -1;  ///< ...this one
   /// Or, over covered ground but with too few features ever to be located, or with none of the
   /// covering keyframes verifying a certain prediction (CoverageOptions::carry_within_sigmas), it
   /// became the reference at its predicted pose (nothing measured: no correction to send).
@@ -175,6 +179,7 @@ class Slam {
     int featureless = 0;         ///< covered, too few features to verify: carried
     int unverified_carried = 0;  ///< covered, none verified, prediction certain (localising only: any): carried
     int few_points_carried = 0;  ///< covered, none verified, prediction not certain, too few points for a keyframe: carried
+    int closed_in_place = 0;     ///< covered, located beyond the bound: the loop closed between keyframes, no keyframe
   };
   const CoverageMisses& coverage_misses() const { return coverage_misses_; }
   /// Keyframes that let their features go to keep within the memory budget, and the bytes the
@@ -215,9 +220,11 @@ class Slam {
   SlamStep close_loop(SlamStep step);
   /// Locates the frame in a covering keyframe and makes it the reference, or carries the
   /// reference to it when it is covered but too featureless to locate, or none verifies and its
-  /// prediction is certain and local (carriable()); false (and nothing changed) after an
-  /// unplaced odometry break, when no keyframe covers it, one locates it beyond the correction
-  /// bound, or none verifies it and it is not carriable.
+  /// prediction is certain and local (carriable()); when one locates it beyond the correction
+  /// bound, closes that loop without a keyframe if it can (close_loop_in_place()). False (and
+  /// nothing changed) after an unplaced odometry break, when no keyframe covers it, one locates
+  /// it beyond the bound and the loop cannot close in place, or none verifies it and it is not
+  /// carriable.
   bool reanchor(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera, OdometryLink link,
                 const std::optional<Matrix6d>& odometry_covariance, const FrameFeatures& features,
                 const sensors::SensorProfile& sensor, SlamStep& step);
@@ -253,6 +260,21 @@ class Slam {
                         const Eigen::Isometry3d& T_odom_camera, OdometryLink link,
                         const std::optional<Matrix6d>& odometry_covariance, const Keyframe& kf,
                         const LoopConstraint& located, SlamStep& step);
+  /// Adds the loop edge kf -> to (measurement T_kf_to), optimises the graph.
+  void add_loop_and_optimise(const Keyframe& kf, int64_t to, const Eigen::Isometry3d& T_kf_to,
+                             const Matrix6d& information, SlamStep& step);
+  /// Re-anchors: the frame, `located` in keyframe kf and predicted by the reference and the
+  /// odometry since (`predicted`: that prediction's covariance in the reference's keyframe),
+  /// becomes the reference, in kf, at the fusion of the two.
+  void locate_reference(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera, const Keyframe& kf,
+                        const LoopConstraint& located, const Matrix6d& predicted, SlamStep& step);
+  /// A covered frame that keyframe `kf` located beyond the correction bound (re-anchoring's
+  /// verification with `seed`): when kf may close a loop (not the reference's keyframe, old
+  /// enough), verifies as a loop and passes the loop gate, closes the loop by an edge from kf
+  /// to the reference's keyframe through the frame (`predicted`: its covariance there) and goes on
+  /// from the frame. False (nothing changed but the inconsistency counts) otherwise.
+  bool close_loop_in_place(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera, const Keyframe& kf, const Matrix6d& predicted, const FrameFeatures& features,
+                           const sensors::SensorProfile& sensor, uint64_t seed, SlamStep& step);
   /// Makes the frame a keyframe (features extracted), closes its loop if it has one.
   SlamStep add_keyframe(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera, OdometryLink link,
                         const std::optional<Matrix6d>& odometry_covariance, const sensors::FrameMotion& motion,

@@ -30,9 +30,17 @@ struct CoverageOptions {
   double max_rotation_rad = 10.0 * kPi / 180.0;  ///< ...and angle of its estimated pose
   int max_candidates = 3;                        ///< covering keyframes verified, nearest first
   /// The located pose may differ from the estimate by at most this; a larger correction is a
-  /// loop closure, through a new keyframe and an optimisation of the graph.
+  /// loop closure and an optimisation of the graph (below).
   double max_correction_m = 0.05;
   double max_correction_rad = 2.0 * kPi / 180.0;
+  /// Such a loop closes by an edge from the covering keyframe to the reference's keyframe,
+  /// through the frame (its location there and its odometry from the reference), when the pair
+  /// may close a loop (LoopSearchOptions::min_age_s), the frame verifies as a loop does and the
+  /// edge passes the loop gate (LoopConsistencyOptions); else, and when false, through a new
+  /// keyframe. A revisit then adds no vertex: on a loop flown for half an hour, where the
+  /// drift between re-anchorings exceeds the bound once a lap, each lap made a keyframe and
+  /// the mapper a scan for it (docs/decisions/2026-12-07-loops-closed-without-a-keyframe.md).
+  bool close_loops_in_place = true;
   /// A covered frame that no covering keyframe verifies (blur, a view the keyframes see at
   /// another scale) is carried at its predicted pose rather than made a keyframe while that
   /// prediction is certain and local: this many of its standard deviations (largest axis) lie

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <memory>
 #include <random>
 
 #include "common/error.h"
@@ -334,6 +335,97 @@ TEST(Slam, AnUnverifiedCoveredFrameWithTooFewPointsForAKeyframeIsCarried) {
   EXPECT_TRUE(all_points.keyframe);
   EXPECT_EQ(misses.not_verified, 1);
   EXPECT_EQ(misses.few_points_carried, 0);
+}
+
+// Back over keyframe 0 after half a lap whose odometry drifted 10 cm: the covering keyframe
+// locates the frame beyond the correction bound, a loop. It closes by an edge from keyframe 0 to
+// the reference's keyframe, through the frame, with no keyframe added
+// (CoverageOptions::close_loops_in_place): the graph moves the drifted keyframes back towards
+// the truth and the frame is located in keyframe 0. Not in place, and through a new keyframe as
+// before, when the option is off, when keyframe 0 is too recent for a loop
+// (LoopSearchOptions::min_age_s), or when the edge disagrees with the odometry (the loop gate).
+TEST(Slam, AFrameLocatedTooFarClosesItsLoopWithoutAKeyframe) {
+  const SyntheticRoom room(5, 3.0, 2.5, 2.5);
+  const auto path = test::circle_path(30, 1.0, 0.5);
+  const Matrix6d vo_covariance = Matrix6d::Identity() * 1e-6;  // the VO's own, since the reference
+  // The odometry drifts along x, a tenth of a metre over the way out.
+  const auto odometry = [&](size_t i) {
+    Eigen::Isometry3d T = path[i];
+    T.translation().x() += 0.1 * static_cast<double>(i) / static_cast<double>(path.size() - 1);
+    return T;
+  };
+  const auto back_at_the_start = [&](const SlamOptions& options, SlamStep& step) {
+    auto slam = std::make_unique<Slam>(options, builtin_vocabulary());
+    int64_t utime = 1'000'000;
+    for (size_t i = 0; i < path.size(); ++i)
+      slam->add(room.render(path[i], test::test_camera(), utime += 200'000), odometry(i));
+    Eigen::Isometry3d T_odom = path.front();
+    T_odom.translation().x() += 0.1;
+    step = slam->add(room.render(path.front(), test::test_camera(), utime += 200'000), T_odom,
+                     OdometryLink::kContinuous, vo_covariance);
+    return slam;
+  };
+  const auto newest_keyframe_error = [&](const Slam& slam) {
+    const Keyframe& kf = slam.keyframes().back();
+    size_t best = 0;  // its truth: the path pose whose odometry it was made at
+    for (size_t j = 0; j < path.size(); ++j) {
+      if (se3::translation_distance(odometry(j), kf.T_odom_camera) <
+          se3::translation_distance(odometry(best), kf.T_odom_camera))
+        best = j;
+    }
+    return se3::translation_distance(slam.graph().poses.back(), path[best]);
+  };
+
+  SlamStep step;
+  {
+    SlamOptions no_loop;
+    no_loop.coverage.close_loops_in_place = false;
+    auto slam = back_at_the_start(no_loop, step);
+    EXPECT_TRUE(step.keyframe) << "through a new keyframe";
+    EXPECT_TRUE(step.loop_closed);
+    EXPECT_EQ(slam->coverage_misses().too_far, 1);
+    EXPECT_EQ(slam->coverage_misses().closed_in_place, 0);
+  }
+  auto slam = back_at_the_start(SlamOptions{}, step);
+  const size_t keyframes = slam->keyframes().size();
+  EXPECT_FALSE(step.keyframe);
+  EXPECT_TRUE(step.loop_closed);
+  EXPECT_TRUE(step.reanchored);
+  EXPECT_TRUE(step.new_reference());
+  EXPECT_EQ(step.loop_keyframe_id, 0);
+  EXPECT_EQ(step.reanchor_keyframe_id, 0);
+  ASSERT_TRUE(step.optimisation.has_value());
+  EXPECT_EQ(slam->coverage_misses().closed_in_place, 1);
+  EXPECT_EQ(slam->coverage_misses().too_far, 0);
+  EXPECT_EQ(slam->num_loop_closures(), 1);
+  EXPECT_EQ(slam->keyframes().size(), keyframes);
+  const auto& edge = slam->graph().edges.back();
+  EXPECT_EQ(edge.kind, EdgeKind::kLoopClosure);
+  EXPECT_EQ(edge.from, 0);
+  EXPECT_EQ(edge.to, static_cast<int>(keyframes) - 1) << "to the reference's keyframe, the newest";
+  // The frame is where it is, and the drifted keyframes moved back.
+  EXPECT_EQ(slam->reference().keyframe_id, 0);
+  EXPECT_LT(se3::translation_distance(slam->world_pose(slam->reference().T_odom_camera), path.front()), 0.01);
+  EXPECT_LT(newest_keyframe_error(*slam), 0.03) << "10 cm of drift before the loop";
+
+  {  // Keyframe 0 too recent to close a loop with: a keyframe.
+    SlamOptions recent;
+    recent.loops.min_age_s = 100.0;
+    back_at_the_start(recent, step);
+    EXPECT_TRUE(step.keyframe);
+    EXPECT_FALSE(step.loop_closed) << "no candidate is old enough for the keyframe's own search either";
+  }
+  {  // The loop gate refuses the edge: a keyframe, whose own loop the gate refuses as well.
+    SlamOptions strict;
+    strict.loop_consistency.sigmas = 1e-3;
+    strict.loop_consistency.min_translation_m = 0.01;
+    strict.loop_consistency.min_rotation_rad = 0.001;
+    auto refused = back_at_the_start(strict, step);
+    EXPECT_TRUE(step.keyframe);
+    EXPECT_FALSE(step.loop_closed);
+    EXPECT_GE(refused->num_inconsistent_loops(), 1);
+    EXPECT_EQ(refused->coverage_misses().closed_in_place, 0);
+  }
 }
 
 // A covered frame that no covering keyframe verifies (here: the same pose in a room of other
