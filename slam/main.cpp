@@ -288,12 +288,16 @@ int serve(const Options& o, const SlamOptions& options, std::shared_ptr<const Vo
                    published_id(adapter.slam(), out.step->keyframe_id),
                    published_id(adapter.slam(), out.step->loop_keyframe_id), out.step->loop.inliers,
                    out.step->loop.rms_px, out.step->optimisation->start_chi2, out.step->optimisation->final_chi2);
-    } else if (out.step && out.step->loop_closed && out.step->reanchored) {
-      spdlog::info("a frame located in keyframe {} closes a loop from it to keyframe {} ({} inliers, {:.2f} px); "
-                   "chi2 {:.4g} -> {:.4g}",
-                   published_id(adapter.slam(), out.step->loop_keyframe_id),
-                   published_id(adapter.slam(), adapter.slam().reference().keyframe_id), out.step->loop.inliers,
-                   out.step->loop.rms_px, out.step->optimisation->start_chi2, out.step->optimisation->final_chi2);
+    } else if (out.step && out.step->loop_closed && !out.step->keyframe && !out.step->relocalised) {
+      // Closed without a keyframe: the loop is the graph's newest edge (Slam::close_loop_in_place).
+      const auto& loop = adapter.slam().graph().edges.back();
+      spdlog::info("a frame located in keyframe {} closes a loop from it to keyframe {} without a keyframe ({} "
+                   "inliers, {:.2f} px); chi2 {:.4g} -> {:.4g}; the frame {}",
+                   published_id(adapter.slam(), adapter.slam().graph().ids[static_cast<size_t>(loop.from)]),
+                   published_id(adapter.slam(), adapter.slam().graph().ids[static_cast<size_t>(loop.to)]),
+                   out.step->loop.inliers, out.step->loop.rms_px, out.step->optimisation->start_chi2,
+                   out.step->optimisation->final_chi2,
+                   out.step->reanchored ? "located there" : "carried at its prediction (the graph disagrees)");
     }
   };
   node->subscribe<rgbd_frame_t>(o.adapter.camera_channel, [&](const rgbd_frame_t& m) { publish(adapter.on_frame(m)); });

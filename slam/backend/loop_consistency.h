@@ -31,14 +31,24 @@ struct LoopConsistency {
   double allowed_rotation_rad = 0.0;
 };
 
-/// Compares the loop measurement T_from_to (from < to) with graph.poses[from]^-1 poses[to],
-/// allowing for the odometry edges (kind kOdometry) between the two vertices: their information
-/// in the graph, or `odometry_information[e]` for edge e when given (one per edge; the back-end
-/// passes its constant noise model there, so that the gate stays as conservative as it was
-/// when the graph's odometry edges take the VO's own, tighter covariance).
+/// An odometry measurement the loop was measured through that is no edge of the graph: the
+/// motion from `to` to a frame that a loop closed without a keyframe located (Slam), and its
+/// information (the graph's error convention).
+struct OdometryBeyondChain {
+  Eigen::Isometry3d motion = Eigen::Isometry3d::Identity();
+  Matrix6d information = Matrix6d::Identity();
+};
+
+/// Compares the loop measurement T_from_to with graph.poses[from]^-1 poses[to] (either vertex
+/// the older), allowing for the odometry edges (kind kOdometry) between the two vertices: their
+/// information in the graph, or `odometry_information[e]` for edge e when given (one per edge;
+/// the back-end passes its constant noise model there, so that the gate stays as conservative as
+/// it was when the graph's odometry edges take the VO's own, tighter covariance); and for
+/// `beyond`, when given, as one more edge of the chain.
 LoopConsistency check_loop_against_odometry(const PoseGraph3d& graph, int from, int to,
                                             const Eigen::Isometry3d& T_from_to,
                                             const LoopConsistencyOptions& options,
-                                            const std::vector<Matrix6d>* odometry_information = nullptr);
+                                            const std::vector<Matrix6d>* odometry_information = nullptr,
+                                            const OdometryBeyondChain* beyond = nullptr);
 
 }  // namespace kestrel::slam

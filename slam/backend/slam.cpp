@@ -108,6 +108,10 @@ Matrix6d composed_information(const Eigen::Isometry3d& B, const Matrix6d& covari
   return information_of(Ad * covariance_A * Ad.transpose() + right_covariance(information_B));
 }
 
+// The 99 % quantile of the chi-square distribution with 6 degrees of freedom: two estimates of a
+// pose agree when their difference's Mahalanobis norm squared is below it.
+constexpr double kChi2Of6Dof99Percent = 16.812;
+
 // A loop edge kf -> r through one frame, located in keyframe kf (`located`: T_kf_frame and its
 // information) and predicted in keyframe r (T_r_frame, with its right-perturbation covariance):
 // T_kf_r = T_kf_frame T_r_frame^-1, the two uncertainties composed.
@@ -627,57 +631,60 @@ void Slam::add_loop_and_optimise(const Keyframe& kf, int64_t to, const Eigen::Is
   ++revision_;
 }
 
-void Slam::locate_reference(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera, const Keyframe& kf,
-                            const LoopConstraint& located, const Matrix6d& predicted, SlamStep& step) {
-  // The frame in keyframe k twice: predicted (the reference and the odometry since, with
-  // their covariances) and located (the features'); the reference becomes their fusion, so
-  // a precise odometry is not replaced by a coarser location, and drift is still bounded.
-  const auto k = static_cast<size_t>(kf.id);
-  const Eigen::Isometry3d T_k_predicted = graph_.poses[k].inverse() * world_pose(T_odom_camera);
-  const Eigen::Isometry3d T_predicted_located = T_k_predicted.inverse() * located.T_candidate_query;
-  const Matrix6d measured = right_covariance(located.information);
-  const Matrix6d gain = predicted * (predicted + measured).inverse();
-  const Eigen::Isometry3d T_k_frame = T_k_predicted * se3::exp(gain * se3::log(T_predicted_located));
-  Matrix6d fused = (Matrix6d::Identity() - gain) * predicted;
-  fused = 0.5 * (fused + fused.transpose());
-  reference_ = OdometryReference{kf.id, frame.utime, T_odom_camera, frame.T_body_camera, T_k_frame, fused};
-  reference_marginal_ = marginal_covariance(graph_, static_cast<int>(k), options_.optimizer.kernel);
-  step.reanchored = true;
-  step.reanchor_keyframe_id = kf.id;
-  step.loop = located;
-  ++reanchors_;
-}
-
-bool Slam::close_loop_in_place(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera, const Keyframe& kf, const Matrix6d& predicted, const FrameFeatures& features,
+bool Slam::close_loop_in_place(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera, OdometryLink link,
+                               const Keyframe& kf, const Matrix6d& predicted, const FrameFeatures& features,
                                const sensors::SensorProfile& sensor, uint64_t seed, SlamStep& step) {
-  if (!options_.coverage.close_loops_in_place || kf.id == reference_.keyframe_id) return false;
+  const int64_t r = reference_.keyframe_id;
+  if (!options_.coverage.close_loops_in_place || kf.id == r) return false;
   // A loop candidate as close_loop() takes them: old enough not to re-measure what the odometry
   // just measured, and verified as a loop is (the re-anchoring's location drops the spread test).
   const auto min_age_us = static_cast<int64_t>(std::llround(options_.loops.min_age_s * 1e6));
   if (kf.session == session_ && kf.utime > frame.utime - min_age_us) return false;
+  ++step.candidates;
   const LoopConstraint loop =
       verify_loop(features, kf.features, loop_verification(options_.verification, kf.sensor, sensor), seed);
   if (!loop.accepted) return false;
   const Eigen::Isometry3d T_r_frame =
       reference_.T_keyframe_camera * reference_.T_odom_camera.inverse() * T_odom_camera;
   const EdgeThroughFrame edge = edge_through_frame(loop, T_r_frame, predicted);
+  // The gate allows for the odometry edges between the two keyframes and for the odometry from
+  // r to the frame, in the constant model, as the edge of a keyframe made at the frame would
+  // have it. Refused, nothing is counted: that keyframe is made, and its own loop search and
+  // gate judge the same loop.
+  const OdometryBeyondChain to_frame{T_r_frame,
+                                     odometry_information(T_r_frame, options_.odometry, weaker(link, reference_.link))};
   if (options_.loops.max_distance_m > 0.0 &&
-      !check_loop_against_odometry(graph_, static_cast<int>(kf.id), static_cast<int>(reference_.keyframe_id),
-                                   edge.T_kf_r, options_.loop_consistency, &gate_information_)
+      !check_loop_against_odometry(graph_, static_cast<int>(kf.id), static_cast<int>(r), edge.T_kf_r,
+                                   options_.loop_consistency, &gate_information_, &to_frame)
            .consistent) {
-    ++step.inconsistent;
-    ++inconsistent_loops_;
     return false;
   }
-  add_loop_and_optimise(kf, reference_.keyframe_id, edge.T_kf_r, edge.information, step);
-  // Then the frame is located in kf as a re-anchoring does, against the optimised graph: the
-  // loop moved the keyframes as far as the edge could (little, when the odometry to the frame
-  // was uncertain), and the location places the frame itself. Its features enter twice, in the
-  // edge and in the reference, should the next keyframe be made from this reference rather than
-  // from a later re-anchoring; a keyframe made for the loop avoided that and kept a vertex and a
-  // scan per lap (docs/decisions/2026-12-07-loops-closed-without-a-keyframe.md).
-  locate_reference(frame, T_odom_camera, kf, loop, predicted, step);
+  add_loop_and_optimise(kf, r, edge.T_kf_r, edge.information, step);
+  step.loop = loop;
   ++coverage_misses_.closed_in_place;
+  // The frame, against the optimised graph: the loop moved the keyframes as far as its edge
+  // could, which is little when the odometry to the frame was uncertain. Where the graph and the
+  // location agree within their uncertainties the frame is located in kf, at the location (the
+  // prediction is in the edge already); else (a loop the robust kernel took for an outlier) it
+  // stays at its prediction, as a keyframe made for such a loop stayed where the odometry put it.
+  // The location enters twice, in the edge and in the reference, should the next keyframe be
+  // made from this reference rather than from a later re-anchoring: a keyframe made for the loop
+  // avoided that, and kept a vertex and a mapper scan per lap
+  // (docs/decisions/2026-12-07-loops-closed-without-a-keyframe.md).
+  const Eigen::Isometry3d T_k_predicted = graph_.poses[static_cast<size_t>(kf.id)].inverse() * world_pose(T_odom_camera);
+  const Matrix6d located = right_covariance(loop.information);
+  const Vector6d error = se3::log(T_k_predicted.inverse() * loop.T_candidate_query);
+  const double chi2 = error.dot((predicted + located).ldlt().solve(error));
+  if (chi2 <= kChi2Of6Dof99Percent) {
+    reference_ = OdometryReference{kf.id, frame.utime, T_odom_camera, frame.T_body_camera, loop.T_candidate_query, located};
+    reference_marginal_ = marginal_covariance(graph_, static_cast<int>(kf.id), options_.optimizer.kernel);
+    step.reanchored = true;
+    step.reanchor_keyframe_id = kf.id;
+    ++reanchors_;
+  } else {
+    carry_reference(frame, T_odom_camera, link, predicted, step);
+    reference_marginal_ = marginal_covariance(graph_, static_cast<int>(r), options_.optimizer.kernel);
+  }
   return true;
 }
 
@@ -745,7 +752,7 @@ bool Slam::reanchor(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_came
       if (!localising) {
         // A loop to close: by an edge between keyframes the map has (CoverageOptions::
         // close_loops_in_place), else through a new keyframe.
-        if (close_loop_in_place(frame, T_odom_camera, kf, predicted, features, sensor, seed, step)) return true;
+        if (close_loop_in_place(frame, T_odom_camera, link, kf, predicted, features, sensor, seed, step)) return true;
         ++coverage_misses_.too_far;
         return false;
       }
@@ -760,7 +767,22 @@ bool Slam::reanchor(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_came
       lost_since_utime_ = frame.utime;
       return true;
     }
-    locate_reference(frame, T_odom_camera, kf, located, predicted, step);
+    // The frame in keyframe k twice: predicted (the reference and the odometry since, with
+    // their covariances) and located (the features'); the reference becomes their fusion, so
+    // a precise odometry is not replaced by a coarser location, and drift is still bounded.
+    const Eigen::Isometry3d T_k_predicted = graph_.poses[k].inverse() * T_world_frame;
+    const Matrix6d measured = right_covariance(located.information);
+    const Matrix6d gain = predicted * (predicted + measured).inverse();
+    const Eigen::Isometry3d T_k_frame = T_k_predicted * se3::exp(gain * se3::log(T_expected_located));
+    Matrix6d fused = (Matrix6d::Identity() - gain) * predicted;
+    fused = 0.5 * (fused + fused.transpose());
+    const auto marginal = marginal_covariance(graph_, static_cast<int>(k), options_.optimizer.kernel);
+    reference_ = OdometryReference{kf.id, frame.utime, T_odom_camera, frame.T_body_camera, T_k_frame, fused};
+    reference_marginal_ = marginal;
+    step.reanchored = true;
+    step.reanchor_keyframe_id = kf.id;
+    step.loop = located;
+    ++reanchors_;
     return true;
   }
   // Localisation only, a view of the map that does not verify adds no keyframe either; in

@@ -70,12 +70,8 @@ struct OdometryReference {
 struct SlamStep {
   bool keyframe = false;          ///< the frame became a keyframe
   int64_t keyframe_id = -1;
-  /// Instead, it was located in a covering keyframe (`loop` holds the constraint)... When that
-  /// location was beyond the correction bound, `loop_closed` too: the loop closed by an edge from
-  /// that keyframe to the reference's (CoverageOptions::close_loops_in_place), which stays the
-  /// reference's keyframe.
-  bool reanchored = false;
-  int64_t reanchor_keyframe_id = -1;  ///< ...this one
+  bool reanchored = false;        ///< instead, it was located in a covering keyframe...
+  int64_t reanchor_keyframe_id = -1;  ///< ...this one (`loop` holds the constraint)
   /// Or, over covered ground but with too few features ever to be located, or with none of the
   /// covering keyframes verifying a certain prediction (CoverageOptions::carry_within_sigmas), it
   /// became the reference at its predicted pose (nothing measured: no correction to send).
@@ -86,8 +82,12 @@ struct SlamStep {
   bool relocalised = false;
   int candidates = 0;             ///< loop candidates verified
   int inconsistent = 0;           ///< of them, verified but refused as disagreeing with the odometry
+  /// A loop closed: the new keyframe's with an earlier one; or, over covered ground, without a
+  /// keyframe (CoverageOptions::close_loops_in_place): an edge from the keyframe that located the
+  /// frame beyond the correction bound to the reference's keyframe before this frame, the frame
+  /// then re-anchored or carried.
   bool loop_closed = false;
-  int64_t loop_keyframe_id = -1;  ///< the earlier keyframe it closed with
+  int64_t loop_keyframe_id = -1;  ///< the keyframe it closed with (older than the frame by LoopSearchOptions::min_age_s)
   LoopConstraint loop;            ///< the accepted constraint, or the last rejection
   std::optional<OptimizerSummary> optimisation;  ///< when the graph was optimised
   /// Later frames are measured from this one (Slam::reference()).
@@ -263,17 +263,14 @@ class Slam {
   /// Adds the loop edge kf -> to (measurement T_kf_to), optimises the graph.
   void add_loop_and_optimise(const Keyframe& kf, int64_t to, const Eigen::Isometry3d& T_kf_to,
                              const Matrix6d& information, SlamStep& step);
-  /// Re-anchors: the frame, `located` in keyframe kf and predicted by the reference and the
-  /// odometry since (`predicted`: that prediction's covariance in the reference's keyframe),
-  /// becomes the reference, in kf, at the fusion of the two.
-  void locate_reference(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera, const Keyframe& kf,
-                        const LoopConstraint& located, const Matrix6d& predicted, SlamStep& step);
   /// A covered frame that keyframe `kf` located beyond the correction bound (re-anchoring's
-  /// verification with `seed`): when kf may close a loop (not the reference's keyframe, old
-  /// enough), verifies as a loop and passes the loop gate, closes the loop by an edge from kf
-  /// to the reference's keyframe through the frame (`predicted`: its covariance there) and goes on
-  /// from the frame. False (nothing changed but the inconsistency counts) otherwise.
-  bool close_loop_in_place(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera, const Keyframe& kf, const Matrix6d& predicted, const FrameFeatures& features,
+  /// verification with `seed`; `predicted`: the frame's covariance in the reference's keyframe r):
+  /// when kf may close a loop (not r, old enough), the frame verifies as a loop and the edge
+  /// passes the loop gate, closes the loop by an edge from kf to r through the frame, optimises,
+  /// and makes the frame the reference (located in kf, or carried at its prediction when the
+  /// optimised graph disagrees with the location). False, and nothing changed, otherwise.
+  bool close_loop_in_place(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera, OdometryLink link,
+                           const Keyframe& kf, const Matrix6d& predicted, const FrameFeatures& features,
                            const sensors::SensorProfile& sensor, uint64_t seed, SlamStep& step);
   /// Makes the frame a keyframe (features extracted), closes its loop if it has one.
   SlamStep add_keyframe(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera, OdometryLink link,

@@ -56,7 +56,7 @@ struct LoopRun {
   std::vector<Eigen::Isometry3d> truth, odometry, optimised;
   int loop_closures = 0;
   int false_closures = 0;
-  int64_t last_loop_keyframe = -1;           ///< the newest keyframe when the last loop closed
+  int64_t last_loop_keyframe = -1;           ///< the reference's keyframe when the last loop closed
   std::optional<Matrix6d> loop_covariance;   ///< Slam::reference_marginal() then
   PoseGraph3d graph;                         ///< at the end
   std::vector<size_t> keyframes;             ///< keyframes made after each frame
@@ -81,13 +81,14 @@ LoopRun run(const SyntheticRoom& room, const std::vector<Eigen::Isometry3d>& tru
     if (step.loop_closed) {
       ++r.loop_closures;
       r.loop_frames.push_back(k);
-      r.last_loop_keyframe = step.keyframe_id;
+      // The reference's keyframe: the new keyframe, or where a loop closed without one put it.
+      r.last_loop_keyframe = slam.reference().keyframe_id;
       r.loop_covariance = slam.reference_marginal();
-      // The closure's relative pose against the truth of the two keyframes' frames.
+      // The closure's relative pose against the truth: the earlier keyframe's frame and this
+      // frame (the new keyframe's, or the frame located without one: CoverageOptions).
       const auto& kfs = slam.keyframes();
       const auto frame_of = [&](int64_t id) { return static_cast<size_t>((kfs[static_cast<size_t>(id)].utime - 1'000'000) / 200'000); };
-      const Eigen::Isometry3d true_rel =
-          truth[frame_of(step.loop_keyframe_id)].inverse() * truth[frame_of(step.keyframe_id)];
+      const Eigen::Isometry3d true_rel = truth[frame_of(step.loop_keyframe_id)].inverse() * truth[k];
       if (se3::translation_distance(true_rel, step.loop.T_candidate_query) > 0.1 ||
           se3::rotation_distance(true_rel, step.loop.T_candidate_query) > 0.05) {
         ++r.false_closures;
@@ -354,15 +355,16 @@ TEST(Slam, AFrameLocatedTooFarClosesItsLoopWithoutAKeyframe) {
     T.translation().x() += 0.1 * static_cast<double>(i) / static_cast<double>(path.size() - 1);
     return T;
   };
-  const auto back_at_the_start = [&](const SlamOptions& options, SlamStep& step) {
+  const auto back_at_the_start = [&](const SlamOptions& options, SlamStep& step,
+                                      OdometryLink link = OdometryLink::kContinuous) {
     auto slam = std::make_unique<Slam>(options, builtin_vocabulary());
     int64_t utime = 1'000'000;
     for (size_t i = 0; i < path.size(); ++i)
       slam->add(room.render(path[i], test::test_camera(), utime += 200'000), odometry(i));
     Eigen::Isometry3d T_odom = path.front();
     T_odom.translation().x() += 0.1;
-    step = slam->add(room.render(path.front(), test::test_camera(), utime += 200'000), T_odom,
-                     OdometryLink::kContinuous, vo_covariance);
+    step = slam->add(room.render(path.front(), test::test_camera(), utime += 200'000), T_odom, link,
+                     link == OdometryLink::kContinuous ? std::optional<Matrix6d>(vo_covariance) : std::nullopt);
     return slam;
   };
   const auto newest_keyframe_error = [&](const Slam& slam) {
@@ -398,6 +400,7 @@ TEST(Slam, AFrameLocatedTooFarClosesItsLoopWithoutAKeyframe) {
   EXPECT_EQ(slam->coverage_misses().closed_in_place, 1);
   EXPECT_EQ(slam->coverage_misses().too_far, 0);
   EXPECT_EQ(slam->num_loop_closures(), 1);
+  EXPECT_EQ(slam->num_inconsistent_loops(), 0);
   EXPECT_EQ(slam->keyframes().size(), keyframes);
   const auto& edge = slam->graph().edges.back();
   EXPECT_EQ(edge.kind, EdgeKind::kLoopClosure);
@@ -415,16 +418,35 @@ TEST(Slam, AFrameLocatedTooFarClosesItsLoopWithoutAKeyframe) {
     EXPECT_TRUE(step.keyframe);
     EXPECT_FALSE(step.loop_closed) << "no candidate is old enough for the keyframe's own search either";
   }
-  {  // The loop gate refuses the edge: a keyframe, whose own loop the gate refuses as well.
+  {  // The loop gate refuses the edge: a keyframe, whose own loop search finds the same loop and
+     // refuses it (counted there only: as many refusals as with the option off, one candidate
+     // verified more, the one tried in place).
     SlamOptions strict;
     strict.loop_consistency.sigmas = 1e-3;
     strict.loop_consistency.min_translation_m = 0.01;
     strict.loop_consistency.min_rotation_rad = 0.001;
     auto refused = back_at_the_start(strict, step);
+    const SlamStep refused_step = step;
     EXPECT_TRUE(step.keyframe);
     EXPECT_FALSE(step.loop_closed);
     EXPECT_GE(refused->num_inconsistent_loops(), 1);
     EXPECT_EQ(refused->coverage_misses().closed_in_place, 0);
+    EXPECT_EQ(refused->coverage_misses().too_far, 1);
+    strict.coverage.close_loops_in_place = false;
+    auto off = back_at_the_start(strict, step);
+    EXPECT_EQ(refused->num_inconsistent_loops(), off->num_inconsistent_loops());
+    EXPECT_EQ(refused_step.candidates, step.candidates + 1);
+  }
+  {  // Across a VO restart the estimator bridged, the odometry to the frame is uncertain (5 cm
+     // floors): the edge is weak and the keyframes hardly move, but the frame is located all
+     // the same, where it is.
+    auto bridged = back_at_the_start(SlamOptions{}, step, OdometryLink::kBridged);
+    EXPECT_FALSE(step.keyframe);
+    EXPECT_TRUE(step.loop_closed);
+    EXPECT_TRUE(step.reanchored);
+    EXPECT_EQ(bridged->reference().keyframe_id, 0);
+    EXPECT_LT(se3::translation_distance(bridged->world_pose(bridged->reference().T_odom_camera), path.front()), 0.01);
+    EXPECT_GT(newest_keyframe_error(*bridged), 0.03) << "a weak edge should hardly move the keyframes";
   }
 }
 
