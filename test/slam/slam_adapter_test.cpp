@@ -187,6 +187,52 @@ TEST_F(AdapterTest, AFrameOverCoveredGroundIsLocatedInItsKeyframeAndCorrectsTheE
   EXPECT_EQ(corrected, (std::vector<int64_t>{1, 0})) << "located in keyframe 1 (0.3 m), then 0";
 }
 
+// Back over the first keyframe after half a lap whose odometry drifted 10 cm: SLAM closes the
+// loop without a keyframe (Slam::close_loop_in_place), and the graph, whose keyframes moved,
+// goes out (the mapper rebuilds from it) although no keyframe was made.
+TEST_F(AdapterTest, ALoopClosedWithoutAKeyframePublishesTheMovedGraph) {
+  const auto path = test::circle_path(30, 1.0, 0.5);
+  std::vector<Eigen::Isometry3d> odometry;
+  for (size_t i = 0; i < path.size(); ++i) {
+    odometry.push_back(path[i]);
+    odometry.back().translation().x() += 0.1 * static_cast<double>(i) / static_cast<double>(path.size() - 1);
+  }
+  odometry.push_back(path.front());
+  odometry.back().translation().x() += 0.1;
+  const auto at = [](size_t i) { return 1'000'000 + 200'000 * static_cast<int64_t>(i); };
+  std::optional<kestrel::slam_graph_t> last_graph;
+  AdapterOutputs out;
+  for (size_t i = 0; i < odometry.size(); ++i) {
+    const Eigen::Isometry3d& truth = i < path.size() ? path[i] : path.front();
+    kestrel::vo_update_t u{};
+    u.utime = at(i);
+    u.reference_utime = i == 0 ? 0 : at(i - 1);
+    u.status = i == 0 ? kestrel::vo_update_t::STATUS_NO_REFERENCE : kestrel::vo_update_t::STATUS_OK;
+    u.flags = kestrel::vo_update_t::FLAG_NEW_REFERENCE;
+    u.T_reference_current =
+        transport::to_message(i == 0 ? Eigen::Isometry3d::Identity() : odometry[i - 1].inverse() * odometry[i]);
+    u.T_body_camera = transport::to_message(Eigen::Isometry3d::Identity());
+    // The VO's own covariance, as large as the drift: (5 mm)^2 per motion, (0.06 deg)^2.
+    if (i > 0)
+      for (int d = 0; d < 6; ++d) u.covariance[7 * d] = d < 3 ? 2.5e-5 : 1e-6;
+    adapter_.on_frame(transport::encode_rgbd(room_.render(truth, test::test_camera(), at(i))));
+    out = adapter_.on_vo_update(u);
+    if (out.graph && i + 1 < odometry.size()) last_graph = out.graph;
+  }
+  ASSERT_TRUE(out.step);
+  EXPECT_TRUE(out.step->loop_closed);
+  EXPECT_FALSE(out.step->keyframe);
+  EXPECT_TRUE(out.step->reanchored) << "located in keyframe 0";
+  ASSERT_TRUE(out.graph) << "the keyframes moved: the graph goes out";
+  ASSERT_TRUE(last_graph);
+  EXPECT_EQ(out.graph->num_keyframes, last_graph->num_keyframes);
+  EXPECT_GT(out.graph->revision, last_graph->revision);
+  // The newest keyframe, 10 cm off where the odometry put it, is back near its truth.
+  const int newest = out.graph->num_keyframes - 1;
+  const Eigen::Isometry3d before = keyframe_pose(*last_graph, newest), after = keyframe_pose(*out.graph, newest);
+  EXPECT_GT(se3::translation_distance(before, after), 0.05);
+}
+
 // A SLAM process restarted in flight starts its keyframes from index 0 again; what it publishes
 // must not reuse an id of the session before, nor go back in revision, or the mapper would
 // move the old session's images to the new keyframes' poses (slam_messages.h).
