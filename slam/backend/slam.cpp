@@ -460,7 +460,6 @@ SlamStep Slam::add_keyframe(const RgbdFrame& frame, const Eigen::Isometry3d& T_o
 SlamStep Slam::close_loop(SlamStep step) {
   const Keyframe& query = keyframes_.back();
   const Eigen::Isometry3d& T_world_query = graph_.poses.back();
-  const auto min_age_us = static_cast<int64_t>(std::llround(options_.loops.min_age_s * 1e6));
   const LoopSearchOptions& lo = options_.loops;
   const bool gate = gate_by_pose_ && lo.max_distance_m > 0.0;
   auto allowed = [&](int entry) {
@@ -473,7 +472,7 @@ SlamStep Slam::close_loop(SlamStep step) {
     // a placement before it joins the two); only the provisional ones are loop candidates.
     if (!in_world(query.id) && in_world(k.id)) return false;
     const bool across_unplaced_break = !gate_by_pose_ && unplaced_from_ >= 0 && k.id < unplaced_from_;
-    if (k.session == query.session && !across_unplaced_break && k.utime > query.utime - min_age_us) return false;
+    if (!across_unplaced_break && !old_enough_for_a_loop(k, query.utime)) return false;
     if (!gate) return true;
     const Eigen::Isometry3d& T_world_k = graph_.poses[static_cast<size_t>(entry)];
     return se3::translation_distance(T_world_k, T_world_query) <= lo.max_distance_m &&
@@ -490,10 +489,7 @@ SlamStep Slam::close_loop(SlamStep step) {
     step.loop = verify_loop(query.features, earlier.features,
                             loop_verification(options_.verification, earlier.sensor, query.sensor), seed);
     if (!step.loop.accepted) continue;
-    if (gate && !check_loop_against_odometry(graph_, static_cast<int>(earlier.id), static_cast<int>(query.id),
-                                             step.loop.T_candidate_query, options_.loop_consistency,
-                                             &gate_information_)
-                     .consistent) {
+    if (gate && !passes_loop_gate(earlier.id, query.id, step.loop.T_candidate_query)) {
       step.loop.accepted = false;
       ++step.inconsistent;
       ++inconsistent_loops_;
@@ -631,19 +627,29 @@ void Slam::add_loop_and_optimise(const Keyframe& kf, int64_t to, const Eigen::Is
   ++revision_;
 }
 
+bool Slam::old_enough_for_a_loop(const Keyframe& k, int64_t utime) const {
+  const auto min_age_us = static_cast<int64_t>(std::llround(options_.loops.min_age_s * 1e6));
+  return k.session != session_ || k.utime <= utime - min_age_us;
+}
+
+bool Slam::passes_loop_gate(int64_t from, int64_t to, const Eigen::Isometry3d& T_from_to,
+                            const OdometryBeyondChain* beyond) const {
+  return check_loop_against_odometry(graph_, static_cast<int>(from), static_cast<int>(to), T_from_to,
+                                     options_.loop_consistency, &gate_information_, beyond)
+      .consistent;
+}
+
 bool Slam::close_loop_in_place(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera, OdometryLink link,
-                               const Keyframe& kf, const Matrix6d& predicted, const FrameFeatures& features,
-                               const sensors::SensorProfile& sensor, uint64_t seed, SlamStep& step) {
+                               const Keyframe& kf, const Matrix6d& predicted, const LoopConstraint& loop,
+                               SlamStep& step) {
   const int64_t r = reference_.keyframe_id;
   if (!options_.coverage.close_loops_in_place || kf.id == r) return false;
   // A loop candidate as close_loop() takes them: old enough not to re-measure what the odometry
-  // just measured, and verified as a loop is (the re-anchoring's location drops the spread test).
-  const auto min_age_us = static_cast<int64_t>(std::llround(options_.loops.min_age_s * 1e6));
-  if (kf.session == session_ && kf.utime > frame.utime - min_age_us) return false;
+  // just measured, and verified as a loop is. The re-anchoring's verification is the loop's
+  // without the spread test, on the same seed: its location stands once the spread passes.
+  if (!old_enough_for_a_loop(kf, frame.utime)) return false;
   ++step.candidates;
-  const LoopConstraint loop =
-      verify_loop(features, kf.features, loop_verification(options_.verification, kf.sensor, sensor), seed);
-  if (!loop.accepted) return false;
+  if (loop.spread_m < options_.verification.min_spread_m) return false;
   const Eigen::Isometry3d T_r_frame =
       reference_.T_keyframe_camera * reference_.T_odom_camera.inverse() * T_odom_camera;
   const EdgeThroughFrame edge = edge_through_frame(loop, T_r_frame, predicted);
@@ -653,12 +659,7 @@ bool Slam::close_loop_in_place(const RgbdFrame& frame, const Eigen::Isometry3d& 
   // gate judge the same loop.
   const OdometryBeyondChain to_frame{T_r_frame,
                                      odometry_information(T_r_frame, options_.odometry, weaker(link, reference_.link))};
-  if (options_.loops.max_distance_m > 0.0 &&
-      !check_loop_against_odometry(graph_, static_cast<int>(kf.id), static_cast<int>(r), edge.T_kf_r,
-                                   options_.loop_consistency, &gate_information_, &to_frame)
-           .consistent) {
-    return false;
-  }
+  if (options_.loops.max_distance_m > 0.0 && !passes_loop_gate(kf.id, r, edge.T_kf_r, &to_frame)) return false;
   add_loop_and_optimise(kf, r, edge.T_kf_r, edge.information, step);
   step.loop = loop;
   ++coverage_misses_.closed_in_place;
@@ -752,7 +753,7 @@ bool Slam::reanchor(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_came
       if (!localising) {
         // A loop to close: by an edge between keyframes the map has (CoverageOptions::
         // close_loops_in_place), else through a new keyframe.
-        if (close_loop_in_place(frame, T_odom_camera, link, kf, predicted, features, sensor, seed, step)) return true;
+        if (close_loop_in_place(frame, T_odom_camera, link, kf, predicted, located, step)) return true;
         ++coverage_misses_.too_far;
         return false;
       }

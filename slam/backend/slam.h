@@ -263,15 +263,22 @@ class Slam {
   /// Adds the loop edge kf -> to (measurement T_kf_to), optimises the graph.
   void add_loop_and_optimise(const Keyframe& kf, int64_t to, const Eigen::Isometry3d& T_kf_to,
                              const Matrix6d& information, SlamStep& step);
-  /// A covered frame that keyframe `kf` located beyond the correction bound (re-anchoring's
-  /// verification with `seed`; `predicted`: the frame's covariance in the reference's keyframe r):
-  /// when kf may close a loop (not r, old enough), the frame verifies as a loop and the edge
-  /// passes the loop gate, closes the loop by an edge from kf to r through the frame, optimises,
-  /// and makes the frame the reference (located in kf, or carried at its prediction when the
-  /// optimised graph disagrees with the location). False, and nothing changed, otherwise.
+  /// Loops within a session join keyframes at least LoopSearchOptions::min_age_s apart: a younger
+  /// one would re-measure what the odometry just measured.
+  bool old_enough_for_a_loop(const Keyframe& k, int64_t utime) const;
+  /// The loop gate (loop_consistency.h) on the constant odometry model of the graph's edges.
+  bool passes_loop_gate(int64_t from, int64_t to, const Eigen::Isometry3d& T_from_to,
+                        const OdometryBeyondChain* beyond = nullptr) const;
+  /// A covered frame that keyframe `kf` located beyond the correction bound (`loop`: the
+  /// re-anchoring's verification, the loop's without its spread test; `predicted`: the frame's
+  /// covariance in the reference's keyframe r): when kf may close a loop (not r, old enough),
+  /// the location passes the spread test and the edge passes the loop gate, closes the loop by
+  /// an edge from kf to r through the frame, optimises, and makes the frame the reference
+  /// (located in kf, or carried at its prediction when the optimised graph disagrees with the
+  /// location). False, and nothing changed, otherwise.
   bool close_loop_in_place(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera, OdometryLink link,
-                           const Keyframe& kf, const Matrix6d& predicted, const FrameFeatures& features,
-                           const sensors::SensorProfile& sensor, uint64_t seed, SlamStep& step);
+                           const Keyframe& kf, const Matrix6d& predicted, const LoopConstraint& loop,
+                           SlamStep& step);
   /// Makes the frame a keyframe (features extracted), closes its loop if it has one.
   SlamStep add_keyframe(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera, OdometryLink link,
                         const std::optional<Matrix6d>& odometry_covariance, const sensors::FrameMotion& motion,

@@ -141,7 +141,8 @@ LoopConstraint verify_loop(const FrameFeatures& query, const FrameFeatures& cand
   if (c.inliers < o.min_inlier_fraction * c.matches) {
     return reject(c, std::to_string(c.inliers) + " of " + std::to_string(c.matches) + " matches agree");
   }
-  if (o.min_spread_m > 0.0 && spread(query, matches, best) < o.min_spread_m) {
+  c.spread_m = spread(query, matches, best);
+  if (o.min_spread_m > 0.0 && c.spread_m < o.min_spread_m) {
     return reject(c, "inliers do not spread in space");
   }
 

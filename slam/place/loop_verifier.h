@@ -67,6 +67,10 @@ struct LoopConstraint {
   Matrix6d information = Matrix6d::Zero();  ///< of the pose-graph edge candidate -> query
   int matches = 0;                  ///< ratio-test matches with depth in both frames
   int inliers = 0;                  ///< after the adjustment
+  /// The consensus inliers' spread (VerificationOptions::min_spread_m), before the adjustment;
+  /// 0 when verification stopped earlier. Verified with min_spread_m 0, the same frames and seed
+  /// pass with a positive bound exactly when this reaches it.
+  double spread_m = 0.0;
   double rms_px = 0.0;
 };
 
