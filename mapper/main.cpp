@@ -91,7 +91,10 @@ int serve(Options& o) {
     const bool journalling = !o.node.journal_path.empty() && map.journal_error().empty();
     const int compactions = map.journal_compactions();
     const std::string compaction_error = map.journal_compaction_error();
+    const size_t colour_lost = map.mapper().colour_lost();
     publish(handle());
+    if (map.mapper().colour_lost() > colour_lost)
+      spdlog::warn("a keyframe is kept without its colour (the map has its depth): {}", map.mapper().colour_lost_reason());
     if (map.journal_compactions() > compactions)
       spdlog::info("journal {} compacted to the {} stored keyframes", o.node.journal_path,
                    map.mapper().keyframes().size());

@@ -198,7 +198,11 @@ std::optional<kestrel::octomap_t> MapNode::repeat_map(int64_t frame_utime) {
 
 std::optional<kestrel::octomap_t> MapNode::on_frame(const kestrel::rgbd_frame_t& msg, const char* channel) {
   input_since_start_ = true;
-  RgbdFrame frame = transport::decode_rgbd(msg, channel);
+  // In SLAM mode a frame's colour is decoded only if a keyframe takes it (Mapper::buffer_frame).
+  transport::RgbdDeferredColour decoded =
+      options_.pose_source == PoseSource::kSlamGraph ? transport::decode_rgbd_deferring_colour(msg, channel)
+                                                     : transport::RgbdDeferredColour{transport::decode_rgbd(msg, channel), {}};
+  RgbdFrame& frame = decoded.frame;
   if (frame.depth_mm.empty()) throw InputError(std::string(channel) + ": frame has no depth image");
   if (stats_.frames > 0 && frame.utime <= last_frame_utime_) {
     throw InputError(std::string(channel) + ": frame utime " + std::to_string(frame.utime) +
@@ -207,7 +211,7 @@ std::optional<kestrel::octomap_t> MapNode::on_frame(const kestrel::rgbd_frame_t&
   last_frame_utime_ = frame.utime;
   ++stats_.frames;
   if (options_.pose_source == PoseSource::kSlamGraph) {
-    mapper_.buffer_frame(frame, channel);
+    mapper_.buffer_frame(frame, channel, std::move(decoded.colour));
     return repeat_map(frame.utime);
   }
   pending_.push_back(std::move(frame));

@@ -121,22 +121,38 @@ const ScanUpdate& Mapper::insert(const RgbdFrame& frame, const Eigen::Isometry3d
   return update_;
 }
 
-void Mapper::buffer_frame(const RgbdFrame& frame, const char* what) {
+void Mapper::buffer_frame(const RgbdFrame& frame, const char* what, ColourSource colour) {
   frame.validate(what);
   if (frame.depth_mm.empty()) throw InputError(std::string(what) + ": frame has no depth image");
-  if (!buffer_.empty() && frame.utime <= buffer_.back().utime) {
+  if (colour && !frame.rgb.empty()) throw std::invalid_argument("Mapper::buffer_frame: colour given twice");
+  if (!buffer_.empty() && frame.utime <= buffer_.back().decimated.utime) {
     throw InputError(std::string(what) + ": frame utime " + std::to_string(frame.utime) +
                      " is not after the previous frame's");
   }
-  buffer_.push_back(decimate(frame, options_.scan.stride));
+  buffer_.push_back(Buffered{decimate(frame, options_.scan.stride), std::move(colour), frame.camera});
   const int64_t keep_us = static_cast<int64_t>(options_.frame_buffer_s * 1e6);
-  while (!buffer_.empty() && buffer_.front().utime < frame.utime - keep_us) buffer_.pop_front();
+  while (!buffer_.empty() && buffer_.front().decimated.utime < frame.utime - keep_us) buffer_.pop_front();
 }
 
 const RgbdFrame* Mapper::buffered(int64_t utime) const {
   auto it = std::lower_bound(buffer_.begin(), buffer_.end(), utime,
-                             [](const RgbdFrame& f, int64_t t) { return f.utime < t; });
-  if (it != buffer_.end() && it->utime == utime) return &*it;
+                             [](const Buffered& b, int64_t t) { return b.decimated.utime < t; });
+  if (it != buffer_.end() && it->decimated.utime == utime) {
+    if (it->colour) {
+      const ColourSource colour = std::move(it->colour);
+      it->colour = nullptr;
+      try {
+        const cv::Mat rgb = colour();
+        if (rgb.type() != CV_8UC3 || rgb.cols != it->full_camera.width || rgb.rows != it->full_camera.height)
+          throw InputError("the colour image is not the camera's size");
+        it->decimated.rgb = decimate_colour(rgb, it->full_camera, options_.scan.stride);
+      } catch (const InputError& e) {
+        ++colour_lost_;
+        colour_lost_reason_ = e.what();
+      }
+    }
+    return &it->decimated;
+  }
   const auto pinned = pinned_.find(utime);
   return pinned != pinned_.end() ? &pinned->second : nullptr;
 }

@@ -25,8 +25,10 @@
 #include <Eigen/Geometry>
 #include <cstdint>
 #include <deque>
+#include <functional>
 #include <map>
 #include <set>
+#include <string>
 #include <vector>
 
 #include "common/rgbd_frame.h"
@@ -84,8 +86,18 @@ class Mapper {
   const ScanUpdate& insert(const RgbdFrame& frame, const Eigen::Isometry3d& T_world_camera,
                            const char* what = "frame");
 
-  /// SLAM mode: keeps the frame (decimated) for keyframes that name its utime later.
-  void buffer_frame(const RgbdFrame& frame, const char* what = "frame");
+  /// The full-size colour image of a frame buffered without it, made when wanted; throws
+  /// InputError when it cannot be (a corrupt image).
+  using ColourSource = std::function<cv::Mat()>;
+  /// SLAM mode: keeps the frame (decimated) for keyframes that name its utime later. With
+  /// `colour`, `frame` comes without its colour (rgb empty) and `colour` makes it the first
+  /// time buffered() is asked for the frame: most frames never become keyframes. A frame
+  /// whose colour fails is kept without it (colour_lost()).
+  void buffer_frame(const RgbdFrame& frame, const char* what = "frame", ColourSource colour = {});
+  /// Buffered frames whose deferred colour could not be made (they went on without colour,
+  /// which only the PLY export uses), and the last reason.
+  size_t colour_lost() const { return colour_lost_; }
+  const std::string& colour_lost_reason() const { return colour_lost_reason_; }
   /// SLAM mode: one graph revision.
   GraphResult apply_graph(const std::vector<GraphKeyframe>& keyframes);
   enum class Located { kInserted, kNotBuffered };
@@ -99,7 +111,7 @@ class Mapper {
   int64_t next_located_id() const;
   static constexpr int64_t kFirstLocatedId = int64_t{1} << 62;
   /// SLAM mode: the buffered (decimated) frame at `utime`, if it still is (in the buffer or
-  /// pinned).
+  /// pinned), with its colour.
   const RgbdFrame* buffered(int64_t utime) const;
   /// SLAM mode: keeps the buffered frame at `utime` past the buffer's time until a graph names
   /// it: a keyframe SLAM made before it placed the camera in its saved map, which joins the map
@@ -167,7 +179,16 @@ class Mapper {
   KeyframeStore keyframes_;
   ScanUpdate update_;
   Scan scan_;                      // reused: a fresh one per frame cost page faults
-  std::deque<RgbdFrame> buffer_;   // decimated, by increasing utime
+  struct Buffered {
+    RgbdFrame decimated;
+    ColourSource colour;        // set until the colour is made (buffered())
+    PinholeCamera full_camera;  // the camera of the colour `colour` makes
+  };
+  // By increasing utime. Mutable: buffered() makes a deferred colour on first use, which
+  // changes what is cached, not what the frame is.
+  mutable std::deque<Buffered> buffer_;
+  mutable size_t colour_lost_ = 0;
+  mutable std::string colour_lost_reason_;
   std::map<int64_t, RgbdFrame> pinned_;  // utime -> frame kept past the buffer (pin())
   Pin hold_pinned(RgbdFrame frame);      // into pinned_, the oldest let go past the limit
   bool have_last_keyframe_ = false;

@@ -224,10 +224,16 @@ RgbdFrame decimate(const RgbdFrame& frame, int stride) {
   if (stride == 1 && !frame.camera.distorted()) return frame;
   const PickGrid& grid = pick_grid(frame.camera, stride);
   RgbdFrame out = frame;
-  out.rgb = pick(frame.rgb, grid);
+  out.rgb = pick(frame.rgb, grid);  // = decimate_colour()
   out.depth_mm = pick(frame.depth_mm, grid);
   out.camera = grid.camera;
   return out;
+}
+
+cv::Mat decimate_colour(const cv::Mat& rgb, const PinholeCamera& camera, int stride) {
+  if (stride < 1) throw std::invalid_argument("decimate_colour: stride must be >= 1");
+  if (stride == 1 && !camera.distorted()) return rgb;
+  return pick(rgb, pick_grid(camera, stride));
 }
 
 Scan make_scan(const RgbdFrame& frame, const Eigen::Isometry3d& T_world_camera,

@@ -47,6 +47,8 @@ struct Scan {
 /// distortion (see above; the result's camera has none); stride 1 of an undistorted frame
 /// returns a shallow copy.
 RgbdFrame decimate(const RgbdFrame& frame, int stride);
+/// The colour part of decimate(): `rgb` (full size, of `camera`) on the same grid.
+cv::Mat decimate_colour(const cv::Mat& rgb, const PinholeCamera& camera, int stride);
 
 /// The rays of `frame` (every pixel; decimate first) seen from T_world_camera. Depth 0 (no
 /// reading) and depth nearer than options.min_range_m give no ray. Throws InputError naming

@@ -67,22 +67,40 @@ std::vector<uint8_t> jpeg_compress(const cv::Mat& rgb, int quality) {
   return bytes;
 }
 
-cv::Mat jpeg_decompress(const std::vector<uint8_t>& data, int width, int height, const char* what) {
-  thread_local TjHandle slot;
-  TjLease handle(slot, tjInitDecompress);
-  auto corrupt = [&] {
-    return InputError(std::string(what) + ": corrupt JPEG colour image (" + handle.error() + ")");
-  };
+// Reads a JPEG's header with `handle` and checks it against the camera's size.
+void check_jpeg_header(const TjLease& handle, const std::vector<uint8_t>& data, int width, int height,
+                       const char* what) {
   int w = 0, h = 0, subsamp = 0, colorspace = 0;
   // libjpeg-turbo 2.1 takes a non-const source buffer but never writes to it.
   auto* src = const_cast<unsigned char*>(data.data());
   if (tjDecompressHeader3(handle.get(), src, data.size(), &w, &h, &subsamp, &colorspace) != 0)
-    throw corrupt();
+    throw InputError(std::string(what) + ": corrupt JPEG colour image (" + handle.error() + ")");
   if (w != width || h != height) {
     throw InputError(std::string(what) + ": JPEG is " + std::to_string(w) + "x" +
                      std::to_string(h) + " but the camera is " + std::to_string(width) + "x" +
                      std::to_string(height));
   }
+}
+
+// The thread's decompression handle (header checks and decoding share it).
+TjHandle& decompressor() {
+  thread_local TjHandle slot;
+  return slot;
+}
+
+void check_jpeg(const std::vector<uint8_t>& data, int width, int height, const char* what) {
+  TjLease handle(decompressor(), tjInitDecompress);
+  check_jpeg_header(handle, data, width, height, what);
+  handle.succeeded();
+}
+
+cv::Mat jpeg_decompress(const std::vector<uint8_t>& data, int width, int height, const char* what) {
+  TjLease handle(decompressor(), tjInitDecompress);
+  auto corrupt = [&] {
+    return InputError(std::string(what) + ": corrupt JPEG colour image (" + handle.error() + ")");
+  };
+  check_jpeg_header(handle, data, width, height, what);
+  auto* src = const_cast<unsigned char*>(data.data());
   cv::Mat rgb(height, width, CV_8UC3);
   // A warning (a truncated or damaged scan, filled in grey) fails the call as well: the image
   // would not be the scene.
@@ -142,7 +160,10 @@ rgbd_frame_t encode_rgbd(const RgbdFrame& frame, const RgbdEncoding& encoding) {
   return m;
 }
 
-RgbdFrame decode_rgbd(const rgbd_frame_t& m, const char* what) {
+namespace {
+
+// decode_rgbd; with `defer_jpeg`, JPEG colour is checked but not decoded (rgb left empty).
+RgbdFrame decode(const rgbd_frame_t& m, const char* what, bool defer_jpeg) {
   RgbdFrame f;
   f.utime = m.utime;
   f.depth_utime = m.depth_utime;
@@ -167,7 +188,8 @@ RgbdFrame decode_rgbd(const rgbd_frame_t& m, const char* what) {
       std::memcpy(f.rgb.data, m.rgb.data(), m.rgb.size());
       break;
     case rgbd_frame_t::RGB_JPEG:
-      f.rgb = jpeg_decompress(m.rgb, w, h, what);
+      if (defer_jpeg) check_jpeg(m.rgb, w, h, what);
+      else f.rgb = jpeg_decompress(m.rgb, w, h, what);
       break;
     default:
       fail("unknown colour encoding " + std::to_string(m.rgb_encoding));
@@ -197,8 +219,25 @@ RgbdFrame decode_rgbd(const rgbd_frame_t& m, const char* what) {
     default:
       fail("unknown depth encoding " + std::to_string(m.depth_encoding));
   }
-  if (f.rgb.empty() && f.depth_mm.empty()) fail("frame has neither colour nor depth");
+  if (m.rgb_encoding == rgbd_frame_t::RGB_NONE && f.depth_mm.empty()) fail("frame has neither colour nor depth");
   return f;
+}
+
+}  // namespace
+
+RgbdFrame decode_rgbd(const rgbd_frame_t& m, const char* what) { return decode(m, what, false); }
+
+RgbdDeferredColour decode_rgbd_deferring_colour(const rgbd_frame_t& m, const char* what) {
+  RgbdDeferredColour d;
+  d.frame = decode(m, what, true);
+  if (m.rgb_encoding == rgbd_frame_t::RGB_JPEG) {
+    // Shared: the callable is copied with the frame it belongs to, the bytes are not.
+    auto jpeg = std::make_shared<const std::vector<uint8_t>>(m.rgb);
+    d.colour = [jpeg, w = d.frame.camera.width, h = d.frame.camera.height, name = std::string(what)] {
+      return jpeg_decompress(*jpeg, w, h, name.c_str());
+    };
+  }
+  return d;
 }
 
 }  // namespace kestrel::transport

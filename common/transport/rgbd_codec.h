@@ -9,6 +9,8 @@
 // exactly as they would alone; bad input, including a camera no pinhole camera can be
 // (rgbd_codec.cpp, check_plausible_camera), only ever throws InputError.
 
+#include <functional>
+
 #include "common/rgbd_frame.h"
 #include "kestrel/rgbd_frame_t.hpp"
 
@@ -28,5 +30,16 @@ kestrel::rgbd_frame_t encode_rgbd(const RgbdFrame& frame, const RgbdEncoding& en
 /// is unknown, the data is corrupt, truncated or of another size than the camera, or the
 /// camera or its mounting is invalid or implausible.
 RgbdFrame decode_rgbd(const kestrel::rgbd_frame_t& message, const char* what);
+
+/// A frame decoded but for its JPEG colour, and what decodes that colour when it is wanted.
+struct RgbdDeferredColour {
+  RgbdFrame frame;                  ///< `rgb` empty when `colour` is set
+  std::function<cv::Mat()> colour;  ///< set for JPEG colour only: the image, or InputError as decode_rgbd
+};
+/// decode_rgbd, but JPEG colour is only checked (its header and size) and decoded when
+/// `colour` is called, any number of times and after the message is gone. For a consumer
+/// that keeps the colour of few frames (the mapper's keyframes): decoding every frame's JPEG
+/// as it arrived was most of the mapper's CPU time. Raw colour is copied as by decode_rgbd.
+RgbdDeferredColour decode_rgbd_deferring_colour(const kestrel::rgbd_frame_t& message, const char* what);
 
 }  // namespace kestrel::transport

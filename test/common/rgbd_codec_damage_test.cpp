@@ -185,6 +185,52 @@ TEST(RgbdCodecDamage, JpegOfAnotherSizeIsRejectedNamingBoth) {
   damaged_then_good(m, good, reference, "transposed JPEG", false);
 }
 
+// The mapper's path: JPEG colour checked now, decoded later. The colour comes out as
+// decode_rgbd's; every truncation fails at one of the two steps, naming the channel, and the
+// good frame after it is intact; raw colour is not deferred.
+TEST(RgbdCodecDamage, DeferredColourIsTheSameImageAndEveryTruncatedJpegFailsAtOneStep) {
+  const rgbd_frame_t good = encode_rgbd(small_frame(), compressed());
+  const RgbdFrame reference = decode_alone(good);
+  const RgbdDeferredColour d = decode_rgbd_deferring_colour(good, kChannel);
+  EXPECT_TRUE(d.frame.rgb.empty());
+  EXPECT_TRUE(same_image(d.frame.depth_mm, reference.depth_mm));
+  ASSERT_TRUE(d.colour);
+  EXPECT_TRUE(same_image(d.colour(), reference.rgb));
+  EXPECT_TRUE(same_image(d.colour(), reference.rgb)) << "a second call";
+  auto names_the_channel = [](const InputError& e) {
+    return std::string(e.what()).rfind(std::string(kChannel) + ": ", 0) == 0;
+  };
+  int at_once = 0, later = 0;
+  for (size_t n = 0; n < good.rgb.size(); ++n) {
+    rgbd_frame_t m = good;
+    m.rgb.resize(n);
+    m.rgb_size = static_cast<int32_t>(n);
+    try {
+      const RgbdDeferredColour cut = decode_rgbd_deferring_colour(m, kChannel);
+      ASSERT_TRUE(cut.colour);
+      try {
+        cut.colour();
+        ADD_FAILURE() << "JPEG cut to " << n << " bytes decoded";
+        break;
+      } catch (const InputError& e) {
+        ++later;
+        ASSERT_TRUE(names_the_channel(e)) << e.what();
+      }
+    } catch (const InputError& e) {
+      ++at_once;
+      ASSERT_TRUE(names_the_channel(e)) << e.what();
+    }
+    ASSERT_TRUE(same_image(decode_rgbd_deferring_colour(good, kChannel).colour(), reference.rgb)) << "after " << n;
+  }
+  EXPECT_GT(at_once, 0) << "a cut header fails at once";
+  EXPECT_GT(later, 0) << "a cut scan fails when the colour is made";
+  RgbdEncoding raw = compressed();
+  raw.rgb = rgbd_frame_t::RGB_RGB8;
+  const RgbdDeferredColour r = decode_rgbd_deferring_colour(encode_rgbd(small_frame(), raw), kChannel);
+  EXPECT_FALSE(r.colour);
+  EXPECT_TRUE(same_image(r.frame.rgb, small_frame().rgb));
+}
+
 TEST(RgbdCodecDamage, EveryFlippedZstdByteLeavesTheNextFrameIntact) {
   const rgbd_frame_t good = encode_rgbd(small_frame(), compressed());
   for_each_position(good, good.depth.size(), "zstd byte xor 0xff", true,

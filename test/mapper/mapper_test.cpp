@@ -226,6 +226,60 @@ TEST(Mapper, RebuildsAreRateLimitedAndMissingFramesCounted) {
   EXPECT_EQ(mapper.rebuilds(), 1u);
 }
 
+// The scene's frame (depth only) with a colour image: a pattern no two pixels of a row share.
+RgbdFrame with_colour(RgbdFrame frame) {
+  frame.rgb.create(frame.depth_mm.size(), CV_8UC3);
+  for (int v = 0; v < frame.rgb.rows; ++v)
+    for (int u = 0; u < frame.rgb.cols; ++u)
+      frame.rgb.at<cv::Vec3b>(v, u) = cv::Vec3b(static_cast<uint8_t>(u), static_cast<uint8_t>(v), static_cast<uint8_t>(u + 3 * v));
+  return frame;
+}
+
+// A frame buffered without its colour, with a source that makes it: the colour is made only
+// for frames asked for, once, and comes out as from the whole frame; a source that fails
+// leaves the frame its depth.
+TEST(Mapper, DeferredColourIsMadeOnlyForTheFramesAskedForAndAsFromTheWholeFrame) {
+  const Scene scene = test::room_with_a_box();
+  const auto poses = sweep(3);
+  Mapper whole, deferred;
+  int made[3] = {0, 0, 0};
+  for (int i = 0; i < 3; ++i) {
+    const RgbdFrame frame = with_colour(scene.render(test::kinect_camera(), poses[static_cast<size_t>(i)], 1000 + i));
+    whole.buffer_frame(frame);
+    RgbdFrame without = frame;
+    without.rgb = cv::Mat();
+    deferred.buffer_frame(without, "frame", [&made, i, rgb = frame.rgb]() -> cv::Mat {
+      ++made[i];
+      if (i == 2) throw InputError("CAMERA_RGBD: corrupt JPEG colour image (test)");
+      return rgb;
+    });
+  }
+  EXPECT_THROW(deferred.buffer_frame(with_colour(scene.render(test::kinect_camera(), poses[0], 2000)), "frame",
+                                     [] { return cv::Mat(); }),
+               std::invalid_argument) << "colour given twice";
+  const RgbdFrame* a = deferred.buffered(1001);
+  const RgbdFrame* b = whole.buffered(1001);
+  ASSERT_TRUE(a != nullptr && b != nullptr);
+  ASSERT_FALSE(a->rgb.empty());
+  EXPECT_EQ(cv::norm(a->rgb, b->rgb, cv::NORM_INF), 0.0);
+  EXPECT_EQ(cv::norm(a->depth_mm, b->depth_mm, cv::NORM_INF), 0.0);
+  deferred.buffered(1001);
+  EXPECT_EQ(made[0], 0);
+  EXPECT_EQ(made[1], 1) << "made once";
+  EXPECT_EQ(deferred.colour_lost(), 0u);
+  // A keyframe of the frame whose colour fails: stored and inserted with its depth alone.
+  const GraphResult r = deferred.apply_graph({{7, 1002, poses[2]}});
+  EXPECT_EQ(r.inserted.size(), 1u);
+  EXPECT_EQ(made[2], 1);
+  EXPECT_EQ(deferred.colour_lost(), 1u);
+  EXPECT_EQ(deferred.colour_lost_reason(), "CAMERA_RGBD: corrupt JPEG colour image (test)");
+  const StoredKeyframe* kf = deferred.keyframes().find(7);
+  ASSERT_NE(kf, nullptr);
+  EXPECT_TRUE(kf->frame.rgb.empty());
+  EXPECT_FALSE(kf->frame.depth_mm.empty());
+  EXPECT_GT(deferred.map().num_occupied(), 0u);
+}
+
 TEST(Mapper, OutOfOrderFramesAndBadPosesAreInputErrors) {
   const Scene scene = test::room_with_a_box();
   Mapper mapper;

@@ -22,6 +22,7 @@
 #include "common/transport/rgbd_codec.h"
 #include "mapper/map_node.h"
 #include "mapper/octree_io.h"
+#include "mapper/scan.h"
 #include "test/mapper/scene.h"
 #include "test/support/test_support.h"
 
@@ -224,6 +225,49 @@ TEST(MapNode, BadFramesAreRejectedNamingTheChannel) {
   no_depth.depth_size = 0;
   EXPECT_THROW(node.on_frame(no_depth, "CAMERA_RGBD"), InputError);
   EXPECT_EQ(node.stats().frames, 1);
+}
+
+// Frames as the simulator and the link send them (JPEG colour): a keyframe's colour is
+// decoded when the graph takes its frame and is the decoded image; one whose JPEG scan is
+// damaged is kept with its depth, its colour counted as lost.
+TEST(MapNode, JpegColourIsDecodedForKeyframesOnlyAndADamagedOneCostsOnlyTheColour) {
+  const test::Scene scene = test::room_with_a_box();
+  MapNode node(NodeOptions{});
+  transport::RgbdEncoding jpeg;
+  jpeg.rgb = kestrel::rgbd_frame_t::RGB_JPEG;
+  kestrel::slam_graph_t graph{};
+  std::vector<RgbdFrame> decoded;
+  for (int i = 0; i < 3; ++i) {
+    const int64_t t = 100000 * (i + 1);
+    RgbdFrame frame = scene.render(test::kinect_camera(160, 120), pose_at(1e-6 * t), t);
+    frame.rgb.create(frame.depth_mm.size(), CV_8UC3);  // the scene renders depth only
+    cv::randu(frame.rgb, cv::Scalar::all(0), cv::Scalar::all(256));
+    kestrel::rgbd_frame_t m = transport::encode_rgbd(frame, jpeg);
+    if (i == 2) {  // the scan cut short: the header reads, the image does not
+      m.rgb.resize(m.rgb.size() * 2 / 3);
+      m.rgb_size = static_cast<int32_t>(m.rgb.size());
+      EXPECT_THROW(transport::decode_rgbd(m, "CAMERA_RGBD"), InputError);
+    } else {
+      decoded.push_back(transport::decode_rgbd(m, "CAMERA_RGBD"));
+    }
+    node.on_frame(m, "CAMERA_RGBD");
+    graph.keyframes.push_back(keyframe_message(i, t));
+  }
+  graph.num_keyframes = 3;
+  graph.revision = 1;
+  node.on_graph(graph, "SLAM_GRAPH");
+  ASSERT_EQ(node.mapper().keyframes().size(), 3u);
+  for (int i = 0; i < 2; ++i) {
+    const RgbdFrame expected = decimate(decoded[static_cast<size_t>(i)], node.mapper().options().scan.stride);
+    const RgbdFrame& kept = node.mapper().keyframes().find(i)->frame;
+    ASSERT_FALSE(kept.rgb.empty()) << i;
+    EXPECT_EQ(cv::norm(kept.rgb, expected.rgb, cv::NORM_INF), 0.0) << i;
+  }
+  EXPECT_TRUE(node.mapper().keyframes().find(2)->frame.rgb.empty());
+  EXPECT_FALSE(node.mapper().keyframes().find(2)->frame.depth_mm.empty());
+  EXPECT_EQ(node.mapper().colour_lost(), 1u);
+  EXPECT_NE(node.mapper().colour_lost_reason().find("CAMERA_RGBD: corrupt JPEG"), std::string::npos)
+      << node.mapper().colour_lost_reason();
 }
 
 void expect_same_keyframes(const Mapper& a, const Mapper& b) {
