@@ -4,6 +4,7 @@
 #include <Eigen/Geometry>
 #include <chrono>
 #include <cstring>
+#include <optional>
 
 #include "common/transport/convert.h"
 #include "common/transport/log_file.h"
@@ -281,15 +282,37 @@ std::vector<kestrel::replay_control_t> control_examples() {
   return {c};
 }
 
-// Every consumer of frames (vo, mapper, slam, rgbd-codec) decodes with decode_rgbd, whose
-// result must keep RgbdFrame's invariants.
+// Every consumer of frames (vo, slam, rgbd-codec) decodes with decode_rgbd, whose result must
+// keep RgbdFrame's invariants; the mapper with decode_rgbd_deferring_colour, which must accept
+// what decode_rgbd accepts (its colour failing only where decode_rgbd does) and give the same
+// frame.
 void convert_frame(const kestrel::rgbd_frame_t& m) {
-  const RgbdFrame f = transport::decode_rgbd(m, "CAMERA_RGBD");
+  std::optional<RgbdFrame> whole;
   try {
-    f.validate("CAMERA_RGBD");
-  } catch (const InputError& e) {
-    defect("rgbd-codec", std::string("a decoded frame breaks RgbdFrame's invariants: ") + e.what());
+    whole = transport::decode_rgbd(m, "CAMERA_RGBD");
+  } catch (const InputError&) {
   }
+  if (whole) {
+    try {
+      whole->validate("CAMERA_RGBD");
+    } catch (const InputError& e) {
+      defect("rgbd-codec", std::string("a decoded frame breaks RgbdFrame's invariants: ") + e.what());
+    }
+  }
+  transport::RgbdDeferredColour deferred;
+  try {
+    deferred = transport::decode_rgbd_deferring_colour(m, "CAMERA_RGBD");
+    if (deferred.colour) deferred.frame.rgb = deferred.colour();
+  } catch (const InputError&) {
+    if (whole) defect("rgbd-codec", "the deferred decode rejects a frame decode_rgbd accepts");
+    throw;
+  }
+  if (!whole) defect("rgbd-codec", "the deferred decode accepts a frame decode_rgbd rejects");
+  auto same = [](const cv::Mat& a, const cv::Mat& b) {
+    return a.empty() ? b.empty() : !b.empty() && a.size() == b.size() && cv::norm(a, b, cv::NORM_INF) == 0.0;
+  };
+  if (!same(deferred.frame.rgb, whole->rgb) || !same(deferred.frame.depth_mm, whole->depth_mm))
+    defect("rgbd-codec", "the deferred decode gives another frame than decode_rgbd");
 }
 std::vector<kestrel::rgbd_frame_t> frame_examples() {
   RgbdFrame f;
