@@ -4,6 +4,57 @@
 
 namespace kestrel::slam {
 
+namespace {
+
+// The loop of nearest_two, inlined into each kernel below so that its popcounts are compiled
+// for that kernel's target.
+template <bool kHardwarePopcount>
+[[gnu::always_inline]] inline NearestTwo nearest_two_loop(const Descriptor& d, const std::vector<Descriptor>& train) {
+  NearestTwo n;
+  for (size_t i = 0; i < train.size(); ++i) {
+    const Descriptor& t = train[i];
+    int h;
+    if constexpr (kHardwarePopcount) {
+      h = __builtin_popcountll(d[0] ^ t[0]) + __builtin_popcountll(d[1] ^ t[1]) +
+          __builtin_popcountll(d[2] ^ t[2]) + __builtin_popcountll(d[3] ^ t[3]);
+    } else {
+      h = hamming(d, t);
+    }
+    if (h < n.best) {
+      n.second = n.best;
+      n.best = h;
+      n.index = static_cast<int>(i);
+    } else if (h < n.second) {
+      n.second = h;
+    }
+  }
+  return n;
+}
+
+#if (defined(__x86_64__) || defined(__i386__)) && !defined(__POPCNT__)
+[[gnu::target("popcnt")]] NearestTwo nearest_two_popcnt(const Descriptor& d, const std::vector<Descriptor>& train) {
+  return nearest_two_loop<true>(d, train);
+}
+bool cpu_has_popcnt() {
+  static const bool has = [] {
+    __builtin_cpu_init();  // in case this runs before the CPU model's own constructor
+    return __builtin_cpu_supports("popcnt") != 0;
+  }();
+  return has;
+}
+#endif
+
+}  // namespace
+
+NearestTwo nearest_two(const Descriptor& d, const std::vector<Descriptor>& train) {
+#if (defined(__x86_64__) || defined(__i386__)) && !defined(__POPCNT__)
+  if (cpu_has_popcnt()) return nearest_two_popcnt(d, train);
+  return nearest_two_loop<false>(d, train);
+#else
+  return nearest_two_loop<true>(d, train);  // the instruction, or the target's best builtin
+#endif
+}
+
 std::vector<Descriptor> to_descriptors(const cv::Mat& descriptors) {
   if (descriptors.empty()) return {};
   if (descriptors.type() != CV_8UC1 || descriptors.cols != static_cast<int>(sizeof(Descriptor))) {

@@ -3,11 +3,11 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
-#include <opencv2/features2d.hpp>
 #include <optional>
 #include <random>
 
 #include "common/geometry/align.h"
+#include "slam/place/binary_descriptor.h"
 
 namespace kestrel::slam {
 namespace {
@@ -16,19 +16,19 @@ struct Match {
   int query, candidate;  // feature indices
 };
 
-// Ratio-test matches from query to candidate among features with a 3-D point in both.
+// Ratio-test matches from query to candidate among features with a 3-D point in both: each
+// query descriptor's nearest candidate by Hamming distance, if it is near enough and clearly
+// nearer than the second nearest (a tie for the nearest never passes, so which of the tied
+// is "nearest" does not matter). Brute force, as OpenCV's BFMatcher::knnMatch(k = 2) did, but
+// without its per-pair call overhead, which made it most of a SLAM run's time.
 std::vector<Match> ratio_matches(const FrameFeatures& query, const FrameFeatures& candidate,
                                  const VerificationOptions& o) {
   std::vector<Match> out;
   if (query.descriptors.rows < 2 || candidate.descriptors.rows < 2) return out;
-  cv::BFMatcher matcher(cv::NORM_HAMMING);
-  std::vector<std::vector<cv::DMatch>> knn;
-  matcher.knnMatch(query.descriptors, candidate.descriptors, knn, 2);
-  for (const auto& m : knn) {
-    if (m.size() < 2) continue;
-    const double best = static_cast<double>(m[0].distance), second = static_cast<double>(m[1].distance);
+  const std::vector<Descriptor> train = to_descriptors(candidate.descriptors);
+  for (int q = 0; q < query.descriptors.rows; ++q) {
+    const auto [c, best, second] = nearest_two(descriptor_at(query.descriptors, q), train);
     if (best > o.max_hamming || best >= o.ratio * second) continue;
-    const int q = m[0].queryIdx, c = m[0].trainIdx;
     if (query.has_point(static_cast<size_t>(q)) && candidate.has_point(static_cast<size_t>(c))) {
       out.push_back(Match{q, c});
     }

@@ -7,13 +7,16 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <bitset>
 #include <filesystem>
 #include <fstream>
+#include <random>
 
 #include "common/error.h"
 #include "common/geometry/se3.h"
 #include "common/numbers.h"
 #include "sensors/builtin_profiles.h"
+#include "slam/place/binary_descriptor.h"
 #include "slam/place/loop_verifier.h"
 #include "slam/place/place_recognizer.h"
 #include "test/slam/synthetic_room.h"
@@ -43,6 +46,46 @@ std::vector<View> views_along(const SyntheticRoom& room, const std::vector<Eigen
 void expect_pose_near(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b, double metres, double radians) {
   EXPECT_LT(se3::translation_distance(a, b), metres);
   EXPECT_LT(se3::rotation_distance(a, b), radians);
+}
+
+// Hamming distances and the nearest two, against std::bitset's count on random descriptors
+// with planted ties and near copies (the bit-parallel sum and the POPCNT kernel alike).
+TEST(BinaryDescriptor, HammingAndNearestTwoAgreeWithACountOfTheBits) {
+  std::mt19937_64 rng(5);
+  auto bits = [](const Descriptor& a, const Descriptor& b) {
+    int n = 0;
+    for (int w = 0; w < 4; ++w) n += static_cast<int>(std::bitset<64>(a[w] ^ b[w]).count());
+    return n;
+  };
+  std::vector<Descriptor> train(300);
+  for (auto& t : train) t = {rng(), rng(), rng(), rng()};
+  train[17] = train[250];                      // a tie
+  train[40] = {~0ULL, ~0ULL, ~0ULL, ~0ULL};    // 256 bits apart from zero
+  for (int k = 0; k < 200; ++k) {
+    Descriptor d = train[static_cast<size_t>(rng() % train.size())];
+    for (int flips = static_cast<int>(rng() % 40); flips > 0; --flips) d[rng() % 4] ^= 1ULL << (rng() % 64);
+    if (k == 0) d = {0, 0, 0, 0};
+    NearestTwo expected;
+    for (size_t i = 0; i < train.size(); ++i) {
+      const int h = bits(d, train[i]);
+      ASSERT_EQ(hamming(d, train[i]), h);
+      if (h < expected.best) {
+        expected.second = expected.best;
+        expected.best = h;
+        expected.index = static_cast<int>(i);
+      } else if (h < expected.second) {
+        expected.second = h;
+      }
+    }
+    const NearestTwo got = nearest_two(d, train);
+    ASSERT_EQ(got.index, expected.index) << k;
+    ASSERT_EQ(got.best, expected.best) << k;
+    ASSERT_EQ(got.second, expected.second) << k;
+  }
+  EXPECT_EQ(hamming(train[40], Descriptor{}), 256);
+  EXPECT_EQ(nearest_two(train[250], train).index, 17) << "a tie keeps the lower index";
+  EXPECT_EQ(nearest_two(train[250], train).second, 0);
+  EXPECT_EQ(nearest_two(train[0], {}).index, -1);
 }
 
 TEST(FrameFeatures, PointsLieOnTheRenderedSurfaces) {
