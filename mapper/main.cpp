@@ -85,16 +85,22 @@ int serve(Options& o) {
   node->subscribe<rgbd_frame_t>(channel::kCameraRgbd, [&](const rgbd_frame_t& m) {
     publish(map.on_frame(m, channel::kCameraRgbd));
   });
+  // A frame's colour is decoded when a keyframe, a pin or a located frame takes it; one that
+  // fails leaves the frame its depth, and is said here.
+  auto colour_checked = [&](auto&& handle) {
+    const size_t lost = map.mapper().colour_lost();
+    handle();
+    if (const size_t now = map.mapper().colour_lost(); now > lost)
+      spdlog::warn("{} frame(s) kept without their colour (the map has their depth): {}", now - lost,
+                   map.mapper().colour_lost_reason());
+  };
   // Graphs and corrections may journal: a journal given up on the way is said at once. (Here,
   // not in the block below: the handlers keep a reference to it for as long as the node spins.)
   auto journalled = [&](auto&& handle) {
     const bool journalling = !o.node.journal_path.empty() && map.journal_error().empty();
     const int compactions = map.journal_compactions();
     const std::string compaction_error = map.journal_compaction_error();
-    const size_t colour_lost = map.mapper().colour_lost();
-    publish(handle());
-    if (map.mapper().colour_lost() > colour_lost)
-      spdlog::warn("a keyframe is kept without its colour (the map has its depth): {}", map.mapper().colour_lost_reason());
+    colour_checked([&] { publish(handle()); });
     if (map.journal_compactions() > compactions)
       spdlog::info("journal {} compacted to the {} stored keyframes", o.node.journal_path,
                    map.mapper().keyframes().size());
@@ -111,7 +117,7 @@ int serve(Options& o) {
       journalled([&] { return map.on_graph(m, channel::kSlamGraph); });
     }, 0);
     node->subscribe<slam_graph_t>(channel::kSlamGraphUnplaced, [&](const slam_graph_t& m) {
-      map.on_unplaced_graph(m, channel::kSlamGraphUnplaced);
+      colour_checked([&] { map.on_unplaced_graph(m, channel::kSlamGraphUnplaced); });
     }, 0);
     if (o.node.insert_located) {
       node->subscribe<slam_correction_t>(channel::kSlamCorrection, [&](const slam_correction_t& m) {

@@ -129,7 +129,8 @@ void Mapper::buffer_frame(const RgbdFrame& frame, const char* what, ColourSource
     throw InputError(std::string(what) + ": frame utime " + std::to_string(frame.utime) +
                      " is not after the previous frame's");
   }
-  buffer_.push_back(Buffered{decimate(frame, options_.scan.stride), std::move(colour), frame.camera});
+  std::string source = colour ? std::string(what) : std::string();
+  buffer_.push_back(Buffered{decimate(frame, options_.scan.stride), std::move(colour), frame.camera, std::move(source)});
   const int64_t keep_us = static_cast<int64_t>(options_.frame_buffer_s * 1e6);
   while (!buffer_.empty() && buffer_.front().decimated.utime < frame.utime - keep_us) buffer_.pop_front();
 }
@@ -141,12 +142,14 @@ const RgbdFrame* Mapper::buffered(int64_t utime) const {
     if (it->colour) {
       const ColourSource colour = std::move(it->colour);
       it->colour = nullptr;
+      // Whatever fails (a corrupt image, or the decoder itself), the frame keeps its depth and
+      // goes on: a graph half applied would leave the map and its journal apart.
       try {
         const cv::Mat rgb = colour();
         if (rgb.type() != CV_8UC3 || rgb.cols != it->full_camera.width || rgb.rows != it->full_camera.height)
-          throw InputError("the colour image is not the camera's size");
+          throw InputError(it->what + ": the colour image is not the camera's size");
         it->decimated.rgb = decimate_colour(rgb, it->full_camera, options_.scan.stride);
-      } catch (const InputError& e) {
+      } catch (const std::exception& e) {
         ++colour_lost_;
         colour_lost_reason_ = e.what();
       }

@@ -91,8 +91,9 @@ class Mapper {
   using ColourSource = std::function<cv::Mat()>;
   /// SLAM mode: keeps the frame (decimated) for keyframes that name its utime later. With
   /// `colour`, `frame` comes without its colour (rgb empty) and `colour` makes it the first
-  /// time buffered() is asked for the frame: most frames never become keyframes. A frame
-  /// whose colour fails is kept without it (colour_lost()).
+  /// time buffered() is asked for the frame (a keyframe, a pinned or a located frame takes
+  /// it): most frames never are. A frame whose colour fails, for any reason, is kept without
+  /// it (colour_lost()).
   void buffer_frame(const RgbdFrame& frame, const char* what = "frame", ColourSource colour = {});
   /// Buffered frames whose deferred colour could not be made (they went on without colour,
   /// which only the PLY export uses), and the last reason.
@@ -183,6 +184,7 @@ class Mapper {
     RgbdFrame decimated;
     ColourSource colour;        // set until the colour is made (buffered())
     PinholeCamera full_camera;  // the camera of the colour `colour` makes
+    std::string what;           // the frame's source, for errors
   };
   // By increasing utime. Mutable: buffered() makes a deferred colour on first use, which
   // changes what is cached, not what the frame is.

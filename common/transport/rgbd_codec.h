@@ -39,7 +39,9 @@ struct RgbdDeferredColour {
 /// decode_rgbd, but JPEG colour is only checked (its header and size) and decoded when
 /// `colour` is called, any number of times and after the message is gone. For a consumer
 /// that keeps the colour of few frames (the mapper's keyframes): decoding every frame's JPEG
-/// as it arrived was most of the mapper's CPU time. Raw colour is copied as by decode_rgbd.
+/// as it arrived was most of the mapper's CPU time. Raw colour is copied as by decode_rgbd. A
+/// frame whose only image is deferred colour comes back with no image (RgbdFrame::validate
+/// refuses it); the caller decides whether it needs the depth.
 RgbdDeferredColour decode_rgbd_deferring_colour(const kestrel::rgbd_frame_t& message, const char* what);
 
 }  // namespace kestrel::transport

@@ -25,13 +25,12 @@ std::vector<Match> ratio_matches(const FrameFeatures& query, const FrameFeatures
                                  const VerificationOptions& o) {
   std::vector<Match> out;
   if (query.descriptors.rows < 2 || candidate.descriptors.rows < 2) return out;
+  const std::vector<Descriptor> queries = to_descriptors(query.descriptors);
   const std::vector<Descriptor> train = to_descriptors(candidate.descriptors);
-  for (int q = 0; q < query.descriptors.rows; ++q) {
-    const auto [c, best, second] = nearest_two(descriptor_at(query.descriptors, q), train);
+  for (size_t q = 0; q < queries.size(); ++q) {
+    const auto [c, best, second] = nearest_two(queries[q], train);
     if (best > o.max_hamming || best >= o.ratio * second) continue;
-    if (query.has_point(static_cast<size_t>(q)) && candidate.has_point(static_cast<size_t>(c))) {
-      out.push_back(Match{q, c});
-    }
+    if (query.has_point(q) && candidate.has_point(static_cast<size_t>(c))) out.push_back(Match{static_cast<int>(q), c});
   }
   return out;
 }

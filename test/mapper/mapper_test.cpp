@@ -226,7 +226,7 @@ TEST(Mapper, RebuildsAreRateLimitedAndMissingFramesCounted) {
   EXPECT_EQ(mapper.rebuilds(), 1u);
 }
 
-// The scene's frame (depth only) with a colour image: a pattern no two pixels of a row share.
+// The scene's frame (depth only) with a colour image: a pattern of both coordinates.
 RgbdFrame with_colour(RgbdFrame frame) {
   frame.rgb.create(frame.depth_mm.size(), CV_8UC3);
   for (int v = 0; v < frame.rgb.rows; ++v)

@@ -229,7 +229,8 @@ TEST(MapNode, BadFramesAreRejectedNamingTheChannel) {
 
 // Frames as the simulator and the link send them (JPEG colour): a keyframe's colour is
 // decoded when the graph takes its frame and is the decoded image; one whose JPEG scan is
-// damaged is kept with its depth, its colour counted as lost.
+// damaged is kept with its depth, its colour counted as lost; a damaged frame no keyframe
+// takes is never decoded, so costs nothing.
 TEST(MapNode, JpegColourIsDecodedForKeyframesOnlyAndADamagedOneCostsOnlyTheColour) {
   const test::Scene scene = test::room_with_a_box();
   MapNode node(NodeOptions{});
@@ -237,13 +238,13 @@ TEST(MapNode, JpegColourIsDecodedForKeyframesOnlyAndADamagedOneCostsOnlyTheColou
   jpeg.rgb = kestrel::rgbd_frame_t::RGB_JPEG;
   kestrel::slam_graph_t graph{};
   std::vector<RgbdFrame> decoded;
-  for (int i = 0; i < 3; ++i) {
+  for (int i = 0; i < 5; ++i) {
     const int64_t t = 100000 * (i + 1);
     RgbdFrame frame = scene.render(test::kinect_camera(160, 120), pose_at(1e-6 * t), t);
     frame.rgb.create(frame.depth_mm.size(), CV_8UC3);  // the scene renders depth only
     cv::randu(frame.rgb, cv::Scalar::all(0), cv::Scalar::all(256));
     kestrel::rgbd_frame_t m = transport::encode_rgbd(frame, jpeg);
-    if (i == 2) {  // the scan cut short: the header reads, the image does not
+    if (i == 2 || i == 3) {  // the scan cut short: the header reads, the image does not
       m.rgb.resize(m.rgb.size() * 2 / 3);
       m.rgb_size = static_cast<int32_t>(m.rgb.size());
       EXPECT_THROW(transport::decode_rgbd(m, "CAMERA_RGBD"), InputError);
@@ -251,8 +252,17 @@ TEST(MapNode, JpegColourIsDecodedForKeyframesOnlyAndADamagedOneCostsOnlyTheColou
       decoded.push_back(transport::decode_rgbd(m, "CAMERA_RGBD"));
     }
     node.on_frame(m, "CAMERA_RGBD");
-    graph.keyframes.push_back(keyframe_message(i, t));
+    if (i < 3) graph.keyframes.push_back(keyframe_message(i, t));  // frame 3: no keyframe; 4: pinned
   }
+  // Frame 4 pinned for a keyframe SLAM has not placed yet: kept with its colour.
+  kestrel::slam_graph_t unplaced{};
+  unplaced.keyframes = {keyframe_message(9, 500000)};
+  unplaced.num_keyframes = 1;
+  node.on_unplaced_graph(unplaced, "SLAM_GRAPH_UNPLACED");
+  ASSERT_EQ(node.mapper().pinned_frames().size(), 1u);
+  const RgbdFrame pinned_expected = decimate(decoded[2], node.mapper().options().scan.stride);
+  ASSERT_FALSE(node.mapper().pinned_frames()[0]->rgb.empty());
+  EXPECT_EQ(cv::norm(node.mapper().pinned_frames()[0]->rgb, pinned_expected.rgb, cv::NORM_INF), 0.0);
   graph.num_keyframes = 3;
   graph.revision = 1;
   node.on_graph(graph, "SLAM_GRAPH");
@@ -265,7 +275,8 @@ TEST(MapNode, JpegColourIsDecodedForKeyframesOnlyAndADamagedOneCostsOnlyTheColou
   }
   EXPECT_TRUE(node.mapper().keyframes().find(2)->frame.rgb.empty());
   EXPECT_FALSE(node.mapper().keyframes().find(2)->frame.depth_mm.empty());
-  EXPECT_EQ(node.mapper().colour_lost(), 1u);
+  EXPECT_EQ(node.mapper().colour_lost(), 1u) << "frame 3's damage is never decoded";
+  EXPECT_EQ(node.stats().frames, 5);
   EXPECT_NE(node.mapper().colour_lost_reason().find("CAMERA_RGBD: corrupt JPEG"), std::string::npos)
       << node.mapper().colour_lost_reason();
 }

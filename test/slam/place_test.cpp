@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include <opencv2/features2d.hpp>
+
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <bitset>
@@ -49,7 +51,8 @@ void expect_pose_near(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b, do
 }
 
 // Hamming distances and the nearest two, against std::bitset's count on random descriptors
-// with planted ties and near copies (the bit-parallel sum and the POPCNT kernel alike).
+// with planted ties and near copies (hamming() is the portable bit-parallel sum; nearest_two
+// runs the kernel this CPU gets).
 TEST(BinaryDescriptor, HammingAndNearestTwoAgreeWithACountOfTheBits) {
   std::mt19937_64 rng(5);
   auto bits = [](const Descriptor& a, const Descriptor& b) {
@@ -86,6 +89,30 @@ TEST(BinaryDescriptor, HammingAndNearestTwoAgreeWithACountOfTheBits) {
   EXPECT_EQ(nearest_two(train[250], train).index, 17) << "a tie keeps the lower index";
   EXPECT_EQ(nearest_two(train[250], train).second, 0);
   EXPECT_EQ(nearest_two(train[0], {}).index, -1);
+}
+
+// What loop verification took from OpenCV before: BFMatcher::knnMatch(NORM_HAMMING, k = 2)
+// gives the same nearest index (ties: the lower) and the same two distances, on sets from two
+// rows up, with ties and copies planted.
+TEST(BinaryDescriptor, NearestTwoIsWhatOpenCvsBruteForceMatcherFinds) {
+  std::mt19937 rng(11);
+  for (int rows : {2, 3, 40, 257}) {
+    cv::Mat train(rows, 32, CV_8UC1), queries(60, 32, CV_8UC1);
+    cv::randu(train, cv::Scalar::all(0), cv::Scalar::all(256));
+    cv::randu(queries, cv::Scalar::all(0), cv::Scalar::all(256));
+    train.row(0).copyTo(train.row(rows - 1));  // a tie for every query
+    for (int q = 0; q < 20; ++q) train.row(static_cast<int>(rng() % static_cast<unsigned>(rows))).copyTo(queries.row(q));
+    std::vector<std::vector<cv::DMatch>> knn;
+    cv::BFMatcher(cv::NORM_HAMMING).knnMatch(queries, train, knn, 2);
+    const std::vector<Descriptor> t = to_descriptors(train);
+    for (int q = 0; q < queries.rows; ++q) {
+      const NearestTwo n = nearest_two(descriptor_at(queries, q), t);
+      ASSERT_EQ(knn[static_cast<size_t>(q)].size(), 2u);
+      EXPECT_EQ(n.index, knn[static_cast<size_t>(q)][0].trainIdx) << rows << " rows, query " << q;
+      EXPECT_EQ(n.best, static_cast<int>(knn[static_cast<size_t>(q)][0].distance)) << rows << " rows, query " << q;
+      EXPECT_EQ(n.second, static_cast<int>(knn[static_cast<size_t>(q)][1].distance)) << rows << " rows, query " << q;
+    }
+  }
 }
 
 TEST(FrameFeatures, PointsLieOnTheRenderedSurfaces) {
