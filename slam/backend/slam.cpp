@@ -129,15 +129,6 @@ EdgeThroughFrame edge_through_frame(const LoopConstraint& located, const Eigen::
           composed_information(T_frame_r, right_covariance(located.information), information_frame_r)};
 }
 
-// A frame's covariance relative to another start than the reference's: `predicted` is the
-// reference's covariance carried through T_ref_frame plus the odometry's own (Slam::reanchor);
-// the same with `start` in place of `reference`.
-Matrix6d carried_covariance(const Matrix6d& predicted, const Eigen::Isometry3d& T_ref_frame,
-                            const Matrix6d& reference, const Matrix6d& start) {
-  const Matrix6d Ad = se3::adjoint(T_ref_frame.inverse());
-  return predicted + Ad * (start - reference) * Ad.transpose();
-}
-
 // The standard deviation along the most uncertain axis of a 3x3 covariance (NaN when it is not finite).
 double largest_sigma(const Eigen::Matrix3d& covariance) {
   if (!covariance.allFinite()) return std::nan("");
@@ -339,13 +330,11 @@ void Slam::add_odometry_edge(const Keyframe& current, OdometryLink link, const s
   const Eigen::Isometry3d T_ref_cur = link == OdometryLink::kBroken
                                           ? Eigen::Isometry3d::Identity()
                                           : reference_.T_odom_camera.inverse() * current.T_odom_camera;
-  // From the reference's keyframe: through the frame located in it, when re-anchored (or from
-  // where its edges start: OdometryReference::edge_start).
-  const OdometryReference::EdgeStart from = reference_.edges_from();
-  const Eigen::Isometry3d T_prev_cur = from.T_keyframe_camera * T_ref_cur;
+  // From the reference's keyframe: through the frame located in it, when re-anchored.
+  const Eigen::Isometry3d T_prev_cur = reference_.T_keyframe_camera * T_ref_cur;
   const Matrix6d information = composed_information(
-      T_ref_cur, from.covariance, odometry_edge_information(T_ref_cur, options_.odometry, link, covariance));
-  graph_.add_edge(static_cast<int>(from.keyframe_id), static_cast<int>(current.id), T_prev_cur, information,
+      T_ref_cur, reference_.covariance, odometry_edge_information(T_ref_cur, options_.odometry, link, covariance));
+  graph_.add_edge(static_cast<int>(reference_.keyframe_id), static_cast<int>(current.id), T_prev_cur, information,
                   EdgeKind::kOdometry);
   // The loop gate's model of the whole edge: as weak as the weakest link since the keyframe
   // (the reference's covariance already carries a bridge crossed before it, the information
@@ -446,7 +435,7 @@ SlamStep Slam::add_keyframe(const RgbdFrame& frame, const Eigen::Isometry3d& T_o
   kf.T_odom_camera = T_odom_camera;
   kf.T_body_camera = frame.T_body_camera;
   kf.T_camera_depth = motion.T_rgb_depth();
-  kf.link = first_of_frame ? OdometryLink::kContinuous : weaker(link, reference_.edges_from().link);
+  kf.link = first_of_frame ? OdometryLink::kContinuous : weaker(link, reference_.link);
   kf.sensor = sensor;
   kf.features = std::move(features);
   const Eigen::Isometry3d T_world_camera =
@@ -653,10 +642,7 @@ bool Slam::passes_loop_gate(int64_t from, int64_t to, const Eigen::Isometry3d& T
 bool Slam::close_loop_in_place(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera, OdometryLink link,
                                const Keyframe& kf, const Matrix6d& predicted, const LoopConstraint& loop,
                                SlamStep& step) {
-  // r: where the reference's edges start (its keyframe, or the other end of a loop its location
-  // closed already), and the frame in r with that pose's covariance.
-  const OdometryReference::EdgeStart from = reference_.edges_from();
-  const int64_t r = from.keyframe_id;
+  const int64_t r = reference_.keyframe_id;
   if (!options_.coverage.close_loops_in_place || kf.id == r) return false;
   // A loop candidate as close_loop() takes them: old enough not to re-measure what the odometry
   // just measured, and verified as a loop is. The re-anchoring's verification is the loop's
@@ -664,16 +650,15 @@ bool Slam::close_loop_in_place(const RgbdFrame& frame, const Eigen::Isometry3d& 
   if (!old_enough_for_a_loop(kf, frame.utime)) return false;
   ++step.candidates;
   if (loop.spread_m < options_.verification.min_spread_m) return false;
-  const Eigen::Isometry3d T_ref_frame = reference_.T_odom_camera.inverse() * T_odom_camera;
-  const Eigen::Isometry3d T_r_frame = from.T_keyframe_camera * T_ref_frame;
-  const Matrix6d predicted_r = carried_covariance(predicted, T_ref_frame, reference_.covariance, from.covariance);
-  const EdgeThroughFrame edge = edge_through_frame(loop, T_r_frame, predicted_r);
+  const Eigen::Isometry3d T_r_frame =
+      reference_.T_keyframe_camera * reference_.T_odom_camera.inverse() * T_odom_camera;
+  const EdgeThroughFrame edge = edge_through_frame(loop, T_r_frame, predicted);
   // The gate allows for the odometry edges between the two keyframes and for the odometry from
   // r to the frame, in the constant model, as the edge of a keyframe made at the frame would
   // have it. Refused, nothing is counted: that keyframe is made, and its own loop search and
   // gate judge the same loop.
   const OdometryBeyondChain to_frame{T_r_frame,
-                                     odometry_information(T_r_frame, options_.odometry, weaker(link, from.link))};
+                                     odometry_information(T_r_frame, options_.odometry, weaker(link, reference_.link))};
   if (options_.loops.max_distance_m > 0.0 && !passes_loop_gate(kf.id, r, edge.T_kf_r, &to_frame)) return false;
   add_loop_and_optimise(kf, r, edge.T_kf_r, edge.information, step);
   step.loop = loop;
@@ -683,22 +668,23 @@ bool Slam::close_loop_in_place(const RgbdFrame& frame, const Eigen::Isometry3d& 
   // location agree within their uncertainties the frame is located in kf, at the location (the
   // prediction is in the edge already); else (a loop the robust kernel took for an outlier) it
   // stays at its prediction, as a keyframe made for such a loop stayed where the odometry put it.
-  // The location is in the loop's edge: the reference's next edges start from r
-  // (OdometryReference::edge_start), so that it is not counted a second time.
+  // The location enters twice, in the edge and in the reference, should the next keyframe be
+  // made from this reference rather than from a later re-anchoring: a keyframe made for the loop
+  // avoided that, and kept a vertex and a mapper scan per lap
+  // (docs/decisions/2026-12-07-loops-closed-without-a-keyframe.md).
   const Eigen::Isometry3d T_k_predicted = graph_.poses[static_cast<size_t>(kf.id)].inverse() * world_pose(T_odom_camera);
   const Matrix6d located = right_covariance(loop.information);
   const Vector6d error = se3::log(T_k_predicted.inverse() * loop.T_candidate_query);
   const double chi2 = error.dot((predicted + located).ldlt().solve(error));
   if (chi2 <= kChi2Of6Dof99Percent) {
     reference_ = OdometryReference{kf.id, frame.utime, T_odom_camera, frame.T_body_camera, loop.T_candidate_query, located};
-    reference_.edge_start = OdometryReference::EdgeStart{r, T_r_frame, predicted_r, weaker(link, from.link)};
     reference_marginal_ = marginal_covariance(graph_, static_cast<int>(kf.id), options_.optimizer.kernel);
     step.reanchored = true;
     step.reanchor_keyframe_id = kf.id;
     ++reanchors_;
   } else {
     carry_reference(frame, T_odom_camera, link, predicted, step);
-    reference_marginal_ = marginal_covariance(graph_, static_cast<int>(reference_.keyframe_id), options_.optimizer.kernel);
+    reference_marginal_ = marginal_covariance(graph_, static_cast<int>(r), options_.optimizer.kernel);
   }
   return true;
 }
@@ -848,20 +834,13 @@ bool Slam::carriable(const std::vector<size_t>& covering, const Matrix6d& predic
 void Slam::carry_reference(const RgbdFrame& frame, const Eigen::Isometry3d& T_odom_camera, OdometryLink link,
                            const Matrix6d& predicted, SlamStep& step) {
   const Eigen::Isometry3d T_ref_frame = reference_.T_odom_camera.inverse() * T_odom_camera;
-  std::optional<OdometryReference::EdgeStart> edge_start = reference_.edge_start;
-  if (edge_start) {
-    edge_start->covariance = carried_covariance(predicted, T_ref_frame, reference_.covariance, edge_start->covariance);
-    edge_start->T_keyframe_camera = edge_start->T_keyframe_camera * T_ref_frame;
-    edge_start->link = weaker(edge_start->link, link);
-  }
   reference_ = OdometryReference{reference_.keyframe_id,
                                  frame.utime,
                                  T_odom_camera,
                                  frame.T_body_camera,
                                  reference_.T_keyframe_camera * T_ref_frame,
                                  predicted,
-                                 weaker(reference_.link, link),
-                                 edge_start};
+                                 weaker(reference_.link, link)};
   step.carried = true;
 }
 

@@ -64,25 +64,6 @@ struct OdometryReference {
   /// The weakest link the odometry crossed from the keyframe to the frame (a carried
   /// reference may have crossed a bridged restart): the next keyframe's edge is that weak.
   OdometryLink link = OdometryLink::kContinuous;
-
-  /// Where the graph's next edges from this reference start: a keyframe, the frame in it, that
-  /// pose's covariance and the weakest link crossed.
-  struct EdgeStart {
-    int64_t keyframe_id = -1;
-    Eigen::Isometry3d T_keyframe_camera = Eigen::Isometry3d::Identity();
-    Matrix6d covariance = Matrix6d::Zero();
-    OdometryLink link = OdometryLink::kContinuous;
-  };
-  /// Set when the frame's location closed a loop in place (Slam::close_loop_in_place): the
-  /// location is in that loop's edge already, so the next keyframe's odometry edge, or another
-  /// loop closed in place, starts from the loop's other keyframe and runs through the odometry,
-  /// as from a carried reference, instead of counting the location twice. The location still
-  /// gives the pose.
-  std::optional<EdgeStart> edge_start = std::nullopt;
-  /// edge_start, else the reference itself.
-  EdgeStart edges_from() const {
-    return edge_start ? *edge_start : EdgeStart{keyframe_id, T_keyframe_camera, covariance, link};
-  }
 };
 
 /// What one call of Slam::add did.
